@@ -1,0 +1,69 @@
+//! Plain 2D geometry shared by every stage.
+//!
+//! Coordinates are canvas pixels: x to the right, y down, origin at the top-left corner of the
+//! canvas. Pixel (i, j) covers [i, i+1) × [j, j+1), so its center is (i + 0.5, j + 0.5).
+
+/// A position on the canvas, in pixels.
+pub type Point = nalgebra::Point2<f64>;
+/// A displacement on the canvas, in pixels.
+pub type Vec2 = nalgebra::Vector2<f64>;
+
+/// Twice the signed area of a closed ring by the shoelace formula, in px².
+///
+/// With y pointing down, a ring that runs clockwise on screen has a positive value.
+pub fn ring_signed_area2(ring: &[Point]) -> f64 {
+    let n = ring.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum()
+}
+
+/// Signed area of a closed ring in px² (see [`ring_signed_area2`] for the sign).
+pub fn ring_signed_area(ring: &[Point]) -> f64 {
+    0.5 * ring_signed_area2(ring)
+}
+
+/// Whether `p` lies inside the closed ring, by the even-odd rule.
+pub fn point_in_ring(p: Point, ring: &[Point]) -> bool {
+    let n = ring.len();
+    let mut inside = false;
+    let mut j = n.wrapping_sub(1);
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[j]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x_cross = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+            if p.x < x_cross {
+                inside = !inside;
+            }
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Twice the signed area of triangle (a, b, c), in px²; positive when a → b → c turns clockwise
+/// on screen (y down).
+pub fn triangle_area2(a: Point, b: Point, c: Point) -> f64 {
+    (b - a).perp(&(c - a))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unit_square_area_and_inside() {
+        let sq = [
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(1.0, 1.0),
+            Point::new(0.0, 1.0),
+        ];
+        assert_eq!(ring_signed_area(&sq), 1.0);
+        assert!(point_in_ring(Point::new(0.5, 0.5), &sq));
+        assert!(!point_in_ring(Point::new(1.5, 0.5), &sq));
+    }
+}

@@ -1,0 +1,1 @@
+//! Files: the native rig document and images.

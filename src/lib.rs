@@ -1,0 +1,11 @@
+//! sinew: 2D cutout animation.
+//!
+//! The pipeline, stage by stage (see `ARCHITECTURE.md`):
+//! RGBA image → [`trace`] → outlines → [`mesh`] → triangle mesh → weights → skin → [`render`].
+//! [`io`] reads and writes the native rig document and images; [`cli`] is the `sinew` command.
+
+pub mod geom;
+pub mod io;
+pub mod mesh;
+pub mod render;
+pub mod trace;
