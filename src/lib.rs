@@ -8,4 +8,5 @@ pub mod geom;
 pub mod io;
 pub mod mesh;
 pub mod render;
+pub mod rig;
 pub mod trace;

@@ -1,1 +1,9 @@
-//! Files: the native rig document and images.
+//! Files: the native rig document, images, and atomic writes.
+
+pub mod atomic;
+pub mod document;
+pub mod image;
+
+pub use atomic::write_atomic;
+pub use document::{BuildOptions, DocumentError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
+pub use image::{load_png, save_png, ImageError};

@@ -1,0 +1,319 @@
+//! The native rig document (`sinew-rig`, version 1).
+//!
+//! In: a JSON file as in DESIGN.md. Out: a [`RigDocument`] that has been checked: format name and
+//! version known, triangle indices in range, coordinates finite, weight rows matching vertices
+//! and handles, part names unique. Image paths are stored relative to the document's folder.
+//! Saving writes atomically.
+
+use super::atomic::write_atomic;
+use crate::geom::Point;
+use crate::mesh::{Mesh, MeshOptions};
+use crate::rig::{HandleError, Handles};
+use crate::trace::TraceOptions;
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+
+/// The `format` field of every rig document.
+pub const RIG_FORMAT: &str = "sinew-rig";
+/// The version this build reads and writes.
+pub const RIG_VERSION: u32 = 1;
+
+/// A whole rig: parts on one canvas, their meshes and weights, the handles and animations.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigDocument {
+    pub format: String,
+    pub version: u32,
+    /// Canvas size in px, shared by every part's image.
+    pub canvas: [u32; 2],
+    /// Parts in draw order (back to front).
+    pub parts: Vec<PartDoc>,
+    #[serde(default)]
+    pub handles: Handles,
+    /// Animations by name. Kept verbatim: the timeline model reads them.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub animations: BTreeMap<String, serde_json::Value>,
+    /// The options the meshes were built with, so a re-trace reproduces them.
+    #[serde(default)]
+    pub options: BuildOptions,
+}
+
+/// How the document's meshes were built.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BuildOptions {
+    pub trace: TraceOptions,
+    pub mesh: MeshOptions,
+}
+
+/// One image of the rig with its mesh.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PartDoc {
+    pub name: String,
+    /// Path of the image, relative to the document's folder.
+    pub image: String,
+    pub mesh: MeshDoc,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weights: Option<WeightsDoc>,
+}
+
+/// A mesh as stored: vertices in canvas px, triangles as vertex indices.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDoc {
+    pub vertices: Vec<[f64; 2]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Sparse skinning weights: `rows[i]` lists vertex `i`'s non-zero weights as
+/// `(index into handles, weight)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeightsDoc {
+    pub handles: Vec<String>,
+    pub rows: Vec<Vec<(u32, f64)>>,
+}
+
+/// What is wrong with a rig document.
+#[derive(Debug, thiserror::Error)]
+pub enum DocumentError {
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not valid JSON: {reason}")]
+    Json { path: PathBuf, reason: String },
+    #[error("{path}: not a sinew rig (format is {found:?}, expected \"{RIG_FORMAT}\")")]
+    WrongFormat { path: PathBuf, found: String },
+    #[error("{path}: unsupported rig version {found} (this sinew reads version {RIG_VERSION})")]
+    WrongVersion { path: PathBuf, found: String },
+    #[error("{path}: {reason}")]
+    Invalid { path: PathBuf, reason: String },
+}
+
+impl From<&Mesh> for MeshDoc {
+    fn from(mesh: &Mesh) -> Self {
+        MeshDoc {
+            vertices: mesh.vertices.iter().map(|p| [p.x, p.y]).collect(),
+            triangles: mesh.triangles.clone(),
+        }
+    }
+}
+
+impl MeshDoc {
+    pub fn to_mesh(&self) -> Mesh {
+        Mesh {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| Point::new(v[0], v[1]))
+                .collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
+impl RigDocument {
+    /// An empty document for a canvas of `canvas` px.
+    pub fn new(canvas: [u32; 2]) -> Self {
+        RigDocument {
+            format: RIG_FORMAT.into(),
+            version: RIG_VERSION,
+            canvas,
+            parts: Vec::new(),
+            handles: Handles::default(),
+            animations: BTreeMap::new(),
+            options: BuildOptions::default(),
+        }
+    }
+
+    /// Reads and checks the document at `path`.
+    pub fn load(path: &Path) -> Result<Self, DocumentError> {
+        let text = std::fs::read_to_string(path).map_err(|source| DocumentError::Read {
+            path: path.into(),
+            source,
+        })?;
+        Self::from_json(&text, path)
+    }
+
+    /// Parses and checks a document; `path` only names it in errors.
+    pub fn from_json(text: &str, path: &Path) -> Result<Self, DocumentError> {
+        let json_error = |e: serde_json::Error| DocumentError::Json {
+            path: path.into(),
+            reason: e.to_string(),
+        };
+        // Format and version first, so a newer document says so instead of failing on a field.
+        let value: serde_json::Value = serde_json::from_str(text).map_err(json_error)?;
+        let field = |name: &str| {
+            value
+                .get(name)
+                .map(|v| v.to_string())
+                .unwrap_or_else(|| "missing".into())
+        };
+        if value.get("format").and_then(|f| f.as_str()) != Some(RIG_FORMAT) {
+            return Err(DocumentError::WrongFormat {
+                path: path.into(),
+                found: field("format"),
+            });
+        }
+        if value.get("version").and_then(|v| v.as_u64()) != Some(RIG_VERSION as u64) {
+            return Err(DocumentError::WrongVersion {
+                path: path.into(),
+                found: field("version"),
+            });
+        }
+        let doc: RigDocument = serde_json::from_value(value).map_err(json_error)?;
+        doc.validate().map_err(|reason| DocumentError::Invalid {
+            path: path.into(),
+            reason,
+        })?;
+        Ok(doc)
+    }
+
+    /// Writes the document to `path` atomically, as pretty JSON.
+    pub fn save(&self, path: &Path) -> Result<(), DocumentError> {
+        let mut text = serde_json::to_string_pretty(self).map_err(|e| DocumentError::Json {
+            path: path.into(),
+            reason: e.to_string(),
+        })?;
+        text.push('\n');
+        write_atomic(path, text.as_bytes()).map_err(|source| DocumentError::Write {
+            path: path.into(),
+            source,
+        })
+    }
+
+    /// The image of `part`, resolved against the folder of the document at `doc_path`.
+    pub fn image_path(doc_path: &Path, part: &PartDoc) -> PathBuf {
+        doc_path.parent().unwrap_or(Path::new("")).join(&part.image)
+    }
+
+    /// Everything a reader relies on, as a one-line reason.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.canvas[0] == 0 || self.canvas[1] == 0 {
+            return Err(format!(
+                "canvas {}×{} is empty",
+                self.canvas[0], self.canvas[1]
+            ));
+        }
+        self.handles
+            .validate()
+            .map_err(|e: HandleError| format!("handles: {e}"))?;
+        let mut names = HashSet::new();
+        for part in &self.parts {
+            if !names.insert(part.name.as_str()) {
+                return Err(format!("two parts are named '{}'", part.name));
+            }
+            validate_part(part).map_err(|e| format!("part '{}': {e}", part.name))?;
+        }
+        Ok(())
+    }
+}
+
+fn validate_part(part: &PartDoc) -> Result<(), String> {
+    let n = part.mesh.vertices.len();
+    if let Some(i) = part
+        .mesh
+        .vertices
+        .iter()
+        .position(|v| !(v[0].is_finite() && v[1].is_finite()))
+    {
+        return Err(format!("vertex {i} is not finite"));
+    }
+    for (t, tri) in part.mesh.triangles.iter().enumerate() {
+        if let Some(&i) = tri.iter().find(|&&i| i as usize >= n) {
+            return Err(format!(
+                "triangle {t} uses vertex {i}, but the mesh has {n} vertices"
+            ));
+        }
+    }
+    if let Some(w) = &part.weights {
+        if w.rows.len() != n {
+            return Err(format!("{} weight rows for {n} vertices", w.rows.len()));
+        }
+        for (i, row) in w.rows.iter().enumerate() {
+            for &(h, value) in row {
+                if h as usize >= w.handles.len() {
+                    return Err(format!(
+                        "vertex {i} has a weight for handle {h} of {}",
+                        w.handles.len()
+                    ));
+                }
+                if !value.is_finite() {
+                    return Err(format!("vertex {i} has a weight that is not finite"));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> RigDocument {
+        let mut doc = RigDocument::new([4, 4]);
+        doc.parts.push(PartDoc {
+            name: "body".into(),
+            image: "body.png".into(),
+            mesh: MeshDoc {
+                vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+                triangles: vec![[0, 1, 2]],
+            },
+            weights: None,
+        });
+        doc
+    }
+
+    #[test]
+    fn round_trips_through_json() {
+        let doc = sample();
+        let text = serde_json::to_string(&doc).unwrap();
+        assert_eq!(
+            RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
+            doc
+        );
+    }
+
+    #[test]
+    fn rejects_wrong_format_version_and_indices() {
+        let p = Path::new("r.json");
+        let mut v = serde_json::to_value(sample()).unwrap();
+        v["version"] = 2.into();
+        let e = RigDocument::from_json(&v.to_string(), p)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "r.json: unsupported rig version 2 (this sinew reads version 1)"
+        );
+        v["version"] = 1.into();
+        v["format"] = "spine".into();
+        assert!(matches!(
+            RigDocument::from_json(&v.to_string(), p),
+            Err(DocumentError::WrongFormat { .. })
+        ));
+        v["format"] = RIG_FORMAT.into();
+        v["parts"][0]["mesh"]["triangles"][0][2] = 3.into();
+        let e = RigDocument::from_json(&v.to_string(), p)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "r.json: part 'body': triangle 0 uses vertex 3, but the mesh has 3 vertices"
+        );
+        assert!(matches!(
+            RigDocument::from_json("{", p),
+            Err(DocumentError::Json { .. })
+        ));
+    }
+}

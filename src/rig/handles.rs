@@ -1,0 +1,271 @@
+//! The handles file: what the animator placed on the canvas.
+//!
+//! In: JSON as in DESIGN.md (`bones`, `points`, `cages`, `regions`; positions in canvas px).
+//! Out: [`Handles`], checked by [`Handles::validate`]: names unique across all handles, parents
+//! known and acyclic, bones of non-zero length, polygons of at least three points, every
+//! coordinate finite.
+
+use serde::{Deserialize, Serialize};
+use std::collections::{HashMap, HashSet};
+
+/// A bone: rest geometry `head` → `tail` in canvas px; it rotates about its head in its
+/// parent's frame. A bone without a parent starts its own skeleton.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bone {
+    pub name: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parent: Option<String>,
+    pub head: [f64; 2],
+    pub tail: [f64; 2],
+}
+
+/// A loose point handle at `at` (canvas px).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointHandle {
+    pub name: String,
+    pub at: [f64; 2],
+}
+
+/// A cage: a closed polygon (canvas px) whose vertices are handles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cage {
+    pub name: String,
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// A region: a closed polygon (canvas px) whose inside moves rigidly together.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    pub name: String,
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// Every handle of a rig, in file order.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Handles {
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bones: Vec<Bone>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub points: Vec<PointHandle>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cages: Vec<Cage>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub regions: Vec<Region>,
+}
+
+/// What is wrong with a set of handles.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum HandleError {
+    #[error("two handles are named '{0}'")]
+    DuplicateName(String),
+    #[error("handle names must not be empty")]
+    EmptyName,
+    #[error("bone '{bone}' has unknown parent '{parent}'")]
+    UnknownParent { bone: String, parent: String },
+    #[error("bone '{0}' is its own ancestor (cyclic parents)")]
+    CyclicParents(String),
+    #[error("bone '{0}' has zero length (head = tail)")]
+    DegenerateBone(String),
+    #[error("{kind} '{name}' needs at least 3 distinct points")]
+    DegeneratePolygon { kind: &'static str, name: String },
+    #[error("handle '{0}' has a coordinate that is not a finite number")]
+    NonFinite(String),
+}
+
+/// Bones shorter than this (px) are degenerate: they have no direction.
+pub const MIN_BONE_LENGTH_PX: f64 = 1e-6;
+
+impl Handles {
+    pub fn is_empty(&self) -> bool {
+        self.bones.is_empty()
+            && self.points.is_empty()
+            && self.cages.is_empty()
+            && self.regions.is_empty()
+    }
+
+    /// Every handle's name, in the order weights columns use: bones, points, cages, regions.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        let bones = self.bones.iter().map(|b| b.name.as_str());
+        let points = self.points.iter().map(|p| p.name.as_str());
+        let cages = self.cages.iter().map(|c| c.name.as_str());
+        let regions = self.regions.iter().map(|r| r.name.as_str());
+        bones.chain(points).chain(cages).chain(regions)
+    }
+
+    /// Checks names, parents, lengths, polygons and numbers.
+    pub fn validate(&self) -> Result<(), HandleError> {
+        let mut seen = HashSet::new();
+        for name in self.names() {
+            if name.is_empty() {
+                return Err(HandleError::EmptyName);
+            }
+            if !seen.insert(name) {
+                return Err(HandleError::DuplicateName(name.to_string()));
+            }
+        }
+        for b in &self.bones {
+            if !b.head.iter().chain(&b.tail).all(|v| v.is_finite()) {
+                return Err(HandleError::NonFinite(b.name.clone()));
+            }
+            if (b.tail[0] - b.head[0]).hypot(b.tail[1] - b.head[1]) < MIN_BONE_LENGTH_PX {
+                return Err(HandleError::DegenerateBone(b.name.clone()));
+            }
+        }
+        for p in &self.points {
+            if !p.at.iter().all(|v| v.is_finite()) {
+                return Err(HandleError::NonFinite(p.name.clone()));
+            }
+        }
+        let polygons = self.cages.iter().map(|c| ("cage", &c.name, &c.polygon));
+        for (kind, name, polygon) in
+            polygons.chain(self.regions.iter().map(|r| ("region", &r.name, &r.polygon)))
+        {
+            if !polygon.iter().flatten().all(|v| v.is_finite()) {
+                return Err(HandleError::NonFinite(name.clone()));
+            }
+            let distinct: HashSet<(u64, u64)> = polygon
+                .iter()
+                .map(|p| (p[0].to_bits(), p[1].to_bits()))
+                .collect();
+            if distinct.len() < 3 {
+                return Err(HandleError::DegeneratePolygon {
+                    kind,
+                    name: name.clone(),
+                });
+            }
+        }
+        self.check_parents()
+    }
+
+    fn check_parents(&self) -> Result<(), HandleError> {
+        let index: HashMap<&str, usize> = self
+            .bones
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (b.name.as_str(), i))
+            .collect();
+        let mut parent = vec![None; self.bones.len()];
+        for (i, b) in self.bones.iter().enumerate() {
+            if let Some(p) = &b.parent {
+                match index.get(p.as_str()) {
+                    Some(&j) => parent[i] = Some(j),
+                    None => {
+                        return Err(HandleError::UnknownParent {
+                            bone: b.name.clone(),
+                            parent: p.clone(),
+                        })
+                    }
+                }
+            }
+        }
+        for start in 0..self.bones.len() {
+            // A chain longer than the bone count must revisit a bone.
+            let (mut at, mut steps) = (parent[start], 0);
+            while let Some(j) = at {
+                steps += 1;
+                if steps > self.bones.len() {
+                    return Err(HandleError::CyclicParents(self.bones[start].name.clone()));
+                }
+                at = parent[j];
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bone(name: &str, parent: Option<&str>) -> Bone {
+        Bone {
+            name: name.into(),
+            parent: parent.map(Into::into),
+            head: [0.0, 0.0],
+            tail: [0.0, 10.0],
+        }
+    }
+
+    #[test]
+    fn parses_the_design_example_and_validates() {
+        let json = r#"{
+          "bones": [
+            {"name": "hip",   "head": [256, 300], "tail": [256, 240]},
+            {"name": "chest", "parent": "hip", "head": [256, 240], "tail": [256, 160]},
+            {"name": "arm_l", "head": [220, 170], "tail": [170, 230]}
+          ],
+          "points":  [{"name": "nose", "at": [262, 110]}],
+          "cages":   [{"name": "belly", "polygon": [[200, 200], [310, 200], [310, 300], [200, 300]]}],
+          "regions": [{"name": "hand", "polygon": [[160, 220], [180, 220], [180, 240], [160, 240]]}]
+        }"#;
+        let h: Handles = serde_json::from_str(json).unwrap();
+        h.validate().unwrap();
+        assert_eq!(
+            h.names().collect::<Vec<_>>(),
+            ["hip", "chest", "arm_l", "nose", "belly", "hand"]
+        );
+    }
+
+    #[test]
+    fn rejects_bad_handles() {
+        let dup = Handles {
+            bones: vec![bone("a", None)],
+            points: vec![PointHandle {
+                name: "a".into(),
+                at: [1.0, 1.0],
+            }],
+            ..Default::default()
+        };
+        assert_eq!(dup.validate(), Err(HandleError::DuplicateName("a".into())));
+        let unknown = Handles {
+            bones: vec![bone("a", Some("zz"))],
+            ..Default::default()
+        };
+        assert!(matches!(
+            unknown.validate(),
+            Err(HandleError::UnknownParent { .. })
+        ));
+        let cyclic = Handles {
+            bones: vec![bone("a", Some("b")), bone("b", Some("a"))],
+            ..Default::default()
+        };
+        assert!(matches!(
+            cyclic.validate(),
+            Err(HandleError::CyclicParents(_))
+        ));
+        let mut short = bone("a", None);
+        short.tail = short.head;
+        assert_eq!(
+            Handles {
+                bones: vec![short],
+                ..Default::default()
+            }
+            .validate(),
+            Err(HandleError::DegenerateBone("a".into()))
+        );
+        let nan = Handles {
+            points: vec![PointHandle {
+                name: "p".into(),
+                at: [f64::NAN, 0.0],
+            }],
+            ..Default::default()
+        };
+        assert_eq!(nan.validate(), Err(HandleError::NonFinite("p".into())));
+        let flat = Handles {
+            cages: vec![Cage {
+                name: "c".into(),
+                polygon: vec![[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]],
+            }],
+            ..Default::default()
+        };
+        assert!(matches!(
+            flat.validate(),
+            Err(HandleError::DegeneratePolygon { .. })
+        ));
+    }
+}
