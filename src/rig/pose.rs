@@ -1,0 +1,463 @@
+//! Poses and forward kinematics over the bone forest.
+//!
+//! In: validated [`Handles`] and a [`Pose`] (the pose file of DESIGN.md). Out: one affine
+//! [`Affine`] per handle that maps rest canvas positions to posed canvas positions — the
+//! transformations skinning blends.
+//!
+//! Bone frames follow Spine's conventions, so that export is a change of axes only: a bone's
+//! frame has its origin at the head and its x axis along head → tail. A bone's local pose acts
+//! in its parent's frame (the canvas for a root bone): `translate` (px) offsets the head,
+//! `rotate` (degrees, counter-clockwise on screen) turns the bone about its head, `scale` scales
+//! along the bone (x) and across it (y), `shear` (degrees) skews the two axes.
+//!
+//! Angles are counter-clockwise as seen on screen; with y pointing down, that is a clockwise
+//! turn in the usual math orientation, so every rotation matrix here comes from [`rotation`].
+
+use super::handles::Handles;
+use crate::geom::{Point, Vec2};
+use nalgebra::Matrix2;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// An affine map of the canvas: p ↦ linear · p + translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Affine {
+    pub linear: Matrix2<f64>,
+    pub translation: Vec2,
+}
+
+impl Affine {
+    pub fn identity() -> Self {
+        Affine {
+            linear: Matrix2::identity(),
+            translation: Vec2::zeros(),
+        }
+    }
+
+    pub fn translation(t: Vec2) -> Self {
+        Affine {
+            linear: Matrix2::identity(),
+            translation: t,
+        }
+    }
+
+    pub fn apply(&self, p: Point) -> Point {
+        Point::from(self.linear * p.coords + self.translation)
+    }
+
+    /// self ∘ other: first `other`, then `self`.
+    pub fn then_after(&self, other: &Affine) -> Affine {
+        Affine {
+            linear: self.linear * other.linear,
+            translation: self.linear * other.translation + self.translation,
+        }
+    }
+
+    pub fn inverse(&self) -> Option<Affine> {
+        let inv = self.linear.try_inverse()?;
+        Some(Affine {
+            linear: inv,
+            translation: -(inv * self.translation),
+        })
+    }
+}
+
+/// The matrix that turns vectors by `angle_deg` counter-clockwise on screen (y down).
+pub fn rotation(angle_deg: f64) -> Matrix2<f64> {
+    let (s, c) = (-angle_deg.to_radians()).sin_cos();
+    Matrix2::new(c, -s, s, c)
+}
+
+/// The on-screen counter-clockwise angle of a canvas vector, degrees.
+pub fn screen_angle_deg(v: Vec2) -> f64 {
+    (-v.y).atan2(v.x).to_degrees()
+}
+
+/// A bone's local pose, in its parent's frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BonePose {
+    /// Degrees, counter-clockwise on screen, about the head.
+    pub rotate: f64,
+    /// Offset of the head, px, in the parent's frame.
+    pub translate: [f64; 2],
+    /// Along the bone, across it.
+    pub scale: [f64; 2],
+    /// Degrees: x axis, y axis.
+    pub shear: [f64; 2],
+}
+
+impl Default for BonePose {
+    fn default() -> Self {
+        BonePose {
+            rotate: 0.0,
+            translate: [0.0, 0.0],
+            scale: [1.0, 1.0],
+            shear: [0.0, 0.0],
+        }
+    }
+}
+
+/// A point handle's pose: about its rest position, in canvas axes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PointPose {
+    pub translate: [f64; 2],
+    /// Degrees, counter-clockwise on screen.
+    pub rotate: f64,
+    pub scale: [f64; 2],
+}
+
+impl Default for PointPose {
+    fn default() -> Self {
+        PointPose {
+            translate: [0.0, 0.0],
+            rotate: 0.0,
+            scale: [1.0, 1.0],
+        }
+    }
+}
+
+/// A cage's posed polygon (same vertex count as at rest), canvas px.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CagePose {
+    pub polygon: Vec<[f64; 2]>,
+}
+
+/// A drag for skinning IK: the material point at rest position `at` goes to `to` (canvas px).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IkDrag {
+    pub at: [f64; 2],
+    pub to: [f64; 2],
+}
+
+/// The pose file: anything not named stays at rest.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Pose {
+    pub bones: BTreeMap<String, BonePose>,
+    pub points: BTreeMap<String, PointPose>,
+    pub cages: BTreeMap<String, CagePose>,
+    pub ik: Vec<IkDrag>,
+}
+
+/// What is wrong with a pose for a given set of handles.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PoseError {
+    #[error("the pose names {kind} '{name}', which the rig does not have")]
+    UnknownName { kind: &'static str, name: String },
+    #[error("cage '{name}' has {got} vertices in the pose but {expected} at rest")]
+    CageSize {
+        name: String,
+        got: usize,
+        expected: usize,
+    },
+    #[error("the pose of '{0}' has a value that is not a finite number")]
+    NonFinite(String),
+    #[error("the pose of '{0}' makes its transformation singular (a zero scale?)")]
+    Singular(String),
+}
+
+/// A bone's rest frame: origin at the head, x axis along head → tail.
+pub fn bone_rest_frame(head: [f64; 2], tail: [f64; 2]) -> Affine {
+    let direction = Vec2::new(tail[0] - head[0], tail[1] - head[1]);
+    Affine {
+        linear: rotation(screen_angle_deg(direction)),
+        translation: Vec2::new(head[0], head[1]),
+    }
+}
+
+/// The linear part of a local pose: rotate, then shear, then scale, in Spine's composition.
+fn local_linear(rotate_deg: f64, scale: [f64; 2], shear_deg: [f64; 2]) -> Matrix2<f64> {
+    let x_axis = rotation(rotate_deg + shear_deg[0]) * Vec2::new(scale[0], 0.0);
+    let y_axis = rotation(rotate_deg + shear_deg[1]) * Vec2::new(0.0, scale[1]);
+    Matrix2::from_columns(&[x_axis, y_axis])
+}
+
+fn finite(values: &[f64]) -> bool {
+    values.iter().all(|v| v.is_finite())
+}
+
+/// Every bone's posed frame in canvas coordinates (`world_from_bone`), in bone order.
+pub fn bone_world_frames(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
+    for name in pose.bones.keys() {
+        if !handles.bones.iter().any(|b| &b.name == name) {
+            return Err(PoseError::UnknownName {
+                kind: "bone",
+                name: name.clone(),
+            });
+        }
+    }
+    let index: BTreeMap<&str, usize> = handles
+        .bones
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.name.as_str(), i))
+        .collect();
+    let rest: Vec<Affine> = handles
+        .bones
+        .iter()
+        .map(|b| bone_rest_frame(b.head, b.tail))
+        .collect();
+    let mut world: Vec<Option<Affine>> = vec![None; handles.bones.len()];
+    // Validated parents are acyclic: resolving each bone after its ancestors terminates.
+    fn resolve(
+        i: usize,
+        handles: &Handles,
+        pose: &Pose,
+        index: &BTreeMap<&str, usize>,
+        rest: &[Affine],
+        world: &mut Vec<Option<Affine>>,
+    ) -> Result<Affine, PoseError> {
+        if let Some(frame) = world[i] {
+            return Ok(frame);
+        }
+        let bone = &handles.bones[i];
+        let parent = bone.parent.as_deref().and_then(|p| index.get(p).copied());
+        let (world_from_parent, world_from_parent_rest) = match parent {
+            Some(p) => (resolve(p, handles, pose, index, rest, world)?, rest[p]),
+            None => (Affine::identity(), Affine::identity()),
+        };
+        let parent_from_bone_rest = world_from_parent_rest
+            .inverse()
+            .ok_or_else(|| PoseError::Singular(bone.name.clone()))?
+            .then_after(&rest[i]);
+        let local = pose.bones.get(&bone.name).cloned().unwrap_or_default();
+        if !finite(&[
+            local.rotate,
+            local.translate[0],
+            local.translate[1],
+            local.scale[0],
+            local.scale[1],
+            local.shear[0],
+            local.shear[1],
+        ]) {
+            return Err(PoseError::NonFinite(bone.name.clone()));
+        }
+        let rest_angle = screen_angle_deg(parent_from_bone_rest.linear.column(0).into());
+        let parent_from_bone = Affine {
+            linear: local_linear(rest_angle + local.rotate, local.scale, local.shear),
+            translation: parent_from_bone_rest.translation
+                + Vec2::new(local.translate[0], local.translate[1]),
+        };
+        let frame = world_from_parent.then_after(&parent_from_bone);
+        world[i] = Some(frame);
+        Ok(frame)
+    }
+    (0..handles.bones.len())
+        .map(|i| resolve(i, handles, pose, &index, &rest, &mut world))
+        .collect()
+}
+
+/// One skinning transformation per handle column, in [`Handles::names`]' order expanded as
+/// [`handle_columns`] lists them: bones, points, cage vertices, regions (regions stay at rest
+/// unless IK moves them).
+pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
+    let mut out = Vec::new();
+    for (bone, world) in handles.bones.iter().zip(bone_world_frames(handles, pose)?) {
+        let rest_inverse = bone_rest_frame(bone.head, bone.tail)
+            .inverse()
+            .ok_or_else(|| PoseError::Singular(bone.name.clone()))?;
+        out.push(world.then_after(&rest_inverse));
+    }
+    for name in pose.points.keys() {
+        if !handles.points.iter().any(|p| &p.name == name) {
+            return Err(PoseError::UnknownName {
+                kind: "point",
+                name: name.clone(),
+            });
+        }
+    }
+    for point in &handles.points {
+        let p = pose.points.get(&point.name).cloned().unwrap_or_default();
+        if !finite(&[
+            p.translate[0],
+            p.translate[1],
+            p.rotate,
+            p.scale[0],
+            p.scale[1],
+        ]) {
+            return Err(PoseError::NonFinite(point.name.clone()));
+        }
+        // About the rest position: move there, turn and scale, move back, then translate.
+        let at = Vec2::new(point.at[0], point.at[1]);
+        let linear =
+            rotation(p.rotate) * Matrix2::from_diagonal(&Vec2::new(p.scale[0], p.scale[1]));
+        out.push(Affine {
+            linear,
+            translation: at - linear * at + Vec2::new(p.translate[0], p.translate[1]),
+        });
+    }
+    for name in pose.cages.keys() {
+        if !handles.cages.iter().any(|c| &c.name == name) {
+            return Err(PoseError::UnknownName {
+                kind: "cage",
+                name: name.clone(),
+            });
+        }
+    }
+    for cage in &handles.cages {
+        match pose.cages.get(&cage.name) {
+            Some(posed) => {
+                if posed.polygon.len() != cage.polygon.len() {
+                    return Err(PoseError::CageSize {
+                        name: cage.name.clone(),
+                        got: posed.polygon.len(),
+                        expected: cage.polygon.len(),
+                    });
+                }
+                if !finite(&posed.polygon.iter().flatten().copied().collect::<Vec<_>>()) {
+                    return Err(PoseError::NonFinite(cage.name.clone()));
+                }
+                for (rest, to) in cage.polygon.iter().zip(&posed.polygon) {
+                    out.push(Affine::translation(Vec2::new(
+                        to[0] - rest[0],
+                        to[1] - rest[1],
+                    )));
+                }
+            }
+            None => out.extend(cage.polygon.iter().map(|_| Affine::identity())),
+        }
+    }
+    out.extend(handles.regions.iter().map(|_| Affine::identity()));
+    Ok(out)
+}
+
+/// The weight columns of a rig, in order: each bone, each point, each cage vertex
+/// (`cage.0`, `cage.1`, …), each region.
+pub fn handle_columns(handles: &Handles) -> Vec<String> {
+    let mut names: Vec<String> = handles.bones.iter().map(|b| b.name.clone()).collect();
+    names.extend(handles.points.iter().map(|p| p.name.clone()));
+    for cage in &handles.cages {
+        names.extend((0..cage.polygon.len()).map(|k| format!("{}.{k}", cage.name)));
+    }
+    names.extend(handles.regions.iter().map(|r| r.name.clone()));
+    names
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig::{Bone, PointHandle};
+
+    fn arm() -> Handles {
+        Handles {
+            bones: vec![
+                Bone {
+                    name: "upper".into(),
+                    parent: None,
+                    head: [0.0, 0.0],
+                    tail: [10.0, 0.0],
+                },
+                Bone {
+                    name: "lower".into(),
+                    parent: Some("upper".into()),
+                    head: [10.0, 0.0],
+                    tail: [20.0, 0.0],
+                },
+            ],
+            points: vec![PointHandle {
+                name: "p".into(),
+                at: [5.0, 5.0],
+            }],
+            ..Default::default()
+        }
+    }
+
+    fn close(a: Point, b: [f64; 2]) -> bool {
+        (a.x - b[0]).abs() < 1e-9 && (a.y - b[1]).abs() < 1e-9
+    }
+
+    #[test]
+    fn rest_pose_is_identity() {
+        for t in handle_transforms(&arm(), &Pose::default()).unwrap() {
+            assert!(close(t.apply(Point::new(3.0, -7.0)), [3.0, -7.0]));
+        }
+    }
+
+    #[test]
+    fn rotating_the_parent_carries_the_child_counter_clockwise_on_screen() {
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "upper".into(),
+            BonePose {
+                rotate: 90.0,
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&arm(), &pose).unwrap();
+        // Counter-clockwise on screen with y down: +x turns to −y (up).
+        assert!(close(t[0].apply(Point::new(10.0, 0.0)), [0.0, -10.0]));
+        assert!(close(t[1].apply(Point::new(20.0, 0.0)), [0.0, -20.0]));
+        // The child's own rotation turns about its (moved) head.
+        pose.bones.insert(
+            "lower".into(),
+            BonePose {
+                rotate: -90.0,
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&arm(), &pose).unwrap();
+        assert!(close(t[1].apply(Point::new(20.0, 0.0)), [10.0, -10.0]));
+    }
+
+    #[test]
+    fn scale_is_along_the_bone_and_translate_in_the_parent_frame() {
+        let handles = Handles {
+            bones: vec![Bone {
+                name: "b".into(),
+                parent: None,
+                head: [0.0, 0.0],
+                tail: [0.0, 10.0],
+            }],
+            ..Default::default()
+        };
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "b".into(),
+            BonePose {
+                scale: [2.0, 1.0],
+                translate: [3.0, 0.0],
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&handles, &pose).unwrap();
+        assert!(close(t[0].apply(Point::new(0.0, 10.0)), [3.0, 20.0]));
+        assert!(close(t[0].apply(Point::new(1.0, 0.0)), [4.0, 0.0]));
+    }
+
+    #[test]
+    fn point_pose_and_errors() {
+        let mut pose = Pose::default();
+        pose.points.insert(
+            "p".into(),
+            PointPose {
+                rotate: 180.0,
+                translate: [1.0, 0.0],
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&arm(), &pose).unwrap();
+        assert!(close(t[2].apply(Point::new(5.0, 5.0)), [6.0, 5.0]));
+        assert!(close(t[2].apply(Point::new(6.0, 5.0)), [5.0, 5.0]));
+        pose.bones.insert("nope".into(), BonePose::default());
+        assert!(matches!(
+            handle_transforms(&arm(), &pose),
+            Err(PoseError::UnknownName { .. })
+        ));
+        let mut nan = Pose::default();
+        nan.bones.insert(
+            "upper".into(),
+            BonePose {
+                rotate: f64::NAN,
+                ..Default::default()
+            },
+        );
+        assert!(matches!(
+            handle_transforms(&arm(), &nan),
+            Err(PoseError::NonFinite(_))
+        ));
+    }
+}
