@@ -2,11 +2,16 @@
 //!
 //! The pipeline, stage by stage (see `ARCHITECTURE.md`):
 //! RGBA image → [`trace`] → outlines → [`mesh`] → triangle mesh → weights → skin → [`render`].
-//! [`io`] reads and writes the native rig document and images; [`cli`] is the `sinew` command.
+//! [`io`] reads and writes the native rig document and images; [`pipeline`] wires the stages
+//! together; [`cli`] is the `sinew` command.
 
+pub mod cli;
 pub mod geom;
 pub mod io;
 pub mod mesh;
+pub mod pipeline;
 pub mod render;
 pub mod rig;
+pub mod skin;
 pub mod trace;
+pub mod weights;

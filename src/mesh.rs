@@ -10,13 +10,13 @@
 //! every triangle meets the angle and area limits. Faces outside the outer rings or inside holes
 //! are dropped (spade decides inside by the winding parity of the constraint rings).
 
-use crate::geom::{ring_signed_area, triangle_area2, Point};
+use crate::geom::{point_in_ring, ring_signed_area, triangle_area2, Point};
 use crate::trace::Outline;
 use serde::{Deserialize, Serialize};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// How outlines become triangles.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -31,7 +31,7 @@ pub struct MeshOptions {
     /// gives triangles of at most ~164 px²).
     pub max_area_fraction: f64,
     /// Triangles smaller than this (px²) are never split further; it stops refinement from
-    /// chasing tiny features of the outline. Default 0.25.
+    /// chasing tiny features of the outline. Default 0.02.
     pub min_refine_area_px2: f64,
     /// Whether refinement may split outline edges. Off keeps the hull exactly the traced
     /// outline (fewer vertices for game runtimes) at some cost in angle quality. Default true.
@@ -47,7 +47,7 @@ impl Default for MeshOptions {
             refine: true,
             min_angle_deg: 28.0,
             max_area_fraction: 1.0 / 1600.0,
-            min_refine_area_px2: 0.25,
+            min_refine_area_px2: 0.02,
             split_outline: true,
             steiner_budget_factor: 8.0,
         }
@@ -185,11 +185,7 @@ pub fn triangulate(
             "the canvas area must be positive".into(),
         ));
     }
-    let rings: Vec<&[Point]> = outlines
-        .iter()
-        .flat_map(|o| std::iter::once(o.outer.as_slice()).chain(o.holes.iter().map(Vec::as_slice)))
-        .filter(|r| r.len() >= 3)
-        .collect();
+    let rings = outline_rings(outlines);
     if rings.is_empty() {
         return Err(MeshError::Empty);
     }
@@ -206,74 +202,341 @@ pub fn triangulate(
     }
 
     let max_area_px2 = options.max_area_fraction * canvas_area_px2;
+    let region_area: f64 = rings.iter().map(|r| ring_signed_area(r)).sum();
+    let expected = outline_points as f64 + region_area.abs() / max_area_px2;
+    let budget = (options.steiner_budget_factor * expected).ceil() as usize;
+    let params = refinement_parameters(options, max_area_px2, budget, true);
+    let result = cdt.refine(params);
+    let excluded: HashSet<_> = result.excluded_faces.into_iter().collect();
+    let (mesh, _) = extract_faces(&cdt, |f| !excluded.contains(&f));
+    Ok(mesh)
+}
+
+/// Handle geometry a mesh must contain, canvas px.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HandleGeometry {
+    /// Each becomes a mesh vertex (point handles).
+    pub points: Vec<Point>,
+    /// Each becomes a chain of mesh edges (bones).
+    pub segments: Vec<[Point; 2]>,
+    /// Closed polygons whose edges become mesh edges (cage and region outlines).
+    pub polygons: Vec<Vec<Point>>,
+    /// Closed polygons whose inside joins the weight domain (cages reaching past the shape).
+    pub domain_extensions: Vec<Vec<Point>>,
+}
+
+/// A mesh of the weight domain (the shape plus any cage insides) that contains handle geometry.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EmbeddedMesh {
+    /// The weight domain's mesh.
+    pub domain: Mesh,
+    /// Per domain triangle: whether it lies inside the traced shape (and so is drawn).
+    pub in_shape: Vec<bool>,
+}
+
+impl EmbeddedMesh {
+    /// The drawn mesh (the triangles inside the shape, with only the vertices they use) and,
+    /// per drawn vertex, its index in the domain mesh.
+    pub fn shape_mesh(&self) -> (Mesh, Vec<usize>) {
+        let mut new_index = vec![u32::MAX; self.domain.vertices.len()];
+        let mut domain_index = Vec::new();
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for (t, &inside) in self.domain.triangles.iter().zip(&self.in_shape) {
+            if !inside {
+                continue;
+            }
+            triangles.push(t.map(|v| {
+                if new_index[v as usize] == u32::MAX {
+                    new_index[v as usize] = vertices.len() as u32;
+                    vertices.push(self.domain.vertices[v as usize]);
+                    domain_index.push(v as usize);
+                }
+                new_index[v as usize]
+            }));
+        }
+        (
+            Mesh {
+                vertices,
+                triangles,
+            },
+            domain_index,
+        )
+    }
+}
+
+/// Triangulates the shape inside `outlines` together with handle geometry, so that handles'
+/// points and edges are mesh vertices and edges. The domain is the shape plus the insides of
+/// `geometry.domain_extensions`; geometry outside the domain is dropped.
+pub fn triangulate_with_handles(
+    outlines: &[Outline],
+    geometry: &HandleGeometry,
+    canvas_area_px2: f64,
+    options: &MeshOptions,
+) -> Result<EmbeddedMesh, MeshError> {
+    options.validate()?;
+    if !(canvas_area_px2.is_finite() && canvas_area_px2 > 0.0) {
+        return Err(MeshError::InvalidOptions(
+            "the canvas area must be positive".into(),
+        ));
+    }
+    let rings = outline_rings(outlines);
+    if rings.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    let all_finite = geometry
+        .points
+        .iter()
+        .chain(geometry.segments.iter().flatten())
+        .chain(geometry.polygons.iter().flatten())
+        .chain(geometry.domain_extensions.iter().flatten())
+        .all(|p| p.x.is_finite() && p.y.is_finite());
+    if !all_finite {
+        return Err(MeshError::NonFinite);
+    }
+    let extensions: Vec<&[Point]> = geometry
+        .domain_extensions
+        .iter()
+        .map(Vec::as_slice)
+        .collect();
+    let (points, edges) =
+        constraint_graph(&rings.iter().chain(&extensions).copied().collect::<Vec<_>>())?;
+    let mut conflict = false;
+    let mut cdt =
+        ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(points, edges, |_| {
+            conflict = true
+        })
+        .map_err(|_| MeshError::NonFinite)?;
+    if conflict {
+        return Err(MeshError::CrossingOutlines);
+    }
+
+    // Geometry far outside the domain only costs refinement work: clip it to the domain's box.
+    let bounds = Bounds::of(rings.iter().chain(&extensions).flat_map(|r| r.iter())).expanded(1.0);
+    for p in &geometry.points {
+        if bounds.contains(*p) {
+            cdt.insert(Point2::new(p.x, p.y))
+                .map_err(|_| MeshError::NonFinite)?;
+        }
+    }
+    let polygon_edges = geometry
+        .polygons
+        .iter()
+        .flat_map(|poly| (0..poly.len()).map(move |i| [poly[i], poly[(i + 1) % poly.len()]]));
+    for [a, b] in geometry.segments.iter().copied().chain(polygon_edges) {
+        let Some((a, b)) = bounds.clip_segment(a, b) else {
+            continue;
+        };
+        let from = cdt
+            .insert(Point2::new(a.x, a.y))
+            .map_err(|_| MeshError::NonFinite)?;
+        let to = cdt
+            .insert(Point2::new(b.x, b.y))
+            .map_err(|_| MeshError::NonFinite)?;
+        if from != to {
+            cdt.add_constraint_and_split(from, to, |p| p);
+        }
+    }
+
+    // Handle polygons would flip spade's inside/outside parity, so refine everywhere in the
+    // hull and classify faces by their centroids afterwards.
+    let max_area_px2 = options.max_area_fraction * canvas_area_px2;
+    let expected = cdt.num_vertices() as f64 + bounds.area() / max_area_px2;
+    let budget = (options.steiner_budget_factor * expected).ceil() as usize;
+    cdt.refine(refinement_parameters(options, max_area_px2, budget, false));
+
+    let in_shape = |c: Point| rings.iter().filter(|r| point_in_ring(c, r)).count() % 2 == 1;
+    let in_extension = |c: Point| extensions.iter().any(|r| point_in_ring(c, r));
+    let (domain, centroids) = extract_faces(&cdt, |_| true);
+    let mut keep = Vec::with_capacity(domain.triangles.len());
+    let mut shape = Vec::with_capacity(domain.triangles.len());
+    for c in &centroids {
+        let inside = in_shape(*c);
+        keep.push(inside || in_extension(*c));
+        shape.push(inside);
+    }
+    let triangles: Vec<[u32; 3]> = domain
+        .triangles
+        .iter()
+        .zip(&keep)
+        .filter(|(_, &k)| k)
+        .map(|(t, _)| *t)
+        .collect();
+    let in_shape: Vec<bool> = shape
+        .iter()
+        .zip(&keep)
+        .filter(|(_, &k)| k)
+        .map(|(s, _)| *s)
+        .collect();
+    let domain = drop_unused_vertices(Mesh {
+        vertices: domain.vertices,
+        triangles,
+    });
+    Ok(EmbeddedMesh { domain, in_shape })
+}
+
+/// Every outer ring and hole of the outlines, in order.
+fn outline_rings(outlines: &[Outline]) -> Vec<&[Point]> {
+    outlines
+        .iter()
+        .flat_map(|o| std::iter::once(o.outer.as_slice()).chain(o.holes.iter().map(Vec::as_slice)))
+        .filter(|r| r.len() >= 3)
+        .collect()
+}
+
+fn refinement_parameters(
+    options: &MeshOptions,
+    max_area_px2: f64,
+    budget: usize,
+    exclude_outer: bool,
+) -> RefinementParameters<f64> {
     let mut params = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
+        .exclude_outer_faces(exclude_outer)
         .with_angle_limit(AngleLimit::from_deg(if options.refine {
             options.min_angle_deg
         } else {
             0.0
         }))
         .with_min_required_area(options.min_refine_area_px2)
-        .with_max_additional_vertices(if options.refine {
-            let region_area: f64 = rings.iter().map(|r| ring_signed_area(r)).sum();
-            let expected = outline_points as f64 + region_area.abs() / max_area_px2;
-            (options.steiner_budget_factor * expected).ceil() as usize
-        } else {
-            0
-        });
+        .with_max_additional_vertices(if options.refine { budget } else { 0 });
     if options.refine {
         params = params.with_max_allowed_area(max_area_px2);
     }
     if !options.split_outline {
         params = params.keep_constraint_edges();
     }
-    let result = cdt.refine(params);
-    let excluded: std::collections::HashSet<_> = result.excluded_faces.into_iter().collect();
+    params
+}
 
-    // Keep inner faces only, renumbering the vertices they use in spade's (deterministic) order.
-    let mut index_of: HashMap<usize, u32> = HashMap::new();
-    let mut used = vec![false; cdt.num_vertices()];
+/// An axis-aligned box, canvas px.
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    min: Point,
+    max: Point,
+}
+
+impl Bounds {
+    fn of<'a>(points: impl Iterator<Item = &'a Point>) -> Self {
+        let mut b = Bounds {
+            min: Point::new(f64::INFINITY, f64::INFINITY),
+            max: Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        };
+        for p in points {
+            b.min = Point::new(b.min.x.min(p.x), b.min.y.min(p.y));
+            b.max = Point::new(b.max.x.max(p.x), b.max.y.max(p.y));
+        }
+        b
+    }
+
+    fn expanded(self, margin: f64) -> Self {
+        Bounds {
+            min: self.min - crate::geom::Vec2::new(margin, margin),
+            max: self.max + crate::geom::Vec2::new(margin, margin),
+        }
+    }
+
+    fn area(&self) -> f64 {
+        (self.max.x - self.min.x).max(0.0) * (self.max.y - self.min.y).max(0.0)
+    }
+
+    fn contains(&self, p: Point) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+
+    /// The part of segment a–b inside the box (Liang–Barsky), if any.
+    fn clip_segment(&self, a: Point, b: Point) -> Option<(Point, Point)> {
+        let d = b - a;
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (p, q) in [
+            (-d.x, a.x - self.min.x),
+            (d.x, self.max.x - a.x),
+            (-d.y, a.y - self.min.y),
+            (d.y, self.max.y - a.y),
+        ] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    return None;
+                }
+            } else {
+                let r = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(r);
+                } else {
+                    t1 = t1.min(r);
+                }
+            }
+        }
+        (t0 <= t1).then(|| (a + d * t0, a + d * t1))
+    }
+}
+
+/// The faces `keep` accepts, with vertices renumbered in spade's (deterministic) order, each
+/// triangle oriented positively; also each kept triangle's centroid.
+fn extract_faces<F>(
+    cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>,
+    keep: F,
+) -> (Mesh, Vec<Point>)
+where
+    F: Fn(spade::handles::FixedFaceHandle<spade::handles::InnerTag>) -> bool,
+{
     let inner: Vec<[usize; 3]> = cdt
         .inner_faces()
-        .filter(|f| !excluded.contains(&f.fix()))
+        .filter(|f| keep(f.fix()))
         .map(|f| f.vertices().map(|v| v.fix().index()))
         .collect();
+    let positions: Vec<Point> = cdt
+        .vertices()
+        .map(|v| Point::new(v.position().x, v.position().y))
+        .collect();
+    let mut triangles = Vec::with_capacity(inner.len());
+    let mut centroids = Vec::with_capacity(inner.len());
     for t in &inner {
+        let [a, b, c] = t.map(|v| positions[v]);
+        let area2 = triangle_area2(a, b, c);
+        // Spade's faces are counter-clockwise in y-up terms, i.e. negative here; flip them.
+        let tri = if area2 < 0.0 {
+            [t[0], t[2], t[1]]
+        } else if area2 > 0.0 {
+            *t
+        } else {
+            continue;
+        };
+        triangles.push(tri.map(|v| v as u32));
+        centroids.push(Point::from((a.coords + b.coords + c.coords) / 3.0));
+    }
+    (
+        drop_unused_vertices(Mesh {
+            vertices: positions,
+            triangles,
+        }),
+        centroids,
+    )
+}
+
+/// Removes vertices no triangle uses, keeping the others' order.
+fn drop_unused_vertices(mesh: Mesh) -> Mesh {
+    let mut new_index = vec![u32::MAX; mesh.vertices.len()];
+    for t in &mesh.triangles {
         for &v in t {
-            used[v] = true;
+            new_index[v as usize] = 0;
         }
     }
     let mut vertices = Vec::new();
-    for (i, v) in cdt.vertices().enumerate() {
-        if used[i] {
-            index_of.insert(i, vertices.len() as u32);
-            let p = v.position();
-            vertices.push(Point::new(p.x, p.y));
+    for (i, p) in mesh.vertices.iter().enumerate() {
+        if new_index[i] == 0 {
+            new_index[i] = vertices.len() as u32;
+            vertices.push(*p);
         }
     }
-    let triangles = inner
+    let triangles = mesh
+        .triangles
         .iter()
-        .filter_map(|t| {
-            let [a, b, c] = t.map(|v| index_of[&v]);
-            let area2 = triangle_area2(
-                vertices[a as usize],
-                vertices[b as usize],
-                vertices[c as usize],
-            );
-            // Spade's faces are counter-clockwise in y-up terms, i.e. negative here; flip them.
-            if area2 < 0.0 {
-                Some([a, c, b])
-            } else if area2 > 0.0 {
-                Some([a, b, c])
-            } else {
-                None
-            }
-        })
+        .map(|t| t.map(|v| new_index[v as usize]))
         .collect();
-    Ok(Mesh {
+    Mesh {
         vertices,
         triangles,
-    })
+    }
 }
 
 /// The rings' points (deduplicated exactly) and the constraint edges between them.

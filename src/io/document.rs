@@ -10,6 +10,7 @@ use crate::geom::Point;
 use crate::mesh::{Mesh, MeshOptions};
 use crate::rig::{HandleError, Handles};
 use crate::trace::TraceOptions;
+use crate::weights::WeightOptions;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -45,6 +46,7 @@ pub struct RigDocument {
 pub struct BuildOptions {
     pub trace: TraceOptions,
     pub mesh: MeshOptions,
+    pub weights: WeightOptions,
 }
 
 /// One image of the rig with its mesh.

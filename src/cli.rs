@@ -1,0 +1,347 @@
+//! The `sinew` command: argument parsing and the thin glue from arguments to the library.
+//!
+//! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
+//! and exits with code 2. Outputs are computed first and written last, each atomically.
+
+use crate::io::{self, BuildOptions, RigDocument};
+use crate::mesh::{MeshOptions, MeshStats};
+use crate::pipeline::{self, Scene};
+use crate::render;
+use crate::rig::{Handles, Pose};
+use crate::trace::TraceOptions;
+use crate::weights::{WeightMethod, WeightOptions};
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "sinew",
+    version,
+    about = "2D cutout animation: trace, mesh, weigh, pose, render"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Trace and mesh images into a rig document (several images = several parts, in draw order).
+    Rig(RigArgs),
+    /// Draw a rig in a pose (the rest pose when none is given).
+    Pose(PoseArgs),
+    /// Run the whole pipeline on the bundled character.
+    Demo(DemoArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct RigArgs {
+    /// Layer images (PNG, all the same size), back to front.
+    #[arg(required = true)]
+    pub images: Vec<PathBuf>,
+    /// The rig document to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the mesh wireframe over the sprites as a PNG.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
+    /// The handles file (bones, points, cages, regions); with it, weights are computed.
+    #[arg(long)]
+    pub handles: Option<PathBuf>,
+    #[command(flatten)]
+    pub build: BuildArgs,
+}
+
+/// Tracing and meshing parameters; each defaults to the library's default.
+#[derive(Args, Debug)]
+pub struct BuildArgs {
+    /// fine: quality mesh for skinning; coarse: few vertices, for game runtimes.
+    #[arg(long, value_enum, default_value_t = Detail::Fine)]
+    pub detail: Detail,
+    /// A pixel is opaque from this alpha on (0–255).
+    #[arg(long)]
+    pub alpha_threshold: Option<u8>,
+    /// Outward padding of the outline, px.
+    #[arg(long)]
+    pub padding: Option<f64>,
+    /// Outline simplification tolerance, px.
+    #[arg(long)]
+    pub simplify: Option<f64>,
+    /// Smallest triangle angle refinement aims for, degrees.
+    #[arg(long)]
+    pub min_angle: Option<f64>,
+    /// Largest triangle area as a fraction of the canvas area.
+    #[arg(long)]
+    pub max_area_fraction: Option<f64>,
+    /// The weights' energy.
+    #[arg(long = "weights", value_enum, default_value_t = WeightMethod::Bbw)]
+    pub weight_method: WeightMethod,
+    /// Content-aware weights: measure color changes as this many px.
+    #[arg(long, value_name = "S")]
+    pub content_aware: Option<f64>,
+    /// Keep the K largest weights per vertex.
+    #[arg(long, value_name = "K")]
+    pub max_influences: Option<usize>,
+}
+
+#[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq)]
+pub enum Detail {
+    #[default]
+    Fine,
+    Coarse,
+}
+
+impl BuildArgs {
+    fn options(&self) -> BuildOptions {
+        let (mut trace, mut mesh) = match self.detail {
+            Detail::Fine => (TraceOptions::default(), MeshOptions::default()),
+            Detail::Coarse => (TraceOptions::coarse(), MeshOptions::coarse()),
+        };
+        if let Some(v) = self.alpha_threshold {
+            trace.alpha_threshold = v;
+        }
+        if let Some(v) = self.padding {
+            trace.padding_px = v;
+        }
+        if let Some(v) = self.simplify {
+            trace.simplify_tolerance_px = v;
+        }
+        if let Some(v) = self.min_angle {
+            mesh.min_angle_deg = v;
+        }
+        if let Some(v) = self.max_area_fraction {
+            mesh.max_area_fraction = v;
+        }
+        let weights = WeightOptions {
+            method: self.weight_method,
+            content_aware: self.content_aware,
+            max_influences: self.max_influences,
+            ..WeightOptions::default()
+        };
+        BuildOptions {
+            trace,
+            mesh,
+            weights,
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct PoseArgs {
+    /// The rig document.
+    pub rig: PathBuf,
+    /// The image to write (PNG).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Also write the posed vertices of every part as JSON.
+    #[arg(long)]
+    pub vertices: Option<PathBuf>,
+    /// The pose file (bone rotations, point moves, cage polygons).
+    #[arg(long)]
+    pub pose: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Output folder.
+    #[arg(short, long, default_value = "out")]
+    pub output: PathBuf,
+    /// The folder of the bundled character (holding layers.json).
+    #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/character"))]
+    pub assets: PathBuf,
+}
+
+/// Runs one parsed command.
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Rig(args) => rig(&args),
+        Command::Pose(args) => pose(&args),
+        Command::Demo(args) => demo(&args),
+    }
+}
+
+/// Reads a JSON file into `T`, naming the file in every error.
+fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("{}: not a valid {what}", path.display()))
+}
+
+fn rig(args: &RigArgs) -> Result<()> {
+    let layers = pipeline::load_layers(&args.images)?;
+    let handles: Handles = match &args.handles {
+        Some(path) => read_json(path, "handles file")?,
+        None => Handles::default(),
+    };
+    let doc_dir = parent_dir(&args.output);
+    let (doc, stats) = pipeline::build_rig(&layers, doc_dir, &args.build.options(), &handles)?;
+    let preview = match &args.preview {
+        Some(_) => Some(preview_image(&doc, &layers)?),
+        None => None,
+    };
+    doc.save(&args.output)?;
+    if let (Some(path), Some(image)) = (&args.preview, preview) {
+        io::save_png(path, &image)?;
+    }
+    for (part, s) in doc.parts.iter().zip(&stats) {
+        report_mesh(&part.name, s);
+    }
+    Ok(())
+}
+
+fn report_mesh(name: &str, s: &MeshStats) {
+    println!(
+        "{name}: {} vertices, {} triangles, smallest angle {:.1}°",
+        s.vertices, s.triangles, s.min_angle_deg
+    );
+}
+
+/// The rest pose on white with every part's wireframe on top.
+fn preview_image(doc: &RigDocument, layers: &[pipeline::Layer]) -> Result<image::RgbaImage> {
+    let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+    let scene = Scene::new(doc.clone(), &images)?;
+    let [w, h] = doc.canvas;
+    let mut canvas = tiny_skia::Pixmap::new(w, h).context("canvas too large")?;
+    canvas.fill(tiny_skia::Color::WHITE);
+    let rest = scene.rest_positions();
+    scene.draw(&mut canvas, &rest, tiny_skia::Transform::identity())?;
+    let wire = tiny_skia::Color::from_rgba8(20, 90, 200, 170);
+    for (part, positions) in doc.parts.iter().zip(&rest) {
+        render::draw_wireframe(
+            &mut canvas,
+            positions,
+            &part.mesh.triangles,
+            tiny_skia::Transform::identity(),
+            wire,
+            0.75,
+        );
+    }
+    Ok(render::rgba_from_pixmap(&canvas))
+}
+
+fn pose(args: &PoseArgs) -> Result<()> {
+    if args.output.is_none() && args.vertices.is_none() {
+        bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
+    }
+    let scene = Scene::load(&args.rig)?;
+    let pose: Pose = match &args.pose {
+        Some(path) => read_json(path, "pose file")?,
+        None => Pose::default(),
+    };
+    let positions = scene.pose_positions(&pose)?;
+    let image = match &args.output {
+        Some(_) => Some(render::rgba_from_pixmap(&scene.render(&positions)?)),
+        None => None,
+    };
+    let vertices = match &args.vertices {
+        Some(_) => Some(vertices_json(&scene.doc, &positions)?),
+        None => None,
+    };
+    if let (Some(path), Some(image)) = (&args.output, image) {
+        io::save_png(path, &image)?;
+    }
+    if let (Some(path), Some(text)) = (&args.vertices, vertices) {
+        io::write_atomic(path, text.as_bytes())
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The `--vertices` file of DESIGN.md.
+fn vertices_json(doc: &RigDocument, positions: &[Vec<crate::geom::Point>]) -> Result<String> {
+    #[derive(Serialize)]
+    struct Part<'a> {
+        name: &'a str,
+        vertices: Vec<[f64; 2]>,
+        triangles: &'a [[u32; 3]],
+    }
+    #[derive(Serialize)]
+    struct Posed<'a> {
+        parts: Vec<Part<'a>>,
+    }
+    let parts = doc
+        .parts
+        .iter()
+        .zip(positions)
+        .map(|(p, pos)| Part {
+            name: &p.name,
+            vertices: pos.iter().map(|v| [v.x, v.y]).collect(),
+            triangles: &p.mesh.triangles,
+        })
+        .collect();
+    Ok(serde_json::to_string(&Posed { parts })? + "\n")
+}
+
+/// The bundled character's layer list.
+#[derive(serde::Deserialize)]
+struct LayerList {
+    layers: Vec<String>,
+}
+
+fn demo(args: &DemoArgs) -> Result<()> {
+    let started = Instant::now();
+    let list_path = args.assets.join("layers.json");
+    let list: LayerList = serde_json::from_str(
+        &std::fs::read_to_string(&list_path)
+            .with_context(|| format!("{}: cannot read", list_path.display()))?,
+    )
+    .with_context(|| format!("{}: not a layer list", list_path.display()))?;
+    let paths: Vec<PathBuf> = list
+        .layers
+        .iter()
+        .map(|name| args.assets.join(format!("{name}.png")))
+        .collect();
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
+
+    let t = Instant::now();
+    let layers = pipeline::load_layers(&paths)?;
+    let load_s = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let handles: Handles = read_json(&args.assets.join("handles.json"), "handles file")?;
+    let (doc, stats) =
+        pipeline::build_rig(&layers, &args.output, &BuildOptions::default(), &handles)?;
+    let rig_s = t.elapsed().as_secs_f64();
+
+    let rig_path = args.output.join("character.json");
+    doc.save(&rig_path)?;
+    let t = Instant::now();
+    let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+    let scene = Scene::new(doc.clone(), &images)?;
+    let rest = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
+    let render_s = t.elapsed().as_secs_f64();
+    let rest_path = args.output.join("rest.png");
+    io::save_png(&rest_path, &rest)?;
+    let preview_path = args.output.join("mesh.png");
+    io::save_png(&preview_path, &preview_image(&doc, &layers)?)?;
+
+    let (v, t_count): (usize, usize) = stats
+        .iter()
+        .fold((0, 0), |a, s| (a.0 + s.vertices, a.1 + s.triangles));
+    println!(
+        "sinew demo: {} parts, {v} vertices, {t_count} triangles",
+        doc.parts.len()
+    );
+    println!("  load images   {:>8.1} ms", load_s * 1e3);
+    println!("  trace + mesh  {:>8.1} ms", rig_s * 1e3);
+    println!("  render        {:>8.1} ms", render_s * 1e3);
+    for path in [&rig_path, &rest_path, &preview_path] {
+        println!("  wrote {}", path.display());
+    }
+    println!(
+        "  total         {:>8.1} ms",
+        started.elapsed().as_secs_f64() * 1e3
+    );
+    Ok(())
+}
+
+/// The folder a file will be written in (`.` for a bare file name).
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}

@@ -1,0 +1,428 @@
+//! The stages wired together, for the command line and the editor alike.
+//!
+//! - [`load_layers`]: image files → [`Layer`]s on one canvas (same size, unique names).
+//! - [`build_rig`]: layers + [`BuildOptions`] + [`Handles`] → a [`RigDocument`] (trace, mesh
+//!   with the handles' geometry embedded, weights, per part).
+//! - [`Scene`]: a loaded document with its textures: poses it (forward kinematics + skinning)
+//!   and draws any vertex positions.
+
+use crate::geom::Point;
+use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
+use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
+use crate::render::{self, MeshRenderer, RenderError};
+use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
+use crate::skin::{linear_blend, SkinWeights};
+use crate::trace::{self, TraceError};
+use crate::weights::{self, WeightError};
+use image::RgbaImage;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+/// One input image: a part of the rig.
+pub struct Layer {
+    /// The part's name: the file name without extension.
+    pub name: String,
+    pub path: PathBuf,
+    pub image: RgbaImage,
+}
+
+/// What went wrong between the input files and a rig.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    #[error(transparent)]
+    Document(#[from] io::DocumentError),
+    #[error("{path}: image is {}×{} px, too small to rig (at least {MIN_SPRITE_SIDE_PX}×{MIN_SPRITE_SIDE_PX})", got[0], got[1])]
+    TooSmall { path: PathBuf, got: [u32; 2] },
+    #[error("no input images")]
+    NoImages,
+    #[error("{path}: image is {got:?} px but the canvas (from the first image) is {canvas:?} px; all layers must share one canvas")]
+    SizeMismatch {
+        path: PathBuf,
+        got: [u32; 2],
+        canvas: [u32; 2],
+    },
+    #[error("{path}: a part named '{name}' already exists (part names come from file names)")]
+    DuplicatePart { path: PathBuf, name: String },
+    #[error("{path}: {source}")]
+    Trace { path: PathBuf, source: TraceError },
+    #[error("{path}: no opaque region of at least {min_area_px2} px² (see --alpha-threshold)")]
+    NoShape { path: PathBuf, min_area_px2: f64 },
+    #[error("{path}: {source}")]
+    Mesh { path: PathBuf, source: MeshError },
+    #[error("part '{part}': {source}")]
+    Render { part: String, source: RenderError },
+    #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
+    TextureSize {
+        part: String,
+        got: [u32; 2],
+        canvas: [u32; 2],
+    },
+    #[error("part '{part}': {got} vertex positions for a mesh of {expected} vertices")]
+    PositionCount {
+        part: String,
+        got: usize,
+        expected: usize,
+    },
+    #[error("handles: {0}")]
+    Handles(#[from] HandleError),
+    #[error("handle '{0}' lies outside every part")]
+    HandleOutside(String),
+    #[error("{path}: weights: {source}")]
+    Weights { path: PathBuf, source: WeightError },
+    #[error("pose: {0}")]
+    Pose(#[from] PoseError),
+    #[error("the pose has IK drags, which need the skinning IK solver; this build poses by forward kinematics only")]
+    IkUnsupported,
+    #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
+    UnknownWeightHandle { part: String, handle: String },
+    #[error("canvas {0:?} px is too large to draw")]
+    Canvas([u32; 2]),
+}
+
+/// Images narrower or lower than this (px) are too small to trace and rig.
+pub const MIN_SPRITE_SIDE_PX: u32 = 4;
+
+/// Loads image files as the layers of one canvas, in the given (draw) order.
+pub fn load_layers(paths: &[PathBuf]) -> Result<Vec<Layer>, PipelineError> {
+    let mut layers: Vec<Layer> = Vec::with_capacity(paths.len());
+    let mut names = HashSet::new();
+    for path in paths {
+        let image = io::load_png(path)?;
+        let got = [image.width(), image.height()];
+        if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
+            return Err(PipelineError::TooSmall {
+                path: path.clone(),
+                got,
+            });
+        }
+        if let Some(first) = layers.first() {
+            let canvas = [first.image.width(), first.image.height()];
+            if got != canvas {
+                return Err(PipelineError::SizeMismatch {
+                    path: path.clone(),
+                    got,
+                    canvas,
+                });
+            }
+        }
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if !names.insert(name.clone()) {
+            return Err(PipelineError::DuplicatePart {
+                path: path.clone(),
+                name,
+            });
+        }
+        layers.push(Layer {
+            name,
+            path: path.clone(),
+            image,
+        });
+    }
+    if layers.is_empty() {
+        return Err(PipelineError::NoImages);
+    }
+    Ok(layers)
+}
+
+/// Traces and meshes every layer and, when there are handles, embeds their geometry in every
+/// mesh and computes weights. `doc_dir` is the folder the document will be saved in: image
+/// paths are stored relative to it. Returns the document and each part's mesh statistics.
+pub fn build_rig(
+    layers: &[Layer],
+    doc_dir: &Path,
+    options: &BuildOptions,
+    handles: &Handles,
+) -> Result<(RigDocument, Vec<MeshStats>), PipelineError> {
+    let first = layers.first().ok_or(PipelineError::NoImages)?;
+    let canvas = [first.image.width(), first.image.height()];
+    let canvas_area = canvas[0] as f64 * canvas[1] as f64;
+    let mut doc = RigDocument::new(canvas);
+    doc.options = options.clone();
+    doc.handles = handles.clone();
+    handles.validate()?;
+    let columns = handle_columns(handles);
+    let geometry = handle_geometry(handles);
+    let mut touched = vec![0usize; columns.len()];
+    let mut stats = Vec::with_capacity(layers.len());
+    for layer in layers {
+        let outlines =
+            trace::trace(&layer.image, &options.trace).map_err(|source| PipelineError::Trace {
+                path: layer.path.clone(),
+                source,
+            })?;
+        if outlines.is_empty() {
+            let min_area_px2 = options.trace.min_area_px2;
+            return Err(PipelineError::NoShape {
+                path: layer.path.clone(),
+                min_area_px2,
+            });
+        }
+        let mesh_error = |source| PipelineError::Mesh {
+            path: layer.path.clone(),
+            source,
+        };
+        let (mesh, weights) = if columns.is_empty() {
+            (
+                mesh::triangulate(&outlines, canvas_area, &options.mesh).map_err(mesh_error)?,
+                None,
+            )
+        } else {
+            let embedded =
+                mesh::triangulate_with_handles(&outlines, &geometry, canvas_area, &options.mesh)
+                    .map_err(mesh_error)?;
+            let colors = options
+                .weights
+                .content_aware
+                .map(|_| vertex_colors(&layer.image, &embedded.domain.vertices));
+            let part =
+                weights::part_weights(&embedded, handles, colors.as_deref(), &options.weights)
+                    .map_err(|source| PipelineError::Weights {
+                        path: layer.path.clone(),
+                        source,
+                    })?;
+            for (t, n) in touched.iter_mut().zip(&part.touched) {
+                *t += n;
+            }
+            let weights = WeightsDoc {
+                handles: columns.clone(),
+                rows: part.rows,
+            };
+            (embedded.shape_mesh().0, Some(weights))
+        };
+        stats.push(mesh.stats());
+        doc.parts.push(PartDoc {
+            name: layer.name.clone(),
+            image: relative_path(doc_dir, &layer.path),
+            mesh: MeshDoc::from(&mesh),
+            weights,
+        });
+    }
+    if let Some(column) = touched.iter().position(|&n| n == 0) {
+        return Err(PipelineError::HandleOutside(columns[column].clone()));
+    }
+    Ok((doc, stats))
+}
+
+/// The geometry every mesh must carry for the handles: bone segments, point positions, cage
+/// and region outlines (cage insides also join the weight domain).
+pub fn handle_geometry(handles: &Handles) -> HandleGeometry {
+    let pt = |a: &[f64; 2]| Point::new(a[0], a[1]);
+    let ring = |poly: &Vec<[f64; 2]>| poly.iter().map(pt).collect::<Vec<_>>();
+    HandleGeometry {
+        points: handles.points.iter().map(|p| pt(&p.at)).collect(),
+        segments: handles
+            .bones
+            .iter()
+            .map(|b| [pt(&b.head), pt(&b.tail)])
+            .collect(),
+        polygons: handles
+            .cages
+            .iter()
+            .map(|c| ring(&c.polygon))
+            .chain(handles.regions.iter().map(|r| ring(&r.polygon)))
+            .collect(),
+        domain_extensions: handles.cages.iter().map(|c| ring(&c.polygon)).collect(),
+    }
+}
+
+/// Premultiplied RGB in [0, 1] of the pixel under each vertex (nearest pixel, clamped to the
+/// image), for content-aware weights.
+pub fn vertex_colors(image: &RgbaImage, vertices: &[Point]) -> Vec<[f64; 3]> {
+    let (w, h) = (image.width() as i64, image.height() as i64);
+    vertices
+        .iter()
+        .map(|p| {
+            let x = (p.x.floor() as i64).clamp(0, w - 1) as u32;
+            let y = (p.y.floor() as i64).clamp(0, h - 1) as u32;
+            let px = image.get_pixel(x, y);
+            let a = px[3] as f64 / 255.0;
+            [0, 1, 2].map(|c| a * px[c] as f64 / 255.0)
+        })
+        .collect()
+}
+
+/// `target` as a path relative to `dir` (with `/` separators) when both resolve; otherwise
+/// `target` made absolute.
+pub fn relative_path(dir: &Path, target: &Path) -> String {
+    let absolute = |p: &Path| std::fs::canonicalize(p).ok();
+    let (Some(dir), Some(target)) = (absolute(dir), absolute(target)) else {
+        return target.to_string_lossy().into_owned();
+    };
+    let common = dir
+        .components()
+        .zip(target.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    let ups = dir.components().count() - common;
+    let parts: Vec<String> = std::iter::repeat_n("..".to_string(), ups)
+        .chain(
+            target
+                .components()
+                .skip(common)
+                .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+        )
+        .collect();
+    parts.join("/")
+}
+
+/// A document with its textures and per-part render state, ready to draw.
+pub struct Scene {
+    pub doc: RigDocument,
+    textures: Vec<tiny_skia::Pixmap>,
+    renderers: Vec<MeshRenderer>,
+}
+
+impl Scene {
+    /// Loads the document at `path` and every part's image.
+    pub fn load(path: &Path) -> Result<Self, PipelineError> {
+        let doc = RigDocument::load(path)?;
+        let images = doc
+            .parts
+            .iter()
+            .map(|part| io::load_png(&RigDocument::image_path(path, part)))
+            .collect::<Result<Vec<_>, _>>()?;
+        Scene::new(doc, &images)
+    }
+
+    /// A scene from a document and its parts' images (in part order).
+    pub fn new(doc: RigDocument, images: &[RgbaImage]) -> Result<Self, PipelineError> {
+        let mut textures = Vec::with_capacity(images.len());
+        let mut renderers = Vec::with_capacity(images.len());
+        for (part, image) in doc.parts.iter().zip(images) {
+            let got = [image.width(), image.height()];
+            if got != doc.canvas {
+                return Err(PipelineError::TextureSize {
+                    part: part.name.clone(),
+                    got,
+                    canvas: doc.canvas,
+                });
+            }
+            let mesh = part.mesh.to_mesh();
+            let renderer =
+                MeshRenderer::new(&mesh.vertices, &mesh.triangles).map_err(|source| {
+                    PipelineError::Render {
+                        part: part.name.clone(),
+                        source,
+                    }
+                })?;
+            textures.push(render::pixmap_from_rgba(image).map_err(|source| {
+                PipelineError::Render {
+                    part: part.name.clone(),
+                    source,
+                }
+            })?);
+            renderers.push(renderer);
+        }
+        Ok(Scene {
+            doc,
+            textures,
+            renderers,
+        })
+    }
+
+    /// Every part's rest vertex positions.
+    pub fn rest_positions(&self) -> Vec<Vec<Point>> {
+        self.doc
+            .parts
+            .iter()
+            .map(|p| p.mesh.to_mesh().vertices)
+            .collect()
+    }
+
+    /// Every part's vertex positions in `pose` (forward kinematics, then linear blend
+    /// skinning). Parts without weights stay at rest.
+    pub fn pose_positions(&self, pose: &Pose) -> Result<Vec<Vec<Point>>, PipelineError> {
+        if !pose.ik.is_empty() {
+            return Err(PipelineError::IkUnsupported);
+        }
+        let transforms = handle_transforms(&self.doc.handles, pose)?;
+        let columns = handle_columns(&self.doc.handles);
+        let mut out = self.rest_positions();
+        for (part, positions) in self.doc.parts.iter().zip(out.iter_mut()) {
+            let Some(weights) = &part.weights else {
+                continue;
+            };
+            // The document names its columns; map them onto this rig's transform order.
+            let mut part_transforms = Vec::with_capacity(weights.handles.len());
+            for name in &weights.handles {
+                let j = columns.iter().position(|c| c == name).ok_or_else(|| {
+                    PipelineError::UnknownWeightHandle {
+                        part: part.name.clone(),
+                        handle: name.clone(),
+                    }
+                })?;
+                part_transforms.push(transforms[j]);
+            }
+            let rest = positions.clone();
+            linear_blend(
+                &rest,
+                &SkinWeights::from_rows(&weights.rows),
+                &part_transforms,
+                positions,
+            );
+        }
+        Ok(out)
+    }
+
+    /// Draws every part at `positions` (one list per part, canvas px) onto a transparent canvas
+    /// of the rig's size.
+    pub fn render(&self, positions: &[Vec<Point>]) -> Result<tiny_skia::Pixmap, PipelineError> {
+        let [w, h] = self.doc.canvas;
+        let mut canvas =
+            tiny_skia::Pixmap::new(w, h).ok_or(PipelineError::Canvas(self.doc.canvas))?;
+        self.draw(&mut canvas, positions, tiny_skia::Transform::identity())?;
+        Ok(canvas)
+    }
+
+    /// Draws every part at `positions` onto `canvas` through `canvas_from_world`.
+    pub fn draw(
+        &self,
+        canvas: &mut tiny_skia::Pixmap,
+        positions: &[Vec<Point>],
+        canvas_from_world: tiny_skia::Transform,
+    ) -> Result<(), PipelineError> {
+        for (i, part) in self.doc.parts.iter().enumerate() {
+            let expected = part.mesh.vertices.len();
+            let part_positions = positions.get(i).map(Vec::as_slice).unwrap_or_default();
+            if part_positions.len() != expected {
+                return Err(PipelineError::PositionCount {
+                    part: part.name.clone(),
+                    got: part_positions.len(),
+                    expected,
+                });
+            }
+            self.renderers[i].draw(
+                canvas,
+                self.textures[i].as_ref(),
+                part_positions,
+                canvas_from_world,
+                1.0,
+            );
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_paths() {
+        let dir = std::env::temp_dir().join(format!("sinew-rel-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("a/b")).unwrap();
+        std::fs::create_dir_all(dir.join("c")).unwrap();
+        std::fs::write(dir.join("c/x.png"), b"").unwrap();
+        assert_eq!(
+            relative_path(&dir.join("a/b"), &dir.join("c/x.png")),
+            "../../c/x.png"
+        );
+        assert_eq!(relative_path(&dir.join("c"), &dir.join("c/x.png")), "x.png");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,189 @@
+//! The `sinew` command end to end: it rigs and poses, and bad input ends in one line on stderr,
+//! exit code 2, no panic and no output file (an existing one left as it was).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const EXIT_BAD_INPUT: i32 = 2;
+
+fn sinew(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .output()
+        .expect("run sinew")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinew-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Runs a command that must fail on bad input, and checks how.
+fn assert_bad_input(args: &[&str], expect_in_message: &str) {
+    let out = sinew(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_BAD_INPUT),
+        "{args:?}: stderr {stderr}"
+    );
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(expect_in_message),
+        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
+    );
+}
+
+#[test]
+fn rig_then_pose_writes_rig_preview_image_and_vertices() {
+    let dir = scratch("ok");
+    let sprite = dir.join("critter.png");
+    common::critter(128).save(&sprite).unwrap();
+    let (rig, preview, posed, vertices) = (
+        dir.join("rig.json"),
+        dir.join("preview.png"),
+        dir.join("rest.png"),
+        dir.join("v.json"),
+    );
+    let out = sinew(&["rig", s(&sprite), "-o", s(&rig), "--preview", s(&preview)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("critter:"),
+        "reports counts"
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    assert_eq!(doc["parts"][0]["image"], "critter.png");
+    assert!(image::open(&preview).is_ok());
+
+    let out = sinew(&["pose", s(&rig), "-o", s(&posed), "--vertices", s(&vertices)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&vertices).unwrap()).unwrap();
+    assert_eq!(
+        v["parts"][0]["vertices"],
+        doc["parts"][0]["mesh"]["vertices"]
+    );
+    assert_eq!(image::open(&posed).unwrap().width(), 128);
+    // Same inputs, byte-identical outputs.
+    let rig2 = dir.join("rig2.json");
+    assert!(sinew(&["rig", s(&sprite), "-o", s(&rig2)]).status.success());
+    assert_eq!(std::fs::read(&rig).unwrap(), std::fs::read(&rig2).unwrap());
+}
+
+#[test]
+fn bad_images_fail_cleanly_without_output() {
+    let dir = scratch("bad-images");
+    let good = dir.join("good.png");
+    common::critter(64).save(&good).unwrap();
+    let not_png = dir.join("not.png");
+    std::fs::write(&not_png, b"this is text").unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    let truncated = dir.join("truncated.png");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let empty = dir.join("empty.png");
+    image::RgbaImage::new(32, 32).save(&empty).unwrap();
+    let tiny = dir.join("tiny.png");
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([255, 0, 0, 255]))
+        .save(&tiny)
+        .unwrap();
+    let other_size = dir.join("other.png");
+    common::critter(32).save(&other_size).unwrap();
+    let out = dir.join("rig.json");
+
+    assert_bad_input(&["rig", s(&not_png), "-o", s(&out)], "not a PNG");
+    assert_bad_input(&["rig", s(&truncated), "-o", s(&out)], "cannot decode PNG");
+    assert_bad_input(&["rig", s(&empty), "-o", s(&out)], "no pixel with alpha");
+    assert_bad_input(&["rig", s(&tiny), "-o", s(&out)], "too small to rig");
+    assert_bad_input(
+        &["rig", s(&dir.join("missing.png")), "-o", s(&out)],
+        "cannot read",
+    );
+    assert_bad_input(
+        &["rig", s(&good), s(&other_size), "-o", s(&out)],
+        "share one canvas",
+    );
+    assert_bad_input(
+        &["rig", s(&good), s(&good), "-o", s(&out)],
+        "already exists",
+    );
+    assert_bad_input(
+        &["rig", s(&good), "-o", s(&out), "--padding", "NaN"],
+        "padding",
+    );
+    assert!(!out.exists(), "a failed run wrote {}", out.display());
+
+    // A failure leaves an existing output untouched.
+    std::fs::write(&out, b"previous").unwrap();
+    assert_bad_input(&["rig", s(&empty), "-o", s(&out)], "no pixel with alpha");
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left behind");
+}
+
+#[test]
+fn bad_rig_documents_fail_cleanly_without_output() {
+    let dir = scratch("bad-rigs");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let rig = dir.join("rig.json");
+    assert!(sinew(&["rig", s(&sprite), "-o", s(&rig)]).status.success());
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    let out = dir.join("out.png");
+
+    let mut wrong_version = doc.clone();
+    wrong_version["version"] = 99.into();
+    let p = dir.join("v99.json");
+    std::fs::write(&p, wrong_version.to_string()).unwrap();
+    assert_bad_input(
+        &["pose", s(&p), "-o", s(&out)],
+        "unsupported rig version 99",
+    );
+
+    let mut bad_index = doc.clone();
+    bad_index["parts"][0]["mesh"]["triangles"][0][1] = 100000.into();
+    let p = dir.join("index.json");
+    std::fs::write(&p, bad_index.to_string()).unwrap();
+    assert_bad_input(&["pose", s(&p), "-o", s(&out)], "uses vertex 100000");
+
+    let mut missing_image = doc.clone();
+    missing_image["parts"][0]["image"] = "nowhere.png".into();
+    let p = dir.join("missing-image.json");
+    std::fs::write(&p, missing_image.to_string()).unwrap();
+    assert_bad_input(&["pose", s(&p), "-o", s(&out)], "nowhere.png");
+
+    let p = dir.join("garbage.json");
+    std::fs::write(&p, b"{\"format\": ").unwrap();
+    assert_bad_input(&["pose", s(&p), "-o", s(&out)], "not valid JSON");
+    assert_bad_input(
+        &["pose", s(&dir.join("none.json")), "-o", s(&out)],
+        "cannot read",
+    );
+    assert!(!out.exists());
+}
