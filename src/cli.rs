@@ -326,7 +326,10 @@ fn demo(args: &DemoArgs) -> Result<()> {
         doc.parts.len()
     );
     println!("  load images   {:>8.1} ms", load_s * 1e3);
-    println!("  trace + mesh  {:>8.1} ms", rig_s * 1e3);
+    println!(
+        "  rig           {:>8.1} ms (trace, mesh, weights)",
+        rig_s * 1e3
+    );
     println!("  render        {:>8.1} ms", render_s * 1e3);
     for path in [&rig_path, &rest_path, &preview_path] {
         println!("  wrote {}", path.display());

@@ -270,6 +270,21 @@ pub fn relative_path(dir: &Path, target: &Path) -> String {
     parts.join("/")
 }
 
+/// Transparent pixels around each texture beyond the trace padding, so bilinear sampling at
+/// the mesh's outermost points reads transparency.
+const TEXTURE_BORDER_MARGIN_PX: u32 = 2;
+
+/// The transparent frame each part's texture gets: the trace padding plus a margin.
+fn texture_border_px(doc: &RigDocument) -> u32 {
+    let padding = doc.options.trace.padding_px;
+    let padding = if padding.is_finite() {
+        padding.clamp(0.0, crate::trace::MAX_PADDING_PX)
+    } else {
+        0.0
+    };
+    padding.ceil() as u32 + TEXTURE_BORDER_MARGIN_PX
+}
+
 /// A document with its textures and per-part render state, ready to draw.
 pub struct Scene {
     pub doc: RigDocument,
@@ -302,15 +317,22 @@ impl Scene {
                     canvas: doc.canvas,
                 });
             }
+            // Meshes reach past the canvas by up to the trace padding; a transparent frame
+            // around the texture keeps the sampler from smearing edge pixels out there.
+            let border = texture_border_px(&doc);
+            let offset = crate::geom::Vec2::new(border as f64, border as f64);
             let mesh = part.mesh.to_mesh();
-            let renderer =
-                MeshRenderer::new(&mesh.vertices, &mesh.triangles).map_err(|source| {
-                    PipelineError::Render {
-                        part: part.name.clone(),
-                        source,
-                    }
-                })?;
-            textures.push(render::pixmap_from_rgba(image).map_err(|source| {
+            let uv_px: Vec<Point> = mesh.vertices.iter().map(|p| p + offset).collect();
+            let mut framed =
+                RgbaImage::new(image.width() + 2 * border, image.height() + 2 * border);
+            image::imageops::replace(&mut framed, image, i64::from(border), i64::from(border));
+            let renderer = MeshRenderer::new(&uv_px, &mesh.triangles).map_err(|source| {
+                PipelineError::Render {
+                    part: part.name.clone(),
+                    source,
+                }
+            })?;
+            textures.push(render::pixmap_from_rgba(&framed).map_err(|source| {
                 PipelineError::Render {
                     part: part.name.clone(),
                     source,

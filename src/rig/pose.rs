@@ -251,17 +251,56 @@ pub fn bone_world_frames(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         .collect()
 }
 
+/// Every bone's skinning transformation (rest canvas → posed canvas), in bone order.
+///
+/// A bone left at its default local pose moves exactly as its parent (a root stays exactly
+/// put), so a pose that names nothing reproduces the rest mesh bit for bit; the general
+/// formula `world_from_bone · (world_from_bone_rest)⁻¹` would only cancel up to rounding.
+fn bone_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
+    let world = bone_world_frames(handles, pose)?;
+    let index: BTreeMap<&str, usize> = handles
+        .bones
+        .iter()
+        .enumerate()
+        .map(|(i, b)| (b.name.as_str(), i))
+        .collect();
+    let mut out: Vec<Option<Affine>> = vec![None; handles.bones.len()];
+    // Parents are acyclic (validated, and checked again by bone_world_frames): each pass
+    // settles at least one more bone.
+    while out.iter().any(Option::is_none) {
+        for (i, bone) in handles.bones.iter().enumerate() {
+            if out[i].is_some() {
+                continue;
+            }
+            let parent = match bone.parent.as_deref().and_then(|p| index.get(p)) {
+                Some(&p) => match out[p] {
+                    Some(t) => t,
+                    None => continue,
+                },
+                None => Affine::identity(),
+            };
+            let is_default = pose
+                .bones
+                .get(&bone.name)
+                .is_none_or(|local| *local == BonePose::default());
+            out[i] = Some(if is_default {
+                parent
+            } else {
+                let rest_inverse = bone_rest_frame(bone.head, bone.tail)
+                    .inverse()
+                    .ok_or_else(|| PoseError::Singular(bone.name.clone()))?;
+                world[i].then_after(&rest_inverse)
+            });
+        }
+    }
+    Ok(out.into_iter().flatten().collect())
+}
+
 /// One skinning transformation per handle column, in [`Handles::names`]' order expanded as
 /// [`handle_columns`] lists them: bones, points, cage vertices, regions (regions stay at rest
 /// unless IK moves them).
 pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
-    let mut out = Vec::new();
-    for (bone, world) in handles.bones.iter().zip(bone_world_frames(handles, pose)?) {
-        let rest_inverse = bone_rest_frame(bone.head, bone.tail)
-            .inverse()
-            .ok_or_else(|| PoseError::Singular(bone.name.clone()))?;
-        out.push(world.then_after(&rest_inverse));
-    }
+    let mut out = bone_transforms(handles, pose)?;
     for name in pose.points.keys() {
         if !handles.points.iter().any(|p| &p.name == name) {
             return Err(PoseError::UnknownName {

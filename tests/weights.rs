@@ -1,0 +1,351 @@
+//! Weights and posing end to end, on the bundled character and on generated shapes: partition
+//! of unity, bounds, interpolation, locality, content awareness, and forward kinematics with
+//! linear blend skinning (identity, whole-rig rigid motion, one bent joint).
+
+use image::{Rgba, RgbaImage};
+use sinew::geom::{triangle_area2, Point, Vec2};
+use sinew::io::{BuildOptions, RigDocument};
+use sinew::pipeline::{self, Layer, Scene};
+use sinew::rig::pose::{rotation, BonePose, PointPose};
+use sinew::rig::{handle_columns, Bone, Handles, PointHandle, Pose};
+use sinew::weights::boundary::segment_distance;
+use sinew::weights::WeightOptions;
+use std::path::Path;
+
+const SUM_TOLERANCE: f64 = 1e-9;
+
+fn character() -> (Vec<Layer>, Handles) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    let list: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("layers.json")).unwrap()).unwrap();
+    let paths: Vec<_> = list["layers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| dir.join(format!("{}.png", n.as_str().unwrap())))
+        .collect();
+    let handles: Handles =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("handles.json")).unwrap()).unwrap();
+    (pipeline::load_layers(&paths).unwrap(), handles)
+}
+
+fn rig(layers: &[Layer], handles: &Handles, options: &BuildOptions) -> RigDocument {
+    pipeline::build_rig(layers, &std::env::temp_dir(), options, handles)
+        .unwrap()
+        .0
+}
+
+fn scene(layers: &[Layer], doc: RigDocument) -> Scene {
+    let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+    Scene::new(doc, &images).unwrap()
+}
+
+fn layer(name: &str, image: RgbaImage) -> Layer {
+    Layer {
+        name: name.into(),
+        path: std::env::temp_dir().join(format!("{name}.png")),
+        image,
+    }
+}
+
+#[test]
+fn character_weights_sum_to_one_stay_bounded_and_interpolate() {
+    let (layers, handles) = character();
+    let doc = rig(&layers, &handles, &BuildOptions::default());
+    let columns = handle_columns(&handles);
+    for part in &doc.parts {
+        let weights = part.weights.as_ref().expect("weights");
+        assert_eq!(weights.handles, columns);
+        for (i, row) in weights.rows.iter().enumerate() {
+            let sum: f64 = row.iter().map(|e| e.1).sum();
+            assert!(
+                (sum - 1.0).abs() < SUM_TOLERANCE,
+                "{}: row {i} sums to {sum}",
+                part.name
+            );
+            assert!(
+                row.iter().all(|e| (0.0..=1.0).contains(&e.1)),
+                "{}: row {i} out of bounds",
+                part.name
+            );
+            // A vertex lying on exactly one bone (not at a joint) belongs to it alone.
+            let p = Point::new(part.mesh.vertices[i][0], part.mesh.vertices[i][1]);
+            let on: Vec<usize> = handles
+                .bones
+                .iter()
+                .enumerate()
+                .filter(|(_, b)| {
+                    segment_distance(
+                        p,
+                        Point::new(b.head[0], b.head[1]),
+                        Point::new(b.tail[0], b.tail[1]),
+                    )
+                    .0 < 1e-6
+                })
+                .map(|(j, _)| j)
+                .collect();
+            if on.len() == 1 {
+                assert_eq!(
+                    row,
+                    &vec![(on[0] as u32, 1.0)],
+                    "{}: vertex {i} on bone {}",
+                    part.name,
+                    columns[on[0]]
+                );
+            }
+        }
+    }
+}
+
+/// An opaque bar, 300 × 40 px, on a 320 × 80 canvas.
+fn bar(color: impl Fn(u32) -> [u8; 3]) -> RgbaImage {
+    RgbaImage::from_fn(320, 80, |x, y| {
+        if (10..310).contains(&x) && (20..60).contains(&y) {
+            let c = color(x);
+            Rgba([c[0], c[1], c[2], 255])
+        } else {
+            Rgba([0, 0, 0, 0])
+        }
+    })
+}
+
+fn cross_bone(name: &str, x: f64) -> Bone {
+    Bone {
+        name: name.into(),
+        parent: None,
+        head: [x, 10.0],
+        tail: [x, 70.0],
+    }
+}
+
+#[test]
+fn weights_vanish_where_other_handles_cut_a_handle_off() {
+    // Three bones across the bar's whole height split it into regions; the first bone's weight
+    // must be exactly zero beyond the second.
+    let layers = [layer("bar", bar(|_| [200, 100, 50]))];
+    let handles = Handles {
+        bones: vec![
+            cross_bone("a", 60.0),
+            cross_bone("b", 150.0),
+            cross_bone("c", 250.0),
+        ],
+        ..Default::default()
+    };
+    let doc = rig(&layers, &handles, &BuildOptions::default());
+    let part = &doc.parts[0];
+    let weights = part.weights.as_ref().unwrap();
+    let mut checked = 0;
+    for (v, row) in part.mesh.vertices.iter().zip(&weights.rows) {
+        if v[0] > 150.0 + 1e-6 {
+            let a = row.iter().find(|e| e.0 == 0).map_or(0.0, |e| e.1);
+            assert_eq!(a, 0.0, "bone a has weight {a} at {v:?}, beyond bone b");
+            checked += 1;
+        }
+    }
+    assert!(checked > 50);
+}
+
+/// Position along the bar's center line where `w` changes fastest, from mesh vertices near it.
+fn steepest_x(doc: &RigDocument, handle: u32) -> f64 {
+    let part = &doc.parts[0];
+    let weights = part.weights.as_ref().unwrap();
+    let mut samples: Vec<(f64, f64)> = part
+        .mesh
+        .vertices
+        .iter()
+        .zip(&weights.rows)
+        .filter(|(v, _)| (v[1] - 40.0).abs() < 6.0)
+        .map(|(v, row)| {
+            (
+                v[0],
+                row.iter().find(|e| e.0 == handle).map_or(0.0, |e| e.1),
+            )
+        })
+        .collect();
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    // Slope between samples at least a few px apart, to average out mesh irregularity.
+    const SPAN_PX: f64 = 6.0;
+    let mut best = (0.0, 0.0);
+    for (i, &(x0, w0)) in samples.iter().enumerate() {
+        if let Some(&(x1, w1)) = samples[i..].iter().find(|s| s.0 >= x0 + SPAN_PX) {
+            let slope = (w1 - w0).abs() / (x1 - x0);
+            if slope > best.0 {
+                best = (slope, 0.5 * (x0 + x1));
+            }
+        }
+    }
+    best.1
+}
+
+#[test]
+fn content_aware_weights_change_fastest_across_a_color_edge() {
+    const EDGE_X: u32 = 110;
+    let image = bar(|x| {
+        if x < EDGE_X {
+            [230, 40, 40]
+        } else {
+            [40, 60, 230]
+        }
+    });
+    let layers = [layer("bar", image)];
+    let handles = Handles {
+        points: vec![
+            PointHandle {
+                name: "left".into(),
+                at: [40.0, 40.0],
+            },
+            PointHandle {
+                name: "right".into(),
+                at: [280.0, 40.0],
+            },
+        ],
+        ..Default::default()
+    };
+    let plain = rig(&layers, &handles, &BuildOptions::default());
+    let aware_options = BuildOptions {
+        weights: WeightOptions {
+            content_aware: Some(200.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let aware = rig(&layers, &handles, &aware_options);
+    let (x_plain, x_aware) = (steepest_x(&plain, 0), steepest_x(&aware, 0));
+    eprintln!("steepest change of the left handle's weight: plain at x = {x_plain:.1}, content-aware at x = {x_aware:.1}, color edge at {EDGE_X}");
+    assert!(
+        (x_aware - EDGE_X as f64).abs() < 8.0,
+        "content-aware weights are steepest at {x_aware}"
+    );
+    assert!(
+        (x_plain - EDGE_X as f64).abs() > 20.0,
+        "plain weights are already steepest at the edge ({x_plain})"
+    );
+}
+
+#[test]
+fn identity_pose_reproduces_the_rest_mesh_exactly() {
+    let (layers, handles) = character();
+    let scene = scene(&layers, rig(&layers, &handles, &BuildOptions::default()));
+    assert_eq!(
+        scene.pose_positions(&Pose::default()).unwrap(),
+        scene.rest_positions()
+    );
+}
+
+#[test]
+fn a_whole_rig_rigid_motion_moves_every_vertex_rigidly() {
+    let (layers, handles) = character();
+    let scene = scene(&layers, rig(&layers, &handles, &BuildOptions::default()));
+    let (angle_deg, shift) = (23.0, Vec2::new(-12.0, 7.5));
+    let r = rotation(angle_deg);
+    let moved = |p: [f64; 2]| r * Vec2::new(p[0], p[1]) + shift;
+    let mut pose = Pose::default();
+    for bone in handles.bones.iter().filter(|b| b.parent.is_none()) {
+        let head = moved(bone.head) - Vec2::new(bone.head[0], bone.head[1]);
+        pose.bones.insert(
+            bone.name.clone(),
+            BonePose {
+                rotate: angle_deg,
+                translate: [head.x, head.y],
+                ..Default::default()
+            },
+        );
+    }
+    for point in &handles.points {
+        let d = moved(point.at) - Vec2::new(point.at[0], point.at[1]);
+        pose.points.insert(
+            point.name.clone(),
+            PointPose {
+                rotate: angle_deg,
+                translate: [d.x, d.y],
+                ..Default::default()
+            },
+        );
+    }
+    let posed = scene.pose_positions(&pose).unwrap();
+    for (rest, posed) in scene.rest_positions().iter().zip(&posed) {
+        for (p, q) in rest.iter().zip(posed) {
+            let want = moved([p.x, p.y]);
+            assert!(
+                (q.coords - want).norm() < 1e-9,
+                "{p:?} went to {q:?}, not {want:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bending_one_joint_bends_the_limb_smoothly() {
+    let (layers, handles) = character();
+    let doc = rig(&layers, &handles, &BuildOptions::default());
+    let scene = scene(&layers, doc.clone());
+    let mut pose = Pose::default();
+    pose.bones.insert(
+        "arm_lower_l".into(),
+        BonePose {
+            rotate: 60.0,
+            ..Default::default()
+        },
+    );
+    let posed = scene.pose_positions(&pose).unwrap();
+    let elbow = Point::new(332.0, 282.0);
+    for (part, positions) in doc.parts.iter().zip(&posed) {
+        if !part.name.starts_with("arm_") || !part.name.ends_with("_l") {
+            continue;
+        }
+        // No triangle of the arm turns inside out.
+        for t in &part.mesh.triangles {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            assert!(
+                triangle_area2(a, b, c) > 0.0,
+                "{}: triangle {t:?} inverted",
+                part.name
+            );
+        }
+        // Near the elbow the two bones blend; far from it, each vertex follows one bone.
+        let weights = part.weights.as_ref().unwrap();
+        let blended = part
+            .mesh
+            .vertices
+            .iter()
+            .zip(&weights.rows)
+            .filter(|(v, row)| {
+                (Point::new(v[0], v[1]) - elbow).norm() < 12.0
+                    && row.iter().filter(|e| e.1 > 0.05).count() >= 2
+            })
+            .count();
+        assert!(
+            blended > 0,
+            "{}: no blended vertices around the elbow",
+            part.name
+        );
+    }
+    // The hand turns about the elbow by the bone's rotation.
+    let lower = doc
+        .parts
+        .iter()
+        .position(|p| p.name == "arm_lower_l")
+        .unwrap();
+    let hand = Point::new(359.0, 345.0);
+    let (i, _) = doc.parts[lower]
+        .mesh
+        .vertices
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            (Point::new(a.1[0], a.1[1]) - hand)
+                .norm()
+                .total_cmp(&(Point::new(b.1[0], b.1[1]) - hand).norm())
+        })
+        .unwrap();
+    let rest = Point::new(
+        doc.parts[lower].mesh.vertices[i][0],
+        doc.parts[lower].mesh.vertices[i][1],
+    );
+    let want = elbow + rotation(60.0) * (rest - elbow);
+    assert!(
+        (posed[lower][i] - want).norm() < 1.0,
+        "hand at {:?}, expected {want:?}",
+        posed[lower][i]
+    );
+}
