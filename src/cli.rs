@@ -8,6 +8,7 @@ use crate::mesh::{MeshOptions, MeshStats};
 use crate::pipeline::{self, Scene};
 use crate::render;
 use crate::rig::{Handles, Pose};
+use crate::skin::Blend;
 use crate::trace::TraceOptions;
 use crate::weights::{WeightMethod, WeightOptions};
 use anyhow::{bail, Context, Result};
@@ -142,6 +143,9 @@ pub struct PoseArgs {
     /// The pose file (bone rotations, point moves, cage polygons).
     #[arg(long)]
     pub pose: Option<PathBuf>,
+    /// How handle transformations blend: linear (LBS) or dqs (dual quaternions).
+    #[arg(long, value_enum, default_value_t = Blend::Linear)]
+    pub blend: Blend,
 }
 
 #[derive(Args, Debug)]
@@ -177,7 +181,7 @@ fn rig(args: &RigArgs) -> Result<()> {
         None => Handles::default(),
     };
     let doc_dir = parent_dir(&args.output);
-    let (doc, stats) = pipeline::build_rig(&layers, doc_dir, &args.build.options(), &handles)?;
+    let (doc, stats) = rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
     let preview = match &args.preview {
         Some(_) => Some(preview_image(&doc, &layers)?),
         None => None,
@@ -190,6 +194,29 @@ fn rig(args: &RigArgs) -> Result<()> {
         report_mesh(&part.name, s);
     }
     Ok(())
+}
+
+/// [`pipeline::build_rig`] with a bar over the parts; indicatif draws nothing when stderr is
+/// not a terminal.
+fn rig_with_progress_bar(
+    layers: &[pipeline::Layer],
+    doc_dir: &Path,
+    options: &BuildOptions,
+    handles: &Handles,
+) -> Result<(RigDocument, Vec<MeshStats>)> {
+    let bar = indicatif::ProgressBar::new(layers.len() as u64);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("rigging {bar:30} {pos}/{len} parts {msg}")
+    {
+        bar.set_style(style);
+    }
+    let result =
+        pipeline::build_rig_with_progress(layers, doc_dir, options, handles, &mut |done, name| {
+            bar.set_position(done as u64);
+            bar.set_message(name.to_string());
+        });
+    bar.finish_and_clear();
+    Ok(result?)
 }
 
 fn report_mesh(name: &str, s: &MeshStats) {
@@ -231,7 +258,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
         Some(path) => read_json(path, "pose file")?,
         None => Pose::default(),
     };
-    let positions = scene.pose_positions(&pose)?;
+    let positions = scene.pose_positions_with(&pose, args.blend)?;
     let image = match &args.output {
         Some(_) => Some(render::rgba_from_pixmap(&scene.render(&positions)?)),
         None => None,

@@ -11,7 +11,7 @@ use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, W
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
 use crate::render::{self, MeshRenderer, RenderError};
 use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
-use crate::skin::{linear_blend, SkinWeights};
+use crate::skin::{skin, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
 use crate::weights::{self, WeightError};
 use image::RgbaImage;
@@ -138,6 +138,18 @@ pub fn build_rig(
     options: &BuildOptions,
     handles: &Handles,
 ) -> Result<(RigDocument, Vec<MeshStats>), PipelineError> {
+    build_rig_with_progress(layers, doc_dir, options, handles, &mut |_, _| {})
+}
+
+/// [`build_rig`], calling `progress(parts_done, part_name)` before each part and once at the
+/// end (with an empty name), for progress bars.
+pub fn build_rig_with_progress(
+    layers: &[Layer],
+    doc_dir: &Path,
+    options: &BuildOptions,
+    handles: &Handles,
+    progress: &mut dyn FnMut(usize, &str),
+) -> Result<(RigDocument, Vec<MeshStats>), PipelineError> {
     let first = layers.first().ok_or(PipelineError::NoImages)?;
     let canvas = [first.image.width(), first.image.height()];
     let canvas_area = canvas[0] as f64 * canvas[1] as f64;
@@ -149,7 +161,8 @@ pub fn build_rig(
     let geometry = handle_geometry(handles);
     let mut touched = vec![0usize; columns.len()];
     let mut stats = Vec::with_capacity(layers.len());
-    for layer in layers {
+    for (done, layer) in layers.iter().enumerate() {
+        progress(done, &layer.name);
         let outlines =
             trace::trace(&layer.image, &options.trace).map_err(|source| PipelineError::Trace {
                 path: layer.path.clone(),
@@ -202,6 +215,7 @@ pub fn build_rig(
             weights,
         });
     }
+    progress(layers.len(), "");
     if let Some(column) = touched.iter().position(|&n| n == 0) {
         return Err(PipelineError::HandleOutside(columns[column].clone()));
     }
@@ -359,6 +373,15 @@ impl Scene {
     /// Every part's vertex positions in `pose` (forward kinematics, then linear blend
     /// skinning). Parts without weights stay at rest.
     pub fn pose_positions(&self, pose: &Pose) -> Result<Vec<Vec<Point>>, PipelineError> {
+        self.pose_positions_with(pose, Blend::Linear)
+    }
+
+    /// [`Scene::pose_positions`] with a choice of blending.
+    pub fn pose_positions_with(
+        &self,
+        pose: &Pose,
+        blend: Blend,
+    ) -> Result<Vec<Vec<Point>>, PipelineError> {
         if !pose.ik.is_empty() {
             return Err(PipelineError::IkUnsupported);
         }
@@ -381,10 +404,11 @@ impl Scene {
                 part_transforms.push(transforms[j]);
             }
             let rest = positions.clone();
-            linear_blend(
+            skin(
                 &rest,
                 &SkinWeights::from_rows(&weights.rows),
                 &part_transforms,
+                blend,
                 positions,
             );
         }

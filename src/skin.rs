@@ -5,6 +5,12 @@
 //! Linear blend skinning: v' = Σ_j w_ij (A_j v + t_j), evaluated as v + Σ_j w_ij (A_j v + t_j − v)
 //! so that identity transforms give back the rest positions bit for bit, whatever rounding the
 //! weights' sum carries. Large meshes split across threads.
+//!
+//! Dual-quaternion blending ([`dual_quaternion_blend`], Kavan, Collins, Žára & O'Sullivan 2008)
+//! avoids LBS's collapse at strongly rotated joints: each transform is split by polar
+//! decomposition into a rotation and a stretch; stretches blend linearly in the rest frame,
+//! rotations and translations blend as unit dual quaternions (in 2D: a half-angle unit complex
+//! number and a two-component dual part).
 
 use crate::geom::Point;
 use crate::rig::pose::Affine;
@@ -80,6 +86,142 @@ pub fn linear_blend(
     }
 }
 
+/// How handle transformations blend.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Blend {
+    /// Linear blend skinning: fast, exact for affine handles; joints thin when twisted far.
+    #[default]
+    Linear,
+    /// Dual-quaternion skinning: keeps limbs' thickness at strongly rotated joints.
+    Dqs,
+}
+
+/// Skins `rest` into `out` with the chosen blending.
+pub fn skin(
+    rest: &[Point],
+    weights: &SkinWeights,
+    transforms: &[Affine],
+    blend: Blend,
+    out: &mut [Point],
+) {
+    match blend {
+        Blend::Linear => linear_blend(rest, weights, transforms, out),
+        Blend::Dqs => dual_quaternion_blend(rest, weights, transforms, out),
+    }
+}
+
+/// A 2D rigid motion as a unit dual quaternion: rotation (cos φ/2, sin φ/2) about the canvas
+/// normal, dual part (dx, dy) = ½ t·q. Canvas angles φ follow the matrix convention of
+/// [`Affine::linear`] (y down).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct DualQuaternion2 {
+    c: f64,
+    s: f64,
+    dx: f64,
+    dy: f64,
+}
+
+/// Polar decomposition of a handle's transform: rotation angle (canvas matrix convention),
+/// the stretch left after the rotation (Rᵀ A), and the translation.
+fn split_rigid(t: &Affine) -> (f64, nalgebra::Matrix2<f64>, crate::geom::Vec2) {
+    let a = &t.linear;
+    let phi = (a[(1, 0)] - a[(0, 1)]).atan2(a[(0, 0)] + a[(1, 1)]);
+    let (sin, cos) = phi.sin_cos();
+    let r_transpose = nalgebra::Matrix2::new(cos, sin, -sin, cos);
+    (phi, r_transpose * a, t.translation)
+}
+
+impl DualQuaternion2 {
+    fn from_rotation_translation(phi: f64, t: crate::geom::Vec2) -> Self {
+        let (s, c) = (0.5 * phi).sin_cos();
+        DualQuaternion2 {
+            c,
+            s,
+            dx: 0.5 * (c * t.x + s * t.y),
+            dy: 0.5 * (c * t.y - s * t.x),
+        }
+    }
+
+    /// Applies the normalized blend to `p`.
+    fn apply_normalized(&self, p: Point) -> Point {
+        let n = self.c.hypot(self.s);
+        let (c, s, dx, dy) = (self.c / n, self.s / n, self.dx / n, self.dy / n);
+        let (cos, sin) = (c * c - s * s, 2.0 * c * s);
+        let t = crate::geom::Vec2::new(2.0 * (c * dx - s * dy), 2.0 * (s * dx + c * dy));
+        Point::new(cos * p.x - sin * p.y + t.x, sin * p.x + cos * p.y + t.y)
+    }
+}
+
+/// Dual-quaternion skinning of `rest` into `out` (same length).
+pub fn dual_quaternion_blend(
+    rest: &[Point],
+    weights: &SkinWeights,
+    transforms: &[Affine],
+    out: &mut [Point],
+) {
+    let parts: Vec<(DualQuaternion2, nalgebra::Matrix2<f64>)> = transforms
+        .iter()
+        .map(|t| {
+            let (phi, stretch, translation) = split_rigid(t);
+            (
+                DualQuaternion2::from_rotation_translation(phi, translation),
+                stretch,
+            )
+        })
+        .collect();
+    let blend = |(i, (p, o)): (usize, (&Point, &mut Point))| {
+        let mut pivot: Option<DualQuaternion2> = None;
+        let mut sum = DualQuaternion2 {
+            c: 0.0,
+            s: 0.0,
+            dx: 0.0,
+            dy: 0.0,
+        };
+        let (mut sx, mut sy) = (0.0, 0.0);
+        for (h, w) in weights.row(i) {
+            let (q, stretch) = &parts[h];
+            // q and −q are the same motion: align every term with the first one.
+            let first = *pivot.get_or_insert(*q);
+            let w = if first.c * q.c + first.s * q.s < 0.0 {
+                -w
+            } else {
+                w
+            };
+            sum.c += w * q.c;
+            sum.s += w * q.s;
+            sum.dx += w * q.dx;
+            sum.dy += w * q.dy;
+            let w = w.abs();
+            sx += w * ((stretch[(0, 0)] - 1.0) * p.x + stretch[(0, 1)] * p.y);
+            sy += w * (stretch[(1, 0)] * p.x + (stretch[(1, 1)] - 1.0) * p.y);
+        }
+        *o = if sum.c == 0.0 && sum.s == 0.0 {
+            *p
+        } else {
+            sum.apply_normalized(Point::new(p.x + sx, p.y + sy))
+        };
+    };
+    if rest.len() >= PARALLEL_MIN_VERTICES {
+        rest.par_iter()
+            .zip(out.par_iter_mut())
+            .enumerate()
+            .for_each(blend);
+    } else {
+        rest.iter().zip(out.iter_mut()).enumerate().for_each(blend);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,5 +254,46 @@ mod tests {
         for (p, q) in rest.iter().zip(&out) {
             assert!((rigid.apply(*p) - q).norm() < 1e-12);
         }
+        dual_quaternion_blend(&rest, &weights, &[rigid, rigid], &mut out);
+        for (p, q) in rest.iter().zip(&out) {
+            assert!((rigid.apply(*p) - q).norm() < 1e-9);
+        }
+        dual_quaternion_blend(
+            &rest,
+            &weights,
+            &[Affine::identity(), Affine::identity()],
+            &mut out,
+        );
+        assert_eq!(out, rest);
+    }
+
+    #[test]
+    fn dual_quaternions_keep_volume_where_linear_blending_collapses() {
+        // A vertex half-way between two handles, one turned by 180°: LBS collapses it onto the
+        // pivot, DQS turns it by 90° at its full distance.
+        let rest = [Point::new(10.0, 0.0)];
+        let weights = SkinWeights::from_rows(&[vec![(0, 0.5), (1, 0.5)]]);
+        let turn = Affine {
+            linear: rotation(180.0),
+            translation: Vec2::zeros(),
+        };
+        let mut out = [Point::origin()];
+        linear_blend(&rest, &weights, &[Affine::identity(), turn], &mut out);
+        assert!(out[0].coords.norm() < 1e-9);
+        dual_quaternion_blend(&rest, &weights, &[Affine::identity(), turn], &mut out);
+        assert!((out[0].coords.norm() - 10.0).abs() < 1e-9, "{:?}", out[0]);
+    }
+
+    #[test]
+    fn dual_quaternions_carry_scale() {
+        let rest = [Point::new(3.0, 4.0)];
+        let weights = SkinWeights::from_rows(&[vec![(0, 1.0)]]);
+        let t = Affine {
+            linear: rotation(30.0) * nalgebra::Matrix2::new(2.0, 0.0, 0.0, 0.5),
+            translation: Vec2::new(1.0, 2.0),
+        };
+        let mut out = [Point::origin()];
+        dual_quaternion_blend(&rest, &weights, &[t], &mut out);
+        assert!((out[0] - t.apply(rest[0])).norm() < 1e-9);
     }
 }
