@@ -4,8 +4,8 @@
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
 use crate::io::{self, BuildOptions, RigDocument};
-use crate::mesh::{MeshOptions, MeshStats};
-use crate::pipeline::{self, Scene};
+use crate::mesh::MeshOptions;
+use crate::pipeline::{self, PartReport, Scene};
 use crate::render;
 use crate::rig::{Handles, Pose};
 use crate::skin::Blend;
@@ -191,7 +191,7 @@ fn rig(args: &RigArgs) -> Result<()> {
         io::save_png(path, &image)?;
     }
     for (part, s) in doc.parts.iter().zip(&stats) {
-        report_mesh(&part.name, s);
+        report_part(&part.name, s);
     }
     Ok(())
 }
@@ -203,7 +203,7 @@ fn rig_with_progress_bar(
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
-) -> Result<(RigDocument, Vec<MeshStats>)> {
+) -> Result<(RigDocument, Vec<PartReport>)> {
     let bar = indicatif::ProgressBar::new(layers.len() as u64);
     if let Ok(style) =
         indicatif::ProgressStyle::with_template("rigging {bar:30} {pos}/{len} parts {msg}")
@@ -219,11 +219,24 @@ fn rig_with_progress_bar(
     Ok(result?)
 }
 
-fn report_mesh(name: &str, s: &MeshStats) {
+fn report_part(name: &str, r: &PartReport) {
+    let s = &r.mesh;
     println!(
         "{name}: {} vertices, {} triangles, smallest angle {:.1}°",
         s.vertices, s.triangles, s.min_angle_deg
     );
+    if !r.bound_to_nearest.is_empty() {
+        println!(
+            "  pieces no handle touches follow the nearest handle: {}",
+            r.bound_to_nearest.join(", ")
+        );
+    }
+    if !r.unconverged.is_empty() {
+        eprintln!(
+            "sinew: warning: part '{name}': the weights of {} stopped at the solver's iteration limit (accurate to about 1e-3)",
+            r.unconverged.join(", ")
+        );
+    }
 }
 
 /// The rest pose on white with every part's wireframe on top.
@@ -345,9 +358,9 @@ fn demo(args: &DemoArgs) -> Result<()> {
     let preview_path = args.output.join("mesh.png");
     io::save_png(&preview_path, &preview_image(&doc, &layers)?)?;
 
-    let (v, t_count): (usize, usize) = stats
-        .iter()
-        .fold((0, 0), |a, s| (a.0 + s.vertices, a.1 + s.triangles));
+    let (v, t_count): (usize, usize) = stats.iter().fold((0, 0), |a, s| {
+        (a.0 + s.mesh.vertices, a.1 + s.mesh.triangles)
+    });
     println!(
         "sinew demo: {} parts, {v} vertices, {t_count} triangles",
         doc.parts.len()

@@ -101,7 +101,7 @@ pub struct Mesh {
 }
 
 /// Counts and quality of a mesh, for reports.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct MeshStats {
     pub vertices: usize,
     pub triangles: usize,

@@ -81,6 +81,16 @@ pub enum PipelineError {
     Canvas([u32; 2]),
 }
 
+/// What building one part found, for the report a person reads.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PartReport {
+    pub mesh: MeshStats,
+    /// Handles whose bounded weights stopped at the iteration limit (accurate to about 1e-3).
+    pub unconverged: Vec<String>,
+    /// Handles that pieces no handle touches were bound to rigidly.
+    pub bound_to_nearest: Vec<String>,
+}
+
 /// Images narrower or lower than this (px) are too small to trace and rig.
 pub const MIN_SPRITE_SIDE_PX: u32 = 4;
 
@@ -137,7 +147,7 @@ pub fn build_rig(
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
-) -> Result<(RigDocument, Vec<MeshStats>), PipelineError> {
+) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     build_rig_with_progress(layers, doc_dir, options, handles, &mut |_, _| {})
 }
 
@@ -149,7 +159,7 @@ pub fn build_rig_with_progress(
     options: &BuildOptions,
     handles: &Handles,
     progress: &mut dyn FnMut(usize, &str),
-) -> Result<(RigDocument, Vec<MeshStats>), PipelineError> {
+) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     let first = layers.first().ok_or(PipelineError::NoImages)?;
     let canvas = [first.image.width(), first.image.height()];
     let canvas_area = canvas[0] as f64 * canvas[1] as f64;
@@ -175,6 +185,7 @@ pub fn build_rig_with_progress(
                 min_area_px2,
             });
         }
+        let mut notes = PartReport::default();
         let mesh_error = |source| PipelineError::Mesh {
             path: layer.path.clone(),
             source,
@@ -201,13 +212,19 @@ pub fn build_rig_with_progress(
             for (t, n) in touched.iter_mut().zip(&part.touched) {
                 *t += n;
             }
+            let name = |j: &usize| columns[*j].clone();
+            notes.unconverged = part.unconverged.iter().map(name).collect();
+            notes.bound_to_nearest = part.bound_to_nearest.iter().map(name).collect();
             let weights = WeightsDoc {
                 handles: columns.clone(),
                 rows: part.rows,
             };
             (embedded.shape_mesh().0, Some(weights))
         };
-        stats.push(mesh.stats());
+        stats.push(PartReport {
+            mesh: mesh.stats(),
+            ..notes
+        });
         doc.parts.push(PartDoc {
             name: layer.name.clone(),
             image: relative_path(doc_dir, &layer.path),

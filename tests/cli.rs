@@ -187,3 +187,73 @@ fn bad_rig_documents_fail_cleanly_without_output() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn bad_handles_fail_cleanly_without_output() {
+    let dir = scratch("bad-handles");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let out = dir.join("rig.json");
+    let write = |name: &str, json: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, json).unwrap();
+        p
+    };
+    let cyclic = write(
+        "cyclic.json",
+        r#"{"bones": [{"name": "a", "parent": "b", "head": [10, 10], "tail": [20, 20]}, {"name": "b", "parent": "a", "head": [20, 20], "tail": [30, 30]}]}"#,
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&cyclic), "-o", s(&out)],
+        "cyclic",
+    );
+    let unknown = write(
+        "unknown.json",
+        r#"{"bones": [{"name": "a", "parent": "zz", "head": [10, 10], "tail": [20, 20]}]}"#,
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&unknown), "-o", s(&out)],
+        "unknown parent 'zz'",
+    );
+    let outside = write(
+        "outside.json",
+        r#"{"bones": [{"name": "a", "head": [20, 30], "tail": [40, 30]}], "points": [{"name": "far", "at": [500, 500]}]}"#,
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&outside), "-o", s(&out)],
+        "'far' lies outside every part",
+    );
+    let nan = write(
+        "nan.json",
+        r#"{"points": [{"name": "p", "at": [1e999, 3]}]}"#,
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&nan), "-o", s(&out)],
+        "nan.json",
+    );
+    let typo = write("typo.json", r#"{"bone": []}"#);
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&typo), "-o", s(&out)],
+        "typo.json",
+    );
+    assert!(!out.exists());
+
+    let good = write(
+        "good.json",
+        r#"{"bones": [{"name": "a", "head": [20, 30], "tail": [40, 30]}]}"#,
+    );
+    assert!(
+        sinew(&["rig", s(&sprite), "--handles", s(&good), "-o", s(&out)])
+            .status
+            .success()
+    );
+    let pose = write("pose.json", r#"{"bones": {"nope": {"rotate": 10}}}"#);
+    let png = dir.join("posed.png");
+    assert_bad_input(
+        &["pose", s(&out), "--pose", s(&pose), "-o", s(&png)],
+        "bone 'nope'",
+    );
+    let ik = write("ik.json", r#"{"ik": [{"at": [30, 30], "to": [35, 30]}]}"#);
+    assert_bad_input(&["pose", s(&out), "--pose", s(&ik), "-o", s(&png)], "IK");
+    assert!(!png.exists());
+}

@@ -69,6 +69,8 @@ pub struct PartWeights {
     pub touched: Vec<usize>,
     /// Columns that pieces without a handle were bound to rigidly.
     pub bound_to_nearest: Vec<usize>,
+    /// Columns whose bounded solve stopped at its iteration limit before its tolerances.
+    pub unconverged: Vec<usize>,
 }
 
 /// What went wrong computing weights.
@@ -193,8 +195,13 @@ pub fn part_weights(
             Domain::new(&lifted, &mesh.triangles)
         }
     };
+    let mut unconverged = Vec::new();
     let mut w = match options.method {
-        WeightMethod::Bbw => bounded_biharmonic_weights(&domain, &bc, &options.bbw)?.0,
+        WeightMethod::Bbw => {
+            let (w, report) = bounded_biharmonic_weights(&domain, &bc, &options.bbw)?;
+            unconverged = report.unconverged;
+            w
+        }
         WeightMethod::Harmonic => harmonic_weights(&domain, &bc)?,
         WeightMethod::Biharmonic => biharmonic_weights(&domain, &bc)?,
     };
@@ -209,6 +216,7 @@ pub fn part_weights(
         rows,
         touched,
         bound_to_nearest,
+        unconverged,
     })
 }
 

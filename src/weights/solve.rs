@@ -8,16 +8,17 @@
 //! - Biharmonic: minimize wᵀ K M⁻¹ K w per handle (a bi-Laplace solve), no bounds.
 //! - Bounded biharmonic (Jacobson, Baran, Popović & Sorkine 2011, "Bounded Biharmonic Weights
 //!   for Real-Time Deformation"): the biharmonic energy subject to 0 ≤ w ≤ 1, per handle, then
-//!   rows normalized to sum to one. Solved by a primal–dual active-set method (Hintermüller, Ito
-//!   & Kunisch 2002) warm-started from the unconstrained biharmonic solution: each iteration
-//!   clamps the vertices that violate a bound or whose multiplier says they stay clamped, and
-//!   solves the bi-Laplace system on the rest. Handles solve in parallel (rayon).
+//!   rows normalized to sum to one. Solved by a primal–dual interior-point method (Mehrotra's
+//!   predictor–corrector) started from the unconstrained biharmonic solution; its Newton
+//!   systems all share one sparsity pattern, analyzed once. (A primal–dual active-set method
+//!   was tried first: on the bi-Laplacian, which is not an M-matrix, it cycled.) Handles solve
+//!   in parallel (rayon).
 //!
 //! Every vertex of every connected piece of the domain must be reached by some handle vertex;
 //! otherwise the systems are singular and the solve reports [`SolveError::Unreachable`].
 
 use super::laplacian::{cotangent_stiffness, squared_edge_lengths, voronoi_mass};
-use super::sparse::{mat_vec, sandwich_diagonal, SolveError, SubmatrixCholesky};
+use super::sparse::{mat_vec, sandwich_diagonal, SharedPattern, SolveError, SubmatrixCholesky};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use sprs::CsMat;
@@ -141,22 +142,30 @@ impl WeightMatrix {
 /// A row summing to less than this has no meaningful direction to normalize.
 pub const EMPTY_ROW_SUM: f64 = 1e-9;
 
-/// Parameters of the bounded biharmonic solve.
+/// Parameters of the bounded biharmonic solve (a primal–dual interior-point method).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BbwOptions {
-    /// Active-set iterations per handle before giving up on exact convergence (the result is
-    /// then clamped to the bounds). Default 40.
-    pub max_active_set_iterations: usize,
-    /// A weight counts as violating a bound when it is beyond it by more than this. Default 1e-10.
-    pub bound_tolerance: f64,
+    /// Interior-point iterations per handle before giving up (the iterate is then clamped to
+    /// the bounds and the handle reported as unconverged). Default 50.
+    pub max_iterations: usize,
+    /// Converged when the mean complementarity (x·z + (1−x)·w) / 2n falls below this, in the
+    /// problem scaled so that the linear term's largest entry is 1. Default 1e-13.
+    pub complementarity_tolerance: f64,
+    /// … and the scaled gradient residual ‖Hx + g − z + w‖∞ below this. Default 1e-10.
+    pub residual_tolerance: f64,
+    /// Weights this close to a bound are snapped onto it, so clamped regions are exactly 0 (or
+    /// 1). Default 1e-8.
+    pub snap_to_bound: f64,
 }
 
 impl Default for BbwOptions {
     fn default() -> Self {
         BbwOptions {
-            max_active_set_iterations: 40,
-            bound_tolerance: 1e-10,
+            max_iterations: 50,
+            complementarity_tolerance: 1e-13,
+            residual_tolerance: 1e-10,
+            snap_to_bound: 1e-8,
         }
     }
 }
@@ -253,6 +262,12 @@ pub fn biharmonic_weights(
 }
 
 /// Bounded biharmonic weights (not yet normalized: see [`WeightMatrix::normalize_rows`]).
+///
+/// Per handle, the box-constrained QP min ½ xᵀ H x + gᵀ x, 0 ≤ x ≤ 1 over the free vertices
+/// (H = Q[F, F], g = Q[F, fixed] · fixed values) is solved by Mehrotra's predictor–corrector
+/// interior-point method. Every Newton system is H plus a positive diagonal, so one symbolic
+/// Cholesky analysis serves all handles and iterations; each iteration is one numeric
+/// factorization and two solves.
 pub fn bounded_biharmonic_weights(
     domain: &Domain,
     bc: &BoundaryConditions,
@@ -260,11 +275,28 @@ pub fn bounded_biharmonic_weights(
 ) -> Result<(WeightMatrix, BbwReport), SolveError> {
     let q = domain.bilaplacian();
     let n = q.rows();
+    check_reachable(&q, bc)?;
     let free = free_vertices(n, bc);
-    let start = solve_quadratic(&q, bc)?;
+    let pattern = SharedPattern::new(&q, &free)?;
+    let unconstrained = pattern.factor(&pattern.values)?;
     let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = (0..bc.handle_count)
         .into_par_iter()
-        .map(|j| bounded_column(&q, &free, start.column(j), options))
+        .map(|j| {
+            let mut w = fixed_column(n, bc, j);
+            if w.iter().all(|&x| x == 0.0) {
+                // Zero boundary values: zero is optimal and feasible.
+                return Ok((w, 0, true));
+            }
+            let qw = mat_vec(&q, &w);
+            let g: Vec<f64> = free.iter().map(|&i| qw[i]).collect();
+            let mut start: Vec<f64> = g.iter().map(|v| -v).collect();
+            unconstrained.solve_in_place(&mut start);
+            let (x, iterations, converged) = box_qp_interior_point(&pattern, &g, &start, options)?;
+            for (k, &i) in free.iter().enumerate() {
+                w[i] = x[k];
+            }
+            Ok((w, iterations, converged))
+        })
         .collect();
     let mut columns = Vec::with_capacity(bc.handle_count);
     let mut report = BbwReport::default();
@@ -279,80 +311,140 @@ pub fn bounded_biharmonic_weights(
     Ok((WeightMatrix::from_columns(n, &columns), report))
 }
 
-/// Which bound, if any, a free vertex is clamped to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Clamp {
-    None,
-    Lower,
-    Upper,
+/// Keeps interior-point iterates this far (relatively) from the bounds.
+const FRACTION_TO_BOUNDARY: f64 = 0.995;
+/// The starting point is the unconstrained solution pushed this far inside the box.
+const START_MARGIN: f64 = 0.05;
+
+/// Largest step α ≤ 1 keeping v + α·dv > 0 for every component, times the fraction-to-boundary.
+fn max_step(v: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let limit = v
+        .filter(|&(_, d)| d < 0.0)
+        .map(|(x, d)| -x / d)
+        .fold(f64::INFINITY, f64::min);
+    (FRACTION_TO_BOUNDARY * limit).min(1.0)
 }
 
-/// One handle's bounded solve by primal–dual active sets, from the unconstrained solution `w`
-/// (which already holds the fixed values). Returns the column, the iterations and whether the
-/// active set settled.
-fn bounded_column(
-    q: &CsMat<f64>,
-    free: &[usize],
-    mut w: Vec<f64>,
+/// The largest step along (dx, dz, dw) that keeps x, t = 1 − x, z and w positive.
+fn step_length(
+    x: &[f64],
+    t: &[f64],
+    z: &[f64],
+    w: &[f64],
+    dx: &[f64],
+    dz: &[f64],
+    dw: &[f64],
+) -> f64 {
+    let n = x.len();
+    max_step((0..n).map(|i| (x[i], dx[i])))
+        .min(max_step((0..n).map(|i| (t[i], -dx[i]))))
+        .min(max_step((0..n).map(|i| (z[i], dz[i]))))
+        .min(max_step((0..n).map(|i| (w[i], dw[i]))))
+}
+
+/// min ½ xᵀ H x + gᵀ x subject to 0 ≤ x ≤ 1, H given by `pattern` (SPD). Returns x, the
+/// iterations taken and whether the tolerances were met.
+fn box_qp_interior_point(
+    pattern: &SharedPattern,
+    g: &[f64],
+    start: &[f64],
     options: &BbwOptions,
 ) -> Result<(Vec<f64>, usize, bool), SolveError> {
-    let tol = options.bound_tolerance;
-    let mut clamp = vec![Clamp::None; w.len()];
-    let mut gradient = mat_vec(q, &w);
-    for iteration in 1..=options.max_active_set_iterations {
-        // A clamped vertex stays clamped while its multiplier (the gradient) pushes it against
-        // the bound; a free vertex becomes clamped when it crosses a bound.
-        let mut changed = false;
-        for &i in free {
-            let next = match clamp[i] {
-                Clamp::Lower if gradient[i] > 0.0 => Clamp::Lower,
-                Clamp::Upper if gradient[i] < 0.0 => Clamp::Upper,
-                Clamp::Lower | Clamp::Upper => Clamp::None,
-                Clamp::None if w[i] < -tol => Clamp::Lower,
-                Clamp::None if w[i] > 1.0 + tol => Clamp::Upper,
-                Clamp::None => Clamp::None,
-            };
-            changed |= next != clamp[i];
-            clamp[i] = next;
+    let n = g.len();
+    // Scale so the linear term's largest entry is 1: gradients and multipliers are then of
+    // order one, and the absolute tolerances mean the same on any mesh and canvas size.
+    let g_max = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if g_max == 0.0 {
+        // H is positive definite: with no pull from the fixed values, zero is the optimum.
+        return Ok((vec![0.0; n], 0, true));
+    }
+    let scale = 1.0 / g_max;
+    let h: Vec<f64> = pattern.values.iter().map(|v| v * scale).collect();
+    let g: Vec<f64> = g.iter().map(|v| v * scale).collect();
+    let mut x: Vec<f64> = start
+        .iter()
+        .map(|v| v.clamp(START_MARGIN, 1.0 - START_MARGIN))
+        .collect();
+    // The upper slack t = 1 − x is carried on its own: computed as 1 − x it would round to
+    // zero for weights within 1e-16 of one.
+    let mut t: Vec<f64> = x.iter().map(|v| 1.0 - v).collect();
+    let mut z = vec![1.0; n];
+    let mut w = vec![1.0; n];
+    let mut values = h.clone();
+    let mut converged = false;
+    let mut iterations = 0;
+    while iterations < options.max_iterations {
+        let hx = pattern.mat_vec(&h, &x);
+        let gradient: Vec<f64> = hx.iter().zip(&g).map(|(a, b)| a + b).collect();
+        let residual = (0..n)
+            .map(|i| (gradient[i] - z[i] + w[i]).abs())
+            .fold(0.0, f64::max);
+        let mu = (0..n).map(|i| x[i] * z[i] + t[i] * w[i]).sum::<f64>() / (2 * n).max(1) as f64;
+        if mu < options.complementarity_tolerance && residual < options.residual_tolerance {
+            converged = true;
+            break;
         }
-        if !changed {
-            clamp_to_bounds(&mut w, free);
-            return Ok((w, iteration - 1, true));
+        values.copy_from_slice(&h);
+        for i in 0..n {
+            values[pattern.diagonal[i]] += z[i] / x[i] + w[i] / t[i];
         }
-        for &i in free {
-            match clamp[i] {
-                Clamp::Lower => w[i] = 0.0,
-                Clamp::Upper => w[i] = 1.0,
-                Clamp::None => {}
-            }
-        }
-        let inactive: Vec<usize> = free
-            .iter()
-            .copied()
-            .filter(|&i| clamp[i] == Clamp::None)
+        // Near the end the barrier terms span many orders of magnitude; if the factorization
+        // breaks down there, the iterate is as good as this arithmetic allows.
+        let Ok(chol) = pattern.factor(&values) else {
+            break;
+        };
+        iterations += 1;
+        // Predictor: the pure Newton (affine-scaling) direction.
+        let mut dx_aff: Vec<f64> = gradient.iter().map(|v| -v).collect();
+        chol.solve_in_place(&mut dx_aff);
+        let dz_aff: Vec<f64> = (0..n).map(|i| -z[i] - z[i] / x[i] * dx_aff[i]).collect();
+        let dw_aff: Vec<f64> = (0..n).map(|i| -w[i] + w[i] / t[i] * dx_aff[i]).collect();
+        let alpha_aff = step_length(&x, &t, &z, &w, &dx_aff, &dz_aff, &dw_aff);
+        let mu_aff = (0..n)
+            .map(|i| {
+                let (xa, ta) = (x[i] + alpha_aff * dx_aff[i], t[i] - alpha_aff * dx_aff[i]);
+                xa * (z[i] + alpha_aff * dz_aff[i]) + ta * (w[i] + alpha_aff * dw_aff[i])
+            })
+            .sum::<f64>()
+            / (2 * n) as f64;
+        let sigma_mu = (mu_aff / mu).powi(3) * mu;
+        // Corrector: centering plus the second-order term of the complementarity.
+        let mut dx: Vec<f64> = (0..n)
+            .map(|i| {
+                -gradient[i] + sigma_mu / x[i]
+                    - sigma_mu / t[i]
+                    - dx_aff[i] * dz_aff[i] / x[i]
+                    - dx_aff[i] * dw_aff[i] / t[i]
+            })
             .collect();
-        if !inactive.is_empty() {
-            let chol = SubmatrixCholesky::new(q, &inactive)?;
-            for &i in &inactive {
-                w[i] = 0.0;
-            }
-            let qw = mat_vec(q, &w);
-            let mut rhs: Vec<f64> = inactive.iter().map(|&i| -qw[i]).collect();
-            chol.solve_in_place(&mut rhs);
-            for (k, &i) in inactive.iter().enumerate() {
-                w[i] = rhs[k];
-            }
+        chol.solve_in_place(&mut dx);
+        let dz: Vec<f64> = (0..n)
+            .map(|i| (sigma_mu - x[i] * z[i] - dx_aff[i] * dz_aff[i] - z[i] * dx[i]) / x[i])
+            .collect();
+        let dw: Vec<f64> = (0..n)
+            .map(|i| (sigma_mu - t[i] * w[i] + dx_aff[i] * dw_aff[i] + w[i] * dx[i]) / t[i])
+            .collect();
+        let alpha = step_length(&x, &t, &z, &w, &dx, &dz, &dw);
+        if !alpha.is_finite() || alpha <= 0.0 {
+            break;
         }
-        gradient = mat_vec(q, &w);
+        for i in 0..n {
+            x[i] += alpha * dx[i];
+            t[i] -= alpha * dx[i];
+            z[i] += alpha * dz[i];
+            w[i] += alpha * dw[i];
+        }
     }
-    clamp_to_bounds(&mut w, free);
-    Ok((w, options.max_active_set_iterations, false))
-}
-
-fn clamp_to_bounds(w: &mut [f64], free: &[usize]) {
-    for &i in free {
-        w[i] = w[i].clamp(0.0, 1.0);
+    for v in &mut x {
+        *v = if *v < options.snap_to_bound {
+            0.0
+        } else if *v > 1.0 - options.snap_to_bound {
+            1.0
+        } else {
+            *v
+        };
     }
+    Ok((x, iterations, converged))
 }
 
 #[cfg(test)]

@@ -75,6 +75,121 @@ impl SubmatrixCholesky {
     }
 }
 
+/// The lower triangle of a symmetric principal sub-matrix A[keep, keep] in compressed columns,
+/// with its symbolic Cholesky analysis (fill-reducing ordering, elimination tree) done once, so
+/// that matrices with the same pattern and other values (A + a diagonal, as interior-point
+/// iterations produce) factor numerically only.
+pub struct SharedPattern {
+    symbolic: faer::sparse::SymbolicSparseColMat<usize>,
+    llt_symbolic: faer::sparse::linalg::solvers::SymbolicLlt<usize>,
+    /// A's values in the pattern's order.
+    pub values: Vec<f64>,
+    /// Where each column's diagonal entry sits in `values`.
+    pub diagonal: Vec<usize>,
+}
+
+impl SharedPattern {
+    /// Analyzes A[keep, keep] (A symmetric; every kept diagonal entry must be stored).
+    pub fn new(a: &CsMat<f64>, keep: &[usize]) -> Result<Self, SolveError> {
+        let pos = positions(a.rows(), keep);
+        let len = keep.len();
+        let mut col_ptr = Vec::with_capacity(len + 1);
+        let mut row_idx = Vec::new();
+        let mut values = Vec::new();
+        let mut diagonal = Vec::with_capacity(len);
+        col_ptr.push(0);
+        for (k, &i) in keep.iter().enumerate() {
+            // Column k of the lower triangle = row k's entries at or below the diagonal.
+            let mut column: Vec<(usize, f64)> = a
+                .outer_view(i)
+                .map(|row| {
+                    row.iter()
+                        .filter_map(|(j, &v)| {
+                            (pos[j] != usize::MAX && pos[j] >= k).then_some((pos[j], v))
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            column.sort_unstable_by_key(|e| e.0);
+            if column.first().map(|e| e.0) != Some(k) {
+                column.insert(0, (k, 0.0));
+            }
+            diagonal.push(row_idx.len());
+            for (r, v) in column {
+                row_idx.push(r);
+                values.push(v);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let symbolic =
+            faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
+        let llt_symbolic =
+            faer::sparse::linalg::solvers::SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower)
+                .map_err(|e| SolveError::Assembly(format!("{e:?}")))?;
+        Ok(SharedPattern {
+            symbolic,
+            llt_symbolic,
+            values,
+            diagonal,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.diagonal.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.diagonal.is_empty()
+    }
+
+    /// Factors the matrix with this pattern and the given values (numeric phase only).
+    pub fn factor(&self, values: &[f64]) -> Result<PatternCholesky, SolveError> {
+        let mat = faer::sparse::SparseColMatRef::new(self.symbolic.as_ref(), values);
+        let llt = faer::sparse::linalg::solvers::Llt::try_new_with_symbolic(
+            self.llt_symbolic.clone(),
+            mat,
+            Side::Lower,
+        )
+        .map_err(|_| SolveError::NotPositiveDefinite)?;
+        Ok(PatternCholesky {
+            llt,
+            len: self.len(),
+        })
+    }
+
+    /// y = A x with A given by this pattern and `values` (symmetric: lower triangle stored).
+    pub fn mat_vec(&self, values: &[f64], x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; x.len()];
+        let (col_ptr, row_idx) = (self.symbolic.col_ptr(), self.symbolic.row_idx());
+        for c in 0..self.len() {
+            for k in col_ptr[c]..col_ptr[c + 1] {
+                let (r, v) = (row_idx[k], values[k]);
+                y[r] += v * x[c];
+                if r != c {
+                    y[c] += v * x[r];
+                }
+            }
+        }
+        y
+    }
+}
+
+/// A numeric Cholesky factorization over a [`SharedPattern`].
+pub struct PatternCholesky {
+    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
+    len: usize,
+}
+
+impl PatternCholesky {
+    /// Solves in place for one right-hand side.
+    pub fn solve_in_place(&self, b: &mut [f64]) {
+        if self.len > 0 {
+            self.llt
+                .solve_in_place(MatMut::from_column_major_slice_mut(b, self.len, 1));
+        }
+    }
+}
+
 /// y = A x for a CSR matrix.
 pub fn mat_vec(a: &CsMat<f64>, x: &[f64]) -> Vec<f64> {
     a.outer_iterator()
