@@ -179,16 +179,7 @@ pub fn triangulate(
     canvas_area_px2: f64,
     options: &MeshOptions,
 ) -> Result<Mesh, MeshError> {
-    options.validate()?;
-    if !(canvas_area_px2.is_finite() && canvas_area_px2 > 0.0) {
-        return Err(MeshError::InvalidOptions(
-            "the canvas area must be positive".into(),
-        ));
-    }
-    let rings = outline_rings(outlines);
-    if rings.is_empty() {
-        return Err(MeshError::Empty);
-    }
+    let rings = checked_rings(outlines, canvas_area_px2, options)?;
     let (points, edges) = constraint_graph(&rings)?;
     let outline_points = points.len();
     let mut conflict = false;
@@ -274,16 +265,7 @@ pub fn triangulate_with_handles(
     canvas_area_px2: f64,
     options: &MeshOptions,
 ) -> Result<EmbeddedMesh, MeshError> {
-    options.validate()?;
-    if !(canvas_area_px2.is_finite() && canvas_area_px2 > 0.0) {
-        return Err(MeshError::InvalidOptions(
-            "the canvas area must be positive".into(),
-        ));
-    }
-    let rings = outline_rings(outlines);
-    if rings.is_empty() {
-        return Err(MeshError::Empty);
-    }
+    let rings = checked_rings(outlines, canvas_area_px2, options)?;
     let all_finite = geometry
         .points
         .iter()
@@ -373,6 +355,25 @@ pub fn triangulate_with_handles(
         triangles,
     });
     Ok(EmbeddedMesh { domain, in_shape })
+}
+
+/// Checks the options and the canvas area, and returns the outline rings (at least one).
+fn checked_rings<'a>(
+    outlines: &'a [Outline],
+    canvas_area_px2: f64,
+    options: &MeshOptions,
+) -> Result<Vec<&'a [Point]>, MeshError> {
+    options.validate()?;
+    if !(canvas_area_px2.is_finite() && canvas_area_px2 > 0.0) {
+        return Err(MeshError::InvalidOptions(
+            "the canvas area must be positive".into(),
+        ));
+    }
+    let rings = outline_rings(outlines);
+    if rings.is_empty() {
+        return Err(MeshError::Empty);
+    }
+    Ok(rings)
 }
 
 /// Every outer ring and hole of the outlines, in order.

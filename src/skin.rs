@@ -57,6 +57,21 @@ impl SkinWeights {
     }
 }
 
+/// Runs `f` on every (index, (rest, out)) pair, across threads for large meshes.
+fn for_each_vertex<F>(rest: &[Point], out: &mut [Point], f: F)
+where
+    F: Fn((usize, (&Point, &mut Point))) + Sync + Send,
+{
+    if rest.len() >= PARALLEL_MIN_VERTICES {
+        rest.par_iter()
+            .zip(out.par_iter_mut())
+            .enumerate()
+            .for_each(f);
+    } else {
+        rest.iter().zip(out.iter_mut()).enumerate().for_each(f);
+    }
+}
+
 /// Below this many vertices, threads cost more than they save.
 const PARALLEL_MIN_VERTICES: usize = 8192;
 
@@ -76,14 +91,7 @@ pub fn linear_blend(
         }
         *o = Point::new(p.x + dx, p.y + dy);
     };
-    if rest.len() >= PARALLEL_MIN_VERTICES {
-        rest.par_iter()
-            .zip(out.par_iter_mut())
-            .enumerate()
-            .for_each(blend);
-    } else {
-        rest.iter().zip(out.iter_mut()).enumerate().for_each(blend);
-    }
+    for_each_vertex(rest, out, blend);
 }
 
 /// How handle transformations blend.
@@ -212,14 +220,7 @@ pub fn dual_quaternion_blend(
             sum.apply_normalized(Point::new(p.x + sx, p.y + sy))
         };
     };
-    if rest.len() >= PARALLEL_MIN_VERTICES {
-        rest.par_iter()
-            .zip(out.par_iter_mut())
-            .enumerate()
-            .for_each(blend);
-    } else {
-        rest.iter().zip(out.iter_mut()).enumerate().for_each(blend);
-    }
+    for_each_vertex(rest, out, blend);
 }
 
 #[cfg(test)]

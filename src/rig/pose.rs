@@ -182,14 +182,11 @@ fn finite(values: &[f64]) -> bool {
 
 /// Every bone's posed frame in canvas coordinates (`world_from_bone`), in bone order.
 pub fn bone_world_frames(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
-    for name in pose.bones.keys() {
-        if !handles.bones.iter().any(|b| &b.name == name) {
-            return Err(PoseError::UnknownName {
-                kind: "bone",
-                name: name.clone(),
-            });
-        }
-    }
+    check_names(
+        "bone",
+        pose.bones.keys(),
+        handles.bones.iter().map(|b| &b.name),
+    )?;
     let index: BTreeMap<&str, usize> = handles
         .bones
         .iter()
@@ -251,6 +248,23 @@ pub fn bone_world_frames(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         .collect()
 }
 
+/// Fails on the first name the pose uses that the rig lacks.
+fn check_names<'a>(
+    kind: &'static str,
+    posed: impl Iterator<Item = &'a String>,
+    known: impl Iterator<Item = &'a String> + Clone,
+) -> Result<(), PoseError> {
+    for name in posed {
+        if !known.clone().any(|k| k == name) {
+            return Err(PoseError::UnknownName {
+                kind,
+                name: name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Every bone's skinning transformation (rest canvas → posed canvas), in bone order.
 ///
 /// A bone left at its default local pose moves exactly as its parent (a root stays exactly
@@ -301,14 +315,11 @@ fn bone_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseEr
 /// unless IK moves them).
 pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
     let mut out = bone_transforms(handles, pose)?;
-    for name in pose.points.keys() {
-        if !handles.points.iter().any(|p| &p.name == name) {
-            return Err(PoseError::UnknownName {
-                kind: "point",
-                name: name.clone(),
-            });
-        }
-    }
+    check_names(
+        "point",
+        pose.points.keys(),
+        handles.points.iter().map(|p| &p.name),
+    )?;
     for point in &handles.points {
         let p = pose.points.get(&point.name).cloned().unwrap_or_default();
         if !finite(&[
@@ -329,14 +340,11 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
             translation: at - linear * at + Vec2::new(p.translate[0], p.translate[1]),
         });
     }
-    for name in pose.cages.keys() {
-        if !handles.cages.iter().any(|c| &c.name == name) {
-            return Err(PoseError::UnknownName {
-                kind: "cage",
-                name: name.clone(),
-            });
-        }
-    }
+    check_names(
+        "cage",
+        pose.cages.keys(),
+        handles.cages.iter().map(|c| &c.name),
+    )?;
     for cage in &handles.cages {
         match pose.cages.get(&cage.name) {
             Some(posed) => {
