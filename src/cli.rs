@@ -86,6 +86,9 @@ pub struct BuildArgs {
     /// Keep the K largest weights per vertex.
     #[arg(long, value_name = "K")]
     pub max_influences: Option<usize>,
+    /// Monotone bounded biharmonic weights: no spurious local extrema (slower).
+    #[arg(long)]
+    pub monotone: bool,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq)]
@@ -120,6 +123,7 @@ impl BuildArgs {
             method: self.weight_method,
             content_aware: self.content_aware,
             max_influences: self.max_influences,
+            monotone: self.monotone,
             ..WeightOptions::default()
         };
         BuildOptions {
@@ -143,7 +147,8 @@ pub struct PoseArgs {
     /// The pose file (bone rotations, point moves, cage polygons).
     #[arg(long)]
     pub pose: Option<PathBuf>,
-    /// How handle transformations blend: linear (LBS) or dqs (dual quaternions).
+    /// How handle transformations blend: linear (LBS), dqs (dual quaternions) or stretch
+    /// (LBS with stretchable bones).
     #[arg(long, value_enum, default_value_t = Blend::Linear)]
     pub blend: Blend,
 }

@@ -10,8 +10,9 @@ use crate::geom::Point;
 use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
 use crate::render::{self, MeshRenderer, RenderError};
+use crate::rig::pose::bone_stretches;
 use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
-use crate::skin::{skin, Blend, SkinWeights};
+use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
 use crate::weights::{self, WeightError};
 use image::RgbaImage;
@@ -403,6 +404,11 @@ impl Scene {
             return Err(PipelineError::IkUnsupported);
         }
         let transforms = handle_transforms(&self.doc.handles, pose)?;
+        // Bones come first among the columns, so bone i's stretch is column i's.
+        let stretches = match blend {
+            Blend::Stretch => bone_stretches(&self.doc.handles, pose)?,
+            Blend::Linear | Blend::Dqs => Vec::new(),
+        };
         let columns = handle_columns(&self.doc.handles);
         let mut out = self.rest_positions();
         for (part, positions) in self.doc.parts.iter().zip(out.iter_mut()) {
@@ -411,6 +417,7 @@ impl Scene {
             };
             // The document names its columns; map them onto this rig's transform order.
             let mut part_transforms = Vec::with_capacity(weights.handles.len());
+            let mut part_stretches = Vec::with_capacity(weights.handles.len());
             for name in &weights.handles {
                 let j = columns.iter().position(|c| c == name).ok_or_else(|| {
                     PipelineError::UnknownWeightHandle {
@@ -419,15 +426,22 @@ impl Scene {
                     }
                 })?;
                 part_transforms.push(transforms[j]);
+                part_stretches.push(stretches.get(j).copied().flatten());
             }
             let rest = positions.clone();
-            skin(
-                &rest,
-                &SkinWeights::from_rows(&weights.rows),
-                &part_transforms,
-                blend,
-                positions,
-            );
+            let skin_weights = SkinWeights::from_rows(&weights.rows);
+            match blend {
+                Blend::Stretch => stretchable_blend(
+                    &rest,
+                    &skin_weights,
+                    &part_transforms,
+                    &part_stretches,
+                    positions,
+                ),
+                Blend::Linear | Blend::Dqs => {
+                    skin(&rest, &skin_weights, &part_transforms, blend, positions)
+                }
+            }
         }
         Ok(out)
     }

@@ -13,7 +13,7 @@
 //! number and a two-component dual part).
 
 use crate::geom::Point;
-use crate::rig::pose::Affine;
+use crate::rig::pose::{Affine, BoneStretch};
 use rayon::prelude::*;
 
 /// Sparse weights in compressed rows: vertex i's influences are
@@ -94,6 +94,30 @@ pub fn linear_blend(
     for_each_vertex(rest, out, blend);
 }
 
+/// Linear blend skinning where some handles are stretchable bones: column j with
+/// `stretches[j] = Some(s)` contributes `s.rigid(v) + e_j(v) · s.stretch` (see
+/// [`BoneStretch`]) instead of its transform; the other columns blend as in [`linear_blend`].
+pub fn stretchable_blend(
+    rest: &[Point],
+    weights: &SkinWeights,
+    transforms: &[Affine],
+    stretches: &[Option<BoneStretch>],
+    out: &mut [Point],
+) {
+    let blend = |(i, (p, o)): (usize, (&Point, &mut Point))| {
+        let mut d = crate::geom::Vec2::zeros();
+        for (h, w) in weights.row(i) {
+            let moved = match stretches.get(h).copied().flatten() {
+                Some(s) => s.rigid.apply(*p) + s.stretch * s.endpoint_weight(*p),
+                None => transforms[h].apply(*p),
+            };
+            d += w * (moved - p);
+        }
+        *o = p + d;
+    };
+    for_each_vertex(rest, out, blend);
+}
+
 /// How handle transformations blend.
 #[derive(
     Clone,
@@ -113,6 +137,9 @@ pub enum Blend {
     Linear,
     /// Dual-quaternion skinning: keeps limbs' thickness at strongly rotated joints.
     Dqs,
+    /// Linear blending with stretchable bones: a bone scaled along its length stretches its
+    /// limb and carries what lies past its tail ([`stretchable_blend`]).
+    Stretch,
 }
 
 /// Skins `rest` into `out` with the chosen blending.
@@ -124,7 +151,8 @@ pub fn skin(
     out: &mut [Point],
 ) {
     match blend {
-        Blend::Linear => linear_blend(rest, weights, transforms, out),
+        // Without per-bone stretch data, stretchable blending is linear blending.
+        Blend::Linear | Blend::Stretch => linear_blend(rest, weights, transforms, out),
         Blend::Dqs => dual_quaternion_blend(rest, weights, transforms, out),
     }
 }
@@ -283,6 +311,61 @@ mod tests {
         assert!(out[0].coords.norm() < 1e-9);
         dual_quaternion_blend(&rest, &weights, &[Affine::identity(), turn], &mut out);
         assert!((out[0].coords.norm() - 10.0).abs() < 1e-9, "{:?}", out[0]);
+    }
+
+    #[test]
+    fn stretchable_bones_carry_what_lies_past_the_tail() {
+        use crate::rig::pose::{bone_stretches, handle_transforms, BonePose, Pose};
+        use crate::rig::{Bone, Handles};
+        let handles = Handles {
+            bones: vec![Bone {
+                name: "b".into(),
+                parent: None,
+                head: [0.0, 0.0],
+                tail: [10.0, 0.0],
+            }],
+            ..Default::default()
+        };
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "b".into(),
+            BonePose {
+                scale: [2.0, 1.0],
+                rotate: 90.0,
+                ..Default::default()
+            },
+        );
+        let transforms = handle_transforms(&handles, &pose).unwrap();
+        let stretches = bone_stretches(&handles, &pose).unwrap();
+        let rest = [
+            Point::new(5.0, 2.0),
+            Point::new(15.0, 0.0),
+            Point::new(-3.0, 0.0),
+        ];
+        let weights = SkinWeights::from_rows(&[vec![(0, 1.0)], vec![(0, 1.0)], vec![(0, 1.0)]]);
+        let (mut plain, mut stretched) = ([Point::origin(); 3], [Point::origin(); 3]);
+        linear_blend(&rest, &weights, &transforms, &mut plain);
+        stretchable_blend(&rest, &weights, &transforms, &stretches, &mut stretched);
+        // Along the bone both agree: the limb stretches evenly.
+        assert!((plain[0] - stretched[0]).norm() < 1e-9);
+        // Past the tail, LBS keeps scaling (15 → 30 along the turned bone); the stretchable
+        // bone moves the point with the tail (to 20 + 5).
+        assert!(
+            (plain[1] - Point::new(0.0, -30.0)).norm() < 1e-9,
+            "{:?}",
+            plain[1]
+        );
+        assert!(
+            (stretched[1] - Point::new(0.0, -25.0)).norm() < 1e-9,
+            "{:?}",
+            stretched[1]
+        );
+        // Behind the head, nothing stretches.
+        assert!(
+            (stretched[2] - Point::new(0.0, 3.0)).norm() < 1e-9,
+            "{:?}",
+            stretched[2]
+        );
     }
 
     #[test]

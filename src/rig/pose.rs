@@ -310,6 +310,68 @@ fn bone_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseEr
     Ok(out.into_iter().flatten().collect())
 }
 
+/// How a bone scaled along its length stretches a limb instead of scaling it (Jacobson &
+/// Sorkine 2011, "Stretchable and Twistable Bones for Skeletal Shape Deformation"): a vertex
+/// moves by the bone's rigid motion plus the stretch of its tail times its endpoint weight —
+/// its position along the bone, 0 at the head and 1 at the tail, clamped — so what lies past the
+/// tail is carried along, not enlarged.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoneStretch {
+    /// The bone's skinning transformation without its own along-bone scale.
+    pub rigid: Affine,
+    /// Where the scale moves the tail, beyond where the rigid part puts it (px).
+    pub stretch: Vec2,
+    /// The rest head, and the rest head → tail vector divided by its squared length.
+    pub head: Point,
+    pub axis_per_length2: Vec2,
+}
+
+impl BoneStretch {
+    /// The endpoint weight of a rest position: its parameter along the bone, clamped to [0, 1].
+    pub fn endpoint_weight(&self, p: Point) -> f64 {
+        (p - self.head).dot(&self.axis_per_length2).clamp(0.0, 1.0)
+    }
+}
+
+/// Per bone, its stretch when its pose scales it along its length (`scale[0] ≠ 1`).
+pub fn bone_stretches(
+    handles: &Handles,
+    pose: &Pose,
+) -> Result<Vec<Option<BoneStretch>>, PoseError> {
+    let transforms = bone_transforms(handles, pose)?;
+    let mut out = Vec::with_capacity(handles.bones.len());
+    for (bone, t) in handles.bones.iter().zip(&transforms) {
+        let scale_along = pose.bones.get(&bone.name).map_or(1.0, |p| p.scale[0]);
+        if scale_along == 1.0 || scale_along == 0.0 {
+            out.push(None);
+            continue;
+        }
+        let rest = bone_rest_frame(bone.head, bone.tail);
+        let rest_inverse = rest
+            .inverse()
+            .ok_or_else(|| PoseError::Singular(bone.name.clone()))?;
+        // world_from_bone = t · rest; dropping the bone's own x scale is a right factor there.
+        let world = t.then_after(&rest);
+        let unscale = Affine {
+            linear: Matrix2::from_diagonal(&Vec2::new(1.0 / scale_along, 1.0)),
+            translation: Vec2::zeros(),
+        };
+        let rigid = world.then_after(&unscale).then_after(&rest_inverse);
+        let (head, tail) = (
+            Point::new(bone.head[0], bone.head[1]),
+            Point::new(bone.tail[0], bone.tail[1]),
+        );
+        let axis = tail - head;
+        out.push(Some(BoneStretch {
+            rigid,
+            stretch: t.apply(tail) - rigid.apply(tail),
+            head,
+            axis_per_length2: axis / axis.norm_squared(),
+        }));
+    }
+    Ok(out)
+}
+
 /// One skinning transformation per handle column, in [`Handles::names`]' order expanded as
 /// [`handle_columns`] lists them: bones, points, cage vertices, regions (regions stay at rest
 /// unless IK moves them).

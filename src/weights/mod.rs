@@ -2,18 +2,23 @@
 //!
 //! - [`laplacian`]: cotangent stiffness and mixed-Voronoi mass from edge lengths (flat or lifted).
 //! - [`sparse`]: principal sub-matrix Cholesky (faer) and products shared by the solvers.
-//! - [`solve`]: harmonic, biharmonic and bounded biharmonic weights (active set).
+//! - [`solve`]: harmonic, biharmonic and bounded biharmonic weights (interior point).
+//! - [`monotone`]: bounded biharmonic weights without spurious extrema (Jacobson et al. 2012).
 //! - [`reference`]: the same bounded QP by clarabel, the yardstick in tests.
 //! - [`boundary`]: handles → fixed weights on the mesh vertices that carry their geometry.
 //! - [`part`]: one part end to end: boundary conditions, solve, normalize, sparsify.
 
 pub mod boundary;
 pub mod laplacian;
+pub mod monotone;
 pub mod part;
 pub mod reference;
 pub mod solve;
 pub mod sparse;
 
+pub use monotone::{
+    count_spurious_extrema, monotone_bounded_biharmonic_weights, MonotoneOptions, MonotoneReport,
+};
 pub use part::{part_weights, PartWeights, WeightError, WeightMethod, WeightOptions};
 pub use solve::{
     biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions, BbwReport,

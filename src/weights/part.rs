@@ -10,6 +10,7 @@
 //! an unweighted attachment to one bone.
 
 use super::boundary::{boundary_conditions, centroid, distance_to_column};
+use super::monotone::{monotone_bounded_biharmonic_weights, MonotoneOptions};
 use super::solve::{
     biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions,
     BoundaryConditions, Domain, WeightMatrix,
@@ -46,6 +47,11 @@ pub struct WeightOptions {
     pub max_influences: Option<usize>,
     /// Weights below this are dropped before renormalizing. Default 1e-6.
     pub min_weight: f64,
+    /// With method `bbw`: monotone bounded biharmonic weights (Jacobson, Weinkauf & Sorkine
+    /// 2012), whose per-handle weights have no spurious local extrema away from the handles
+    /// (row normalization may add tiny ones), at the cost of an interior-point QP per handle
+    /// (clarabel) with edge constraints per handle. Default: off.
+    pub monotone: bool,
 }
 
 impl Default for WeightOptions {
@@ -56,6 +62,7 @@ impl Default for WeightOptions {
             content_aware: None,
             max_influences: None,
             min_weight: 1e-6,
+            monotone: false,
         }
     }
 }
@@ -197,6 +204,9 @@ pub fn part_weights(
     };
     let mut unconverged = Vec::new();
     let mut w = match options.method {
+        WeightMethod::Bbw if options.monotone => {
+            monotone_bounded_biharmonic_weights(&domain, &bc, &MonotoneOptions::default())?.0
+        }
         WeightMethod::Bbw => {
             let (w, report) = bounded_biharmonic_weights(&domain, &bc, &options.bbw)?;
             unconverged = report.unconverged;
