@@ -68,8 +68,10 @@ pub enum PipelineError {
     },
     #[error("handles: {0}")]
     Handles(#[from] HandleError),
-    #[error("handle '{0}' lies outside every part")]
+    #[error("handle '{0}' lies outside every part it may weigh")]
     HandleOutside(String),
+    #[error("handles: 'bind' gives handle '{handle}' the part '{part}', which is not a layer")]
+    UnknownBindPart { handle: String, part: String },
     #[error("{path}: weights: {source}")]
     Weights { path: PathBuf, source: WeightError },
     #[error("pose: {0}")]
@@ -169,7 +171,17 @@ pub fn build_rig_with_progress(
     doc.handles = handles.clone();
     handles.validate()?;
     let columns = handle_columns(handles);
-    let geometry = handle_geometry(handles);
+    if let Some((handle, part)) = handles.bind.iter().find_map(|(handle, parts)| {
+        parts
+            .iter()
+            .find(|p| !layers.iter().any(|l| &l.name == *p))
+            .map(|p| (handle, p))
+    }) {
+        return Err(PipelineError::UnknownBindPart {
+            handle: handle.clone(),
+            part: part.clone(),
+        });
+    }
     let mut touched = vec![0usize; columns.len()];
     let mut stats = Vec::with_capacity(layers.len());
     for (done, layer) in layers.iter().enumerate() {
@@ -197,6 +209,7 @@ pub fn build_rig_with_progress(
                 None,
             )
         } else {
+            let geometry = handle_geometry(&handles.for_part(&layer.name));
             let embedded =
                 mesh::triangulate_with_handles(&outlines, &geometry, canvas_area, &options.mesh)
                     .map_err(mesh_error)?;
@@ -204,12 +217,18 @@ pub fn build_rig_with_progress(
                 .weights
                 .content_aware
                 .map(|_| vertex_colors(&layer.image, &embedded.domain.vertices));
-            let part =
-                weights::part_weights(&embedded, handles, colors.as_deref(), &options.weights)
-                    .map_err(|source| PipelineError::Weights {
-                        path: layer.path.clone(),
-                        source,
-                    })?;
+            let binding = handles.columns_binding(&layer.name);
+            let part = weights::part::bound_part_weights(
+                &embedded,
+                handles,
+                &binding,
+                colors.as_deref(),
+                &options.weights,
+            )
+            .map_err(|source| PipelineError::Weights {
+                path: layer.path.clone(),
+                source,
+            })?;
             for (t, n) in touched.iter_mut().zip(&part.touched) {
                 *t += n;
             }

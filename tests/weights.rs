@@ -436,3 +436,38 @@ fn cages_reaching_past_the_shape_and_regions_get_weights() {
         assert!((q - want).norm() < 1e-9);
     }
 }
+
+#[test]
+fn a_bound_handle_leaves_other_parts_alone() {
+    // Two layers overlapping in the middle of the bar; bone "b" crosses both but is bound to
+    // the first: the second layer's mesh must not carry it nor any of its weight.
+    let layers = [
+        layer("front", bar(|_| [200, 100, 50])),
+        layer("back", bar(|_| [50, 100, 200])),
+    ];
+    let mut handles = Handles {
+        bones: vec![cross_bone("a", 60.0), cross_bone("b", 150.0)],
+        ..Default::default()
+    };
+    handles.bind.insert("b".into(), vec!["front".into()]);
+    let doc = rig(&layers, &handles, &BuildOptions::default());
+    let weight_of_b = |part: usize| -> f64 {
+        let rows = &doc.parts[part].weights.as_ref().unwrap().rows;
+        rows.iter()
+            .flat_map(|row| row.iter().filter(|e| e.0 == 1).map(|e| e.1))
+            .fold(0.0, f64::max)
+    };
+    assert!(weight_of_b(0) > 0.99, "b weighs its own part");
+    assert_eq!(weight_of_b(1), 0.0, "b must not weigh the other part");
+    // Bound to a part that is not a layer: a clear error.
+    handles.bind.insert("b".into(), vec!["nowhere".into()]);
+    let err = pipeline::build_rig(
+        &layers,
+        &std::env::temp_dir(),
+        &BuildOptions::default(),
+        &handles,
+    )
+    .err()
+    .expect("an unknown part is an error");
+    assert!(err.to_string().contains("'nowhere'"), "{err}");
+}

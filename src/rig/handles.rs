@@ -6,7 +6,7 @@
 //! coordinate finite.
 
 use serde::{Deserialize, Serialize};
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// A bone: rest geometry `head` → `tail` in canvas px; it rotates about its head in its
 /// parent's frame. A bone without a parent starts its own skeleton.
@@ -56,6 +56,11 @@ pub struct Handles {
     pub cages: Vec<Cage>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub regions: Vec<Region>,
+    /// Handle name → the parts (layer names) it may weigh. A handle not listed weighs every
+    /// part it touches; a listed one is left out of the others' meshes and weights (a tail
+    /// bone that passes behind a leg layer must not drag the leg).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub bind: BTreeMap<String, Vec<String>>,
 }
 
 /// What is wrong with a set of handles.
@@ -75,6 +80,10 @@ pub enum HandleError {
     DegeneratePolygon { kind: &'static str, name: String },
     #[error("handle '{0}' has a coordinate that is not a finite number")]
     NonFinite(String),
+    #[error("'bind' names handle '{0}', which does not exist")]
+    UnknownBindHandle(String),
+    #[error("'bind' lists no part for handle '{0}'")]
+    EmptyBind(String),
 }
 
 /// Bones shorter than this (px) are degenerate: they have no direction.
@@ -97,7 +106,60 @@ impl Handles {
         bones.chain(points).chain(cages).chain(regions)
     }
 
-    /// Checks names, parents, lengths, polygons and numbers.
+    /// Whether the handle `name` may weigh the part named `part` (see [`Handles::bind`]).
+    pub fn binds(&self, name: &str, part: &str) -> bool {
+        self.bind
+            .get(name)
+            .is_none_or(|parts| parts.iter().any(|p| p == part))
+    }
+
+    /// The same handles less those that may not weigh `part` (see [`Handles::bind`]): what
+    /// that part's mesh must carry.
+    pub fn for_part(&self, part: &str) -> Handles {
+        Handles {
+            bones: self
+                .bones
+                .iter()
+                .filter(|h| self.binds(&h.name, part))
+                .cloned()
+                .collect(),
+            points: self
+                .points
+                .iter()
+                .filter(|h| self.binds(&h.name, part))
+                .cloned()
+                .collect(),
+            cages: self
+                .cages
+                .iter()
+                .filter(|h| self.binds(&h.name, part))
+                .cloned()
+                .collect(),
+            regions: self
+                .regions
+                .iter()
+                .filter(|h| self.binds(&h.name, part))
+                .cloned()
+                .collect(),
+            bind: BTreeMap::new(),
+        }
+    }
+
+    /// Per weight column (see [`crate::rig::handle_columns`]: bones, points, one per cage
+    /// vertex, regions), whether it may weigh `part`.
+    pub fn columns_binding(&self, part: &str) -> Vec<bool> {
+        let bones = self.bones.iter().map(|b| self.binds(&b.name, part));
+        let points = self.points.iter().map(|p| self.binds(&p.name, part));
+        let cages = self
+            .cages
+            .iter()
+            .flat_map(|c| std::iter::repeat_n(self.binds(&c.name, part), c.polygon.len()));
+        let regions = self.regions.iter().map(|r| self.binds(&r.name, part));
+        bones.chain(points).chain(cages).chain(regions).collect()
+    }
+
+    /// Checks names, parents, lengths, polygons and numbers. (Part names in [`Handles::bind`]
+    /// are checked against the layers by whoever knows them.)
     pub fn validate(&self) -> Result<(), HandleError> {
         let mut seen = HashSet::new();
         for name in self.names() {
@@ -106,6 +168,14 @@ impl Handles {
             }
             if !seen.insert(name) {
                 return Err(HandleError::DuplicateName(name.to_string()));
+            }
+        }
+        for (name, parts) in &self.bind {
+            if !seen.contains(name.as_str()) {
+                return Err(HandleError::UnknownBindHandle(name.clone()));
+            }
+            if parts.is_empty() {
+                return Err(HandleError::EmptyBind(name.clone()));
             }
         }
         for b in &self.bones {
@@ -267,5 +337,33 @@ mod tests {
             flat.validate(),
             Err(HandleError::DegeneratePolygon { .. })
         ));
+    }
+
+    #[test]
+    fn bind_names_known_handles_and_expands_to_columns() {
+        let mut h = Handles {
+            points: vec![PointHandle {
+                name: "p".into(),
+                at: [0.0, 0.0],
+            }],
+            cages: vec![Cage {
+                name: "c".into(),
+                polygon: vec![[0.0, 0.0], [9.0, 0.0], [0.0, 9.0]],
+            }],
+            ..Default::default()
+        };
+        h.bind.insert("c".into(), vec!["body".into()]);
+        assert_eq!(h.validate(), Ok(()));
+        assert_eq!(h.columns_binding("body"), vec![true; 4]);
+        assert_eq!(h.columns_binding("arm"), vec![true, false, false, false]);
+        assert!(h.for_part("arm").cages.is_empty());
+        h.bind.insert("ghost".into(), vec!["body".into()]);
+        assert_eq!(
+            h.validate(),
+            Err(HandleError::UnknownBindHandle("ghost".into()))
+        );
+        h.bind.remove("ghost");
+        h.bind.insert("p".into(), vec![]);
+        assert_eq!(h.validate(), Err(HandleError::EmptyBind("p".into())));
     }
 }

@@ -92,12 +92,24 @@ pub fn boundary_conditions(
     handles: &Handles,
 ) -> (BoundaryConditions, Vec<usize>) {
     let columns = crate::rig::handle_columns(handles).len();
+    bound_boundary_conditions(vertices, handles, &vec![true; columns])
+}
+
+/// [`boundary_conditions`] from the columns marked in `binding` only (the others fix nothing
+/// and so get zero weight).
+pub fn bound_boundary_conditions(
+    vertices: &[Point],
+    handles: &Handles,
+    binding: &[bool],
+) -> (BoundaryConditions, Vec<usize>) {
+    let columns = crate::rig::handle_columns(handles).len();
     let mut bc = BoundaryConditions {
         handle_count: columns,
         ..Default::default()
     };
     let mut touched = vec![0; columns];
-    for (i, vertex_claims) in claims(vertices, handles, columns).into_iter().enumerate() {
+    for (i, mut vertex_claims) in claims(vertices, handles, columns).into_iter().enumerate() {
+        vertex_claims.retain(|claim| claim.iter().all(|&(c, _)| binding[c]));
         if vertex_claims.is_empty() {
             continue;
         }
@@ -119,6 +131,17 @@ pub fn boundary_conditions(
         bc.fix(i, &merged);
     }
     (bc, touched)
+}
+
+/// Of the columns marked in `binding`, the one whose geometry is nearest to `p` (the first on
+/// ties; column 0 when none is marked).
+pub fn nearest_column(p: Point, handles: &Handles, binding: &[bool]) -> usize {
+    (0..binding.len())
+        .filter(|&c| binding[c])
+        .min_by(|&a, &b| {
+            distance_to_column(p, handles, a).total_cmp(&distance_to_column(p, handles, b))
+        })
+        .unwrap_or(0)
 }
 
 /// Distance from `p` to the geometry of weight column `column` (bones and cage edges as
@@ -182,6 +205,7 @@ mod tests {
                 name: "p".into(),
                 at: [5.0, 5.0],
             }],
+            bind: Default::default(),
             cages: vec![Cage {
                 name: "c".into(),
                 polygon: vec![[30.0, 0.0], [40.0, 0.0], [40.0, 10.0]],

@@ -9,7 +9,7 @@
 //! cannot be solved for; they follow the handle nearest to them rigidly, as cutout tools bind
 //! an unweighted attachment to one bone.
 
-use super::boundary::{boundary_conditions, centroid, distance_to_column};
+use super::boundary::{bound_boundary_conditions, centroid, nearest_column};
 use super::monotone::{monotone_bounded_biharmonic_weights, MonotoneOptions};
 use super::solve::{
     biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions,
@@ -122,6 +122,7 @@ fn pieces(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<usize> {
 fn bind_free_pieces(
     embedded: &EmbeddedMesh,
     handles: &Handles,
+    binding: &[bool],
     bc: &mut BoundaryConditions,
 ) -> Vec<usize> {
     let vertices = &embedded.domain.vertices;
@@ -140,11 +141,7 @@ fn bind_free_pieces(
         }
         let members: Vec<usize> = (0..vertices.len()).filter(|&i| piece[i] == r).collect();
         let c = centroid(members.iter().map(|&i| vertices[i]));
-        let nearest = (0..bc.handle_count)
-            .min_by(|&a, &b| {
-                distance_to_column(c, handles, a).total_cmp(&distance_to_column(c, handles, b))
-            })
-            .unwrap_or(0);
+        let nearest = nearest_column(c, handles, binding);
         for i in members {
             bc.fix_to_handle(i, nearest);
         }
@@ -162,8 +159,28 @@ pub fn part_weights(
     options: &WeightOptions,
 ) -> Result<PartWeights, WeightError> {
     let columns = handle_columns(handles).len();
-    if columns == 0 {
+    bound_part_weights(embedded, handles, &vec![true; columns], colors, options)
+}
+
+/// [`part_weights`] with only the columns marked in `binding` (one flag per column of
+/// [`handle_columns`], see [`Handles::columns_binding`]) allowed to weigh the part; the others
+/// get weight zero everywhere.
+pub fn bound_part_weights(
+    embedded: &EmbeddedMesh,
+    handles: &Handles,
+    binding: &[bool],
+    colors: Option<&[[f64; 3]]>,
+    options: &WeightOptions,
+) -> Result<PartWeights, WeightError> {
+    let columns = handle_columns(handles).len();
+    if columns == 0 || !binding.iter().any(|&b| b) {
         return Err(WeightError::NoHandles);
+    }
+    if binding.len() != columns {
+        return Err(WeightError::InvalidOptions(format!(
+            "{} binding flags for {columns} weight columns",
+            binding.len()
+        )));
     }
     if !(options.min_weight.is_finite() && (0.0..1.0).contains(&options.min_weight)) {
         return Err(WeightError::InvalidOptions(
@@ -176,8 +193,8 @@ pub fn part_weights(
         ));
     }
     let mesh = &embedded.domain;
-    let (mut bc, touched) = boundary_conditions(&mesh.vertices, handles);
-    let bound_to_nearest = bind_free_pieces(embedded, handles, &mut bc);
+    let (mut bc, touched) = bound_boundary_conditions(&mesh.vertices, handles, binding);
+    let bound_to_nearest = bind_free_pieces(embedded, handles, binding, &mut bc);
     let domain = match options.content_aware {
         None => Domain::new(
             &mesh.vertices.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
@@ -216,7 +233,7 @@ pub fn part_weights(
         WeightMethod::Biharmonic => biharmonic_weights(&domain, &bc)?,
     };
     let empty = w.normalize_rows();
-    fill_empty_rows(&mut w, &empty, mesh, handles);
+    fill_empty_rows(&mut w, &empty, mesh, handles, binding);
     let (_, domain_index) = embedded.shape_mesh();
     let rows = domain_index
         .iter()
@@ -236,14 +253,10 @@ fn fill_empty_rows(
     empty: &[usize],
     mesh: &crate::mesh::Mesh,
     handles: &Handles,
+    binding: &[bool],
 ) {
     for &i in empty {
-        let p = mesh.vertices[i];
-        let nearest = (0..w.handle_count)
-            .min_by(|&a, &b| {
-                distance_to_column(p, handles, a).total_cmp(&distance_to_column(p, handles, b))
-            })
-            .unwrap_or(0);
+        let nearest = nearest_column(mesh.vertices[i], handles, binding);
         let m = w.handle_count;
         w.data[i * m..(i + 1) * m]
             .iter_mut()
