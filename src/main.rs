@@ -9,9 +9,22 @@ fn main() -> ExitCode {
     match sinew::cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            // `{:#}` joins the causes on one line.
-            eprintln!("sinew: error: {error:#}");
+            eprintln!("sinew: error: {}", one_line(&error));
             ExitCode::from(EXIT_BAD_INPUT)
         }
     }
+}
+
+/// The error and its causes on one line, leaving out a cause whose text a message before it
+/// already quotes (library errors carry their source's text in their own message).
+fn one_line(error: &anyhow::Error) -> String {
+    let mut line = error.to_string();
+    for cause in error.chain().skip(1) {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+    }
+    line.replace('\n', " ")
 }
