@@ -5,6 +5,7 @@
 //! [`io`] reads and writes the native rig document and images; [`pipeline`] wires the stages
 //! together; [`cli`] is the `sinew` command.
 
+pub mod anim;
 pub mod cli;
 pub mod geom;
 pub mod io;

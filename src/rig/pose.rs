@@ -133,6 +133,24 @@ pub struct IkDrag {
     pub to: [f64; 2],
 }
 
+/// A part's look: a tint multiplying its texture, and whether it is drawn.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PartPose {
+    /// RGBA multiplier, each channel in [0, 1].
+    pub color: [f64; 4],
+    pub visible: bool,
+}
+
+impl Default for PartPose {
+    fn default() -> Self {
+        PartPose {
+            color: [1.0, 1.0, 1.0, 1.0],
+            visible: true,
+        }
+    }
+}
+
 /// The pose file: anything not named stays at rest.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -141,6 +159,12 @@ pub struct Pose {
     pub points: BTreeMap<String, PointPose>,
     pub cages: BTreeMap<String, CagePose>,
     pub ik: Vec<IkDrag>,
+    /// Parts by name; a part not named keeps [`PartPose::default`].
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub parts: BTreeMap<String, PartPose>,
+    /// Part names back to front; `None` keeps the rig's order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub draw_order: Option<Vec<String>>,
 }
 
 /// What is wrong with a pose for a given set of handles.

@@ -1,0 +1,86 @@
+//! Checking an animation against the rig it animates.
+//!
+//! In: an [`Animation`] (already checked on its own), the rig's [`Handles`] and its part names.
+//! Out: `Ok` when every name a timeline uses exists in the rig, every cage key has the rig cage's
+//! vertex count, and every draw-order key lists each part exactly once.
+
+use super::timeline::Animation;
+use super::AnimError;
+use crate::io::RigDocument;
+use crate::rig::Handles;
+use std::collections::BTreeMap;
+
+impl Animation {
+    /// Fails on the first name the rig lacks, cage of the wrong size or incomplete draw order.
+    pub fn check_rig(
+        &self,
+        name: &str,
+        handles: &Handles,
+        parts: &[&str],
+    ) -> Result<(), AnimError> {
+        let unknown = |kind: &'static str, what: &str| AnimError::UnknownName {
+            animation: name.into(),
+            kind,
+            name: what.into(),
+        };
+        for bone in self.bones.keys() {
+            if !handles.bones.iter().any(|b| &b.name == bone) {
+                return Err(unknown("bone", bone));
+            }
+        }
+        for point in self.points.keys() {
+            if !handles.points.iter().any(|p| &p.name == point) {
+                return Err(unknown("point", point));
+            }
+        }
+        for (cage, keys) in &self.cages {
+            let rest = handles
+                .cages
+                .iter()
+                .find(|c| &c.name == cage)
+                .ok_or_else(|| unknown("cage", cage))?;
+            if let Some((key, k)) = keys
+                .iter()
+                .enumerate()
+                .find(|(_, k)| k.value.len() != rest.polygon.len())
+            {
+                return Err(AnimError::CageSize {
+                    animation: name.into(),
+                    cage: cage.clone(),
+                    key,
+                    got: k.value.len(),
+                    expected: rest.polygon.len(),
+                });
+            }
+        }
+        for part in self.parts.keys() {
+            if !parts.contains(&part.as_str()) {
+                return Err(unknown("part", part));
+            }
+        }
+        for (key, k) in self.draw_order.iter().flatten().enumerate() {
+            if let Some(part) = k.value.iter().find(|p| !parts.contains(&p.as_str())) {
+                return Err(unknown("part", part));
+            }
+            if let Some(missing) = parts.iter().find(|p| !k.value.iter().any(|q| q == *p)) {
+                return Err(AnimError::DrawOrderIncomplete {
+                    animation: name.into(),
+                    key,
+                    missing: missing.to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Every animation of a rig document, parsed, checked on its own and against the document's
+/// handles and parts.
+pub fn load_animations(doc: &RigDocument) -> Result<BTreeMap<String, Animation>, AnimError> {
+    let parts: Vec<&str> = doc.parts.iter().map(|p| p.name.as_str()).collect();
+    let animations = super::parse_animations(&doc.animations)?;
+    for (name, animation) in &animations {
+        animation.check_rig(name, &doc.handles, &parts)?;
+    }
+    Ok(animations)
+}

@@ -1,0 +1,226 @@
+//! Interpolation between two keys: linear, stepped, or a cubic Bézier in (time, value) units.
+//!
+//! In: a segment from key (t0, v0) to key (t1, v1) — seconds and the timeline's value units —,
+//! the curve stored on the segment's first key, and a time t in [t0, t1]. Out: the value at t.
+//!
+//! A Bézier curve is Spine 4.x's: per value channel four numbers `cx1, cy1, cx2, cy2`, the two
+//! inner control points in absolute units (seconds, value units); the outer control points are
+//! the keys themselves. Its time coordinate x(s) is inverted exactly (Newton safeguarded by
+//! bisection, to machine precision), where Spine's runtimes walk a 10-segment polyline instead
+//! (differences of ~0.1° on a typical rotate key; see /work/shared/spine-format.md §7).
+
+use serde::de::{self, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use std::fmt;
+
+/// How a key's value travels to the next key's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Curve {
+    /// Straight in time (`"linear"`, or no `curve` field).
+    #[default]
+    Linear,
+    /// Hold the value until the next key (`"stepped"`).
+    Stepped,
+    /// Cubic Bézier: `cx1, cy1, cx2, cy2` per value channel, flat (Spine's layout: for a 2-value
+    /// timeline, the x channel's four numbers then the y channel's).
+    Bezier(Vec<f64>),
+}
+
+/// Numbers per Bézier channel: `cx1, cy1, cx2, cy2`.
+pub const BEZIER_NUMBERS_PER_CHANNEL: usize = 4;
+
+/// The solver stops when a Newton step moves the curve parameter by at most this many ulps of 1,
+/// or when bisection has shrunk the bracket to this width.
+pub const BEZIER_PARAMETER_TOLERANCE: f64 = 2.0 * f64::EPSILON;
+
+/// Iteration cap of the solver; bisection alone reaches machine precision in 53 steps.
+pub const BEZIER_MAX_ITERATIONS: usize = 100;
+
+impl Curve {
+    pub fn is_linear(&self) -> bool {
+        matches!(self, Curve::Linear)
+    }
+}
+
+impl Serialize for Curve {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        match self {
+            Curve::Linear => serializer.serialize_str("linear"),
+            Curve::Stepped => serializer.serialize_str("stepped"),
+            Curve::Bezier(numbers) => numbers.serialize(serializer),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Curve {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct CurveVisitor;
+        impl<'de> Visitor<'de> for CurveVisitor {
+            type Value = Curve;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("\"linear\", \"stepped\" or an array of Bézier numbers")
+            }
+            fn visit_str<E: de::Error>(self, v: &str) -> Result<Curve, E> {
+                match v {
+                    "linear" => Ok(Curve::Linear),
+                    "stepped" => Ok(Curve::Stepped),
+                    other => Err(E::custom(format!(
+                        "unknown curve \"{other}\" (expected \"linear\", \"stepped\" or an array \
+                         of Bézier numbers)"
+                    ))),
+                }
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Curve, A::Error> {
+                let mut numbers = Vec::with_capacity(seq.size_hint().unwrap_or(4));
+                while let Some(x) = seq.next_element::<f64>()? {
+                    numbers.push(x);
+                }
+                Ok(Curve::Bezier(numbers))
+            }
+        }
+        deserializer.deserialize_any(CurveVisitor)
+    }
+}
+
+/// One coordinate of a cubic Bézier with control values p0..p3 at parameter s ∈ [0, 1].
+pub fn cubic(p: [f64; 4], s: f64) -> f64 {
+    let u = 1.0 - s;
+    u * u * u * p[0] + 3.0 * u * u * s * p[1] + 3.0 * u * s * s * p[2] + s * s * s * p[3]
+}
+
+/// d/ds of [`cubic`].
+pub fn cubic_derivative(p: [f64; 4], s: f64) -> f64 {
+    let u = 1.0 - s;
+    3.0 * (u * u * (p[1] - p[0]) + 2.0 * u * s * (p[2] - p[1]) + s * s * (p[3] - p[2]))
+}
+
+/// The parameter s ∈ [0, 1] where the time coordinate x(s) with control times `x` equals `t`.
+///
+/// x must be non-decreasing (inner control times within [x0, x3], which validation enforces),
+/// so the root is unique. Newton steps are taken while they stay inside the bracket that the
+/// signs of x(s) − t maintain; otherwise the bracket is bisected, so the solve always converges.
+pub fn solve_bezier_parameter(x: [f64; 4], t: f64) -> f64 {
+    if t <= x[0] {
+        return 0.0;
+    }
+    if t >= x[3] {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    // The linear guess is exact when the handles sit at thirds, as a linear-looking curve does.
+    let mut s = (t - x[0]) / (x[3] - x[0]);
+    for _ in 0..BEZIER_MAX_ITERATIONS {
+        let f = cubic(x, s) - t;
+        if f == 0.0 {
+            return s;
+        }
+        if f < 0.0 {
+            lo = s;
+        } else {
+            hi = s;
+        }
+        if hi - lo <= BEZIER_PARAMETER_TOLERANCE {
+            break;
+        }
+        let slope = cubic_derivative(x, s);
+        let newton = s - f / slope;
+        if slope > 0.0 && newton > lo && newton < hi {
+            let step = (newton - s).abs();
+            s = newton;
+            if step <= BEZIER_PARAMETER_TOLERANCE {
+                break;
+            }
+        } else {
+            s = 0.5 * (lo + hi);
+        }
+    }
+    s
+}
+
+/// The value of one Bézier channel at time t: the curve through (t0, v0), (cx1, cy1),
+/// (cx2, cy2), (t1, v1), with `handles = [cx1, cy1, cx2, cy2]`.
+pub fn bezier_value(t0: f64, v0: f64, handles: &[f64], t1: f64, v1: f64, t: f64) -> f64 {
+    let [cx1, cy1, cx2, cy2] = match handles {
+        &[a, b, c, d] => [a, b, c, d],
+        // Validation rejects other lengths; without handles the segment is linear.
+        _ => return v0 + (v1 - v0) * ((t - t0) / (t1 - t0)),
+    };
+    let s = solve_bezier_parameter([t0, cx1, cx2, t1], t);
+    cubic([v0, cy1, cy2, v1], s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn handles_at_thirds_are_a_cubic_in_time() {
+        // x(s) = s exactly, so y is the cubic itself: y(0.25) = 3·0.75·0.0625 + 0.015625.
+        let h = [1.0 / 3.0, 0.0, 2.0 / 3.0, 1.0];
+        assert!((bezier_value(0.0, 0.0, &h, 1.0, 1.0, 0.25) - 0.15625).abs() < 1e-15);
+        assert!((bezier_value(0.0, 0.0, &h, 1.0, 1.0, 0.5) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn asymmetric_handles_hit_the_hand_computed_point() {
+        // x(0.5) = 0.375·0.2 + 0.375·0.9 + 0.125·1 = 0.5375; y(0.5) = 0.375·3 − 0.375 + 0.125·2 = 1.
+        let h = [0.2, 3.0, 0.9, -1.0];
+        let v = bezier_value(0.0, 0.0, &h, 1.0, 2.0, 0.5375);
+        assert!((v - 1.0).abs() < 1e-14, "{v}");
+    }
+
+    #[test]
+    fn ease_in_out_halfway_is_the_middle_value() {
+        // Both handles at mid-time: x(0.5) = 0.375 + 0.375 + 0.25 = 1; y(0.5) = 3.75 + 1.25.
+        let h = [1.0, 0.0, 1.0, 10.0];
+        assert!((bezier_value(0.0, 0.0, &h, 2.0, 10.0, 1.0) - 5.0).abs() < 1e-13);
+        // Eased: a quarter of the way in time is under half of a quarter of the way in value
+        // (x(s) = 3s − 3s² + 2s³ = 0.5 at s ≈ 0.201964, y = 10·s²·(3 − 2s) ≈ 1.058925).
+        let v = bezier_value(0.0, 0.0, &h, 2.0, 10.0, 0.5);
+        assert!((v - 1.058925).abs() < 1e-6, "{v}");
+    }
+
+    #[test]
+    fn solver_reaches_machine_precision_even_with_flat_ends() {
+        // Handles on the keys' times: x'(0) = x'(1) = 0, where plain Newton stalls.
+        for x in [
+            [0.0, 0.0, 1.0, 1.0],
+            [2.0, 2.9, 3.0, 3.0],
+            [0.0, 0.5, 0.5, 1.0],
+        ] {
+            for k in 0..=1000 {
+                let t = x[0] + (x[3] - x[0]) * (k as f64 / 1000.0);
+                let s = solve_bezier_parameter(x, t);
+                assert!((0.0..=1.0).contains(&s));
+                let err = (cubic(x, s) - t).abs();
+                assert!(
+                    err <= 8.0 * f64::EPSILON * x[3].abs().max(1.0),
+                    "{x:?} {t} {err}"
+                );
+            }
+            // Near the flat ends too.
+            for t in [x[0] + 1e-12, x[3] - 1e-12] {
+                let s = solve_bezier_parameter(x, t);
+                assert!((cubic(x, s) - t).abs() <= 8.0 * f64::EPSILON * x[3].abs().max(1.0));
+            }
+        }
+    }
+
+    #[test]
+    fn curve_json_forms() {
+        let c: Curve = serde_json::from_str("\"stepped\"").unwrap();
+        assert_eq!(c, Curve::Stepped);
+        let c: Curve = serde_json::from_str("[0.1, 2, 0.3, 4]").unwrap();
+        assert_eq!(c, Curve::Bezier(vec![0.1, 2.0, 0.3, 4.0]));
+        let err = serde_json::from_str::<Curve>("\"smooth\"").unwrap_err();
+        assert!(
+            err.to_string().contains("unknown curve \"smooth\""),
+            "{err}"
+        );
+        assert!(serde_json::from_str::<Curve>("3").is_err());
+        assert_eq!(
+            serde_json::to_string(&Curve::Stepped).unwrap(),
+            "\"stepped\""
+        );
+    }
+}

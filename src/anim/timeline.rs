@@ -1,0 +1,566 @@
+//! The animation model: keys, timelines, and their checks.
+//!
+//! In: one animation as JSON (an entry of the rig document's `animations` map). Out: an
+//! [`Animation`] whose keys are checked: times finite, ≥ 0 and strictly increasing; values
+//! finite; Bézier curves of the right length with their control times inside their segment;
+//! colors in [0, 1]; cage keys of one vertex count; draw-order keys without repeated names.
+//! Units: seconds, degrees (counter-clockwise on screen), canvas px, colors as 0..1 multipliers.
+
+use super::curve::{Curve, BEZIER_NUMBERS_PER_CHANNEL};
+use super::AnimError;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use std::collections::BTreeMap;
+
+/// A key: a value at a time, and how it travels to the next key.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Key<V> {
+    /// Seconds from the start of the animation.
+    pub time: f64,
+    pub value: V,
+    /// Interpolation to the next key (ignored on the last key).
+    #[serde(default, skip_serializing_if = "Curve::is_linear")]
+    pub curve: Curve,
+}
+
+/// A key of a timeline that only ever steps (visibility, draw order): no curve.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepKey<V> {
+    pub time: f64,
+    pub value: V,
+}
+
+/// A color multiplier, channels in [0, 1]; in files a `"rrggbbaa"` hex string as Spine writes
+/// it (`"rrggbb"` means opaque).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgba(pub [f64; 4]);
+
+impl Serialize for Rgba {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let byte = |c: f64| (c.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let [r, g, b, a] = self.0.map(byte);
+        serializer.serialize_str(&format!("{r:02x}{g:02x}{b:02x}{a:02x}"))
+    }
+}
+
+impl<'de> Deserialize<'de> for Rgba {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let text = String::deserialize(deserializer)?;
+        parse_hex_color(&text).ok_or_else(|| {
+            serde::de::Error::custom(format!(
+                "color \"{text}\" is not an \"rrggbbaa\" (or \"rrggbb\") hex string"
+            ))
+        })
+    }
+}
+
+fn parse_hex_color(text: &str) -> Option<Rgba> {
+    if !(text.len() == 6 || text.len() == 8) || !text.is_ascii() {
+        return None;
+    }
+    let mut rgba = [1.0; 4];
+    for (i, c) in rgba.iter_mut().enumerate().take(text.len() / 2) {
+        *c = f64::from(u8::from_str_radix(&text[2 * i..2 * i + 2], 16).ok()?) / 255.0;
+    }
+    Some(Rgba(rgba))
+}
+
+/// A key value seen as a run of numbers that interpolate channel by channel.
+pub trait Channels: Clone {
+    /// Whether a Bézier's `cy` values are in the value's own units, one curve per number (Spine's
+    /// bone, color and IK timelines), or a 0..1 fraction of the way, one curve for all numbers
+    /// (Spine's deform timelines; used for cage polygons).
+    const CURVE_PER_CHANNEL: bool = true;
+    fn numbers(&self) -> &[f64];
+    fn numbers_mut(&mut self) -> &mut [f64];
+    /// How many Bézier channels (4 numbers each) a key's curve holds.
+    fn curve_channels(&self) -> usize {
+        if Self::CURVE_PER_CHANNEL {
+            self.numbers().len()
+        } else {
+            1
+        }
+    }
+}
+
+impl Channels for f64 {
+    fn numbers(&self) -> &[f64] {
+        std::slice::from_ref(self)
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        std::slice::from_mut(self)
+    }
+}
+
+impl Channels for [f64; 2] {
+    fn numbers(&self) -> &[f64] {
+        self
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        self
+    }
+}
+
+impl Channels for Rgba {
+    fn numbers(&self) -> &[f64] {
+        &self.0
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        &mut self.0
+    }
+}
+
+impl Channels for Vec<[f64; 2]> {
+    const CURVE_PER_CHANNEL: bool = false;
+    fn numbers(&self) -> &[f64] {
+        self.as_flattened()
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        self.as_flattened_mut()
+    }
+}
+
+/// A bone's timelines; each value replaces the bone's [`crate::rig::pose::BonePose`] field.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BoneTimelines {
+    /// Degrees, counter-clockwise on screen; interpolated as authored (0 → 360 is a full turn).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotate: Option<Vec<Key<f64>>>,
+    /// px, in the parent's frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub translate: Option<Vec<Key<[f64; 2]>>>,
+    /// Along the bone, across it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale: Option<Vec<Key<[f64; 2]>>>,
+    /// Degrees: x axis, y axis.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shear: Option<Vec<Key<[f64; 2]>>>,
+}
+
+/// A point handle's timelines, as [`crate::rig::pose::PointPose`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PointTimelines {
+    /// px, canvas axes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub translate: Option<Vec<Key<[f64; 2]>>>,
+    /// Degrees, counter-clockwise on screen, about the point's rest position.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotate: Option<Vec<Key<f64>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scale: Option<Vec<Key<[f64; 2]>>>,
+}
+
+/// A part's timelines, as [`crate::rig::pose::PartPose`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PartTimelines {
+    /// RGBA multiplier; a Bézier has 4 channels whose `cy` are channel values in [0, 1].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub color: Option<Vec<Key<Rgba>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub visible: Option<Vec<StepKey<bool>>>,
+}
+
+/// A keyed skinning-IK drag: the material point at rest position `at` (canvas px) goes to the
+/// keyed position.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IkTimeline {
+    pub at: [f64; 2],
+    pub to: Vec<Key<[f64; 2]>>,
+}
+
+/// One animation: timelines by what they move. Anything without a timeline stays at rest.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Animation {
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub bones: BTreeMap<String, BoneTimelines>,
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub points: BTreeMap<String, PointTimelines>,
+    /// Posed polygons (canvas px), the same vertex count on every key and as at rest.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub cages: BTreeMap<String, Vec<Key<Vec<[f64; 2]>>>>,
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub parts: BTreeMap<String, PartTimelines>,
+    /// Each key lists every part of the rig once, back to front.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub draw_order: Option<Vec<StepKey<Vec<String>>>>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ik: Vec<IkTimeline>,
+}
+
+/// What is wrong with one timeline (the enclosing [`AnimError`] names it).
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum TimelineError {
+    #[error("{0}")]
+    Json(String),
+    #[error("has no keys")]
+    NoKeys,
+    #[error("key {key} has time {time}, which is not a finite number ≥ 0")]
+    BadTime { key: usize, time: f64 },
+    #[error("key {key} at {time} s does not come after the previous key at {previous} s")]
+    TimeNotIncreasing {
+        key: usize,
+        time: f64,
+        previous: f64,
+    },
+    #[error("key {key} has a value that is not a finite number")]
+    NonFinite { key: usize },
+    #[error("key {key} has a curve of {got} numbers; expected {expected} (4 per value channel)")]
+    CurveLength {
+        key: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error("key {key} has a curve number that is not finite")]
+    CurveNonFinite { key: usize },
+    #[error("key {key} has a curve handle outside its segment's time span [{start}, {end}] s")]
+    CurveTime { key: usize, start: f64, end: f64 },
+    #[error("key {key} has a color channel outside [0, 1]")]
+    ColorRange { key: usize },
+    #[error("key {key} has {got} vertices but key 0 has {expected}")]
+    VertexCount {
+        key: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error("key {key} lists part '{name}' twice")]
+    DuplicatePart { key: usize, name: String },
+}
+
+/// Times: finite, ≥ 0, strictly increasing; at least one key.
+fn check_times(times: impl Iterator<Item = f64>) -> Result<(), TimelineError> {
+    let mut previous: Option<f64> = None;
+    for (key, time) in times.enumerate() {
+        if !(time.is_finite() && time >= 0.0) {
+            return Err(TimelineError::BadTime { key, time });
+        }
+        if let Some(previous) = previous {
+            if time <= previous {
+                return Err(TimelineError::TimeNotIncreasing {
+                    key,
+                    time,
+                    previous,
+                });
+            }
+        }
+        previous = Some(time);
+    }
+    match previous {
+        Some(_) => Ok(()),
+        None => Err(TimelineError::NoKeys),
+    }
+}
+
+/// Times, finite values, and curves of the right length whose handles stay in their segment —
+/// which keeps each segment's time a monotone function of the curve parameter.
+fn check_keys<V: Channels>(keys: &[Key<V>]) -> Result<(), TimelineError> {
+    check_times(keys.iter().map(|k| k.time))?;
+    for (i, k) in keys.iter().enumerate() {
+        if !k.value.numbers().iter().all(|v| v.is_finite()) {
+            return Err(TimelineError::NonFinite { key: i });
+        }
+        let Curve::Bezier(numbers) = &k.curve else {
+            continue;
+        };
+        let expected = BEZIER_NUMBERS_PER_CHANNEL * k.value.curve_channels();
+        if numbers.len() != expected {
+            return Err(TimelineError::CurveLength {
+                key: i,
+                got: numbers.len(),
+                expected,
+            });
+        }
+        if !numbers.iter().all(|v| v.is_finite()) {
+            return Err(TimelineError::CurveNonFinite { key: i });
+        }
+        if let Some(next) = keys.get(i + 1) {
+            let inside = |cx: f64| cx >= k.time && cx <= next.time;
+            let handle_times = numbers.chunks_exact(2).map(|pair| pair[0]);
+            if !handle_times.clone().all(inside) {
+                return Err(TimelineError::CurveTime {
+                    key: i,
+                    start: k.time,
+                    end: next.time,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+fn check_step_keys<V>(keys: &[StepKey<V>]) -> Result<(), TimelineError> {
+    check_times(keys.iter().map(|k| k.time))
+}
+
+fn check_color_keys(keys: &[Key<Rgba>]) -> Result<(), TimelineError> {
+    check_keys(keys)?;
+    match keys
+        .iter()
+        .position(|k| !k.value.0.iter().all(|c| (0.0..=1.0).contains(c)))
+    {
+        Some(key) => Err(TimelineError::ColorRange { key }),
+        None => Ok(()),
+    }
+}
+
+fn check_cage_keys(keys: &[Key<Vec<[f64; 2]>>]) -> Result<(), TimelineError> {
+    check_keys(keys)?;
+    let expected = keys.first().map_or(0, |k| k.value.len());
+    match keys.iter().position(|k| k.value.len() != expected) {
+        Some(key) => Err(TimelineError::VertexCount {
+            key,
+            got: keys[key].value.len(),
+            expected,
+        }),
+        None => Ok(()),
+    }
+}
+
+fn check_draw_order_keys(keys: &[StepKey<Vec<String>>]) -> Result<(), TimelineError> {
+    check_step_keys(keys)?;
+    for (key, k) in keys.iter().enumerate() {
+        let mut seen = std::collections::HashSet::new();
+        if let Some(name) = k.value.iter().find(|n| !seen.insert(n.as_str())) {
+            return Err(TimelineError::DuplicatePart {
+                key,
+                name: name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+impl Animation {
+    /// Parses and checks the animation `name` from its JSON value.
+    pub fn from_json(name: &str, value: &serde_json::Value) -> Result<Animation, AnimError> {
+        match Animation::deserialize(value) {
+            Ok(animation) => {
+                animation.validate(name)?;
+                Ok(animation)
+            }
+            Err(whole) => {
+                Err(
+                    locate_json_error(name, value).unwrap_or_else(|| AnimError::Malformed {
+                        animation: name.into(),
+                        reason: whole.to_string(),
+                    }),
+                )
+            }
+        }
+    }
+
+    /// Checks every timeline on its own (no rig needed); see the module doc for what.
+    pub fn validate(&self, name: &str) -> Result<(), AnimError> {
+        let fail = |timeline: String| {
+            move |problem| AnimError::Timeline {
+                animation: name.into(),
+                timeline,
+                problem,
+            }
+        };
+        for (bone, t) in &self.bones {
+            let path = |what: &str| format!("bones.{bone}.{what}");
+            if let Some(keys) = &t.rotate {
+                check_keys(keys).map_err(fail(path("rotate")))?;
+            }
+            for (what, keys) in [
+                ("translate", &t.translate),
+                ("scale", &t.scale),
+                ("shear", &t.shear),
+            ] {
+                if let Some(keys) = keys {
+                    check_keys(keys).map_err(fail(path(what)))?;
+                }
+            }
+        }
+        for (point, t) in &self.points {
+            let path = |what: &str| format!("points.{point}.{what}");
+            if let Some(keys) = &t.rotate {
+                check_keys(keys).map_err(fail(path("rotate")))?;
+            }
+            for (what, keys) in [("translate", &t.translate), ("scale", &t.scale)] {
+                if let Some(keys) = keys {
+                    check_keys(keys).map_err(fail(path(what)))?;
+                }
+            }
+        }
+        for (cage, keys) in &self.cages {
+            check_cage_keys(keys).map_err(fail(format!("cages.{cage}")))?;
+        }
+        for (part, t) in &self.parts {
+            if let Some(keys) = &t.color {
+                check_color_keys(keys).map_err(fail(format!("parts.{part}.color")))?;
+            }
+            if let Some(keys) = &t.visible {
+                check_step_keys(keys).map_err(fail(format!("parts.{part}.visible")))?;
+            }
+        }
+        if let Some(keys) = &self.draw_order {
+            check_draw_order_keys(keys).map_err(fail("draw_order".into()))?;
+        }
+        for (i, drag) in self.ik.iter().enumerate() {
+            if !drag.at.iter().all(|v| v.is_finite()) {
+                return Err(fail(format!("ik[{i}].at"))(TimelineError::NonFinite {
+                    key: 0,
+                }));
+            }
+            check_keys(&drag.to).map_err(fail(format!("ik[{i}].to")))?;
+        }
+        Ok(())
+    }
+
+    /// The time of the latest key over all timelines, seconds (0 for an empty animation).
+    pub fn duration_s(&self) -> f64 {
+        fn last<K>(keys: &[K], time: impl Fn(&K) -> f64) -> f64 {
+            keys.last().map_or(0.0, time)
+        }
+        let key = |k: &Key<f64>| k.time;
+        let key2 = |k: &Key<[f64; 2]>| k.time;
+        let mut end = 0.0_f64;
+        let mut see = |t: f64| end = end.max(t);
+        for t in self.bones.values() {
+            see(t.rotate.as_deref().map_or(0.0, |k| last(k, key)));
+            for keys in [&t.translate, &t.scale, &t.shear] {
+                see(keys.as_deref().map_or(0.0, |k| last(k, key2)));
+            }
+        }
+        for t in self.points.values() {
+            see(t.rotate.as_deref().map_or(0.0, |k| last(k, key)));
+            for keys in [&t.translate, &t.scale] {
+                see(keys.as_deref().map_or(0.0, |k| last(k, key2)));
+            }
+        }
+        for keys in self.cages.values() {
+            see(last(keys, |k| k.time));
+        }
+        for t in self.parts.values() {
+            see(t.color.as_deref().map_or(0.0, |k| last(k, |k| k.time)));
+            see(t.visible.as_deref().map_or(0.0, |k| last(k, |k| k.time)));
+        }
+        if let Some(keys) = &self.draw_order {
+            see(last(keys, |k| k.time));
+        }
+        for drag in &self.ik {
+            see(last(&drag.to, key2));
+        }
+        end
+    }
+}
+
+/// Every animation of a rig document's `animations` map, parsed and checked on its own.
+pub fn parse_animations(
+    animations: &BTreeMap<String, serde_json::Value>,
+) -> Result<BTreeMap<String, Animation>, AnimError> {
+    animations
+        .iter()
+        .map(|(name, value)| Ok((name.clone(), Animation::from_json(name, value)?)))
+        .collect()
+}
+
+/// Where in an animation's JSON serde failed: tries each timeline (then each key) on its own,
+/// so the message names the timeline. `None` when no single piece fails by itself.
+fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError> {
+    let fail = |timeline: String, reason: String| AnimError::Timeline {
+        animation: name.into(),
+        timeline,
+        problem: TimelineError::Json(reason),
+    };
+    let malformed = |reason: String| AnimError::Malformed {
+        animation: name.into(),
+        reason,
+    };
+    let object = value.as_object()?;
+    for (section, content) in object {
+        match section.as_str() {
+            "bones" | "points" | "parts" => {
+                let names = content.as_object()?;
+                for (thing, timelines) in names {
+                    let Some(timelines) = timelines.as_object() else {
+                        return Some(fail(
+                            format!("{section}.{thing}"),
+                            "expected an object of timelines".into(),
+                        ));
+                    };
+                    for (timeline, keys) in timelines {
+                        let path = format!("{section}.{thing}.{timeline}");
+                        let probed = match (section.as_str(), timeline.as_str()) {
+                            ("bones" | "points", "rotate") => probe_keys::<Key<f64>>(keys),
+                            ("bones", "translate" | "scale" | "shear")
+                            | ("points", "translate" | "scale") => {
+                                probe_keys::<Key<[f64; 2]>>(keys)
+                            }
+                            ("parts", "color") => probe_keys::<Key<Rgba>>(keys),
+                            ("parts", "visible") => probe_keys::<StepKey<bool>>(keys),
+                            _ => {
+                                let expected = match section.as_str() {
+                                    "bones" => "rotate, translate, scale or shear",
+                                    "points" => "translate, rotate or scale",
+                                    _ => "color or visible",
+                                };
+                                return Some(fail(
+                                    path,
+                                    format!("unknown timeline '{timeline}' (expected {expected})"),
+                                ));
+                            }
+                        };
+                        if let Err((at, reason)) = probed {
+                            return Some(fail(path + &at, reason));
+                        }
+                    }
+                }
+            }
+            "cages" => {
+                for (cage, keys) in content.as_object()? {
+                    if let Err((at, reason)) = probe_keys::<Key<Vec<[f64; 2]>>>(keys) {
+                        return Some(fail(format!("cages.{cage}{at}"), reason));
+                    }
+                }
+            }
+            "draw_order" => {
+                if let Err((at, reason)) = probe_keys::<StepKey<Vec<String>>>(content) {
+                    return Some(fail(format!("draw_order{at}"), reason));
+                }
+            }
+            "ik" => {
+                for (i, drag) in content.as_array()?.iter().enumerate() {
+                    if let Err(e) = IkTimeline::deserialize(drag) {
+                        if let Some(Err((at, reason))) =
+                            drag.get("to").map(probe_keys::<Key<[f64; 2]>>)
+                        {
+                            return Some(fail(format!("ik[{i}].to{at}"), reason));
+                        }
+                        return Some(fail(format!("ik[{i}]"), e.to_string()));
+                    }
+                }
+            }
+            other => {
+                return Some(malformed(format!(
+                    "unknown section '{other}' (expected bones, points, cages, parts, \
+                     draw_order or ik)"
+                )))
+            }
+        }
+    }
+    None
+}
+
+/// Deserializes a key list, key by key; on failure, the key's place (" key 3") and serde's reason.
+fn probe_keys<K: DeserializeOwned>(keys: &serde_json::Value) -> Result<(), (String, String)> {
+    match keys.as_array() {
+        Some(list) => {
+            for (i, key) in list.iter().enumerate() {
+                K::deserialize(key).map_err(|e| (format!(" key {i}"), e.to_string()))?;
+            }
+            Ok(())
+        }
+        None => Vec::<K>::deserialize(keys)
+            .map(|_| ())
+            .map_err(|e| (String::new(), e.to_string())),
+    }
+}
