@@ -3,6 +3,7 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+use crate::anim;
 use crate::io::{self, BuildOptions, RigDocument};
 use crate::mesh::MeshOptions;
 use crate::pipeline::{self, PartReport, Scene};
@@ -11,7 +12,7 @@ use crate::rig::{Handles, Pose};
 use crate::skin::Blend;
 use crate::trace::TraceOptions;
 use crate::weights::{WeightMethod, WeightOptions};
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -145,8 +146,14 @@ pub struct PoseArgs {
     #[arg(long)]
     pub vertices: Option<PathBuf>,
     /// The pose file (bone rotations, point moves, cage polygons).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "anim")]
     pub pose: Option<PathBuf>,
+    /// Pose from this animation of the rig document, at `--time`.
+    #[arg(long)]
+    pub anim: Option<String>,
+    /// Seconds into `--anim` (looping past its end). Default 0.
+    #[arg(long, requires = "anim", allow_negative_numbers = true)]
+    pub time: Option<f64>,
     /// How handle transformations blend: linear (LBS), dqs (dual quaternions) or stretch
     /// (LBS with stretchable bones).
     #[arg(long, value_enum, default_value_t = Blend::Linear)]
@@ -272,9 +279,16 @@ fn pose(args: &PoseArgs) -> Result<()> {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
     let scene = Scene::load(&args.rig)?;
-    let pose: Pose = match &args.pose {
-        Some(path) => read_json(path, "pose file")?,
-        None => Pose::default(),
+    let pose: Pose = match (&args.pose, &args.anim) {
+        (Some(path), _) => read_json(path, "pose file")?,
+        (None, Some(name)) => {
+            let time_s = args.time.unwrap_or(0.0);
+            if !time_s.is_finite() {
+                bail!("--time must be a finite number of seconds");
+            }
+            animation(&scene.doc, name)?.sample(time_s, true)
+        }
+        (None, None) => Pose::default(),
     };
     let positions = scene.pose_positions_with(&pose, args.blend)?;
     let image = match &args.output {
@@ -293,6 +307,22 @@ fn pose(args: &PoseArgs) -> Result<()> {
             .with_context(|| format!("{}: cannot write", path.display()))?;
     }
     Ok(())
+}
+
+/// The document's animation `name`, checked against its rig.
+fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
+    let mut animations = anim::load_animations(doc)?;
+    animations.remove(name).ok_or_else(|| {
+        let known: Vec<&str> = doc.animations.keys().map(String::as_str).collect();
+        anyhow!(
+            "the rig has no animation '{name}' (it has: {})",
+            if known.is_empty() {
+                "none".to_string()
+            } else {
+                known.join(", ")
+            }
+        )
+    })
 }
 
 /// The `--vertices` file of DESIGN.md.
