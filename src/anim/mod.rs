@@ -169,6 +169,11 @@ mod tests {
             m.starts_with("animation 'walk': unknown section 'bone'"),
             "{m}"
         );
+        let m = message(json!({"bones": [1]}));
+        assert_eq!(
+            m,
+            "animation 'walk', bones: expected an object: name → timelines"
+        );
         let m = message(json!([1, 2]));
         assert!(m.starts_with("animation 'walk': invalid type"), "{m}");
         let m = message(json!({"points": {"p": {"rotate": [{"time": -1, "value": 0}]}}}));
