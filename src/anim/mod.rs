@@ -169,6 +169,11 @@ mod tests {
             m.starts_with("animation 'walk': unknown section 'bone'"),
             "{m}"
         );
+        let m = message(json!({"bones": [1]}));
+        assert_eq!(
+            m,
+            "animation 'walk', bones: expected an object: name → timelines"
+        );
         let m = message(json!([1, 2]));
         assert!(m.starts_with("animation 'walk': invalid type"), "{m}");
         let m = message(json!({"points": {"p": {"rotate": [{"time": -1, "value": 0}]}}}));
@@ -276,5 +281,47 @@ mod tests {
             check(json!({"draw_order": [{"time": 0, "value": ["head", "body", "hat"]}]})),
             Err("animation 'walk' names part 'hat', which the rig does not have".into())
         );
+    }
+
+    #[test]
+    fn the_bundled_animations_fit_the_character_and_loop_seamlessly() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/character");
+        let read = |file: &str| -> serde_json::Value {
+            serde_json::from_str(&std::fs::read_to_string(format!("{dir}/{file}")).unwrap())
+                .unwrap()
+        };
+        let handles: Handles = serde_json::from_value(read("handles.json")).unwrap();
+        let layers = read("layers.json");
+        let parts: Vec<&str> = layers["layers"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l.as_str().unwrap())
+            .collect();
+        let raw: std::collections::BTreeMap<String, serde_json::Value> =
+            serde_json::from_value(read("animations.json")).unwrap();
+        let animations = parse_animations(&raw).unwrap();
+        assert_eq!(
+            animations.keys().collect::<Vec<_>>(),
+            ["walk", "wave"].iter().collect::<Vec<_>>()
+        );
+        for (name, anim) in &animations {
+            anim.check_rig(name, &handles, &parts).unwrap();
+            let duration = anim.duration_s();
+            // The end of the cycle runs into its start: no jump when it wraps.
+            let end = anim.sample(duration, false);
+            let start = anim.sample(0.0, false);
+            for (bone, pose) in &end.bones {
+                let other = &start.bones[bone];
+                assert!((pose.rotate - other.rotate).abs() < 1e-9, "{name} {bone}");
+                assert_eq!(pose.translate, other.translate, "{name} {bone}");
+            }
+            assert_eq!(end.points, start.points, "{name}");
+            // Every frame poses the rig.
+            for k in 0..24 {
+                let pose = anim.sample(duration * k as f64 / 24.0, true);
+                crate::rig::handle_transforms(&handles, &pose).unwrap();
+            }
+        }
     }
 }

@@ -463,6 +463,8 @@ pub fn parse_animations(
         .collect()
 }
 
+const NOT_A_MAP: &str = "expected an object: name → timelines";
+
 /// Where in an animation's JSON serde failed: tries each timeline (then each key) on its own,
 /// so the message names the timeline. `None` when no single piece fails by itself.
 fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError> {
@@ -479,7 +481,9 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
     for (section, content) in object {
         match section.as_str() {
             "bones" | "points" | "parts" => {
-                let names = content.as_object()?;
+                let Some(names) = content.as_object() else {
+                    return Some(fail(section.clone(), NOT_A_MAP.into()));
+                };
                 for (thing, timelines) in names {
                     let Some(timelines) = timelines.as_object() else {
                         return Some(fail(
@@ -516,7 +520,10 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                 }
             }
             "cages" => {
-                for (cage, keys) in content.as_object()? {
+                let Some(cages) = content.as_object() else {
+                    return Some(fail(section.clone(), NOT_A_MAP.into()));
+                };
+                for (cage, keys) in cages {
                     if let Err((at, reason)) = probe_keys::<Key<Vec<[f64; 2]>>>(keys) {
                         return Some(fail(format!("cages.{cage}{at}"), reason));
                     }
@@ -528,7 +535,10 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                 }
             }
             "ik" => {
-                for (i, drag) in content.as_array()?.iter().enumerate() {
+                let Some(drags) = content.as_array() else {
+                    return Some(fail(section.clone(), "expected an array of drags".into()));
+                };
+                for (i, drag) in drags.iter().enumerate() {
                     if let Err(e) = IkTimeline::deserialize(drag) {
                         if let Some(Err((at, reason))) =
                             drag.get("to").map(probe_keys::<Key<[f64; 2]>>)
