@@ -46,6 +46,7 @@ if [ "${#gifs[@]}" -eq 0 ]; then
   gifs=("$out/demo/demo.gif" "$out/demo/demo_on_white.gif")
 fi
 
+mkdir -p "$out"
 status=0
 for gif in "${gifs[@]}"; do
   name="$(basename "$gif" .gif)"
