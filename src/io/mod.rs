@@ -1,8 +1,9 @@
-//! Files: the native rig document, images, and atomic writes.
+//! Files: the native rig document, images, animation sequences, and atomic writes.
 
 pub mod atomic;
 pub mod document;
 pub mod image;
+pub mod sequence;
 
 pub use atomic::write_atomic;
 pub use document::{BuildOptions, DocumentError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
