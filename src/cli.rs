@@ -7,6 +7,7 @@ use crate::anim;
 use crate::io::{self, BuildOptions, RigDocument};
 use crate::mesh::MeshOptions;
 use crate::pipeline::{self, PartReport, Scene};
+use crate::playback::{self, FrameView};
 use crate::render;
 use crate::rig::{Handles, Pose};
 use crate::skin::Blend;
@@ -35,8 +36,53 @@ pub enum Command {
     Rig(RigArgs),
     /// Draw a rig in a pose (the rest pose when none is given).
     Pose(PoseArgs),
+    /// Render an animation of a rig to numbered PNGs (a folder), a GIF or a sprite sheet.
+    Render(RenderArgs),
     /// Run the whole pipeline on the bundled character.
     Demo(DemoArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// The rig document.
+    pub rig: PathBuf,
+    /// The animation to play.
+    #[arg(long)]
+    pub anim: String,
+    /// Frames per second.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f64,
+    /// Output px per canvas px.
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Output size WxH in px (default: the scaled canvas); the canvas is centered in it.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<[u32; 2]>,
+    /// Background color #rrggbb or #rrggbbaa (default: transparent).
+    #[arg(long)]
+    pub background: Option<String>,
+    /// How handle transformations blend.
+    #[arg(long, value_enum, default_value_t = Blend::Linear)]
+    pub blend: Blend,
+    /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
+    /// OUT.json beside it).
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// Parses `WxH` (px).
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("'{text}' is not WxH"))?;
+    let side = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| n > 0)
+            .ok_or_else(|| format!("'{text}' is not WxH with positive whole numbers"))
+    };
+    Ok([side(w)?, side(h)?])
 }
 
 #[derive(Args, Debug)]
@@ -175,6 +221,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Rig(args) => rig(&args),
         Command::Pose(args) => pose(&args),
+        Command::Render(args) => render_animation(&args),
         Command::Demo(args) => demo(&args),
     }
 }
@@ -309,6 +356,52 @@ fn pose(args: &PoseArgs) -> Result<()> {
     Ok(())
 }
 
+fn render_animation(args: &RenderArgs) -> Result<()> {
+    let scene = Scene::load(&args.rig)?;
+    let animation = animation(&scene.doc, &args.anim)?;
+    let background = args
+        .background
+        .as_deref()
+        .map(io::sequence::parse_rgba_hex)
+        .transpose()?;
+    let view = FrameView::new(scene.doc.canvas, args.scale, args.size, background)?;
+    let times = playback::frame_times(animation.duration_s(), args.fps)?;
+    // Check the target before rendering: an unknown extension fails at once.
+    io::sequence::format_for_path(&args.output)?;
+    let frames = render_with_progress_bar(&scene, &animation, &times, args.blend, &view)?;
+    let report =
+        io::sequence::write_sequence(&frames, args.fps, &args.output, &Default::default())?;
+    println!(
+        "{}: {} frames of {}×{} px, {:.2} s",
+        args.output.display(),
+        report.frame_count,
+        report.frame_size_px.0,
+        report.frame_size_px.1,
+        report.duration_s
+    );
+    Ok(())
+}
+
+/// Renders the frames at `times` with a progress bar on a terminal.
+fn render_with_progress_bar(
+    scene: &Scene,
+    animation: &anim::Animation,
+    times: &[f64],
+    blend: Blend,
+    view: &FrameView,
+) -> Result<Vec<image::RgbaImage>> {
+    let bar = indicatif::ProgressBar::new(times.len() as u64);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("rendering {bar:30} {pos}/{len} frames")
+    {
+        bar.set_style(style);
+    }
+    let poses = playback::poses_at(animation, times);
+    let frames = playback::render_poses(scene, &poses, blend, view, &|| bar.inc(1));
+    bar.finish_and_clear();
+    Ok(frames?)
+}
+
 /// The document's animation `name`, checked against its rig.
 fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
     let mut animations = anim::load_animations(doc)?;
@@ -381,32 +474,77 @@ fn demo(args: &DemoArgs) -> Result<()> {
         pipeline::build_rig(&layers, &args.output, &BuildOptions::default(), &handles)?;
     let rig_s = t.elapsed().as_secs_f64();
 
+    let mut doc = doc;
+    let animations_path = args.assets.join("animations.json");
+    doc.animations = read_json(&animations_path, "animations file")?;
+    let animations = anim::load_animations(&doc)
+        .with_context(|| format!("{}: bad animation", animations_path.display()))?;
     let rig_path = args.output.join("character.json");
     doc.save(&rig_path)?;
+    let mut written = vec![rig_path];
+
     let t = Instant::now();
     let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
     let scene = Scene::new(doc.clone(), &images)?;
     let rest = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
-    let render_s = t.elapsed().as_secs_f64();
+    let rest_s = t.elapsed().as_secs_f64();
     let rest_path = args.output.join("rest.png");
     io::save_png(&rest_path, &rest)?;
     let preview_path = args.output.join("mesh.png");
     io::save_png(&preview_path, &preview_image(&doc, &layers)?)?;
+    written.extend([rest_path, preview_path]);
+
+    let view = FrameView::new(doc.canvas, 1.0, None, None)?;
+    let mut render_s = 0.0;
+    let mut write_s = 0.0;
+    let mut frame_count = 0;
+    for (name, animation) in &animations {
+        let t = Instant::now();
+        let times = playback::frame_times(animation.duration_s(), DEMO_FPS)?;
+        let poses = playback::poses_at(animation, &times);
+        let frames = playback::render_poses(&scene, &poses, Blend::Linear, &view, &|| {})?;
+        render_s += t.elapsed().as_secs_f64();
+        frame_count += frames.len();
+        let t = Instant::now();
+        for target in [
+            args.output.join(format!("{name}.gif")),
+            args.output.join(format!("{name}.png")),
+            args.output.join(name),
+        ] {
+            let report =
+                io::sequence::write_sequence(&frames, DEMO_FPS, &target, &Default::default())?;
+            if report.format == io::sequence::SequenceFormat::Folder {
+                written.push(target);
+            } else {
+                written.extend(report.files);
+            }
+        }
+        write_s += t.elapsed().as_secs_f64();
+    }
 
     let (v, t_count): (usize, usize) = stats.iter().fold((0, 0), |a, s| {
         (a.0 + s.mesh.vertices, a.1 + s.mesh.triangles)
     });
     println!(
-        "sinew demo: {} parts, {v} vertices, {t_count} triangles",
-        doc.parts.len()
+        "sinew demo: {} parts, {v} vertices, {t_count} triangles; animations {}",
+        doc.parts.len(),
+        animations.keys().cloned().collect::<Vec<_>>().join(", ")
     );
     println!("  load images   {:>8.1} ms", load_s * 1e3);
     println!(
         "  rig           {:>8.1} ms (trace, mesh, weights)",
         rig_s * 1e3
     );
-    println!("  render        {:>8.1} ms", render_s * 1e3);
-    for path in [&rig_path, &rest_path, &preview_path] {
+    println!("  rest pose     {:>8.1} ms", rest_s * 1e3);
+    println!(
+        "  animate       {:>8.1} ms ({frame_count} frames at {DEMO_FPS} fps, sampled and rendered)",
+        render_s * 1e3
+    );
+    println!(
+        "  write         {:>8.1} ms (GIFs, sheets, frames)",
+        write_s * 1e3
+    );
+    for path in &written {
         println!("  wrote {}", path.display());
     }
     println!(
@@ -415,6 +553,9 @@ fn demo(args: &DemoArgs) -> Result<()> {
     );
     Ok(())
 }
+
+/// Frame rate of the demo's renders.
+const DEMO_FPS: f64 = 24.0;
 
 /// The folder a file will be written in (`.` for a bare file name).
 fn parent_dir(path: &Path) -> &Path {

@@ -11,6 +11,7 @@ pub mod geom;
 pub mod io;
 pub mod mesh;
 pub mod pipeline;
+pub mod playback;
 pub mod render;
 pub mod rig;
 pub mod skin;

@@ -227,7 +227,10 @@ mod tests {
         assert_eq!(some.sheet.max_side_px, 2048);
         assert_eq!(some.sheet.padding_px, 2);
         let text = serde_json::to_string(&some).unwrap();
-        assert_eq!(serde_json::from_str::<SequenceOptions>(&text).unwrap(), some);
+        assert_eq!(
+            serde_json::from_str::<SequenceOptions>(&text).unwrap(),
+            some
+        );
     }
 
     #[test]

@@ -1,0 +1,183 @@
+//! Playing an animation into frames.
+//!
+//! In: a [`Scene`], an [`Animation`], a frame rate and a [`FrameView`] (output size in px, the
+//! scale from canvas px to output px, an optional background). Out: one straight-alpha RGBA8
+//! image per frame, at times 0, 1/fps, 2/fps, … up to but not including the animation's
+//! duration (the loop's end is its start), ready for [`crate::io::sequence`].
+//!
+//! Frames render in parallel; each is computed on its own, so the output does not depend on
+//! the thread count.
+
+use crate::anim::Animation;
+use crate::pipeline::{PipelineError, Scene};
+use crate::render;
+use crate::rig::Pose;
+use crate::skin::Blend;
+use image::RgbaImage;
+use rayon::prelude::*;
+
+/// Frame rates above this are refused: nothing plays them, and a typo (`--fps 2400`) would
+/// otherwise render for minutes.
+pub const MAX_FPS: f64 = 240.0;
+
+/// Where frames are drawn: an output of `size_px`, the canvas scaled by `scale` about its
+/// center and centered in it, over `background` (straight RGBA8; transparent when `None`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameView {
+    pub size_px: [u32; 2],
+    pub scale: f64,
+    pub background: Option<[u8; 4]>,
+}
+
+/// What is wrong with a playback request.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PlaybackError {
+    #[error("the frame rate must be a number in (0, {MAX_FPS}] frames per second, not {0}")]
+    Fps(f64),
+    #[error("the scale must be a positive number, not {0}")]
+    Scale(f64),
+    #[error("the output size must be at least 1×1 px")]
+    Size,
+}
+
+impl FrameView {
+    /// The canvas at `scale`, in an output of `size_px` (default: the scaled canvas, rounded
+    /// up).
+    pub fn new(
+        canvas_px: [u32; 2],
+        scale: f64,
+        size_px: Option<[u32; 2]>,
+        background: Option<[u8; 4]>,
+    ) -> Result<Self, PlaybackError> {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(PlaybackError::Scale(scale));
+        }
+        let size_px = size_px
+            .unwrap_or_else(|| canvas_px.map(|c| (f64::from(c) * scale).ceil().max(1.0) as u32));
+        if size_px.contains(&0) {
+            return Err(PlaybackError::Size);
+        }
+        Ok(FrameView {
+            size_px,
+            scale,
+            background,
+        })
+    }
+
+    /// Output px from canvas px: scale about the canvas center, then center in the output.
+    pub fn output_from_canvas(&self, canvas_px: [u32; 2]) -> tiny_skia::Transform {
+        let s = self.scale as f32;
+        let half = |c: u32| c as f32 / 2.0;
+        let tx = half(self.size_px[0]) - s * half(canvas_px[0]);
+        let ty = half(self.size_px[1]) - s * half(canvas_px[1]);
+        tiny_skia::Transform::from_row(s, 0.0, 0.0, s, tx, ty)
+    }
+}
+
+/// Frame times (s) of an animation lasting `duration_s` played at `fps`: 0, 1/fps, … while
+/// below the duration; a single frame at 0 for an animation without duration.
+pub fn frame_times(duration_s: f64, fps: f64) -> Result<Vec<f64>, PlaybackError> {
+    if !(fps.is_finite() && fps > 0.0 && fps <= MAX_FPS) {
+        return Err(PlaybackError::Fps(fps));
+    }
+    // A frame that lands on the duration up to rounding is the loop's start again.
+    let count = ((duration_s * fps) - FRAME_TIME_SLACK).ceil().max(1.0) as usize;
+    Ok((0..count).map(|i| i as f64 / fps).collect())
+}
+
+/// How far below a whole frame count `duration · fps` may fall and still count as it.
+const FRAME_TIME_SLACK: f64 = 1e-9;
+
+/// The poses of `animation` at `times_s`, looping.
+pub fn poses_at(animation: &Animation, times_s: &[f64]) -> Vec<Pose> {
+    times_s.iter().map(|&t| animation.sample(t, true)).collect()
+}
+
+/// Renders one pose through `view`.
+pub fn render_pose(
+    scene: &Scene,
+    pose: &Pose,
+    blend: Blend,
+    view: &FrameView,
+) -> Result<RgbaImage, PipelineError> {
+    let positions = scene.pose_positions_with(pose, blend)?;
+    let [w, h] = view.size_px;
+    let mut canvas = tiny_skia::Pixmap::new(w, h).ok_or(PipelineError::Canvas(view.size_px))?;
+    if let Some([r, g, b, a]) = view.background {
+        canvas.fill(tiny_skia::Color::from_rgba8(r, g, b, a));
+    }
+    draw_pose(
+        scene,
+        &mut canvas,
+        &positions,
+        pose,
+        view.output_from_canvas(scene.doc.canvas),
+    )?;
+    Ok(render::rgba_from_pixmap(&canvas))
+}
+
+/// Draws the parts at `positions` as `pose` shows them (tint, visibility, draw order).
+fn draw_pose(
+    scene: &Scene,
+    canvas: &mut tiny_skia::Pixmap,
+    positions: &[Vec<crate::geom::Point>],
+    _pose: &Pose,
+    output_from_canvas: tiny_skia::Transform,
+) -> Result<(), PipelineError> {
+    scene.draw(canvas, positions, output_from_canvas)
+}
+
+/// Renders every pose through `view`, in parallel; `on_frame` is called once per finished
+/// frame (for a progress bar).
+pub fn render_poses(
+    scene: &Scene,
+    poses: &[Pose],
+    blend: Blend,
+    view: &FrameView,
+    on_frame: &(dyn Fn() + Sync),
+) -> Result<Vec<RgbaImage>, PipelineError> {
+    poses
+        .par_iter()
+        .map(|pose| {
+            let frame = render_pose(scene, pose, blend, view);
+            on_frame();
+            frame
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_times_stop_before_the_loop_end() {
+        let t = frame_times(1.0, 4.0).unwrap();
+        assert_eq!(t, vec![0.0, 0.25, 0.5, 0.75]);
+        // 1.05 s at 10 fps: the frame at 1.0 s is still inside.
+        assert_eq!(frame_times(1.05, 10.0).unwrap().len(), 11);
+        // Rounding in duration · fps does not add a frame at the end.
+        assert_eq!(frame_times(0.7, 30.0).unwrap().len(), 21);
+        assert_eq!(frame_times(0.0, 24.0).unwrap(), vec![0.0]);
+        assert_eq!(frame_times(1.0, 0.0), Err(PlaybackError::Fps(0.0)));
+        assert!(frame_times(1.0, f64::NAN).is_err());
+    }
+
+    #[test]
+    fn the_view_centers_the_scaled_canvas() {
+        let view = FrameView::new([100, 50], 2.0, None, None).unwrap();
+        assert_eq!(view.size_px, [200, 100]);
+        let t = view.output_from_canvas([100, 50]);
+        let mut p = [tiny_skia::Point::from_xy(50.0, 25.0)];
+        t.map_points(&mut p);
+        assert_eq!((p[0].x, p[0].y), (100.0, 50.0));
+        let padded = FrameView::new([100, 50], 1.0, Some([300, 300]), None).unwrap();
+        let mut q = [tiny_skia::Point::from_xy(0.0, 0.0)];
+        padded.output_from_canvas([100, 50]).map_points(&mut q);
+        assert_eq!((q[0].x, q[0].y), (100.0, 125.0));
+        assert_eq!(
+            FrameView::new([10, 10], 0.0, None, None),
+            Err(PlaybackError::Scale(0.0))
+        );
+    }
+}
