@@ -257,3 +257,137 @@ fn bad_handles_fail_cleanly_without_output() {
     assert_bad_input(&["pose", s(&out), "--pose", s(&ik), "-o", s(&png)], "IK");
     assert!(!png.exists());
 }
+
+#[test]
+fn demo_writes_rig_animations_gifs_and_sheets_and_render_and_pose_play_them() {
+    let dir = scratch("demo");
+    let out = sinew(&["demo", "-o", s(&dir)]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in [
+        "character.json",
+        "rest.png",
+        "walk.gif",
+        "walk.png",
+        "walk.json",
+        "wave.gif",
+    ] {
+        assert!(
+            dir.join(name).is_file(),
+            "demo did not write {name}: {stdout}"
+        );
+    }
+    // The walk lasts 1 s: 24 frames at the demo's 24 fps, in the GIF, the sheet and the folder.
+    let gif = std::fs::File::open(dir.join("walk.gif")).unwrap();
+    let mut decoder = gif::DecodeOptions::new().read_info(gif).unwrap();
+    let mut frames = 0;
+    while decoder.read_next_frame().unwrap().is_some() {
+        frames += 1;
+    }
+    assert_eq!(frames, 24);
+    let sheet: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("walk.json")).unwrap()).unwrap();
+    assert_eq!(sheet["frames"].as_object().unwrap().len(), 24);
+    assert_eq!(std::fs::read_dir(dir.join("walk")).unwrap().count(), 24);
+
+    // The rig document carries the animations: render and pose play them.
+    let rig = dir.join("character.json");
+    let gif_out = dir.join("again.gif");
+    let out = sinew(&[
+        "render",
+        s(&rig),
+        "--anim",
+        "wave",
+        "--fps",
+        "8",
+        "-o",
+        s(&gif_out),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(gif_out.is_file());
+    let frame = dir.join("walk_quarter.png");
+    let out = sinew(&[
+        "pose",
+        s(&rig),
+        "--anim",
+        "walk",
+        "--time",
+        "0.25",
+        "-o",
+        s(&frame),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rest = image::open(dir.join("rest.png")).unwrap().to_rgba8();
+    let posed = image::open(&frame).unwrap().to_rgba8();
+    assert_eq!(rest.dimensions(), posed.dimensions());
+    assert_ne!(
+        rest.as_raw(),
+        posed.as_raw(),
+        "a walk frame must differ from rest"
+    );
+
+    // Bad requests: one line, exit 2, nothing written.
+    assert_bad_input(
+        &[
+            "render",
+            s(&rig),
+            "--anim",
+            "moonwalk",
+            "-o",
+            s(&dir.join("x.gif")),
+        ],
+        "no animation 'moonwalk'",
+    );
+    assert_bad_input(
+        &[
+            "render",
+            s(&rig),
+            "--anim",
+            "walk",
+            "--fps",
+            "0",
+            "-o",
+            s(&dir.join("y.gif")),
+        ],
+        "frame rate",
+    );
+    assert_bad_input(
+        &[
+            "render",
+            s(&rig),
+            "--anim",
+            "walk",
+            "-o",
+            s(&dir.join("z.txt")),
+        ],
+        "z.txt",
+    );
+    assert_bad_input(
+        &[
+            "render",
+            s(&rig),
+            "--anim",
+            "walk",
+            "--background",
+            "#zzz",
+            "-o",
+            s(&dir.join("w.gif")),
+        ],
+        "zzz",
+    );
+    for name in ["x.gif", "y.gif", "z.txt", "w.gif"] {
+        assert!(!dir.join(name).exists(), "{name} was written");
+    }
+}
