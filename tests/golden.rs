@@ -181,6 +181,22 @@ fn bundled_poses_match_golden() {
 }
 
 #[test]
+fn bundled_animations_match_golden_at_fixed_times() {
+    let animations: std::collections::BTreeMap<String, serde_json::Value> = serde_json::from_str(
+        &std::fs::read_to_string(assets().join("animations.json")).expect("animations.json"),
+    )
+    .expect("animations.json parses");
+    let animations = sinew::anim::parse_animations(&animations).expect("the animations check");
+    for (name, times_s) in [("walk", [0.25, 0.6]), ("wave", [0.4, 1.1])] {
+        let animation = &animations[name];
+        for t in times_s {
+            let pose = animation.sample(t, true);
+            check_golden(&format!("{name}_{:04}ms", (t * 1000.0) as u32), &render_pose(&pose));
+        }
+    }
+}
+
+#[test]
 fn a_two_degree_turn_fails() {
     // The reach pose with one forearm turned 2° further must not pass as the reach pose.
     let mut pose = load_pose("reach");
