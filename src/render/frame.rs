@@ -72,19 +72,34 @@ pub fn draw_parts(
             });
         }
     }
-    let mut scratch = DrawScratch::default();
-    for draw in draws.iter().filter(|d| d.visible) {
-        let part = &parts[draw.part];
-        part.mesh.draw_with(
-            canvas,
-            &part.texture,
-            draw.positions_px,
-            canvas_from_world,
-            draw.tint,
-            &mut scratch,
-        );
-    }
+    SCRATCH.with(|kept| {
+        // A fresh one only if this thread is already drawing (a draw inside a draw).
+        let mut fresh = DrawScratch::default();
+        let mut kept = kept.try_borrow_mut();
+        let scratch = match kept.as_deref_mut() {
+            Ok(kept) => kept,
+            Err(_) => &mut fresh,
+        };
+        for draw in draws.iter().filter(|d| d.visible) {
+            let part = &parts[draw.part];
+            part.mesh.draw_with(
+                canvas,
+                &part.texture,
+                draw.positions_px,
+                canvas_from_world,
+                draw.tint,
+                scratch,
+            );
+        }
+    });
     Ok(())
+}
+
+thread_local! {
+    /// Buffers kept between frames (a part's coverage region is up to a few MB on a large
+    /// canvas; growing and zeroing them anew each frame costs more than drawing small parts).
+    /// What they hold never reaches the output: every draw clears or rewrites what it reads.
+    static SCRATCH: std::cell::RefCell<DrawScratch> = std::cell::RefCell::new(DrawScratch::default());
 }
 
 #[cfg(test)]
