@@ -9,7 +9,7 @@
 use crate::geom::Point;
 use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
-use crate::render::{self, MeshRenderer, RenderError};
+use crate::render::{self, MeshRenderer, PartDraw, RenderError, RenderPart, Texture};
 use crate::rig::pose::bone_stretches;
 use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
 use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
@@ -339,8 +339,7 @@ fn texture_border_px(doc: &RigDocument) -> u32 {
 /// A document with its textures and per-part render state, ready to draw.
 pub struct Scene {
     pub doc: RigDocument,
-    textures: Vec<tiny_skia::Pixmap>,
-    renderers: Vec<MeshRenderer>,
+    parts: Vec<RenderPart>,
 }
 
 impl Scene {
@@ -357,8 +356,7 @@ impl Scene {
 
     /// A scene from a document and its parts' images (in part order).
     pub fn new(doc: RigDocument, images: &[RgbaImage]) -> Result<Self, PipelineError> {
-        let mut textures = Vec::with_capacity(images.len());
-        let mut renderers = Vec::with_capacity(images.len());
+        let mut parts = Vec::with_capacity(images.len());
         for (part, image) in doc.parts.iter().zip(images) {
             let got = [image.width(), image.height()];
             if got != doc.canvas {
@@ -377,25 +375,16 @@ impl Scene {
             let mut framed =
                 RgbaImage::new(image.width() + 2 * border, image.height() + 2 * border);
             image::imageops::replace(&mut framed, image, i64::from(border), i64::from(border));
-            let renderer = MeshRenderer::new(&uv_px, &mesh.triangles).map_err(|source| {
-                PipelineError::Render {
-                    part: part.name.clone(),
-                    source,
-                }
-            })?;
-            textures.push(render::pixmap_from_rgba(&framed).map_err(|source| {
-                PipelineError::Render {
-                    part: part.name.clone(),
-                    source,
-                }
-            })?);
-            renderers.push(renderer);
+            let render_error = |source| PipelineError::Render {
+                part: part.name.clone(),
+                source,
+            };
+            parts.push(RenderPart {
+                mesh: MeshRenderer::new(&uv_px, &mesh.triangles).map_err(render_error)?,
+                texture: Texture::from_rgba(&framed).map_err(render_error)?,
+            });
         }
-        Ok(Scene {
-            doc,
-            textures,
-            renderers,
-        })
+        Ok(Scene { doc, parts })
     }
 
     /// Every part's rest vertex positions.
@@ -482,6 +471,7 @@ impl Scene {
         positions: &[Vec<Point>],
         canvas_from_world: tiny_skia::Transform,
     ) -> Result<(), PipelineError> {
+        let mut draws = Vec::with_capacity(self.doc.parts.len());
         for (i, part) in self.doc.parts.iter().enumerate() {
             let expected = part.mesh.vertices.len();
             let part_positions = positions.get(i).map(Vec::as_slice).unwrap_or_default();
@@ -492,15 +482,35 @@ impl Scene {
                     expected,
                 });
             }
-            self.renderers[i].draw(
-                canvas,
-                self.textures[i].as_ref(),
-                part_positions,
-                canvas_from_world,
-                1.0,
-            );
+            draws.push(PartDraw::new(i, part_positions));
         }
-        Ok(())
+        self.draw_parts(canvas, &draws, canvas_from_world)
+    }
+
+    /// Draws `draws` in the listed order (first = furthest back) onto `canvas` through
+    /// `canvas_from_world`; each names a part by its index in the document and brings its
+    /// positions (world px), tint and visibility. Draws nothing if a visible draw names no part
+    /// or brings the wrong number of positions.
+    pub fn draw_parts(
+        &self,
+        canvas: &mut tiny_skia::Pixmap,
+        draws: &[PartDraw],
+        canvas_from_world: tiny_skia::Transform,
+    ) -> Result<(), PipelineError> {
+        render::draw_parts(canvas, &self.parts, draws, canvas_from_world).map_err(|source| {
+            let index = match source {
+                RenderError::UnknownPart { part, .. } | RenderError::PositionCount { part, .. } => {
+                    part
+                }
+                _ => usize::MAX,
+            };
+            let part = self
+                .doc
+                .parts
+                .get(index)
+                .map_or_else(|| format!("#{index}"), |p| p.name.clone());
+            PipelineError::Render { part, source }
+        })
     }
 }
 

@@ -116,15 +116,37 @@ pub fn render_pose(
     Ok(render::rgba_from_pixmap(&canvas))
 }
 
-/// Draws the parts at `positions` as `pose` shows them (tint, visibility, draw order).
-fn draw_pose(
+/// Draws the parts at `positions` as `pose` shows them: its draw order (the document's
+/// otherwise), each part's tint and visibility.
+pub fn draw_pose(
     scene: &Scene,
     canvas: &mut tiny_skia::Pixmap,
     positions: &[Vec<crate::geom::Point>],
-    _pose: &Pose,
+    pose: &Pose,
     output_from_canvas: tiny_skia::Transform,
 ) -> Result<(), PipelineError> {
-    scene.draw(canvas, positions, output_from_canvas)
+    let parts = &scene.doc.parts;
+    let order: Vec<usize> = match &pose.draw_order {
+        Some(names) => names
+            .iter()
+            .filter_map(|n| parts.iter().position(|p| &p.name == n))
+            .collect(),
+        None => (0..parts.len()).collect(),
+    };
+    let draws: Vec<render::PartDraw> = order
+        .into_iter()
+        .map(|i| {
+            let mut draw =
+                render::PartDraw::new(i, positions.get(i).map(Vec::as_slice).unwrap_or_default());
+            if let Some(state) = pose.parts.get(&parts[i].name) {
+                let [r, g, b, a] = state.color.map(|c| c as f32);
+                draw.tint = render::Tint { r, g, b, a };
+                draw.visible = state.visible;
+            }
+            draw
+        })
+        .collect();
+    scene.draw_parts(canvas, &draws, output_from_canvas)
 }
 
 /// Renders every pose through `view`, in parallel; `on_frame` is called once per finished

@@ -191,7 +191,10 @@ fn bundled_animations_match_golden_at_fixed_times() {
         let animation = &animations[name];
         for t in times_s {
             let pose = animation.sample(t, true);
-            check_golden(&format!("{name}_{:04}ms", (t * 1000.0) as u32), &render_pose(&pose));
+            check_golden(
+                &format!("{name}_{:04}ms", (t * 1000.0) as u32),
+                &render_pose(&pose),
+            );
         }
     }
 }

@@ -1,53 +1,44 @@
-//! One part's textured, deformed mesh → a layer → the canvas (see the module doc of
-//! [`super`] for the approach).
+//! One part's textured, deformed mesh → the canvas (see the module doc of [`super`] for the
+//! approach).
 //!
 //! Spaces: texture pixels (the mesh's rest positions), world pixels (the deformed positions),
-//! canvas pixels (world through `canvas_from_world`) and layer pixels (canvas pixels shifted
-//! by the integer origin of the part's layer).
+//! canvas pixels (world through `canvas_from_world`) and region pixels (canvas pixels relative
+//! to the corner of the part's clipped bounding box, where its coverage lives).
 
-use tiny_skia::{
-    BlendMode, FillRule, FilterQuality, Mask, Paint, PathBuilder, Pattern, Pixmap, PixmapRef,
-    SpreadMode, Transform,
-};
+use tiny_skia::{Pixmap, Transform};
 
 use crate::geom::Point;
 
-use super::composite::{composite_layer, Coverage};
-use super::pixel_math::CHANNEL_MAX;
-use super::topology::{BoundaryEdge, Mat2, TexturedTriangle, Topology, DEGENERATE_AREA2_PX2};
+use super::blend::{source_over, tinted, Tint, TintFactors};
+use super::coverage::CoverageMask;
+use super::raster::{floor_i64, for_each_run, to_fixed, FixedPoint, PixelRect, MAX_COORD_PX};
+use super::skirt::skirt_offsets;
+use super::texture::{sampler_coord, sampler_step, Texture};
+use super::topology::{TexturedTriangle, Topology, DEGENERATE_AREA2_PX2};
+use super::vec2::{add, cross, mat_mul, mat_vec, sub};
 use super::RenderError;
 
-/// How far, in output pixels, the skirt extends the mesh past its boundary edges.
-///
-/// A pixel that the antialiased boundary covers partly has its center at most √2/2 px outside
-/// the boundary, and needs texture colour there; 1 px covers that with margin.
-pub const SKIRT_PX: f64 = 1.0;
-
-/// Longest skirt offset at a vertex, as a multiple of [`SKIRT_PX`]. A mitre grows as
-/// 1/sin(θ/2) at a corner of angle θ; past this (corners sharper than ~29°, as SVG's default
-/// miter limit) the skirt is cut short and the very tip of the corner loses a little coverage.
-const MAX_MITER_RATIO: f64 = 4.0;
-
-/// Length, in px, below which an edge or a sum of normals has no usable direction.
-const MIN_DIRECTION_PX: f64 = 1e-9;
-
-/// Extra pixels kept around the part's bounding box in its layer, so that rounding in the
-/// rasterizer can never push coverage off the layer.
-const LAYER_MARGIN_PX: f64 = 1.0;
-
-/// Scale added to a pattern map that is a pure translation by a fractional offset: tiny-skia
-/// samples any pure translation with nearest-neighbour filtering, which would snap a part moved
-/// by a fraction of a pixel to whole pixels. The change is below 0.001 px over 2000 px.
-const BILINEAR_NUDGE: f32 = 4.0 * f32::EPSILON;
+/// Whole pixels kept around the part's bounding box in its coverage region, so that rounding can
+/// never push coverage off the region.
+const REGION_MARGIN_PX: f64 = 1.0;
 
 /// The per-mesh state rendering needs that does not change between frames.
 pub struct MeshRenderer {
     topology: Topology,
 }
 
+/// Buffers one draw needs, kept between parts and frames to save allocations.
+#[derive(Default)]
+pub(super) struct DrawScratch {
+    coverage: CoverageMask,
+    points: Vec<[f64; 2]>,
+    fixed: Vec<FixedPoint>,
+    maps: Vec<Option<TextureMap>>,
+}
+
 impl MeshRenderer {
     /// Precomputes what drawing needs from the mesh's connectivity and rest positions
-    /// (`uv_px`: texture pixels): the texture-space basis of each triangle, the boundary edges
+    /// (`uv_px`: texture pixels): the texture-space edges of each triangle, the boundary edges
     /// and the boundary loops.
     ///
     /// Triangles with (near) zero area in texture space are kept out: they cannot carry a
@@ -64,410 +55,312 @@ impl MeshRenderer {
         self.topology.vertex_count
     }
 
-    /// Draws the mesh textured with `texture` (premultiplied, sampled in texture pixels)
-    /// source-over onto `canvas`, with its vertices at `positions_px` (world pixels, one per
-    /// vertex, in the order of `uv_px`) mapped through `canvas_from_world`, at `opacity`
-    /// (0..=1) for the part as a whole.
+    /// Draws the mesh textured with `texture` (sampled in texture pixels) source-over onto
+    /// `canvas`, with its vertices at `positions_px` (world pixels, one per vertex, in the order
+    /// of `uv_px`) mapped through `canvas_from_world`, its colours multiplied by `tint`.
     ///
-    /// Draws nothing when the positions do not match the mesh (wrong count, NaN or infinite),
-    /// when opacity is not positive, or when the part lies off the canvas. Triangles flipped by
-    /// the deformation are drawn; triangles collapsed to (near) zero area are skipped.
+    /// Draws nothing when the positions do not match the mesh (wrong count, NaN or infinite, or
+    /// beyond ±2²⁰ canvas px), when the tint's alpha is not positive, or when the part lies off
+    /// the canvas. Triangles flipped by the deformation are drawn; triangles collapsed to (near)
+    /// zero area are skipped. Where triangles overlap (a fold), the one listed last shows.
     pub fn draw(
         &self,
         canvas: &mut Pixmap,
-        texture: PixmapRef,
+        texture: &Texture,
         positions_px: &[Point],
         canvas_from_world: Transform,
-        opacity: f32,
+        tint: Tint,
     ) {
-        let opacity = opacity_u8(opacity);
-        if opacity == 0 || self.topology.triangles.is_empty() {
-            return;
-        }
-        let Some(mut points) =
-            canvas_positions(positions_px, self.topology.vertex_count, canvas_from_world)
-        else {
-            return;
-        };
-        let Some(region) = LayerRegion::around(&points, canvas.width(), canvas.height()) else {
-            return;
-        };
-        let Some(mut layer) = Pixmap::new(region.width, region.height) else {
-            return;
-        };
-        region.shift_to_layer(&mut points);
-        self.paint_layer(&mut layer, texture, &points);
-
-        let mask = if self.topology.loops.is_empty() {
-            None
-        } else {
-            match self.boundary_mask(&points, region.width, region.height) {
-                Some(mask) => Some(mask),
-                None => return,
-            }
-        };
-        let coverage = match &mask {
-            Some(mask) => Coverage::Masked(mask),
-            // No boundary (every edge shared twice): nothing to antialias against.
-            None => Coverage::Everywhere,
-        };
-        composite_layer(canvas, &layer, coverage, (region.x, region.y), opacity);
+        let mut scratch = DrawScratch::default();
+        self.draw_with(
+            canvas,
+            texture,
+            positions_px,
+            canvas_from_world,
+            tint,
+            &mut scratch,
+        );
     }
 
-    /// Fills the skirts, then every triangle, into `layer` (transparent, layer pixels).
-    ///
-    /// Skirts go first so that where one reaches over the mesh (at a concave corner) the
-    /// triangle's own texture replaces it.
-    fn paint_layer(&self, layer: &mut Pixmap, texture: PixmapRef, layer_px: &[[f64; 2]]) {
-        let maps: Vec<Option<Affine>> = self
-            .topology
-            .triangles
-            .iter()
-            .map(|t| Affine::texture_to_layer(t, layer_px))
-            .collect();
-        let mut painter = TexturePainter::new(texture, layer.width(), layer.height());
+    /// [`MeshRenderer::draw`] with caller-kept buffers.
+    pub(super) fn draw_with(
+        &self,
+        canvas: &mut Pixmap,
+        texture: &Texture,
+        positions_px: &[Point],
+        canvas_from_world: Transform,
+        tint: Tint,
+        scratch: &mut DrawScratch,
+    ) {
+        let tint = TintFactors::new(tint);
+        if tint.is_invisible() || self.topology.triangles.is_empty() {
+            return;
+        }
+        if !canvas_positions(
+            positions_px,
+            self.topology.vertex_count,
+            canvas_from_world,
+            &mut scratch.points,
+        ) {
+            return;
+        }
+        let points = &scratch.points;
+        let Some(region) = region_around(points, canvas.width(), canvas.height()) else {
+            return;
+        };
+        self.cover(points, region, &mut scratch.coverage);
 
-        let offsets = skirt_offsets(&self.topology, layer_px);
+        scratch.fixed.clear();
+        scratch
+            .fixed
+            .extend(points.iter().filter_map(|&p| to_fixed(p)));
+        scratch.maps.clear();
+        scratch.maps.extend(
+            self.topology
+                .triangles
+                .iter()
+                .map(|t| TextureMap::new(t, points)),
+        );
+        let canvas_width = canvas.width() as usize;
+        let mut target = Target {
+            canvas: canvas.data_mut(),
+            canvas_width,
+            region,
+            coverage: scratch.coverage.coverage_mut(),
+            texture,
+            tint,
+        };
+        // Each pixel is drawn once, by the first shape that owns its center: the target clears
+        // its coverage on drawing. Last-listed triangles go first so that they show in a fold,
+        // and triangles before skirts so that a skirt reaching over the mesh (at a concave
+        // corner) never hides the mesh's own texture.
+        for (triangle, map) in self.topology.triangles.iter().zip(&scratch.maps).rev() {
+            if let Some(map) = map {
+                let corners = triangle.vertices.map(|v| scratch.fixed[v as usize]);
+                target.fill_triangle(corners, map);
+            }
+        }
+        let offsets = skirt_offsets(&self.topology, points);
         for edge in &self.topology.boundary_edges {
-            if let Some(map) = maps[edge.triangle] {
-                let (a, b) = (layer_px[edge.from as usize], layer_px[edge.to as usize]);
-                let quad = [
-                    a,
-                    b,
-                    add(b, offsets[edge.to_slot]),
-                    add(a, offsets[edge.from_slot]),
-                ];
-                painter.fill(layer, &quad, map);
-            }
-        }
-        for (triangle, map) in self.topology.triangles.iter().zip(&maps) {
-            if let Some(map) = *map {
-                let corners = triangle.vertices.map(|v| layer_px[v as usize]);
-                painter.fill(layer, &corners, map);
-            }
-        }
-    }
-
-    /// An antialiased coverage mask of the boundary loops, layer-sized; `None` when it cannot
-    /// be built (then nothing should be drawn).
-    fn boundary_mask(&self, layer_px: &[[f64; 2]], width: u32, height: u32) -> Option<Mask> {
-        let mut builder = PathBuilder::new();
-        for ring in &self.topology.loops {
-            let mut vertices = ring.iter().map(|&v| layer_px[v as usize]);
-            let Some([x, y]) = vertices.next() else {
+            let Some(map) = &scratch.maps[edge.triangle] else {
                 continue;
             };
-            builder.move_to(x as f32, y as f32);
-            for [x, y] in vertices {
-                builder.line_to(x as f32, y as f32);
+            let (a, b) = (points[edge.from as usize], points[edge.to as usize]);
+            let outward = (
+                to_fixed(add(a, offsets[edge.from_slot])),
+                to_fixed(add(b, offsets[edge.to_slot])),
+            );
+            let (Some(a_out), Some(b_out)) = outward else {
+                continue;
+            };
+            let (a, b) = (
+                scratch.fixed[edge.from as usize],
+                scratch.fixed[edge.to as usize],
+            );
+            for corners in [[a, b, b_out], [a, b_out, a_out]] {
+                target.fill_triangle(corners, map);
             }
-            builder.close();
         }
-        let path = builder.finish()?;
-        let mut mask = Mask::new(width, height)?;
-        // Non-zero winding: holes run opposite to the outer boundary and stay empty, while a
-        // mirrored or folded-over part still counts as inside.
-        mask.fill_path(&path, FillRule::Winding, true, Transform::identity());
-        Some(mask)
+    }
+
+    /// The exact area coverage of the part's boundary loops over `region`.
+    fn cover(&self, points: &[[f64; 2]], region: PixelRect, coverage: &mut CoverageMask) {
+        let (width, height) = (
+            (region.x1 - region.x0) as usize,
+            (region.y1 - region.y0) as usize,
+        );
+        coverage.start(width, height);
+        if self.topology.loops.is_empty() {
+            // No boundary (every edge shared twice): nothing to antialias against.
+            coverage.cover_everything();
+            return;
+        }
+        let origin = [region.x0 as f64, region.y0 as f64];
+        let local = |v: u32| sub(points[v as usize], origin);
+        for ring in &self.topology.loops {
+            for (k, &v) in ring.iter().enumerate() {
+                let next = ring[(k + 1) % ring.len()];
+                coverage.add_edge(local(v), local(next));
+            }
+        }
+        coverage.finish();
     }
 }
 
-/// Opacity 0..=1 as an 8-bit coverage factor; NaN and negatives become 0.
-fn opacity_u8(opacity: f32) -> u8 {
-    if opacity > 0.0 {
-        (opacity.min(1.0) * CHANNEL_MAX as f32).round() as u8
-    } else {
-        0
-    }
-}
-
-/// World positions mapped to canvas pixels, or `None` unless there is exactly one finite
-/// position per vertex.
+/// Fills `points` with the world positions mapped to canvas pixels; `false` unless there is
+/// exactly one position per vertex and every mapped one is finite and within
+/// [`MAX_COORD_PX`].
 fn canvas_positions(
     positions_px: &[Point],
     vertex_count: usize,
     canvas_from_world: Transform,
-) -> Option<Vec<[f64; 2]>> {
+    points: &mut Vec<[f64; 2]>,
+) -> bool {
     if positions_px.len() != vertex_count {
-        return None;
+        return false;
     }
     let t = canvas_from_world;
     let [sx, kx, tx, ky, sy, ty] = [t.sx, t.kx, t.tx, t.ky, t.sy, t.ty].map(f64::from);
-    positions_px
-        .iter()
-        .map(|p| {
-            let q = [sx * p.x + kx * p.y + tx, ky * p.x + sy * p.y + ty];
-            (q[0].is_finite() && q[1].is_finite()).then_some(q)
-        })
-        .collect()
+    points.clear();
+    points.extend(
+        positions_px
+            .iter()
+            .map(|p| [sx * p.x + kx * p.y + tx, ky * p.x + sy * p.y + ty]),
+    );
+    // The comparison is false for NaN.
+    let usable = |v: f64| v.abs() <= MAX_COORD_PX;
+    points.iter().all(|p| usable(p[0]) && usable(p[1]))
 }
 
-/// The canvas pixels a part's layer covers: its bounding box with a margin, clipped to the
-/// canvas.
-struct LayerRegion {
-    x: u32,
-    y: u32,
-    width: u32,
-    height: u32,
+/// The canvas pixels the part can cover: its bounding box with a margin, clipped to the canvas;
+/// `None` if that misses the canvas.
+fn region_around(points: &[[f64; 2]], canvas_width: u32, canvas_height: u32) -> Option<PixelRect> {
+    let (min, max) = points.iter().fold(
+        ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+        |(min, max), p| {
+            (
+                [min[0].min(p[0]), min[1].min(p[1])],
+                [max[0].max(p[0]), max[1].max(p[1])],
+            )
+        },
+    );
+    let (x0, x1) = clipped_span(min[0], max[0], canvas_width)?;
+    let (y0, y1) = clipped_span(min[1], max[1], canvas_height)?;
+    Some(PixelRect { x0, y0, x1, y1 })
 }
 
-impl LayerRegion {
-    /// The region around `points` (canvas pixels, finite), or `None` if it misses the canvas.
-    fn around(points: &[[f64; 2]], canvas_width: u32, canvas_height: u32) -> Option<Self> {
-        let (min, max) = points.iter().fold(
-            ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-            |(min, max), p| {
-                (
-                    [min[0].min(p[0]), min[1].min(p[1])],
-                    [max[0].max(p[0]), max[1].max(p[1])],
-                )
-            },
-        );
-        let (x, width) = clipped_span(min[0], max[0], canvas_width)?;
-        let (y, height) = clipped_span(min[1], max[1], canvas_height)?;
-        Some(LayerRegion {
-            x,
-            y,
-            width,
-            height,
-        })
-    }
-
-    /// Shifts canvas pixel positions into this layer's pixels.
-    fn shift_to_layer(&self, points: &mut [[f64; 2]]) {
-        let (dx, dy) = (f64::from(self.x), f64::from(self.y));
-        for p in points {
-            *p = [p[0] - dx, p[1] - dy];
-        }
-    }
-}
-
-/// The whole pixels touched by [lo, hi] plus the margin, clipped to 0..limit, as
-/// (start, length); `None` if empty.
-fn clipped_span(lo: f64, hi: f64, limit: u32) -> Option<(u32, u32)> {
+/// The whole pixels touched by [lo, hi] plus the margin, clipped to 0..limit, as a half-open
+/// range; `None` if empty.
+fn clipped_span(lo: f64, hi: f64, limit: u32) -> Option<(i64, i64)> {
     let limit = f64::from(limit);
-    let start = (lo.floor() - LAYER_MARGIN_PX).clamp(0.0, limit);
-    let end = (hi.ceil() + LAYER_MARGIN_PX).clamp(0.0, limit);
-    (end > start).then_some((start as u32, (end - start) as u32))
+    let start = (lo.floor() - REGION_MARGIN_PX).clamp(0.0, limit);
+    let end = (hi.ceil() + REGION_MARGIN_PX).clamp(0.0, limit);
+    (end > start).then_some((start as i64, end as i64))
 }
 
-/// An affine map from texture pixels to layer pixels: `linear · uv + translation`.
-#[derive(Clone, Copy)]
-struct Affine {
-    linear: Mat2,
-    translation: [f64; 2],
+/// A triangle's affine map from canvas pixels to sampler coordinates, in fixed point so that
+/// each run of pixels starts with a few integer operations.
+struct TextureMap {
+    /// A pixel near the triangle (the one holding its first corner) and the sampler coordinates
+    /// of its center. Steps are rounded to 1/2¹⁶ texel, so measuring from nearby keeps the
+    /// accumulated error far below the 1/256 texel the sampler resolves.
+    reference_px: [i64; 2],
+    at_reference: [i64; 2],
+    /// Sampler steps of (u, v) per pixel to the right and per pixel down.
+    step_x: [i64; 2],
+    step_y: [i64; 2],
 }
 
-impl Affine {
-    /// The map taking the triangle's rest corners onto its corners in `layer_px`, or `None`
-    /// when the triangle has (near) zero area there.
-    fn texture_to_layer(triangle: &TexturedTriangle, layer_px: &[[f64; 2]]) -> Option<Self> {
-        let [p0, p1, p2] = triangle.vertices.map(|v| layer_px[v as usize]);
+impl TextureMap {
+    /// The map taking the triangle's corners at `points` (canvas px) back onto its rest corners,
+    /// or `None` when the triangle has (near) zero area on the canvas.
+    fn new(triangle: &TexturedTriangle, points: &[[f64; 2]]) -> Option<Self> {
+        let [p0, p1, p2] = triangle.vertices.map(|v| points[v as usize]);
         let (e1, e2) = (sub(p1, p0), sub(p2, p0));
-        if cross(e1, e2).abs() <= DEGENERATE_AREA2_PX2 {
+        let det = cross(e1, e2);
+        if det.abs() <= DEGENERATE_AREA2_PX2 {
             return None;
         }
-        let edges = [[e1[0], e2[0]], [e1[1], e2[1]]];
-        let linear = mat_mul(edges, triangle.uv_basis_inverse);
-        let translation = sub(p0, mat_vec(linear, triangle.uv_origin));
-        Some(Affine {
-            linear,
-            translation,
+        let inverse_det = 1.0 / det;
+        let canvas_edges_inverse = [
+            [e2[1] * inverse_det, -e2[0] * inverse_det],
+            [-e1[1] * inverse_det, e1[0] * inverse_det],
+        ];
+        let linear = mat_mul(triangle.uv_edges, canvas_edges_inverse);
+        let reference_px = p0.map(floor_i64);
+        let center = reference_px.map(|v| v as f64 + 0.5);
+        let uv = add(mat_vec(linear, sub(center, p0)), triangle.uv_origin);
+        Some(TextureMap {
+            reference_px,
+            at_reference: uv.map(sampler_coord),
+            step_x: [sampler_step(linear[0][0]), sampler_step(linear[1][0])],
+            step_y: [sampler_step(linear[0][1]), sampler_step(linear[1][1])],
         })
     }
 
-    /// The map as a tiny-skia pattern transform, nudged off pure fractional translations so
-    /// that it is still sampled bilinearly (see [`BILINEAR_NUDGE`]).
-    fn to_pattern_transform(self) -> Transform {
-        let [[sx, kx], [ky, sy]] = self.linear.map(|row| row.map(|v| v as f32));
-        let [tx, ty] = self.translation.map(|v| v as f32);
-        let mut t = Transform::from_row(sx, ky, kx, sy, tx, ty);
-        if t.is_translate() && (tx.fract() != 0.0 || ty.fract() != 0.0) {
-            t.sx += BILINEAR_NUDGE;
-            t.sy += BILINEAR_NUDGE;
-        }
-        t
+    /// The sampler coordinates of the center of canvas pixel (`x`, `y`).
+    fn at_pixel(&self, x: i64, y: i64) -> [i64; 2] {
+        let (dx, dy) = (x - self.reference_px[0], y - self.reference_px[1]);
+        [0, 1].map(|k| self.at_reference[k] + dx * self.step_x[k] + dy * self.step_y[k])
     }
 }
 
-/// Fills polygons into a layer with the texture under a per-polygon affine map, reusing one
-/// path allocation throughout.
-struct TexturePainter<'a> {
-    texture: PixmapRef<'a>,
-    builder: Option<PathBuilder>,
-    width: f64,
-    height: f64,
+/// Where and how runs of pixels are drawn for one part.
+struct Target<'a> {
+    /// Premultiplied RGBA8, row-major.
+    canvas: &'a mut [u8],
+    canvas_width: usize,
+    region: PixelRect,
+    /// The region's coverage; a drawn pixel's is set to 0 so nothing draws it again.
+    coverage: &'a mut [u8],
+    texture: &'a Texture,
+    tint: TintFactors,
 }
 
-impl<'a> TexturePainter<'a> {
-    fn new(texture: PixmapRef<'a>, width: u32, height: u32) -> Self {
-        TexturePainter {
-            texture,
-            builder: Some(PathBuilder::new()),
-            width: f64::from(width),
-            height: f64::from(height),
-        }
+impl Target<'_> {
+    /// Draws the pixels the triangle `corners` owns that are not drawn yet, each with the
+    /// texture sampled at its center through `map`.
+    fn fill_triangle(&mut self, corners: [FixedPoint; 3], map: &TextureMap) {
+        for_each_run(corners, self.region, |row, start, end| {
+            self.fill_run(row, start, end, map)
+        });
     }
 
-    /// Fills the polygon `corners` (layer pixels) without antialiasing, replacing what is
-    /// there: every pixel whose center lies inside gets the texture sampled through `map`.
-    fn fill(&mut self, layer: &mut Pixmap, corners: &[[f64; 2]], map: Affine) {
-        if self.misses_layer(corners) {
-            return;
+    /// Draws the pixels `start..end` of `row` (canvas pixels, inside the region) not drawn yet.
+    #[inline(always)]
+    fn fill_run(&mut self, row: i64, start: i64, end: i64, map: &TextureMap) {
+        let region_width = (self.region.x1 - self.region.x0) as usize;
+        let mask_row = (row - self.region.y0) as usize * region_width;
+        let mask = &mut self.coverage[mask_row + (start - self.region.x0) as usize
+            ..mask_row + (end - self.region.x0) as usize];
+        let canvas_row = row as usize * self.canvas_width;
+        let pixels =
+            &mut self.canvas[(canvas_row + start as usize) * 4..(canvas_row + end as usize) * 4];
+        let at = map.at_pixel(start, row);
+        if self.texture.holds_run(at, map.step_x, end - start) {
+            shade_run::<false>(mask, pixels, self.texture, self.tint, at, map.step_x);
+        } else {
+            shade_run::<true>(mask, pixels, self.texture, self.tint, at, map.step_x);
         }
-        let mut builder = self.builder.take().unwrap_or_default();
-        let mut corner_iter = corners.iter();
-        if let Some(&[x, y]) = corner_iter.next() {
-            builder.move_to(x as f32, y as f32);
-        }
-        for &[x, y] in corner_iter {
-            builder.line_to(x as f32, y as f32);
-        }
-        builder.close();
-        let Some(path) = builder.finish() else {
-            return;
-        };
-        let paint = Paint {
-            shader: Pattern::new(
-                self.texture,
-                SpreadMode::Pad,
-                FilterQuality::Bilinear,
-                1.0,
-                map.to_pattern_transform(),
-            ),
-            blend_mode: BlendMode::Source,
-            anti_alias: false,
-            ..Paint::default()
-        };
-        layer.fill_path(
-            &path,
-            &paint,
-            FillRule::Winding,
-            Transform::identity(),
-            None,
-        );
-        self.builder = Some(path.clear());
-    }
-
-    /// Whether the polygon's bounding box lies entirely off the layer (saves tiny-skia's
-    /// per-fill setup for parts of a zoomed-in view that are off screen).
-    fn misses_layer(&self, corners: &[[f64; 2]]) -> bool {
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for c in corners {
-            lo = [lo[0].min(c[0]), lo[1].min(c[1])];
-            hi = [hi[0].max(c[0]), hi[1].max(c[1])];
-        }
-        hi[0] < 0.0 || hi[1] < 0.0 || lo[0] > self.width || lo[1] > self.height
     }
 }
 
-/// Per boundary vertex (indexed like `Topology::boundary_vertices`), the displacement from the
-/// vertex to its skirt corner, in layer pixels: along the bisector of the outward normals of
-/// its boundary edges, long enough that every edge's skirt is [`SKIRT_PX`] wide (a mitre),
-/// capped at [`MAX_MITER_RATIO`].
-fn skirt_offsets(topology: &Topology, layer_px: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    let edges = &topology.boundary_edges;
-    let normals: Vec<Option<[f64; 2]>> =
-        edges.iter().map(|e| outward_normal(e, layer_px)).collect();
-
-    let slots = topology.boundary_vertices.len();
-    let mut sums = vec![[0.0; 2]; slots];
-    for (e, n) in edges.iter().zip(&normals) {
-        if let Some(n) = *n {
-            sums[e.from_slot] = add(sums[e.from_slot], n);
-            sums[e.to_slot] = add(sums[e.to_slot], n);
-        }
-    }
-    // Opposite normals cancel at a needle tip or a vertex with no usable edge; such a vertex
-    // gets no skirt corner, which only thins the skirt next to it.
-    let bisectors: Vec<Option<[f64; 2]>> = sums.into_iter().map(unit).collect();
-
-    let mut min_cos = vec![1.0f64; slots];
-    for (e, n) in edges.iter().zip(&normals) {
-        if let Some(n) = *n {
-            for slot in [e.from_slot, e.to_slot] {
-                if let Some(b) = bisectors[slot] {
-                    min_cos[slot] = min_cos[slot].min(dot(b, n));
+/// Samples, scales and blends each pixel of a run whose coverage is not zero yet, then clears
+/// its coverage; `CLAMP` as for [`Texture::sample`].
+#[inline(always)]
+fn shade_run<const CLAMP: bool>(
+    coverage: &mut [u8],
+    pixels: &mut [u8],
+    texture: &Texture,
+    tint: TintFactors,
+    [mut u, mut v]: [i64; 2],
+    [du, dv]: [i64; 2],
+) {
+    let untinted = tint.is_identity();
+    for (cover, px) in coverage.iter_mut().zip(pixels.chunks_exact_mut(4)) {
+        let amount = *cover;
+        if amount != 0 {
+            *cover = 0;
+            let src = texture.sample::<CLAMP>(u, v);
+            if src != 0 {
+                let src = if untinted && amount == u8::MAX {
+                    src
+                } else {
+                    tinted(src, u32::from(amount), tint)
+                };
+                if let Ok(px) = <&mut [u8; 4]>::try_from(px) {
+                    let out = if src >> 24 == 0xFF {
+                        src
+                    } else {
+                        source_over(u32::from_le_bytes(*px), src)
+                    };
+                    *px = out.to_le_bytes();
                 }
             }
         }
+        u += du;
+        v += dv;
     }
-    bisectors
-        .iter()
-        .zip(&min_cos)
-        .map(|(b, &cos)| match b {
-            Some(b) => scale(*b, SKIRT_PX / cos.max(1.0 / MAX_MITER_RATIO)),
-            None => [0.0; 2],
-        })
-        .collect()
-}
-
-/// The unit normal of a boundary edge pointing away from its triangle in the current
-/// deformation (so it follows flips and mirroring), or `None` when the edge or the triangle has
-/// collapsed.
-fn outward_normal(edge: &BoundaryEdge, layer_px: &[[f64; 2]]) -> Option<[f64; 2]> {
-    let [a, b, c] = [edge.from, edge.to, edge.opposite].map(|v| layer_px[v as usize]);
-    let along = sub(b, a);
-    let length = dot(along, along).sqrt();
-    if length < MIN_DIRECTION_PX {
-        return None;
-    }
-    let normal = [along[1] / length, -along[0] / length];
-    let inward_reach = dot(normal, sub(c, a));
-    if (inward_reach * length).abs() <= DEGENERATE_AREA2_PX2 {
-        return None;
-    }
-    Some(if inward_reach > 0.0 {
-        scale(normal, -1.0)
-    } else {
-        normal
-    })
-}
-
-fn add(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] + b[0], a[1] + b[1]]
-}
-
-fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    [a[0] - b[0], a[1] - b[1]]
-}
-
-fn scale(a: [f64; 2], s: f64) -> [f64; 2] {
-    [a[0] * s, a[1] * s]
-}
-
-fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
-    a[0] * b[0] + a[1] * b[1]
-}
-
-fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
-    a[0] * b[1] - a[1] * b[0]
-}
-
-/// `a` scaled to length 1, or `None` if it is too short to have a direction.
-fn unit(a: [f64; 2]) -> Option<[f64; 2]> {
-    let length = dot(a, a).sqrt();
-    (length >= MIN_DIRECTION_PX).then(|| scale(a, 1.0 / length))
-}
-
-fn mat_mul(a: Mat2, b: Mat2) -> Mat2 {
-    [
-        [
-            a[0][0] * b[0][0] + a[0][1] * b[1][0],
-            a[0][0] * b[0][1] + a[0][1] * b[1][1],
-        ],
-        [
-            a[1][0] * b[0][0] + a[1][1] * b[1][0],
-            a[1][0] * b[0][1] + a[1][1] * b[1][1],
-        ],
-    ]
-}
-
-fn mat_vec(m: Mat2, v: [f64; 2]) -> [f64; 2] {
-    [
-        m[0][0] * v[0] + m[0][1] * v[1],
-        m[1][0] * v[0] + m[1][1] * v[1],
-    ]
 }
 
 #[cfg(test)]
@@ -477,7 +370,7 @@ mod tests {
     use crate::render::test_support::{
         canvas, colorful_image, colorful_texture, distance_to_ring, fan_mesh, grid_mesh, linspace,
     };
-    use crate::render::{max_channel_diff_where, pixmap_from_rgba, psnr_rgba, rgba_from_pixmap};
+    use crate::render::{max_channel_diff_where, psnr_rgba, rgba_from_pixmap};
 
     /// PSNR, in dB, above which a render counts as reproducing its texture.
     const REST_POSE_MIN_PSNR_DB: f64 = 45.0;
@@ -503,10 +396,10 @@ mod tests {
         )
     }
 
-    fn draw_rest_pose(uv: &[Point], triangles: &[[u32; 3]], texture: &Pixmap) -> Pixmap {
+    fn draw_rest_pose(uv: &[Point], triangles: &[[u32; 3]], texture: &Texture) -> Pixmap {
         let renderer = MeshRenderer::new(uv, triangles).expect("valid mesh");
         let mut out = canvas(texture.width(), texture.height());
-        renderer.draw(&mut out, texture.as_ref(), uv, Transform::identity(), 1.0);
+        renderer.draw(&mut out, texture, uv, Transform::identity(), Tint::WHITE);
         out
     }
 
@@ -514,7 +407,7 @@ mod tests {
     fn rest_pose_grid_reproduces_texture() {
         let inside = |x: f64, y: f64| (8.0..56.0).contains(&x) && (8.0..56.0).contains(&y);
         let expected = colorful_image(64, 64, inside);
-        let texture = pixmap_from_rgba(&expected).expect("non-empty");
+        let texture = Texture::from_rgba(&expected).expect("non-empty");
         let (uv, triangles) = grid_mesh(&linspace(4.0, 60.0, 9), &linspace(4.0, 60.0, 9));
 
         let got = rgba_from_pixmap(&draw_rest_pose(&uv, &triangles, &texture));
@@ -529,7 +422,7 @@ mod tests {
     fn rest_pose_fan_of_thin_triangles_reproduces_texture() {
         let center = Point::new(32.0, 32.0);
         let expected = colorful_image(64, 64, |x, y| (Point::new(x, y) - center).norm() < 22.0);
-        let texture = pixmap_from_rgba(&expected).expect("non-empty");
+        let texture = Texture::from_rgba(&expected).expect("non-empty");
         let (uv, triangles) = fan_mesh(center, 28.0, 90);
 
         let got = rgba_from_pixmap(&draw_rest_pose(&uv, &triangles, &texture));
@@ -543,13 +436,13 @@ mod tests {
     #[test]
     fn view_transform_moves_the_part() {
         let expected = colorful_image(32, 32, |x, y| x > 4.0 && y > 4.0 && x < 28.0 && y < 28.0);
-        let texture = pixmap_from_rgba(&expected).expect("non-empty");
+        let texture = Texture::from_rgba(&expected).expect("non-empty");
         let (uv, triangles) = grid_mesh(&linspace(2.0, 30.0, 5), &linspace(2.0, 30.0, 5));
         let renderer = MeshRenderer::new(&uv, &triangles).expect("valid mesh");
         let mut out = canvas(48, 48);
         let shift = Transform::from_translate(10.0, 5.0);
 
-        renderer.draw(&mut out, texture.as_ref(), &uv, shift, 1.0);
+        renderer.draw(&mut out, &texture, &uv, shift, Tint::WHITE);
 
         let got = rgba_from_pixmap(&out);
         let moved = image::imageops::crop_imm(&got, 10, 5, 32, 32).to_image();
@@ -558,6 +451,14 @@ mod tests {
 
     #[test]
     fn deformed_mesh_with_slivers_has_no_seams() {
+        for zoom in [1.0, 4.0] {
+            slivers_have_no_seams_at(zoom);
+        }
+    }
+
+    /// The sliver mesh drawn through a view scaling by `zoom`: every pixel well inside is
+    /// opaque.
+    fn slivers_have_no_seams_at(zoom: f64) {
         let texture = colorful_texture(128, 128, |_, _| true);
         // A grid with a few columns and rows only a hair apart: cells there split into
         // slivers down to 0.001 px wide.
@@ -574,16 +475,16 @@ mod tests {
             .map(|&p| deform(p, center, 7.0, 1.04, 1.5))
             .collect();
         let renderer = MeshRenderer::new(&uv, &triangles).expect("valid mesh");
-        let mut out = canvas(128, 128);
+        let side = (128.0 * zoom) as u32;
+        let mut out = canvas(side, side);
+        let view = Transform::from_scale(zoom as f32, zoom as f32);
 
-        renderer.draw(
-            &mut out,
-            texture.as_ref(),
-            &positions,
-            Transform::identity(),
-            1.0,
-        );
+        renderer.draw(&mut out, &texture, &positions, view, Tint::WHITE);
 
+        let positions: Vec<Point> = positions
+            .iter()
+            .map(|p| Point::from(p.coords * zoom))
+            .collect();
         let (nx, ny) = (xs.len(), ys.len());
         let perimeter: Vec<usize> = (0..nx)
             .chain((1..ny).map(|j| j * nx + nx - 1))
@@ -599,12 +500,13 @@ mod tests {
             for x in 0..out.width() {
                 let c = pixel_center(x, y);
                 if point_in_ring(c, &ring) && distance_to_ring(c, &ring) >= clearance {
-                    assert_eq!(alpha_at(&out, x, y), 255, "seam at ({x}, {y})");
+                    assert_eq!(alpha_at(&out, x, y), 255, "seam at ({x}, {y}), zoom {zoom}");
                     checked += 1;
                 }
             }
         }
-        assert!(checked > 8000, "only {checked} pixels checked");
+        let expected = 8000.0 * zoom * zoom;
+        assert!(checked as f64 > expected, "only {checked} pixels checked");
     }
 
     /// Largest difference between a pixel's alpha and 255 × its exact coverage by the shape:
@@ -642,10 +544,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &positions,
             Transform::identity(),
-            1.0,
+            Tint::WHITE,
         );
 
         let mut partial = 0;
@@ -667,12 +569,12 @@ mod tests {
     }
 
     /// An 8×8 opaque texture, black left of x = 4 and white right of it.
-    fn black_white_texture() -> Pixmap {
+    fn black_white_texture() -> Texture {
         let img = image::RgbaImage::from_fn(8, 8, |x, _| {
             let v = if x < 4 { 0 } else { 255 };
             image::Rgba([v, v, v, 255])
         });
-        pixmap_from_rgba(&img).expect("non-empty")
+        Texture::from_rgba(&img).expect("non-empty")
     }
 
     fn red_at(p: &Pixmap, x: u32, y: u32) -> i32 {
@@ -689,10 +591,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &positions,
             Transform::identity(),
-            1.0,
+            Tint::WHITE,
         );
 
         // Pixel 7's center maps to texture x = 3.75, a quarter of the way from the black texel
@@ -718,10 +620,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &positions,
             Transform::identity(),
-            1.0,
+            Tint::WHITE,
         );
 
         // Pixel 8's center maps to texture x = 4.0, halfway between black and white.
@@ -732,9 +634,44 @@ mod tests {
     }
 
     #[test]
+    fn a_part_moved_by_a_fraction_of_a_pixel_moves_by_that_fraction() {
+        let texture = black_white_texture();
+        let (uv, triangles) = grid_mesh(&linspace(0.0, 8.0, 3), &linspace(0.0, 8.0, 3));
+        let renderer = MeshRenderer::new(&uv, &triangles).expect("valid mesh");
+        let red_row = |shift_px: f64| {
+            let moved: Vec<Point> = uv
+                .iter()
+                .map(|p| p + nalgebra::Vector2::new(shift_px, 0.0))
+                .collect();
+            let mut out = canvas(12, 8);
+            renderer.draw(
+                &mut out,
+                &texture,
+                &moved,
+                Transform::identity(),
+                Tint::WHITE,
+            );
+            (0..12).map(|x| red_at(&out, x, 4)).collect::<Vec<i32>>()
+        };
+        // Unmoved, pixel 4 is the first white texel. Moved right by d, its center samples
+        // texture x = 4.5 − d, a fraction 1 − d of the way from the black texel center (3.5) to
+        // the white one (4.5).
+        assert_eq!(red_row(0.0)[4], 255);
+        for shift_px in [0.1, 0.3, 0.6] {
+            let row = red_row(shift_px);
+            let expected = 255.0 * (1.0 - shift_px);
+            assert!(
+                (f64::from(row[4]) - expected).abs() <= 2.0,
+                "moved {shift_px} px: {row:?}"
+            );
+            assert_eq!(row[3], 0, "moved {shift_px} px: {row:?}");
+        }
+    }
+
+    #[test]
     fn translucent_texture_blends_source_over_at_opacity() {
         let straight = image::RgbaImage::from_pixel(16, 16, image::Rgba([200, 0, 0, 128]));
-        let texture = pixmap_from_rgba(&straight).expect("non-empty");
+        let texture = Texture::from_rgba(&straight).expect("non-empty");
         let (uv, triangles) = grid_mesh(&linspace(0.0, 16.0, 3), &linspace(0.0, 16.0, 3));
         let renderer = MeshRenderer::new(&uv, &triangles).expect("valid mesh");
         let mut out = canvas(16, 16);
@@ -743,10 +680,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &uv,
             Transform::identity(),
-            opacity,
+            Tint::opacity(opacity),
         );
 
         let src_alpha = 128.0 / 255.0 * f64::from(opacity);
@@ -809,10 +746,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &positions,
             Transform::identity(),
-            1.0,
+            Tint::WHITE,
         );
 
         assert_eq!(
@@ -836,40 +773,40 @@ mod tests {
         let mut out = canvas(16, 16);
         let id = Transform::identity();
 
-        flat.draw(&mut out, texture.as_ref(), &collinear, id, 1.0);
-        tri.draw(&mut out, texture.as_ref(), &good[..2], id, 1.0);
+        flat.draw(&mut out, &texture, &collinear, id, Tint::WHITE);
+        tri.draw(&mut out, &texture, &good[..2], id, Tint::WHITE);
         tri.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &[good[0], good[1], Point::new(f64::NAN, 1.0)],
             id,
-            1.0,
+            Tint::WHITE,
         );
-        tri.draw(&mut out, texture.as_ref(), &good, id, f32::NAN);
-        tri.draw(&mut out, texture.as_ref(), &good, id, 0.0);
+        tri.draw(&mut out, &texture, &good, id, Tint::opacity(f32::NAN));
+        tri.draw(&mut out, &texture, &good, id, Tint::opacity(0.0));
         tri.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &good,
             Transform::from_scale(0.0, 0.0),
-            1.0,
+            Tint::WHITE,
         );
         tri.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &good,
             Transform::from_translate(-100.0, 0.0),
-            1.0,
+            Tint::WHITE,
         );
         assert!(out.data().iter().all(|&b| b == 0));
 
         // Absurd zoom: must not panic, whatever it draws.
         tri.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &good,
             Transform::from_scale(1e30, 1e30),
-            1.0,
+            Tint::WHITE,
         );
     }
 
@@ -888,10 +825,10 @@ mod tests {
 
         renderer.draw(
             &mut out,
-            texture.as_ref(),
+            &texture,
             &positions,
             Transform::identity(),
-            1.0,
+            Tint::WHITE,
         );
 
         assert_eq!(alpha_at(&out, 22, 10), 255);
@@ -901,44 +838,5 @@ mod tests {
             .filter(|&x| (1..255).contains(&alpha_at(&out, x, 16)))
             .count();
         assert!(partial >= 1);
-    }
-
-    /// Prints timing only; asserts nothing. Run with
-    /// `cargo test --release --lib render -- --ignored --nocapture`.
-    #[test]
-    #[ignore]
-    fn timing_512px_part_with_1000_triangles() {
-        let center = Point::new(256.0, 256.0);
-        let texture = colorful_texture(512, 512, |x, y| (Point::new(x, y) - center).norm() < 240.0);
-        let (uv, triangles) = grid_mesh(&linspace(8.0, 504.0, 23), &linspace(8.0, 504.0, 23));
-        let positions: Vec<Point> = uv
-            .iter()
-            .map(|&p| deform(p, center, 4.0, 0.97, 3.0))
-            .collect();
-        let renderer = MeshRenderer::new(&uv, &triangles).expect("valid mesh");
-        let mut out = canvas(512, 512);
-        let runs = 20;
-        let mut times = Vec::with_capacity(runs);
-        for _ in 0..runs {
-            let start = std::time::Instant::now();
-            renderer.draw(
-                &mut out,
-                texture.as_ref(),
-                &positions,
-                Transform::identity(),
-                1.0,
-            );
-            times.push(start.elapsed().as_secs_f64() * 1e3);
-        }
-        times.sort_by(f64::total_cmp);
-        let drawn = out.pixels().iter().filter(|p| p.alpha() > 0).count();
-        println!(
-            "draw 512×512 part, {} triangles, {drawn} px drawn: median {:.2} ms, min {:.2} ms \
-             ({:.1} ns/px at the minimum)",
-            triangles.len(),
-            times[runs / 2],
-            times[0],
-            times[0] * 1e6 / drawn as f64
-        );
     }
 }

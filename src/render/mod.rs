@@ -1,58 +1,70 @@
-//! Deformed textured meshes → pixels, with tiny-skia.
+//! Deformed textured meshes → pixels, with a scanline rasterizer of our own.
 //!
-//! In: a canvas `Pixmap` (premultiplied RGBA) and, per part, a texture (premultiplied
-//! `Pixmap`), the mesh's rest vertex positions in texture pixels (`uv_px`), its triangles, and
-//! per frame its deformed vertex positions in world pixels (the rig's canvas pixels) plus a
-//! `canvas_from_world` transform for the view. Out: the part composited source-over onto the
-//! canvas with bilinear sampling, antialiased outer edges and no seams between adjacent
-//! triangles. Pixel (i, j) covers [i, i+1) × [j, j+1) in every space, as in tiny-skia.
+//! In: a canvas `Pixmap` (premultiplied RGBA8) and, per part, a [`Texture`] (premultiplied),
+//! the mesh's rest vertex positions in texture pixels (`uv_px`), its triangles, and per frame
+//! its deformed vertex positions in world pixels (the rig's canvas pixels), a [`Tint`] and a
+//! visibility flag, plus a `canvas_from_world` transform for the view ([`draw_parts`] takes a
+//! list of [`PartDraw`]s in the caller's order). Out: each part composited source-over onto the
+//! canvas with bilinear sampling, antialiased outer edges, no seams between adjacent triangles
+//! and no snapping of sub-pixel positions. Pixel (i, j) covers [i, i+1) × [j, j+1) in every
+//! space, as in tiny-skia. The output is a pure function of the inputs: integer arithmetic
+//! decides ownership and blending, and nothing depends on the thread count.
 //!
 //! How a part is drawn ([`MeshRenderer::draw`]):
 //!
-//! 1. Each part is painted into its own scratch layer the size of the part's bounding box
-//!    (clipped to the canvas), not straight onto the canvas. Every triangle is filled without
-//!    antialiasing, with a `Pattern` shader carrying the triangle's affine texture → output map
-//!    and `BlendMode::Source`. Non-antialiased fills sample pixel centers, and adjacent
-//!    triangles share their edge's exact coordinates, so the triangles partition the pixel
-//!    centers and no seam can appear (antialiased triangles would each cover a shared edge
-//!    pixel partially, and 1 - (1 - a)(1 - b) < 1 leaves a hairline).
-//! 2. Before the triangles, a "skirt" quad is filled outward from every boundary edge
-//!    ([`SKIRT_PX`] wide, mitred at the vertices so the skirts of adjacent edges meet) with
-//!    the affine map of the edge's triangle extended past the edge. Pixels whose center lies
-//!    just outside the mesh but whose area is partly inside it thereby get texture colour.
-//! 3. An antialiased `Mask` of the deformed boundary loops (non-zero winding, so holes stay
-//!    holes and a mirrored or folded part still counts as inside) gives each pixel's coverage.
-//! 4. The layer, times coverage and opacity, is composited source-over onto the canvas once.
+//! 1. Coverage ([`coverage`]): the part's boundary loops (non-zero winding, so holes stay holes
+//!    and a mirrored or folded part still counts as inside) give each pixel of the part's
+//!    bounding box the exact fraction of its area inside the part, by signed-area accumulation.
+//! 2. Triangles ([`raster`]): each triangle owns the pixels whose centers lie inside it, decided
+//!    in fixed point (1/256 px) with a tie rule that gives every center on a shared edge or
+//!    vertex to exactly one triangle, so adjacent triangles neither overlap nor leave a seam.
+//!    Each owned pixel samples the texture bilinearly ([`texture`]) at its center mapped through
+//!    the triangle's affine map (texture coordinates stay in `f64` until the per-row fixed-point
+//!    stepping, so placement is exact to 1/256 texel), is scaled by its coverage and the tint and
+//!    blended source-over ([`blend`]), and its coverage is then cleared, so that nothing draws
+//!    it twice.
+//! 3. Skirts ([`skirt`]): pixels partly covered by the part but whose centers lie just outside
+//!    it get their colour from a band 1 px wide outside each boundary edge, drawn the same way
+//!    with the map of the edge's triangle extended past the edge.
 //!
-//! Why a layer rather than drawing triangles straight onto the canvas: tiny-skia needs a mask
-//! the size of the target pixmap, so a layer keeps the mask as small as the part; `Source`
-//! fills make skirts that overlap triangles (at concave corners) and triangles that overlap
-//! each other (folds) replace rather than accumulate, so no pixel is blended twice; and
-//! opacity applies to the part as a whole, as a paint program applies layer opacity.
+//! Why not tiny-skia per triangle, as before: its per-fill set-up (path, edge list, pipeline
+//! compilation) costs about a microsecond per triangle and its `f32` bilinear pipeline tens of
+//! nanoseconds per pixel, where the bundled character has 16k triangles; and an antialiased
+//! mask per part layer plus a compositing pass cost a pass over the whole bounding box each.
+//! tiny-skia still draws the wireframe overlays and holds the canvas.
 //!
 //! Limits: at convex corners sharper than ~29° the skirt's mitre is capped, so the extreme tip
 //! can lose a little antialiased coverage; triangles of (near) zero area in texture or output
-//! space are skipped. Cost is dominated by tiny-skia's per-pixel bilinear sampling (its `f32`
-//! pipeline): a few tens of ns per covered pixel, plus on the order of a microsecond of set-up per
-//! triangle; the layer and mask cost one allocation each per part and frame.
+//! space are skipped; where triangles of one part overlap (a fold) the one listed last shows;
+//! canvas coordinates must stay within ±2²⁰ px.
 
+mod blend;
 mod compare;
-mod composite;
 mod convert;
+mod coverage;
+mod frame;
 mod mesh_renderer;
 mod pixel_math;
+mod raster;
+mod skirt;
+mod texture;
 mod topology;
+mod vec2;
 mod wireframe;
 
 #[cfg(test)]
 mod test_support;
 
+pub use blend::Tint;
 pub use compare::{max_channel_diff, max_channel_diff_where, psnr_premultiplied, psnr_rgba};
 pub use convert::{pixmap_from_rgba, rgba_from_pixmap};
-pub use mesh_renderer::{MeshRenderer, SKIRT_PX};
+pub use frame::{draw_parts, PartDraw, RenderPart};
+pub use mesh_renderer::MeshRenderer;
+pub use skirt::SKIRT_PX;
+pub use texture::Texture;
 pub use wireframe::draw_wireframe;
 
-/// Why a mesh or image cannot be rendered.
+/// Why a mesh, an image or a frame cannot be rendered.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RenderError {
     /// The mesh has no vertices or no triangles.
@@ -70,7 +82,17 @@ pub enum RenderError {
     /// A rest vertex position is NaN or infinite.
     #[error("vertex {vertex} has a non-finite texture position")]
     NonFiniteCoordinate { vertex: usize },
-    /// An image with no pixels, which a tiny-skia `Pixmap` cannot hold.
+    /// An image with no pixels.
     #[error("the image is empty ({width}×{height} px)")]
     EmptyImage { width: u32, height: u32 },
+    /// A draw names a part the frame was not given.
+    #[error("part {part} does not exist (there are {parts} parts)")]
+    UnknownPart { part: usize, parts: usize },
+    /// A draw brings a different number of positions than its part's mesh has vertices.
+    #[error("part {part}: {got} vertex positions for a mesh of {expected} vertices")]
+    PositionCount {
+        part: usize,
+        got: usize,
+        expected: usize,
+    },
 }

@@ -5,7 +5,7 @@ use tiny_skia::Pixmap;
 
 use crate::geom::Point;
 
-use super::pixmap_from_rgba;
+use super::Texture;
 
 /// A straight-alpha image, opaque and colourful where `opaque(x, y)` holds for the pixel
 /// center, transparent elsewhere. The colour varies smoothly in red and green and alternates
@@ -22,8 +22,8 @@ pub fn colorful_image(width: u32, height: u32, opaque: impl Fn(f64, f64) -> bool
 }
 
 /// [`colorful_image`] as a premultiplied texture.
-pub fn colorful_texture(width: u32, height: u32, opaque: impl Fn(f64, f64) -> bool) -> Pixmap {
-    pixmap_from_rgba(&colorful_image(width, height, opaque)).expect("non-empty test texture")
+pub fn colorful_texture(width: u32, height: u32, opaque: impl Fn(f64, f64) -> bool) -> Texture {
+    Texture::from_rgba(&colorful_image(width, height, opaque)).expect("non-empty test texture")
 }
 
 /// A transparent canvas.

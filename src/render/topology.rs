@@ -1,29 +1,27 @@
 //! What the renderer derives once from a mesh's connectivity and rest positions: the triangles
-//! that can carry a texture map (with their inverted texture-space basis), the boundary edges
+//! that can carry a texture map (with their texture-space edges), the boundary edges
 //! (edges of exactly one such triangle) and the boundary loops they chain into.
 //!
 //! All positions here are texture pixels; nothing depends on the deformation.
 
 use crate::geom::{triangle_area2, Point};
 
+use super::vec2::Mat2;
 use super::RenderError;
 
 /// Twice the area, in px², below which a triangle is treated as degenerate: it cannot define an
 /// affine map, and it covers no pixel center worth drawing.
 pub(super) const DEGENERATE_AREA2_PX2: f64 = 1e-9;
 
-/// A 2×2 matrix, row-major.
-pub(super) type Mat2 = [[f64; 2]; 2];
-
 /// A triangle with a usable texture-space shape.
 pub(super) struct TexturedTriangle {
     pub vertices: [u32; 3],
     /// Texture position of `vertices[0]`.
     pub uv_origin: [f64; 2],
-    /// Inverse of the matrix whose columns are the texture-space edges from `vertices[0]` to
-    /// `vertices[1]` and `vertices[2]`: maps a texture offset to edge coordinates, so that a
-    /// frame's affine map is one matrix product away.
-    pub uv_basis_inverse: Mat2,
+    /// The matrix whose columns are the texture-space edges from `vertices[0]` to `vertices[1]`
+    /// and `vertices[2]`: with the same matrix of a frame's edges it gives the triangle's
+    /// texture-from-canvas map.
+    pub uv_edges: Mat2,
 }
 
 /// A boundary edge, directed so that its triangle lies on the same side of every boundary edge
@@ -111,13 +109,13 @@ impl TexturedTriangle {
         Some(TexturedTriangle {
             vertices,
             uv_origin: [a.x, a.y],
-            uv_basis_inverse: [[e2.y / det, -e2.x / det], [-e1.y / det, e1.x / det]],
+            uv_edges: [[e1.x, e2.x], [e1.y, e2.y]],
         })
     }
 
     /// Whether the triangle runs clockwise on screen in texture space (see `triangle_area2`).
     fn is_clockwise(&self) -> bool {
-        let [[a, b], [c, d]] = self.uv_basis_inverse;
+        let [[a, b], [c, d]] = self.uv_edges;
         a * d - b * c > 0.0
     }
 }
