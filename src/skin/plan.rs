@@ -56,7 +56,7 @@ pub enum PlanError {
     MalformedWeights(&'static str),
     #[error("vertex {vertex}: rest position is not finite in f32")]
     NonFiniteRest { vertex: usize },
-    #[error("vertex {vertex}: weight is not finite")]
+    #[error("vertex {vertex}: weight is not finite in f32")]
     NonFiniteWeight { vertex: usize },
     #[error("vertex {vertex}: handle {handle} is past the plan's limit of 65536 handles")]
     HandleIndex { vertex: usize, handle: u32 },
@@ -153,8 +153,13 @@ impl LbsPlan {
             }
             keep_largest(&mut row, influences);
             for (k, &(id, w)) in row.iter().enumerate() {
+                // Finite in f64 is not enough: the weight must fit f32, also after rescaling.
+                let w = w as f32;
+                if !w.is_finite() {
+                    return Err(PlanError::NonFiniteWeight { vertex });
+                }
                 plan.handles[block * influences + k].0[lane] = id;
-                plan.weights[block * influences + k].0[lane] = w as f32;
+                plan.weights[block * influences + k].0[lane] = w;
             }
         }
         Ok(plan)
@@ -725,6 +730,11 @@ mod tests {
             LbsPlan::precompute(&rest[..1], &far, 4),
             Err(PlanError::HandleIndex { vertex: 0, .. })
         ));
+        let huge = SkinWeights::from_rows(&[vec![(0, 1e300)]]);
+        assert_eq!(
+            LbsPlan::precompute(&rest[..1], &huge, 4),
+            Err(PlanError::NonFiniteWeight { vertex: 0 })
+        );
         let mut nan_rest = rest.clone();
         nan_rest[2].y = f64::NAN;
         assert_eq!(
