@@ -1,12 +1,15 @@
-//! Linear blend skinning (`sinew::skin::linear_blend`) of 100k vertices with 4 influences each.
+//! Linear blend skinning of 100k vertices with 4 influences each: the f64 compressed-row path
+//! (`sinew::skin::linear_blend`) against the packed f32 plan (`sinew::skin::LbsPlan::solve`).
 //!
 //! Rest positions, weights (4 distinct handles per vertex out of 20, positive, summing to one) and
 //! the 20 affine transforms (rotation, anisotropic scale, translation) are random from a fixed
-//! seed, built once outside the timing; `out` is preallocated.
+//! seed, built once outside the timing; outputs are preallocated. Each path runs inside a rayon
+//! pool of fixed size (`ThreadPoolBuilder`), 1 and 2 threads:
 //!
-//! - `lbs/100kx4/global`: on rayon's global pool (as the app runs it; `RAYON_NUM_THREADS` sets its
-//!   size, all cores by default).
-//! - `lbs/100kx4/1thread`: inside a one-thread rayon pool's `install`, the single-core cost.
+//! - `lbs/100kx4/f64_csr_{1,2}thread`: the per-frame cost of `linear_blend` (f64 points).
+//! - `lbs/100kx4/f32_plan_{1,2}thread`: the per-frame cost of `LbsPlan::solve` (f32 `[x, y]`),
+//!   including turning the 20 transforms into its table.
+//! - `lbs_plan_precompute/100kx4`: the one-off `LbsPlan::precompute`.
 //!
 //! Target (on the two-core reference machine): 100k×4 < 0.25 ms on two threads.
 //!
@@ -15,7 +18,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sinew::geom::{Point, Vec2};
 use sinew::rig::pose::{rotation, Affine};
-use sinew::skin::{linear_blend, SkinWeights};
+use sinew::skin::{linear_blend, LbsPlan, SkinWeights};
 use std::hint::black_box;
 
 const VERTICES: usize = 100_000;
@@ -85,26 +88,50 @@ fn inputs() -> (Vec<Point>, SkinWeights, Vec<Affine>) {
     (rest, weights, transforms)
 }
 
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("rayon pool")
+}
+
 fn lbs(c: &mut Criterion) {
     let (rest, weights, transforms) = inputs();
-    let mut out = vec![Point::origin(); rest.len()];
+    let plan = LbsPlan::precompute(&rest, &weights, INFLUENCES).expect("plan");
+    let mut out_f64 = vec![Point::origin(); rest.len()];
+    let mut out_f32 = vec![[0.0f32; 2]; rest.len()];
     let id = format!("{}kx{INFLUENCES}", VERTICES / 1000);
     let mut group = c.benchmark_group("lbs");
     group.throughput(Throughput::Elements(VERTICES as u64));
-    println!(
-        "lbs: global rayon pool has {} threads",
-        rayon::current_num_threads()
-    );
-    group.bench_function(BenchmarkId::new(&id, "global"), |b| {
-        b.iter(|| linear_blend(black_box(&rest), &weights, &transforms, &mut out))
-    });
-    let single = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("one-thread pool");
-    group.bench_function(BenchmarkId::new(&id, "1thread"), |b| {
-        single
-            .install(|| b.iter(|| linear_blend(black_box(&rest), &weights, &transforms, &mut out)))
+    for threads in [1, 2] {
+        let pool = pool(threads);
+        let suffix = if threads == 1 { "thread" } else { "threads" };
+        group.bench_function(
+            BenchmarkId::new(&id, format!("f64_csr_{threads}{suffix}")),
+            |b| {
+                pool.install(|| {
+                    b.iter(|| linear_blend(black_box(&rest), &weights, &transforms, &mut out_f64))
+                })
+            },
+        );
+        group.bench_function(
+            BenchmarkId::new(&id, format!("f32_plan_{threads}{suffix}")),
+            |b| {
+                pool.install(|| {
+                    b.iter(|| {
+                        black_box(&plan)
+                            .solve(&transforms, &mut out_f32)
+                            .expect("solve")
+                    })
+                })
+            },
+        );
+    }
+    group.finish();
+    let mut group = c.benchmark_group("lbs_plan_precompute");
+    group.sample_size(10);
+    group.bench_function(&id, |b| {
+        b.iter(|| LbsPlan::precompute(black_box(&rest), &weights, INFLUENCES).expect("plan"))
     });
     group.finish();
 }

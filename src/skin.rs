@@ -6,6 +6,10 @@
 //! so that identity transforms give back the rest positions bit for bit, whatever rounding the
 //! weights' sum carries. Large meshes split across threads.
 //!
+//! For skinning the same mesh frame after frame, [`LbsPlan`] ([`plan`]) lays the weights out once
+//! (fixed influences per vertex, f32, blocks of 16 vertices) and skins in f32 several times
+//! faster than [`linear_blend`]; the f64 functions here stay the reference.
+//!
 //! Dual-quaternion blending ([`dual_quaternion_blend`], Kavan, Collins, Žára & O'Sullivan 2008)
 //! avoids LBS's collapse at strongly rotated joints: each transform is split by polar
 //! decomposition into a rotation and a stretch; stretches blend linearly in the rest frame,
@@ -15,6 +19,9 @@
 use crate::geom::Point;
 use crate::rig::pose::{Affine, BoneStretch};
 use rayon::prelude::*;
+
+pub mod plan;
+pub use plan::{LbsPlan, PlanError};
 
 /// Sparse weights in compressed rows: vertex i's influences are
 /// `handles[offsets[i]..offsets[i+1]]` with `weights[..]` alongside.
