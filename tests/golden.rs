@@ -82,36 +82,10 @@ fn load_pose(name: &str) -> Pose {
     serde_json::from_str(&std::fs::read_to_string(&path).expect("a pose file")).expect("a pose")
 }
 
-fn premultiplied(image: &RgbaImage) -> Vec<u8> {
-    image
-        .pixels()
-        .flat_map(|p| {
-            let a = u32::from(p[3]);
-            let m = |c: u8| ((u32::from(c) * a + 127) / 255) as u8;
-            [m(p[0]), m(p[1]), m(p[2]), p[3]]
-        })
-        .collect()
-}
-
 /// (largest premultiplied channel difference, premultiplied PSNR in dB).
 fn difference(a: &RgbaImage, b: &RgbaImage) -> (u8, f64) {
-    if a.dimensions() != b.dimensions() {
-        return (u8::MAX, f64::NEG_INFINITY);
-    }
-    let (pa, pb) = (premultiplied(a), premultiplied(b));
-    let mut max = 0u8;
-    let mut squared = 0.0;
-    for (&x, &y) in pa.iter().zip(&pb) {
-        let d = x.abs_diff(y);
-        max = max.max(d);
-        squared += f64::from(d) * f64::from(d);
-    }
-    let psnr = if squared == 0.0 {
-        f64::INFINITY
-    } else {
-        10.0 * (255.0f64 * 255.0 / (squared / pa.len() as f64)).log10()
-    };
-    (max, psnr)
+    let max = render::max_channel_diff(&render::premultiplied(a), &render::premultiplied(b));
+    (max, render::psnr_premultiplied(a, b))
 }
 
 fn within_tolerance(a: &RgbaImage, b: &RgbaImage) -> bool {
@@ -120,7 +94,8 @@ fn within_tolerance(a: &RgbaImage, b: &RgbaImage) -> bool {
 }
 
 fn diff_image(a: &RgbaImage, b: &RgbaImage) -> RgbaImage {
-    let (pa, pb) = (premultiplied(a), premultiplied(b));
+    let (pa, pb) = (render::premultiplied(a), render::premultiplied(b));
+    let (pa, pb) = (pa.as_raw(), pb.as_raw());
     RgbaImage::from_fn(a.width(), a.height(), |x, y| {
         let i = 4 * (y * a.width() + x) as usize;
         let d = |k: usize| (u16::from(pa[i + k].abs_diff(pb[i + k])) * DIFF_GAIN).min(255) as u8;

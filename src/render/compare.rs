@@ -40,7 +40,7 @@ pub fn psnr_premultiplied(a: &RgbaImage, b: &RgbaImage) -> f64 {
 }
 
 /// Each channel times alpha / 255, rounded to nearest.
-fn premultiplied(image: &RgbaImage) -> RgbaImage {
+pub fn premultiplied(image: &RgbaImage) -> RgbaImage {
     let mut out = image.clone();
     for px in out.pixels_mut() {
         let a = u32::from(px[3]);

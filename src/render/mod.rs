@@ -56,7 +56,9 @@ mod wireframe;
 mod test_support;
 
 pub use blend::Tint;
-pub use compare::{max_channel_diff, max_channel_diff_where, psnr_premultiplied, psnr_rgba};
+pub use compare::{
+    max_channel_diff, max_channel_diff_where, premultiplied, psnr_premultiplied, psnr_rgba,
+};
 pub use convert::{pixmap_from_rgba, rgba_from_pixmap};
 pub use frame::{draw_parts, PartDraw, RenderPart};
 pub use mesh_renderer::MeshRenderer;
