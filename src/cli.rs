@@ -242,7 +242,10 @@ fn rig(args: &RigArgs) -> Result<()> {
     let doc_dir = parent_dir(&args.output);
     let (doc, stats) = rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
     let preview = match &args.preview {
-        Some(_) => Some(preview_image(&doc, &layers)?),
+        Some(_) => {
+            let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+            Some(preview_image(&Scene::new(doc.clone(), &images)?)?)
+        }
         None => None,
     };
     doc.save(&args.output)?;
@@ -299,9 +302,8 @@ fn report_part(name: &str, r: &PartReport) {
 }
 
 /// The rest pose on white with every part's wireframe on top.
-fn preview_image(doc: &RigDocument, layers: &[pipeline::Layer]) -> Result<image::RgbaImage> {
-    let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
-    let scene = Scene::new(doc.clone(), &images)?;
+fn preview_image(scene: &Scene) -> Result<image::RgbaImage> {
+    let doc = &scene.doc;
     let [w, h] = doc.canvas;
     let mut canvas = tiny_skia::Pixmap::new(w, h).context("canvas too large")?;
     canvas.fill(tiny_skia::Color::WHITE);
@@ -491,7 +493,7 @@ fn demo(args: &DemoArgs) -> Result<()> {
     let rest_path = args.output.join("rest.png");
     io::save_png(&rest_path, &rest)?;
     let preview_path = args.output.join("mesh.png");
-    io::save_png(&preview_path, &preview_image(&doc, &layers)?)?;
+    io::save_png(&preview_path, &preview_image(&scene)?)?;
     written.extend([rest_path, preview_path]);
 
     let view = FrameView::new(doc.canvas, 1.0, None, None)?;
