@@ -177,6 +177,7 @@ impl BuildArgs {
             trace,
             mesh,
             weights,
+            ik: crate::ik::IkOptions::default(),
         }
     }
 }

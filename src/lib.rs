@@ -8,6 +8,7 @@
 pub mod anim;
 pub mod cli;
 pub mod geom;
+pub mod ik;
 pub mod io;
 pub mod mesh;
 pub mod pipeline;

@@ -7,10 +7,11 @@
 //!   and draws any vertex positions.
 
 use crate::geom::Point;
+use crate::ik::{RigIk, SkinnedMesh};
 use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
 use crate::render::{self, MeshRenderer, PartDraw, RenderError, RenderPart, Texture};
-use crate::rig::pose::bone_stretches;
+use crate::rig::pose::{bone_stretches, Affine};
 use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
 use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
@@ -76,8 +77,8 @@ pub enum PipelineError {
     Weights { path: PathBuf, source: WeightError },
     #[error("pose: {0}")]
     Pose(#[from] PoseError),
-    #[error("the pose has IK drags, which need the skinning IK solver; this build poses by forward kinematics only")]
-    IkUnsupported,
+    #[error("ik: {0}")]
+    Ik(#[from] crate::ik::IkError),
     #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
     UnknownWeightHandle { part: String, handle: String },
     #[error("canvas {0:?} px is too large to draw")]
@@ -340,6 +341,8 @@ fn texture_border_px(doc: &RigDocument) -> u32 {
 pub struct Scene {
     pub doc: RigDocument,
     parts: Vec<RenderPart>,
+    /// The skinning-IK precomputation, made the first time a pose has drags.
+    ik: std::sync::OnceLock<Result<RigIk, crate::ik::IkError>>,
 }
 
 impl Scene {
@@ -384,7 +387,11 @@ impl Scene {
                 texture: Texture::from_rgba(&framed).map_err(render_error)?,
             });
         }
-        Ok(Scene { doc, parts })
+        Ok(Scene {
+            doc,
+            parts,
+            ik: std::sync::OnceLock::new(),
+        })
     }
 
     /// Every part's rest vertex positions.
@@ -397,21 +404,129 @@ impl Scene {
     }
 
     /// Every part's vertex positions in `pose` (forward kinematics, then linear blend
-    /// skinning). Parts without weights stay at rest.
+    /// skinning; skinning IK first when the pose has drags). Parts without weights stay at rest.
     pub fn pose_positions(&self, pose: &Pose) -> Result<Vec<Vec<Point>>, PipelineError> {
         self.pose_positions_with(pose, Blend::Linear)
     }
 
-    /// [`Scene::pose_positions`] with a choice of blending.
+    /// [`Scene::pose_positions`] with a choice of blending. A pose with IK drags is solved from
+    /// its forward-kinematics pose (no warm start), so the result depends on this pose only.
     pub fn pose_positions_with(
         &self,
         pose: &Pose,
         blend: Blend,
     ) -> Result<Vec<Vec<Point>>, PipelineError> {
-        if !pose.ik.is_empty() {
-            return Err(PipelineError::IkUnsupported);
+        let transforms = if pose.ik.is_empty() {
+            handle_transforms(&self.doc.handles, pose)?
+        } else {
+            self.rig_ik()?.transforms(pose)?.transforms
+        };
+        self.positions_from_transforms(&transforms, pose, blend)
+    }
+
+    /// The skinning transformations of a sequence of poses (an animation's frames), solved in
+    /// order so that each IK solve starts from the previous frame's result.
+    pub fn sequence_transforms(&self, poses: &[Pose]) -> Result<Vec<Vec<Affine>>, PipelineError> {
+        let mut ik: Option<RigIk> = None;
+        poses
+            .iter()
+            .map(|pose| {
+                if pose.ik.is_empty() {
+                    return Ok(handle_transforms(&self.doc.handles, pose)?);
+                }
+                if ik.is_none() {
+                    ik = Some(self.rig_ik()?);
+                }
+                match ik.as_mut() {
+                    Some(solver) => Ok(solver.transforms(pose)?.transforms),
+                    None => Err(PipelineError::Ik(crate::ik::IkError::Singular)),
+                }
+            })
+            .collect()
+    }
+
+    /// The rig's meshes as the skinning IK sees them: parts with weights, back to front, their
+    /// weights mapped onto the rig's handle columns.
+    pub fn skinned_meshes(&self) -> Result<Vec<SkinnedMesh>, PipelineError> {
+        let columns = handle_columns(&self.doc.handles);
+        let mut meshes = Vec::new();
+        for part in &self.doc.parts {
+            let Some(weights) = &part.weights else {
+                continue;
+            };
+            let map = self.column_map(&part.name, &weights.handles, &columns)?;
+            let mesh = part.mesh.to_mesh();
+            meshes.push(SkinnedMesh {
+                rest: mesh.vertices,
+                triangles: mesh.triangles,
+                weights: weights
+                    .rows
+                    .iter()
+                    .map(|row| {
+                        row.iter()
+                            .map(|&(k, w)| (map[k as usize] as u32, w))
+                            .collect()
+                    })
+                    .collect(),
+            });
         }
-        let transforms = handle_transforms(&self.doc.handles, pose)?;
+        Ok(meshes)
+    }
+
+    /// A skinning-IK solver for this rig with no warm start (the precomputation is shared).
+    pub fn rig_ik(&self) -> Result<RigIk, PipelineError> {
+        let cached = self.ik.get_or_init(|| {
+            let meshes = self
+                .skinned_meshes()
+                .map_err(|_| crate::ik::IkError::NoWeights)?;
+            if meshes.is_empty() {
+                return Err(crate::ik::IkError::NoWeights);
+            }
+            RigIk::precompute(&self.doc.handles, meshes, self.doc.options.ik.clone())
+        });
+        match cached {
+            Ok(ik) => {
+                let mut fresh = ik.clone();
+                fresh.solver.reset();
+                Ok(fresh)
+            }
+            Err(e) => Err(PipelineError::Ik(e.clone())),
+        }
+    }
+
+    /// For each of a part's weight columns (by name), its index among the rig's columns.
+    fn column_map(
+        &self,
+        part: &str,
+        names: &[String],
+        columns: &[String],
+    ) -> Result<Vec<usize>, PipelineError> {
+        names
+            .iter()
+            .map(|name| {
+                columns.iter().position(|c| c == name).ok_or_else(|| {
+                    PipelineError::UnknownWeightHandle {
+                        part: part.to_string(),
+                        handle: name.clone(),
+                    }
+                })
+            })
+            .collect()
+    }
+
+    /// Every part's vertex positions under per-column skinning `transforms` (from
+    /// [`handle_transforms`] or the skinning IK). Stretchable bones need forward-kinematics
+    /// bone frames: a pose with IK drags blends linearly instead.
+    pub fn positions_from_transforms(
+        &self,
+        transforms: &[Affine],
+        pose: &Pose,
+        blend: Blend,
+    ) -> Result<Vec<Vec<Point>>, PipelineError> {
+        let blend = match blend {
+            Blend::Stretch if !pose.ik.is_empty() => Blend::Linear,
+            other => other,
+        };
         // Bones come first among the columns, so bone i's stretch is column i's.
         let stretches = match blend {
             Blend::Stretch => bone_stretches(&self.doc.handles, pose)?,
@@ -424,18 +539,12 @@ impl Scene {
                 continue;
             };
             // The document names its columns; map them onto this rig's transform order.
-            let mut part_transforms = Vec::with_capacity(weights.handles.len());
-            let mut part_stretches = Vec::with_capacity(weights.handles.len());
-            for name in &weights.handles {
-                let j = columns.iter().position(|c| c == name).ok_or_else(|| {
-                    PipelineError::UnknownWeightHandle {
-                        part: part.name.clone(),
-                        handle: name.clone(),
-                    }
-                })?;
-                part_transforms.push(transforms[j]);
-                part_stretches.push(stretches.get(j).copied().flatten());
-            }
+            let map = self.column_map(&part.name, &weights.handles, &columns)?;
+            let part_transforms: Vec<Affine> = map.iter().map(|&j| transforms[j]).collect();
+            let part_stretches: Vec<_> = map
+                .iter()
+                .map(|&j| stretches.get(j).copied().flatten())
+                .collect();
             let rest = positions.clone();
             let skin_weights = SkinWeights::from_rows(&weights.rows);
             match blend {

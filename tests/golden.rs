@@ -14,12 +14,14 @@
 //! `SINEW_BLESS=1 cargo test --test golden`, then look at every PNG in `golden/` before
 //! committing.
 
+mod common;
+
 use image::{Rgba, RgbaImage};
-use sinew::io::{load_png, save_png, BuildOptions};
-use sinew::pipeline::{self, Layer, Scene};
+use sinew::io::{load_png, save_png};
+use sinew::pipeline::Scene;
 use sinew::render;
 use sinew::rig::pose::BonePose;
-use sinew::rig::{Handles, Pose};
+use sinew::rig::Pose;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
@@ -41,31 +43,7 @@ fn assets() -> PathBuf {
 /// The character's scene, rigged once per test run.
 fn scene() -> &'static Scene {
     static SCENE: OnceLock<Scene> = OnceLock::new();
-    SCENE.get_or_init(build_scene)
-}
-
-fn build_scene() -> Scene {
-    {
-        let list: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(assets().join("layers.json")).expect("layers.json"),
-        )
-        .expect("layers.json parses");
-        let paths: Vec<PathBuf> = list["layers"]
-            .as_array()
-            .expect("a layer list")
-            .iter()
-            .map(|n| assets().join(format!("{}.png", n.as_str().expect("a layer name"))))
-            .collect();
-        let layers: Vec<Layer> = pipeline::load_layers(&paths).expect("layers load");
-        let handles: Handles = serde_json::from_str(
-            &std::fs::read_to_string(assets().join("handles.json")).expect("handles.json"),
-        )
-        .expect("handles.json parses");
-        let (doc, _) = pipeline::build_rig(&layers, &assets(), &BuildOptions::default(), &handles)
-            .expect("the character rigs");
-        let images: Vec<RgbaImage> = layers.into_iter().map(|l| l.image).collect();
-        Scene::new(doc, &images).expect("a scene")
-    }
+    SCENE.get_or_init(common::character_scene)
 }
 
 fn render_pose(pose: &Pose) -> RgbaImage {

@@ -150,6 +150,7 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
             Some(target) => out.ik.push(IkDrag {
                 at: drag.at,
                 to: lerp2(drag.to, target.to, alpha),
+                weight: target.weight,
             }),
             None if !stepped_to_new => out.ik.push(drag.clone()),
             None => {}
@@ -274,15 +275,18 @@ mod tests {
         from.ik.push(IkDrag {
             at: [0.0, 0.0],
             to: [10.0, 0.0],
+            weight: None,
         });
         let mut to = Pose::default();
         to.ik.push(IkDrag {
             at: [0.0, 0.0],
             to: [20.0, 0.0],
+            weight: None,
         });
         to.ik.push(IkDrag {
             at: [5.0, 5.0],
             to: [6.0, 6.0],
+            weight: None,
         });
         to.cages.insert(
             "c".into(),

@@ -180,7 +180,13 @@ impl Animation {
         pose.ik = self
             .ik
             .iter()
-            .filter_map(|drag| sample_keys(&drag.to, t).map(|to| IkDrag { at: drag.at, to }))
+            .filter_map(|drag| {
+                sample_keys(&drag.to, t).map(|to| IkDrag {
+                    at: drag.at,
+                    to,
+                    weight: drag.weight,
+                })
+            })
             .collect();
         pose
     }
@@ -318,6 +324,7 @@ mod tests {
                     key(0.0, [1.0, 2.0], Curve::Linear),
                     key(1.0, [3.0, 2.0], Curve::Linear),
                 ],
+                weight: None,
             }],
             ..Default::default()
         }

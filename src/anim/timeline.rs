@@ -172,6 +172,9 @@ pub struct PartTimelines {
 pub struct IkTimeline {
     pub at: [f64; 2],
     pub to: Vec<Key<[f64; 2]>>,
+    /// A soft drag's strength (see [`crate::rig::pose::IkDrag`]); none: a hard constraint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weight: Option<f64>,
 }
 
 /// One animation: timelines by what they move. Anything without a timeline stays at rest.

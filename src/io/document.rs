@@ -47,6 +47,8 @@ pub struct BuildOptions {
     pub trace: TraceOptions,
     pub mesh: MeshOptions,
     pub weights: WeightOptions,
+    /// How the skinning IK solves drags on this rig.
+    pub ik: crate::ik::IkOptions,
 }
 
 /// One image of the rig with its mesh.

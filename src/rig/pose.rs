@@ -126,11 +126,15 @@ pub struct CagePose {
 }
 
 /// A drag for skinning IK: the material point at rest position `at` goes to `to` (canvas px).
+/// Without a `weight` the drag is a hard constraint (met exactly when feasible); with one it is
+/// a soft pull of that strength (1 ≈ the stiffness of moving one handle).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IkDrag {
     pub at: [f64; 2],
     pub to: [f64; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weight: Option<f64>,
 }
 
 /// A part's look: a tint multiplying its texture, and whether it is drawn.
@@ -168,7 +172,7 @@ pub struct Pose {
 }
 
 /// What is wrong with a pose for a given set of handles.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum PoseError {
     #[error("the pose names {kind} '{name}', which the rig does not have")]
     UnknownName { kind: &'static str, name: String },

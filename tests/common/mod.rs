@@ -185,3 +185,34 @@ pub fn painted(w: u32, h: u32) -> RgbaImage {
         image::Rgba([n as u8, (n >> 8) as u8, (n >> 16) as u8, alpha])
     })
 }
+
+/// The bundled character (`assets/character`), rigged from its layers and handles with default
+/// options.
+pub fn character_scene() -> sinew::pipeline::Scene {
+    use sinew::pipeline::{self, Layer, Scene};
+    let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    let list: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
+    )
+    .expect("layers.json parses");
+    let paths: Vec<std::path::PathBuf> = list["layers"]
+        .as_array()
+        .expect("a layer list")
+        .iter()
+        .map(|n| assets.join(format!("{}.png", n.as_str().expect("a layer name"))))
+        .collect();
+    let layers: Vec<Layer> = pipeline::load_layers(&paths).expect("layers load");
+    let handles: sinew::rig::Handles = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("handles.json")).expect("handles.json"),
+    )
+    .expect("handles.json parses");
+    let (doc, _) = pipeline::build_rig(
+        &layers,
+        &assets,
+        &sinew::io::BuildOptions::default(),
+        &handles,
+    )
+    .expect("the character rigs");
+    let images: Vec<RgbaImage> = layers.into_iter().map(|l| l.image).collect();
+    Scene::new(doc, &images).expect("a scene")
+}

@@ -1,0 +1,553 @@
+//! Fast automatic skinning transformations: the local/global solver over the reduced energy.
+//!
+//! In: a [`Subspace`] (precomputed once per rig) and a [`Problem`] (which handle columns are
+//! free and how, joint and drag constraints, targets). Out: one affine map per handle column,
+//! rest canvas → posed canvas ([`IkSolution`]).
+//!
+//! Following Jacobson, Baran, Kavan, Popović & Sorkine 2012, each solve alternates
+//! - a local step: the best rotation per cluster (closed-form 2×2 fit), and the nearest
+//!   rotation (or scaled rotation) to each rigid handle's linear part;
+//! - a global step: the energy is quadratic in the free handle parameters z, with T = P z + q
+//!   (P selects free entries and expresses keyed children through their free ancestor), and the
+//!   hard constraints E z = e are linear, so the step is one product with matrices prepared by
+//!   a null-space factorization of the KKT system.
+//!
+//! The factorization depends only on the problem's structure (which columns are free, the
+//! keyed children's local transforms, which drags exist and where they grip), not on the
+//! targets: [`FastIk`] keeps it while only targets change, so a drag in the editor costs a few
+//! small dense products per iteration. The last solution warm-starts the next.
+//!
+//! Rigid handles (regions always, bones when [`IkOptions::rigidity`] asks) are held near
+//! rotations by a penalty λ‖L − R‖² (R the nearest rotation, refreshed in every local step); λ is
+//! the column's rigidity times its own stiffness in A, so the term is unit-free. Hard constraints are met exactly whenever they are
+//! feasible; infeasible ones are met in the least-squares sense.
+
+use super::arap::{best_rotation, nearest_rotation};
+use super::subspace::Subspace;
+use super::{IkError, IkOptions};
+use crate::rig::pose::Affine;
+use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
+
+/// How one handle column may move in a solve.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColumnDofs {
+    /// Held at this transform.
+    Fixed(Affine),
+    /// Any affine map; a positive `rigidity` holds its linear part near a rotation (see
+    /// [`IkOptions::rigidity`] for the scale).
+    Affine { rigidity: f64 },
+    /// Translation only, the linear part held at `linear`.
+    Translation { linear: Matrix2<f64> },
+    /// `T_parent ∘ local`, where `parent` is an `Affine` column (a keyed bone under a free one).
+    Follows { parent: usize, local: Affine },
+}
+
+/// The point `at` (rest canvas px) moves with `child` and with `parent` alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    pub child: usize,
+    pub parent: usize,
+    pub at: [f64; 2],
+}
+
+/// A skinned material point and where it must go.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DragRow {
+    /// The point's skinning row (3m): its position is row · T.
+    pub row: Vec<f64>,
+    pub target: [f64; 2],
+    /// `None`: a hard constraint; `Some(w)`: a soft one, relative to one handle's stiffness.
+    pub weight: Option<f64>,
+}
+
+/// One solve's description.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    pub columns: Vec<ColumnDofs>,
+    pub joints: Vec<Joint>,
+    pub drags: Vec<DragRow>,
+    /// Where each column sits when nothing else decides (the forward-kinematics pose).
+    pub anchor: Vec<Affine>,
+}
+
+impl Problem {
+    /// Whether two problems share P, E and the quadratic form, so one factorization serves both.
+    fn same_structure(&self, other: &Problem) -> bool {
+        let dofs_match = self.columns.len() == other.columns.len()
+            && self
+                .columns
+                .iter()
+                .zip(&other.columns)
+                .all(|(a, b)| match (a, b) {
+                    (ColumnDofs::Fixed(_), ColumnDofs::Fixed(_)) => true,
+                    _ => a == b,
+                });
+        dofs_match
+            && self.joints == other.joints
+            && self.drags.len() == other.drags.len()
+            && self
+                .drags
+                .iter()
+                .zip(&other.drags)
+                .all(|(a, b)| a.row == b.row && a.weight == b.weight)
+    }
+}
+
+/// A solve's result.
+#[derive(Clone, Debug)]
+pub struct IkSolution {
+    /// One affine map per handle column.
+    pub transforms: Vec<Affine>,
+    pub iterations: usize,
+    /// The largest distance between a hard drag's point and its target, px.
+    pub drag_error_px: f64,
+    /// The reduced (clustered) ARAP energy of the result, px².
+    pub energy: f64,
+}
+
+/// The factorized global step for one problem structure.
+#[derive(Clone, Debug)]
+struct System {
+    problem: Problem,
+    p: DMatrix<f64>,
+    /// T-space quadratic form: A + rigidity + anchor + soft drags.
+    q_t: DMatrix<f64>,
+    /// Hard constraint rows in T space (joints, then hard drags).
+    e_t: DMatrix<f64>,
+    /// z = x · rhs + y · e.
+    x: DMatrix<f64>,
+    y: DMatrix<f64>,
+    /// X · Pᵀ B.
+    x_pt_b: DMatrix<f64>,
+    /// Free rigid columns: (column, z offset, λ).
+    rigid: Vec<(usize, usize, f64)>,
+    anchor_weight: f64,
+}
+
+/// The skinning-IK solver of one rig: precompute once, then solve per frame or per drag.
+#[derive(Clone, Debug)]
+pub struct FastIk {
+    pub options: IkOptions,
+    pub subspace: Subspace,
+    /// A bound on |v| over the rig's rest vertices, px: converts a change of a linear part
+    /// into a bound on how far a vertex moves.
+    extent_px: f64,
+    system: Option<System>,
+    previous: Option<DMatrix<f64>>,
+}
+
+fn affine_to_rows(t: &Affine, out: &mut DMatrix<f64>, j: usize) {
+    for c in 0..2 {
+        out[(3 * j, c)] = t.linear[(c, 0)];
+        out[(3 * j + 1, c)] = t.linear[(c, 1)];
+        out[(3 * j + 2, c)] = t.translation[c];
+    }
+}
+
+fn rows_to_affine(t: &DMatrix<f64>, j: usize) -> Affine {
+    Affine {
+        linear: Matrix2::new(
+            t[(3 * j, 0)],
+            t[(3 * j + 1, 0)],
+            t[(3 * j, 1)],
+            t[(3 * j + 1, 1)],
+        ),
+        translation: Vector2::new(t[(3 * j + 2, 0)], t[(3 * j + 2, 1)]),
+    }
+}
+
+/// Stacks per-column transforms into T (3m × 2).
+pub fn stack(transforms: &[Affine]) -> DMatrix<f64> {
+    let mut t = DMatrix::zeros(3 * transforms.len(), 2);
+    for (j, a) in transforms.iter().enumerate() {
+        affine_to_rows(a, &mut t, j);
+    }
+    t
+}
+
+/// Unstacks T into per-column transforms.
+pub fn unstack(t: &DMatrix<f64>) -> Vec<Affine> {
+    (0..t.nrows() / 3).map(|j| rows_to_affine(t, j)).collect()
+}
+
+impl FastIk {
+    /// Wraps a precomputed subspace. `extent_px` bounds |v| over the rig's rest vertices.
+    pub fn new(subspace: Subspace, extent_px: f64, options: IkOptions) -> Self {
+        FastIk {
+            options,
+            subspace,
+            extent_px,
+            system: None,
+            previous: None,
+        }
+    }
+
+    /// Forgets the warm start (e.g. when the animation jumps).
+    pub fn reset(&mut self) {
+        self.previous = None;
+    }
+
+    /// Mean diagonal of A over the translation entries: the energy stiffness of moving one
+    /// handle, the unit soft weights are measured in.
+    fn handle_stiffness(&self) -> f64 {
+        let m = self.subspace.column_count.max(1);
+        let s: f64 = (0..self.subspace.column_count)
+            .map(|j| self.subspace.a[(3 * j + 2, 3 * j + 2)])
+            .sum();
+        (s / m as f64).max(f64::MIN_POSITIVE)
+    }
+
+    fn factor(&self, problem: &Problem) -> Result<System, IkError> {
+        let m = self.subspace.column_count;
+        if problem.columns.len() != m || problem.anchor.len() != m {
+            return Err(IkError::ColumnCount {
+                expected: m,
+                got: problem.columns.len(),
+            });
+        }
+        let dim = 3 * m;
+        // Offsets of free parameters.
+        let mut offset = vec![usize::MAX; m];
+        let mut nz = 0;
+        for (j, c) in problem.columns.iter().enumerate() {
+            match c {
+                ColumnDofs::Affine { .. } => {
+                    offset[j] = nz;
+                    nz += 3;
+                }
+                ColumnDofs::Translation { .. } => {
+                    offset[j] = nz;
+                    nz += 1;
+                }
+                ColumnDofs::Fixed(_) | ColumnDofs::Follows { .. } => {}
+            }
+        }
+        let mut p = DMatrix::<f64>::zeros(dim, nz);
+        let mut rigid = Vec::new();
+        let a = &self.subspace.a;
+        let mut q_t = a.clone();
+        for (j, c) in problem.columns.iter().enumerate() {
+            match c {
+                ColumnDofs::Affine { rigidity } => {
+                    for k in 0..3 {
+                        p[(3 * j + k, offset[j] + k)] = 1.0;
+                    }
+                    if *rigidity > 0.0 {
+                        let stiffness = 0.5 * (a[(3 * j, 3 * j)] + a[(3 * j + 1, 3 * j + 1)]);
+                        let lambda = rigidity * stiffness.max(f64::MIN_POSITIVE);
+                        q_t[(3 * j, 3 * j)] += lambda;
+                        q_t[(3 * j + 1, 3 * j + 1)] += lambda;
+                        rigid.push((j, offset[j], lambda));
+                    }
+                }
+                ColumnDofs::Translation { .. } => p[(3 * j + 2, offset[j])] = 1.0,
+                ColumnDofs::Follows { parent, local } => {
+                    let pj = *parent;
+                    if !matches!(problem.columns.get(pj), Some(ColumnDofs::Affine { .. })) {
+                        return Err(IkError::BadFollow {
+                            column: j,
+                            parent: pj,
+                        });
+                    }
+                    // Row c of T_j = (L_p[c,:] G_L, L_p[c,:] G_t + t_p[c]).
+                    let (g, gt) = (local.linear, local.translation);
+                    let o = offset[pj];
+                    p[(3 * j, o)] = g[(0, 0)];
+                    p[(3 * j, o + 1)] = g[(1, 0)];
+                    p[(3 * j + 1, o)] = g[(0, 1)];
+                    p[(3 * j + 1, o + 1)] = g[(1, 1)];
+                    p[(3 * j + 2, o)] = gt[0];
+                    p[(3 * j + 2, o + 1)] = gt[1];
+                    p[(3 * j + 2, o + 2)] = 1.0;
+                }
+                ColumnDofs::Fixed(_) => {}
+            }
+        }
+        let trace_a: f64 = (0..dim).map(|k| a[(k, k)]).sum();
+        let trace_g: f64 = (0..dim).map(|k| self.subspace.gram[(k, k)]).sum();
+        let anchor_weight = if trace_g > 0.0 {
+            self.options.anchor * trace_a / trace_g
+        } else {
+            0.0
+        };
+        q_t += &self.subspace.gram * anchor_weight;
+        let stiffness = self.handle_stiffness();
+        let mut hard: Vec<Vec<f64>> = Vec::new();
+        for joint in &problem.joints {
+            let mut row = vec![0.0; dim];
+            let h = [joint.at[0], joint.at[1], 1.0];
+            for k in 0..3 {
+                row[3 * joint.child + k] += h[k];
+                row[3 * joint.parent + k] -= h[k];
+            }
+            hard.push(row);
+        }
+        for drag in &problem.drags {
+            match drag.weight {
+                None => hard.push(drag.row.clone()),
+                Some(w) => {
+                    let d = DVector::from_column_slice(&drag.row);
+                    q_t += (&d * d.transpose()) * (w * stiffness);
+                }
+            }
+        }
+        let e_t = DMatrix::from_fn(hard.len(), dim, |r, c| hard[r][c]);
+        let h = p.tr_mul(&(&q_t * &p));
+        let e = &e_t * &p;
+        // Null-space method: z = z_p + N y with E z_p = e in the least-squares sense.
+        let (e_pinv, null) = pseudo_inverse_and_null_space(&e, nz)?;
+        let reduced = null.tr_mul(&(&h * &null));
+        let k = reduced.ncols();
+        let x = if k == 0 {
+            DMatrix::zeros(nz, nz)
+        } else {
+            let ridge = 1e-12
+                * (0..k)
+                    .map(|i| reduced[(i, i)].abs())
+                    .fold(0.0, f64::max)
+                    .max(1e-300);
+            let regular = &reduced + DMatrix::identity(k, k) * ridge;
+            let cholesky = regular.cholesky().ok_or(IkError::Singular)?;
+            &null * cholesky.solve(&null.transpose())
+        };
+        let y = (DMatrix::identity(nz, nz) - &x * &h) * &e_pinv;
+        let x_pt_b = &x * p.tr_mul(&self.subspace.b);
+        Ok(System {
+            problem: problem.clone(),
+            p,
+            q_t,
+            e_t,
+            x,
+            y,
+            x_pt_b,
+            rigid,
+            anchor_weight,
+        })
+    }
+
+    /// Solves `problem`, reusing the last factorization when the structure is unchanged and the
+    /// last solution as the starting point.
+    pub fn solve(&mut self, problem: &Problem) -> Result<IkSolution, IkError> {
+        let reuse = matches!(&self.system, Some(s) if s.problem.same_structure(problem));
+        if !reuse {
+            self.system = Some(self.factor(problem)?);
+        }
+        let Some(system) = &self.system else {
+            return Err(IkError::Singular);
+        };
+        let m = self.subspace.column_count;
+        let dim = 3 * m;
+        // q: the fixed entries of T.
+        let mut q = DMatrix::<f64>::zeros(dim, 2);
+        for (j, c) in problem.columns.iter().enumerate() {
+            match c {
+                ColumnDofs::Fixed(t) => affine_to_rows(t, &mut q, j),
+                ColumnDofs::Translation { linear } => {
+                    for cc in 0..2 {
+                        q[(3 * j, cc)] = linear[(cc, 0)];
+                        q[(3 * j + 1, cc)] = linear[(cc, 1)];
+                    }
+                }
+                ColumnDofs::Affine { .. } | ColumnDofs::Follows { .. } => {}
+            }
+        }
+        let anchor = stack(&problem.anchor);
+        let stiffness = self.handle_stiffness();
+        let mut f_const = &self.subspace.gram * &anchor * system.anchor_weight - &system.q_t * &q;
+        let mut targets = Vec::with_capacity(system.e_t.nrows());
+        targets.extend(problem.joints.iter().map(|_| [0.0, 0.0]));
+        for drag in &problem.drags {
+            match drag.weight {
+                None => targets.push(drag.target),
+                Some(w) => {
+                    for (k, &d) in drag.row.iter().enumerate() {
+                        for c in 0..2 {
+                            f_const[(k, c)] += w * stiffness * d * drag.target[c];
+                        }
+                    }
+                }
+            }
+        }
+        let e_q = &system.e_t * &q;
+        let e = DMatrix::from_fn(targets.len(), 2, |r, c| targets[r][c] - e_q[(r, c)]);
+        let z_const = &system.x * system.p.tr_mul(&f_const) + &system.y * &e;
+
+        let (mut t, iteration_limit) = match &self.previous {
+            Some(prev) if prev.nrows() == dim => (prev.clone(), self.options.iterations),
+            _ => (anchor.clone(), self.options.cold_iterations),
+        };
+        let r_count = self.subspace.cluster_count;
+        let nz = system.p.ncols();
+        let mut r_flat = DMatrix::<f64>::zeros(2 * r_count, 2);
+        let mut rigid_rhs = DMatrix::<f64>::zeros(nz, 2);
+        let mut iterations = 0;
+        for _ in 0..iteration_limit.max(1) {
+            iterations += 1;
+            // Local step: cluster rotations from C = Bᵀ T, rigid targets from T.
+            let c = self.subspace.b.tr_mul(&t);
+            for k in 0..r_count {
+                let ck = Matrix2::new(
+                    c[(2 * k, 0)],
+                    c[(2 * k, 1)],
+                    c[(2 * k + 1, 0)],
+                    c[(2 * k + 1, 1)],
+                );
+                let r = best_rotation(&ck);
+                // Rows 2k, 2k+1 hold Rₖᵀ.
+                r_flat[(2 * k, 0)] = r[(0, 0)];
+                r_flat[(2 * k, 1)] = r[(1, 0)];
+                r_flat[(2 * k + 1, 0)] = r[(0, 1)];
+                r_flat[(2 * k + 1, 1)] = r[(1, 1)];
+            }
+            rigid_rhs.fill(0.0);
+            for &(j, o, lambda) in &system.rigid {
+                let l = rows_to_affine(&t, j).linear;
+                let mut target = nearest_rotation(&l);
+                if self.options.allow_uniform_scale {
+                    let s = (target.transpose() * l).trace() * 0.5;
+                    target *= s.max(0.0);
+                }
+                for cc in 0..2 {
+                    rigid_rhs[(o, cc)] = lambda * target[(cc, 0)];
+                    rigid_rhs[(o + 1, cc)] = lambda * target[(cc, 1)];
+                }
+            }
+            // Global step.
+            let z = &z_const + &system.x_pt_b * &r_flat + &system.x * &rigid_rhs;
+            let next = &system.p * &z + &q;
+            let change = (0..m)
+                .map(|j| {
+                    let d = rows_to_affine(&next, j);
+                    let o = rows_to_affine(&t, j);
+                    (d.linear - o.linear).norm() * self.extent_px
+                        + (d.translation - o.translation).norm()
+                })
+                .fold(0.0, f64::max);
+            t = next;
+            if change <= self.options.tolerance_px {
+                break;
+            }
+        }
+        let drag_error_px = problem
+            .drags
+            .iter()
+            .filter(|d| d.weight.is_none())
+            .map(|d| {
+                let row = DVector::from_column_slice(&d.row);
+                let pos = t.tr_mul(&row);
+                (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
+            })
+            .fold(0.0, f64::max);
+        let energy = self.reduced_energy(&t);
+        self.previous = Some(t.clone());
+        Ok(IkSolution {
+            transforms: unstack(&t),
+            iterations,
+            drag_error_px,
+            energy,
+        })
+    }
+
+    /// The clustered ARAP energy of `t` with its best cluster rotations, px².
+    pub fn reduced_energy(&self, t: &DMatrix<f64>) -> f64 {
+        let s = &self.subspace;
+        let c = s.b.tr_mul(t);
+        let mut cross = 0.0;
+        for k in 0..s.cluster_count {
+            let ck = Matrix2::new(
+                c[(2 * k, 0)],
+                c[(2 * k, 1)],
+                c[(2 * k + 1, 0)],
+                c[(2 * k + 1, 1)],
+            );
+            cross += (best_rotation(&ck) * ck).trace();
+        }
+        let quadratic = (t.transpose() * &s.a * t).trace();
+        (quadratic - 2.0 * cross + s.energy_constant).max(0.0)
+    }
+}
+
+/// The pseudo-inverse of `e` (nz × rows) and an orthonormal basis of its null space (nz × k),
+/// by SVD with a relative rank tolerance.
+fn pseudo_inverse_and_null_space(
+    e: &DMatrix<f64>,
+    nz: usize,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), IkError> {
+    if e.nrows() == 0 || nz == 0 {
+        return Ok((DMatrix::zeros(nz, e.nrows()), DMatrix::identity(nz, nz)));
+    }
+    // Work on Eᵀ E's eigen-decomposition (nz × nz, symmetric): its eigenvectors with zero
+    // eigenvalue span the null space; the others give the pseudo-inverse.
+    let ete = e.tr_mul(e);
+    let eig = nalgebra::SymmetricEigen::new(ete);
+    let largest = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+    if !largest.is_finite() {
+        return Err(IkError::NonFinite);
+    }
+    let tolerance = largest * 1e-12;
+    let mut range = Vec::new();
+    let mut null = Vec::new();
+    for (i, &lambda) in eig.eigenvalues.iter().enumerate() {
+        if lambda > tolerance {
+            range.push((i, lambda));
+        } else {
+            null.push(i);
+        }
+    }
+    let v = &eig.eigenvectors;
+    let mut pinv = DMatrix::zeros(nz, e.nrows());
+    for &(i, lambda) in &range {
+        let vi = v.column(i);
+        // E⁺ = Σ vᵢ vᵢᵀ Eᵀ / λᵢ.
+        pinv += (vi * (e * vi).transpose()) / lambda;
+    }
+    let null_basis = DMatrix::from_fn(nz, null.len(), |r, c| v[(r, null[c])]);
+    Ok((pinv, null_basis))
+}
+
+impl FastIk {
+    /// Precomputes the solver for `meshes` skinned over `column_count` handle columns: rotation
+    /// clusters in weight space, then the reduced energy's matrices.
+    pub fn precompute(
+        meshes: &[super::SkinnedMesh],
+        column_count: usize,
+        options: IkOptions,
+    ) -> Result<Self, IkError> {
+        let n: usize = meshes.iter().map(|m| m.rest.len()).sum();
+        if n == 0 || column_count == 0 {
+            return Err(IkError::NoWeights);
+        }
+        let mut points = vec![0.0; n * column_count];
+        let mut base = 0;
+        let mut extent_px: f64 = 0.0;
+        for mesh in meshes {
+            for (i, row) in mesh.weights.iter().enumerate() {
+                for &(j, w) in row {
+                    if j as usize >= column_count || !w.is_finite() {
+                        return Err(IkError::NonFinite);
+                    }
+                    points[(base + i) * column_count + j as usize] = w;
+                }
+            }
+            for p in &mesh.rest {
+                if !p.x.is_finite() || !p.y.is_finite() {
+                    return Err(IkError::NonFinite);
+                }
+                extent_px = extent_px.max(p.coords.norm());
+            }
+            base += mesh.rest.len();
+        }
+        let (clusters, count) = if options.clusters_per_handle == 0 {
+            ((0..n as u32).collect(), n)
+        } else {
+            super::cluster::weight_space_clusters(
+                &points,
+                column_count,
+                options.clusters_per_handle * column_count,
+                options.cluster_iterations,
+            )
+        };
+        let subspace = super::subspace::reduce(meshes, column_count, &clusters, count);
+        Ok(FastIk::new(subspace, extent_px, options))
+    }
+}

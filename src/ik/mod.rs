@@ -1,0 +1,130 @@
+//! Skinning IK: drag a few points of the drawing and every handle the pose leaves free follows.
+//!
+//! In: a rig's skinned meshes and handles, and a [`Pose`](crate::rig::pose::Pose) whose `ik`
+//! drags say where material points (given by their rest positions) must go. Out: one affine map
+//! per handle column, ready for skinning, chosen to keep the whole skinned shape as rigid as
+//! possible (Jacobson, Baran, Kavan, Popović & Sorkine 2012, "Fast Automatic Skinning
+//! Transformations").
+//!
+//! - [`arap`]: the per-vertex ARAP energy (Sorkine & Alexa 2007), the yardstick.
+//! - [`cluster`]: rotation clusters by k-means in weight space.
+//! - [`subspace`]: the energy reduced to the handles' affine parameters (precomputed per rig).
+//! - [`fast`]: the local/global solver over the reduced energy (factorized per constraint set,
+//!   solved per frame).
+//! - [`rig`]: a rig and a pose → which handles are free, fixed or following, joints, drags.
+//! - [`reference`]: the full per-vertex ARAP deformation, the quality bound tests compare with.
+
+pub mod arap;
+pub mod cluster;
+pub mod fast;
+pub mod reference;
+pub mod rig;
+pub mod subspace;
+
+pub use fast::{ColumnDofs, DragRow, FastIk, IkSolution, Joint, Problem};
+pub use rig::RigIk;
+pub use subspace::SkinnedMesh;
+
+use serde::{Deserialize, Serialize};
+
+/// How a free handle that is not a bone may move.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HandleDofs {
+    /// Any affine map: translation, rotation, scale and shear.
+    #[default]
+    Affine,
+    /// Rotation and translation (held near rigid, [`IkOptions::region_rigidity`]).
+    Rigid,
+    /// Translation only.
+    Translation,
+}
+
+/// Skinning-IK parameters. Every field has a default; the rig file, the CLI and the editor share
+/// them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IkOptions {
+    /// Rotation clusters per handle column (k-means in weight space). 0: one rotation per
+    /// vertex, the exact reduced energy (slow; for reference). Default 8.
+    pub clusters_per_handle: usize,
+    /// Lloyd iterations of the clustering. Default 8.
+    pub cluster_iterations: usize,
+    /// Local/global iterations per solve at most, when warm-started from the previous solve
+    /// (dragging, animation frames). Default 8.
+    pub iterations: usize,
+    /// Iterations at most for a solve with no previous solution to start from (a single
+    /// pose): it starts from the forward-kinematics pose, further away. Default 64.
+    pub cold_iterations: usize,
+    /// Stop when no skinned point moves more than this between two iterations, px. Default 0.01.
+    pub tolerance_px: f64,
+    /// How strongly free bones and regions are held to rotations, relative to their own share
+    /// of the energy. Default 0: like every handle of Fast Automatic Skinning Transformations,
+    /// bones are affine maps that the ARAP energy keeps close to rigid (on the bundled
+    /// character's hardest test drags they stretch by up to about 10%); forcing them rigid
+    /// makes linear blending crease at the joints and raises the shape's ARAP energy 2–5×.
+    /// Set it (e.g. 100) for strictly rigid bones.
+    pub rigidity: f64,
+    /// How strongly regions (and points or cage vertices set to `rigid`) are held to rotations,
+    /// in the same units as `rigidity`. Default 100.
+    pub region_rigidity: f64,
+    /// Rigid handles may also scale uniformly. Default false.
+    pub allow_uniform_scale: bool,
+    /// Free point handles. Default affine.
+    pub points: HandleDofs,
+    /// Free cage vertices. Default translation.
+    pub cage_vertices: HandleDofs,
+    /// Joints of a connected skeleton stay connected (hard constraints). Default true.
+    pub connect_joints: bool,
+    /// Pull toward the forward-kinematics pose, relative to the ARAP energy; it only decides
+    /// motions that nothing else decides (a rig with no drag stays in its FK pose). Default 1e-6.
+    pub anchor: f64,
+    /// How far outside every part an ik drag's `at` may lie and still grip the nearest
+    /// triangle, px. Default 2.
+    pub grip_tolerance_px: f64,
+}
+
+impl Default for IkOptions {
+    fn default() -> Self {
+        IkOptions {
+            clusters_per_handle: 8,
+            cluster_iterations: 8,
+            iterations: 8,
+            cold_iterations: 64,
+            tolerance_px: 0.01,
+            rigidity: 0.0,
+            region_rigidity: 100.0,
+            allow_uniform_scale: false,
+            points: HandleDofs::Affine,
+            cage_vertices: HandleDofs::Translation,
+            connect_joints: true,
+            anchor: 1e-6,
+            grip_tolerance_px: 2.0,
+        }
+    }
+}
+
+/// What is wrong with an IK request.
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
+pub enum IkError {
+    #[error(
+        "ik drag at ({0:.1}, {1:.1}) does not grip the drawing: no part covers that point at rest"
+    )]
+    DragOutside(f64, f64),
+    #[error(
+        "no part has skinning weights; compute them (sinew rig --handles) before using ik drags"
+    )]
+    NoWeights,
+    #[error("an ik drag or a handle transform is not a finite number")]
+    NonFinite,
+    #[error(transparent)]
+    Pose(#[from] crate::rig::pose::PoseError),
+    #[error("the problem has {got} handle columns but the rig has {expected}")]
+    ColumnCount { expected: usize, got: usize },
+    #[error("handle column {column} follows column {parent}, which is not a free affine handle")]
+    BadFollow { column: usize, parent: usize },
+    #[error("the skinning IK system is singular (a handle that moves no vertex?)")]
+    Singular,
+    #[error("classic IK: {0}")]
+    Bone(String),
+}

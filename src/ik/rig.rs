@@ -1,0 +1,243 @@
+//! From a rig and a pose to a skinning-IK [`Problem`], and the solver that keeps its state.
+//!
+//! In: validated [`Handles`], the rig's skinned meshes (parts in draw order, weights over
+//! [`handle_columns`]) and a [`Pose`] with `ik` drags. Out: per-column skinning transforms.
+//!
+//! Which handles the solver may move: a bone or point or cage the pose names is *keyed* and
+//! keeps what the pose gives it — relative to its nearest unkeyed ancestor bone if it has one
+//! (a keyed forearm under a free upper arm turns with it), absolutely otherwise. Every other
+//! handle is free: bones affine (or near-rigid, [`IkOptions::rigidity`]), regions near-rigid,
+//! points and cage vertices as
+//! [`IkOptions::points`] and [`IkOptions::cage_vertices`] say. A free bone's head stays on its
+//! parent ([`IkOptions::connect_joints`]). Disjoint skeletons are coupled only through the
+//! shape they skin.
+
+use super::fast::{ColumnDofs, DragRow, FastIk, IkSolution, Joint, Problem};
+use super::subspace::{add_skinning_row, SkinnedMesh};
+use super::{HandleDofs, IkError, IkOptions};
+use crate::geom::Point;
+use crate::rig::handles::Handles;
+use crate::rig::pose::{handle_columns, handle_transforms, Affine, IkDrag, Pose};
+use nalgebra::Matrix2;
+
+/// The skinning-IK solver of one rig, with its precomputation and warm start.
+#[derive(Clone, Debug)]
+pub struct RigIk {
+    pub handles: Handles,
+    /// Shared between clones: solvers of one rig differ only in their warm start.
+    pub meshes: std::sync::Arc<Vec<SkinnedMesh>>,
+    pub solver: FastIk,
+}
+
+impl RigIk {
+    /// Precomputes the reduced energy for `meshes` (parts back to front, weights over the
+    /// columns of [`handle_columns`]`(handles)`).
+    pub fn precompute(
+        handles: &Handles,
+        meshes: Vec<SkinnedMesh>,
+        options: IkOptions,
+    ) -> Result<Self, IkError> {
+        let columns = handle_columns(handles).len();
+        let solver = FastIk::precompute(&meshes, columns, options)?;
+        Ok(RigIk {
+            handles: handles.clone(),
+            meshes: std::sync::Arc::new(meshes),
+            solver,
+        })
+    }
+
+    /// The skinning transformations for `pose`: forward kinematics if it has no drags, the
+    /// skinning IK otherwise (warm-started from the previous call).
+    pub fn transforms(&mut self, pose: &Pose) -> Result<IkSolution, IkError> {
+        let problem = self.problem(pose)?;
+        if problem.drags.is_empty() {
+            return Ok(IkSolution {
+                transforms: problem.anchor,
+                iterations: 0,
+                drag_error_px: 0.0,
+                energy: f64::NAN,
+            });
+        }
+        self.solver.solve(&problem)
+    }
+
+    /// The problem `pose` poses (see the module doc).
+    pub fn problem(&self, pose: &Pose) -> Result<Problem, IkError> {
+        let handles = &self.handles;
+        let options = &self.solver.options;
+        let fk = handle_transforms(handles, pose)?;
+        let mut columns: Vec<ColumnDofs> = Vec::with_capacity(fk.len());
+        let mut joints = Vec::new();
+        let bone_index = |name: &str| handles.bones.iter().position(|b| b.name == name);
+        let keyed = |i: usize| pose.bones.contains_key(&handles.bones[i].name);
+        for (i, bone) in handles.bones.iter().enumerate() {
+            let parent = bone.parent.as_deref().and_then(bone_index);
+            if !keyed(i) {
+                columns.push(ColumnDofs::Affine {
+                    rigidity: options.rigidity,
+                });
+                if let (Some(p), true) = (parent, options.connect_joints) {
+                    joints.push(Joint {
+                        child: i,
+                        parent: p,
+                        at: bone.head,
+                    });
+                }
+                continue;
+            }
+            // The nearest unkeyed ancestor, if any; validated parents are acyclic.
+            let mut ancestor = parent;
+            while let Some(a) = ancestor {
+                if !keyed(a) {
+                    break;
+                }
+                ancestor = handles.bones[a].parent.as_deref().and_then(bone_index);
+            }
+            columns.push(match ancestor {
+                Some(a) => {
+                    let world_from_ancestor = fk[a].inverse().ok_or(IkError::Singular)?;
+                    ColumnDofs::Follows {
+                        parent: a,
+                        local: world_from_ancestor.then_after(&fk[i]),
+                    }
+                }
+                None => ColumnDofs::Fixed(fk[i]),
+            });
+        }
+        let free = |dofs: HandleDofs| match dofs {
+            HandleDofs::Affine => ColumnDofs::Affine { rigidity: 0.0 },
+            HandleDofs::Rigid => ColumnDofs::Affine {
+                rigidity: options.region_rigidity,
+            },
+            HandleDofs::Translation => ColumnDofs::Translation {
+                linear: Matrix2::identity(),
+            },
+        };
+        for point in &handles.points {
+            let j = columns.len();
+            columns.push(if pose.points.contains_key(&point.name) {
+                ColumnDofs::Fixed(fk[j])
+            } else {
+                free(options.points)
+            });
+        }
+        for cage in &handles.cages {
+            let posed = pose.cages.contains_key(&cage.name);
+            for _ in &cage.polygon {
+                let j = columns.len();
+                columns.push(if posed {
+                    ColumnDofs::Fixed(fk[j])
+                } else {
+                    free(options.cage_vertices)
+                });
+            }
+        }
+        for _ in &handles.regions {
+            columns.push(ColumnDofs::Affine {
+                rigidity: options.region_rigidity,
+            });
+        }
+        let drags = pose
+            .ik
+            .iter()
+            .map(|d| self.drag_row(d))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Problem {
+            columns,
+            joints,
+            drags,
+            anchor: fk,
+        })
+    }
+
+    /// The skinning row of the material point a drag grips, and its target.
+    pub fn drag_row(&self, drag: &IkDrag) -> Result<DragRow, IkError> {
+        let values = [
+            drag.at[0],
+            drag.at[1],
+            drag.to[0],
+            drag.to[1],
+            drag.weight.unwrap_or(1.0),
+        ];
+        if values.iter().any(|v| !v.is_finite()) || drag.weight.is_some_and(|w| w < 0.0) {
+            return Err(IkError::NonFinite);
+        }
+        let at = Point::new(drag.at[0], drag.at[1]);
+        let (mesh, triangle, barycentric) =
+            grip(&self.meshes, at, self.solver.options.grip_tolerance_px)
+                .ok_or(IkError::DragOutside(at.x, at.y))?;
+        let mesh = &self.meshes[mesh];
+        let mut row = vec![0.0; 3 * self.solver.subspace.column_count];
+        for (k, &v) in mesh.triangles[triangle].iter().enumerate() {
+            add_skinning_row(
+                mesh.rest[v as usize],
+                &mesh.weights[v as usize],
+                barycentric[k],
+                &mut row,
+            );
+        }
+        Ok(DragRow {
+            row,
+            target: drag.to,
+            weight: drag.weight,
+        })
+    }
+}
+
+/// The topmost mesh triangle under `p` (parts drawn later win), with barycentric coordinates;
+/// failing that, the nearest triangle within `tolerance_px`, gripped at its nearest point.
+pub fn grip(
+    meshes: &[SkinnedMesh],
+    p: Point,
+    tolerance_px: f64,
+) -> Option<(usize, usize, [f64; 3])> {
+    let mut nearest: Option<(f64, usize, usize, [f64; 3])> = None;
+    for (m, mesh) in meshes.iter().enumerate().rev() {
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|v| mesh.rest[v as usize]);
+            let Some(bary) = barycentric(p, a, b, c) else {
+                continue;
+            };
+            if bary.iter().all(|&x| x >= -1e-12) {
+                return Some((m, t, bary));
+            }
+            // Outside: the closest point of the triangle lies on one of its edges.
+            for (u, v) in [(0usize, 1usize), (1, 2), (2, 0)] {
+                let (pu, pv) = ([a, b, c][u], [a, b, c][v]);
+                let e = pv - pu;
+                let s = ((p - pu).dot(&e) / e.norm_squared()).clamp(0.0, 1.0);
+                let d = (pu + e * s - p).norm();
+                if d <= tolerance_px && nearest.as_ref().is_none_or(|n| d < n.0) {
+                    let mut w = [0.0; 3];
+                    w[u] = 1.0 - s;
+                    w[v] = s;
+                    nearest = Some((d, m, t, w));
+                }
+            }
+        }
+    }
+    nearest.map(|(_, m, t, w)| (m, t, w))
+}
+
+/// Barycentric coordinates of `p` in triangle abc, or `None` for a degenerate triangle.
+fn barycentric(p: Point, a: Point, b: Point, c: Point) -> Option<[f64; 3]> {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let det = v0.x * v1.y - v0.y * v1.x;
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let u = (v2.x * v1.y - v2.y * v1.x) / det;
+    let v = (v0.x * v2.y - v0.y * v2.x) / det;
+    Some([1.0 - u - v, u, v])
+}
+
+/// Applies per-column transforms to a rest point through its skinning row (for checks).
+pub fn skinned_position(row: &[f64], transforms: &[Affine]) -> Point {
+    let (mut x, mut y) = (0.0, 0.0);
+    for (j, t) in transforms.iter().enumerate() {
+        let (a, b, c) = (row[3 * j], row[3 * j + 1], row[3 * j + 2]);
+        x += a * t.linear[(0, 0)] + b * t.linear[(0, 1)] + c * t.translation.x;
+        y += a * t.linear[(1, 0)] + b * t.linear[(1, 1)] + c * t.translation.y;
+    }
+    Point::new(x, y)
+}
