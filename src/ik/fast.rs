@@ -413,7 +413,10 @@ impl FastIk {
                 }
             }
             // Global step.
-            let z = &z_const + &system.x_pt_b * &r_flat + &system.x * &rigid_rhs;
+            let mut z = &z_const + &system.x_pt_b * &r_flat;
+            if !system.rigid.is_empty() {
+                z += &system.x * &rigid_rhs;
+            }
             let next = &system.p * &z + &q;
             let change = (0..m)
                 .map(|j| {

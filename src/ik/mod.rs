@@ -46,9 +46,9 @@ pub enum HandleDofs {
 #[serde(default, deny_unknown_fields)]
 pub struct IkOptions {
     /// Rotation clusters per handle column (k-means in weight space). 0: one rotation per
-    /// vertex, the exact reduced energy (slow; for reference). Default 8.
+    /// vertex, the exact reduced energy (slow; for reference). Default 4.
     pub clusters_per_handle: usize,
-    /// Lloyd iterations of the clustering. Default 8.
+    /// Lloyd iterations of the clustering. Default 4.
     pub cluster_iterations: usize,
     /// Local/global iterations per solve at most, when warm-started from the previous solve
     /// (dragging, animation frames). Default 8.
@@ -87,8 +87,8 @@ pub struct IkOptions {
 impl Default for IkOptions {
     fn default() -> Self {
         IkOptions {
-            clusters_per_handle: 8,
-            cluster_iterations: 8,
+            clusters_per_handle: 4,
+            cluster_iterations: 4,
             iterations: 8,
             cold_iterations: 64,
             tolerance_px: 0.01,
