@@ -101,6 +101,16 @@ pub fn render_pose(
     view: &FrameView,
 ) -> Result<RgbaImage, PipelineError> {
     let positions = scene.pose_positions_with(pose, blend)?;
+    render_positions(scene, &positions, pose, view)
+}
+
+/// Renders parts at `positions` (one list per part, canvas px) as `pose` shows them.
+fn render_positions(
+    scene: &Scene,
+    positions: &[Vec<crate::geom::Point>],
+    pose: &Pose,
+    view: &FrameView,
+) -> Result<RgbaImage, PipelineError> {
     let [w, h] = view.size_px;
     let mut canvas = tiny_skia::Pixmap::new(w, h).ok_or(PipelineError::Canvas(view.size_px))?;
     if let Some([r, g, b, a]) = view.background {
@@ -109,7 +119,7 @@ pub fn render_pose(
     draw_pose(
         scene,
         &mut canvas,
-        &positions,
+        positions,
         pose,
         view.output_from_canvas(scene.doc.canvas),
     )?;
@@ -149,8 +159,9 @@ pub fn draw_pose(
     scene.draw_parts(canvas, &draws, output_from_canvas)
 }
 
-/// Renders every pose through `view`, in parallel; `on_frame` is called once per finished
-/// frame (for a progress bar).
+/// Renders every pose through `view`; `on_frame` is called once per finished frame (for a
+/// progress bar). Skinning IK solves the poses in order first, each frame warm-started from the
+/// one before (so a sequence is deterministic and smooth); drawing then runs in parallel.
 pub fn render_poses(
     scene: &Scene,
     poses: &[Pose],
@@ -158,10 +169,14 @@ pub fn render_poses(
     view: &FrameView,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<Vec<RgbaImage>, PipelineError> {
+    let transforms = scene.sequence_transforms(poses)?;
     poses
         .par_iter()
-        .map(|pose| {
-            let frame = render_pose(scene, pose, blend, view);
+        .zip(transforms.par_iter())
+        .map(|(pose, transforms)| {
+            let frame = scene
+                .positions_from_transforms(transforms, pose, blend)
+                .and_then(|positions| render_positions(scene, &positions, pose, view));
             on_frame();
             frame
         })

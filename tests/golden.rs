@@ -128,7 +128,7 @@ fn rest_pose_matches_golden() {
 
 #[test]
 fn bundled_poses_match_golden() {
-    for name in ["reach", "crouch", "stretch"] {
+    for name in ["reach", "crouch", "stretch", "lift"] {
         check_golden(&format!("pose_{name}"), &render_pose(&load_pose(name)));
     }
 }
@@ -140,7 +140,7 @@ fn bundled_animations_match_golden_at_fixed_times() {
     )
     .expect("animations.json parses");
     let animations = sinew::anim::parse_animations(&animations).expect("the animations check");
-    for (name, times_s) in [("walk", [0.25, 0.6]), ("wave", [0.4, 1.1])] {
+    for (name, times_s) in [("walk", [0.25, 0.6]), ("wave", [0.4, 1.1]), ("lift", [0.5, 1.0])] {
         let animation = &animations[name];
         for t in times_s {
             let pose = animation.sample(t, true);
@@ -181,7 +181,7 @@ fn rig_and_render_are_deterministic_across_thread_counts() {
             .num_threads(threads)
             .build()
             .expect("a pool")
-            .install(|| render_pose_in(&build_scene(), &pose))
+            .install(|| render_pose_in(&common::character_scene(), &pose))
     };
     assert_eq!(in_pool(1).as_raw(), in_pool(3).as_raw());
 }

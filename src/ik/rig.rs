@@ -65,6 +65,8 @@ impl RigIk {
     pub fn problem(&self, pose: &Pose) -> Result<Problem, IkError> {
         let handles = &self.handles;
         let options = &self.solver.options;
+        // Bones that bone IK constraints turn are decided, like keyed ones.
+        let pose = &crate::rig::bone_ik::constrained_pose(handles, pose)?;
         let fk = handle_transforms(handles, pose)?;
         let mut columns: Vec<ColumnDofs> = Vec::with_capacity(fk.len());
         let mut joints = Vec::new();

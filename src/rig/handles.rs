@@ -61,6 +61,10 @@ pub struct Handles {
     /// bone that passes behind a leg layer must not drag the leg).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub bind: BTreeMap<String, Vec<String>>,
+    /// Classic bone IK constraints (see [`super::bone_ik`]), applied in order during forward
+    /// kinematics.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub ik: Vec<super::bone_ik::BoneIk>,
 }
 
 /// What is wrong with a set of handles.
@@ -84,6 +88,8 @@ pub enum HandleError {
     UnknownBindHandle(String),
     #[error("'bind' lists no part for handle '{0}'")]
     EmptyBind(String),
+    #[error("ik constraint '{name}': {problem}")]
+    BadIkConstraint { name: String, problem: String },
 }
 
 /// Bones shorter than this (px) are degenerate: they have no direction.
@@ -117,6 +123,7 @@ impl Handles {
     /// that part's mesh must carry.
     pub fn for_part(&self, part: &str) -> Handles {
         Handles {
+            ik: Vec::new(),
             bones: self
                 .bones
                 .iter()
@@ -209,7 +216,51 @@ impl Handles {
                 });
             }
         }
-        self.check_parents()
+        self.check_parents()?;
+        self.check_ik()
+    }
+
+    /// Every IK chain is a parent-linked run of known bones whose target is a known bone that the
+    /// chain does not move.
+    fn check_ik(&self) -> Result<(), HandleError> {
+        let bad = |c: &super::bone_ik::BoneIk, problem: String| HandleError::BadIkConstraint {
+            name: c.name.clone(),
+            problem,
+        };
+        let find = |name: &str| self.bones.iter().find(|b| b.name == name);
+        for c in &self.ik {
+            if c.bones.is_empty() {
+                return Err(bad(c, "names no bones".into()));
+            }
+            if !(c.mix.is_finite() && c.softness_px.is_finite() && c.softness_px >= 0.0) {
+                return Err(bad(
+                    c,
+                    "mix and softness_px must be finite, softness_px ≥ 0".into(),
+                ));
+            }
+            for (k, name) in c.bones.iter().enumerate() {
+                let bone = find(name).ok_or_else(|| bad(c, format!("unknown bone '{name}'")))?;
+                if k > 0 && bone.parent.as_deref() != Some(c.bones[k - 1].as_str()) {
+                    return Err(bad(
+                        c,
+                        format!("'{name}' is not a child of '{}'", c.bones[k - 1]),
+                    ));
+                }
+            }
+            find(&c.target).ok_or_else(|| bad(c, format!("unknown target bone '{}'", c.target)))?;
+            // The target must not hang below the chain, or solving would move its own goal.
+            let mut at = Some(c.target.as_str());
+            while let Some(name) = at {
+                if c.bones.iter().any(|b| b == name) {
+                    return Err(bad(
+                        c,
+                        format!("target '{}' moves with the chain", c.target),
+                    ));
+                }
+                at = find(name).and_then(|b| b.parent.as_deref());
+            }
+        }
+        Ok(())
     }
 
     fn check_parents(&self) -> Result<(), HandleError> {

@@ -1,6 +1,7 @@
 //! Handles and posing: bones (a forest of skeletons), loose points, cages and regions; the pose
-//! file and forward kinematics.
+//! file and forward kinematics, with classic bone IK constraints ([`bone_ik`]).
 
+pub mod bone_ik;
 pub mod handles;
 pub mod pose;
 

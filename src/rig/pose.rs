@@ -402,8 +402,15 @@ pub fn bone_stretches(
 
 /// One skinning transformation per handle column, in [`Handles::names`]' order expanded as
 /// [`handle_columns`] lists them: bones, points, cage vertices, regions (regions stay at rest
-/// unless IK moves them).
+/// unless IK moves them). The rig's bone IK constraints apply first.
 pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
+    let constrained;
+    let pose = if handles.ik.is_empty() {
+        pose
+    } else {
+        constrained = super::bone_ik::constrained_pose(handles, pose)?;
+        &constrained
+    };
     let mut out = bone_transforms(handles, pose)?;
     check_names(
         "point",

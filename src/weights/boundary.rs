@@ -206,6 +206,7 @@ mod tests {
                 at: [5.0, 5.0],
             }],
             bind: Default::default(),
+            ik: Vec::new(),
             cages: vec![Cage {
                 name: "c".into(),
                 polygon: vec![[30.0, 0.0], [40.0, 0.0], [40.0, 10.0]],
