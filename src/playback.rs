@@ -5,8 +5,11 @@
 //! image per frame, at times 0, 1/fps, 2/fps, … up to but not including the animation's
 //! duration (the loop's end is its start), ready for [`crate::io::sequence`].
 //!
-//! Frames render in parallel; each is computed on its own, so the output does not depend on
-//! the thread count.
+//! Skinning IK (poses with drags) is solved frame after frame, each warm-started from the one
+//! before; drawing then runs in parallel, so the output does not depend on the thread count.
+//!
+//! [`bake`] turns an animation into plain keys (bones, points, cages at every frame time) from
+//! the transformations playback solves: what a runtime that knows no skinning IK can play.
 
 use crate::anim::Animation;
 use crate::pipeline::{PipelineError, Scene};
@@ -181,6 +184,118 @@ pub fn render_poses(
             frame
         })
         .collect()
+}
+
+/// Bakes `animation` at `times_s` (ascending; the caller includes the end time if the loop
+/// must close) into an animation with linear keys for every bone, point and cage, computed from
+/// the skinning transformations playback solves — skinning IK and bone IK included — and no
+/// `ik` timelines. Part looks and draw order are kept as authored. Rotations are unwrapped
+/// (each key within 180° of the previous), since runtimes interpolate plain numbers.
+pub fn bake(
+    scene: &Scene,
+    animation: &Animation,
+    times_s: &[f64],
+) -> Result<Animation, PipelineError> {
+    use crate::anim::timeline::{BoneTimelines, Key, PointTimelines};
+    let handles = &scene.doc.handles;
+    let poses: Vec<Pose> = times_s
+        .iter()
+        .map(|&t| animation.sample(t, false))
+        .collect();
+    let transforms = scene.sequence_transforms(&poses)?;
+    let baked: Vec<Pose> = transforms
+        .iter()
+        .map(|t| crate::rig::pose::pose_from_transforms(handles, t))
+        .collect::<Result<_, _>>()?;
+    fn key<V>(time: f64, value: V) -> Key<V> {
+        Key {
+            time,
+            value,
+            curve: crate::anim::Curve::Linear,
+        }
+    }
+    let unwrap = |values: Vec<f64>| -> Vec<f64> {
+        let mut out: Vec<f64> = Vec::with_capacity(values.len());
+        for v in values {
+            out.push(match out.last() {
+                Some(&previous) => previous + ((v - previous + 180.0).rem_euclid(360.0) - 180.0),
+                None => v,
+            });
+        }
+        out
+    };
+    let mut out = Animation {
+        parts: animation.parts.clone(),
+        draw_order: animation.draw_order.clone(),
+        ..Animation::default()
+    };
+    for bone in &handles.bones {
+        let pose = |k: usize| &baked[k].bones[&bone.name];
+        let rotate = unwrap((0..baked.len()).map(|k| pose(k).rotate).collect());
+        let keys2 = |f: &dyn Fn(usize) -> [f64; 2]| {
+            Some(
+                times_s
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &t)| key(t, f(k)))
+                    .collect(),
+            )
+        };
+        out.bones.insert(
+            bone.name.clone(),
+            BoneTimelines {
+                rotate: Some(
+                    times_s
+                        .iter()
+                        .zip(rotate)
+                        .map(|(&t, r)| key(t, r))
+                        .collect(),
+                ),
+                translate: keys2(&|k| pose(k).translate),
+                scale: keys2(&|k| pose(k).scale),
+                shear: keys2(&|k| pose(k).shear),
+            },
+        );
+    }
+    for point in &handles.points {
+        let pose = |k: usize| &baked[k].points[&point.name];
+        let rotate = unwrap((0..baked.len()).map(|k| pose(k).rotate).collect());
+        let keys2 = |f: &dyn Fn(usize) -> [f64; 2]| {
+            Some(
+                times_s
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &t)| key(t, f(k)))
+                    .collect(),
+            )
+        };
+        out.points.insert(
+            point.name.clone(),
+            PointTimelines {
+                translate: keys2(&|k| pose(k).translate),
+                rotate: Some(
+                    times_s
+                        .iter()
+                        .zip(rotate)
+                        .map(|(&t, r)| key(t, r))
+                        .collect(),
+                ),
+                scale: keys2(&|k| pose(k).scale),
+                shear: keys2(&|k| pose(k).shear),
+            },
+        );
+    }
+    for cage in &handles.cages {
+        out.cages.insert(
+            cage.name.clone(),
+            times_s
+                .iter()
+                .zip(&baked)
+                .map(|(&t, pose)| key(t, pose.cages[&cage.name].polygon.clone()))
+                .collect(),
+        );
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -140,7 +140,11 @@ fn bundled_animations_match_golden_at_fixed_times() {
     )
     .expect("animations.json parses");
     let animations = sinew::anim::parse_animations(&animations).expect("the animations check");
-    for (name, times_s) in [("walk", [0.25, 0.6]), ("wave", [0.4, 1.1]), ("lift", [0.5, 1.0])] {
+    for (name, times_s) in [
+        ("walk", [0.25, 0.6]),
+        ("wave", [0.4, 1.1]),
+        ("lift", [0.5, 1.0]),
+    ] {
         let animation = &animations[name];
         for t in times_s {
             let pose = animation.sample(t, true);

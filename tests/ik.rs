@@ -292,3 +292,135 @@ fn rigid_bones_stay_rigid_on_request() {
     assert!(stretch < 0.03, "bones stretch by {stretch}");
     assert!(solution.drag_error_px <= 0.05);
 }
+
+/// A 360 × 120 px bar with two skeletons of two bones each, one per half, not connected.
+fn two_skeleton_bar() -> Scene {
+    use sinew::pipeline::{build_rig, Layer};
+    let mut pixmap = tiny_skia::Pixmap::new(400, 200).unwrap();
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(200, 120, 60, 255);
+    let rect = tiny_skia::Rect::from_xywh(20.0, 40.5, 360.0, 119.0).unwrap();
+    pixmap.fill_rect(rect, &paint, tiny_skia::Transform::identity(), None);
+    let image = common::to_rgba(&pixmap);
+    let handles: sinew::rig::Handles = serde_json::from_value(serde_json::json!({
+        "bones": [
+            {"name": "a1", "head": [40, 100], "tail": [110, 100]},
+            {"name": "a2", "parent": "a1", "head": [110, 100], "tail": [180, 100]},
+            {"name": "b1", "head": [220, 100], "tail": [290, 100]},
+            {"name": "b2", "parent": "b1", "head": [290, 100], "tail": [360, 100]}
+        ]
+    }))
+    .unwrap();
+    let layers = vec![Layer {
+        name: "bar".into(),
+        path: "bar.png".into(),
+        image: image.clone(),
+    }];
+    let (doc, _) = build_rig(
+        &layers,
+        std::path::Path::new("."),
+        &Default::default(),
+        &handles,
+    )
+    .unwrap();
+    Scene::new(doc, &[image]).unwrap()
+}
+
+#[test]
+fn disjoint_skeletons_in_one_shape_move_together() {
+    let bar = two_skeleton_bar();
+    let meshes = bar.skinned_meshes().unwrap();
+    let columns = handle_columns(&bar.doc.handles);
+    // The left end held (two pins fix its turn), the right end lifted by 80 px.
+    let drags = vec![
+        drag([30.0, 70.0], [30.0, 70.0]),
+        drag([30.0, 130.0], [30.0, 130.0]),
+        drag([370.0, 100.0], [350.0, 20.0]),
+    ];
+    let mut ik = bar.rig_ik().unwrap();
+    let solution = ik.transforms(&pose_with(drags.clone())).unwrap();
+    assert!(
+        solution.drag_error_px <= 0.05,
+        "drag error {}",
+        solution.drag_error_px
+    );
+    let positions = skinned(&meshes, &solution.transforms);
+    assert_eq!(inverted(&meshes, &positions), 0);
+    // The right skeleton's root, which nothing drags, rises with the bend; the left one's
+    // joint too, less.
+    let lift = |name: &str, at: [f64; 2]| {
+        let p = Point::new(at[0], at[1]);
+        (solution.transforms[columns.iter().position(|c| c == name).unwrap()].apply(p) - p).y
+    };
+    let (a2, b1) = (lift("a2", [110.0, 100.0]), lift("b1", [220.0, 100.0]));
+    println!("joint a2 rose {:.1} px, root b1 {:.1} px", -a2, -b1);
+    assert!(b1 < -15.0 && a2 < -2.0 && b1 < a2, "a2 {a2}, b1 {b1}");
+    let e = energy(&meshes, &positions);
+    let e_naive = energy(
+        &meshes,
+        &skinned(&meshes, &naive(&meshes, &drags, columns.len())),
+    );
+    println!("bar: ours {e:.1} px², naive {e_naive:.1}");
+    assert!(e_naive > 3.0 * e);
+}
+
+#[test]
+fn a_soft_drag_pulls_without_being_met() {
+    let mut ik = scene().rig_ik().unwrap();
+    let mut drags = pins();
+    let target = [180.0, 150.0];
+    drags.push(IkDrag {
+        at: [256.0, 150.0],
+        to: target,
+        weight: Some(0.05),
+    });
+    let solution = ik.transforms(&pose_with(drags.clone())).unwrap();
+    let row = ik.drag_row(&drags[2]).unwrap();
+    let p = sinew::ik::rig::skinned_position(&row.row, &solution.transforms);
+    let moved = 256.0 - p.x;
+    println!("soft drag: the head moved {moved:.1} px of 76");
+    assert!(moved > 5.0 && moved < 75.0, "moved {moved}");
+    assert!(solution.drag_error_px <= 0.05, "the pins stay hard");
+}
+
+#[test]
+fn baking_reproduces_ik_driven_motion_with_plain_keys() {
+    let animations: std::collections::BTreeMap<String, serde_json::Value> = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("assets/character/animations.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let lift = &sinew::anim::parse_animations(&animations).unwrap()["lift"];
+    let fps = 10.0;
+    let times: Vec<f64> = (0..=20).map(|k| k as f64 / fps).collect();
+    let baked = sinew::playback::bake(scene(), lift, &times).unwrap();
+    assert!(baked.ik.is_empty());
+    let solved = scene()
+        .sequence_transforms(
+            &times
+                .iter()
+                .map(|&t| lift.sample(t, false))
+                .collect::<Vec<_>>(),
+        )
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    for (k, &t) in times.iter().enumerate() {
+        let pose = baked.sample(t, false);
+        assert!(pose.ik.is_empty());
+        let from_keys = scene().pose_positions(&pose).unwrap();
+        let from_ik = scene()
+            .positions_from_transforms(&solved[k], &pose, sinew::skin::Blend::Linear)
+            .unwrap();
+        for (a, b) in from_keys.iter().flatten().zip(from_ik.iter().flatten()) {
+            worst = worst.max((a - b).norm());
+        }
+    }
+    println!("baked keys vs solved frames: {worst:.2e} px");
+    assert!(
+        worst < 1e-6,
+        "baked keys miss the solved frames by {worst} px"
+    );
+}

@@ -97,6 +97,7 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
             translate: lerp2(a.translate, b.translate, alpha),
             rotate: shortest_arc_deg(a.rotate, b.rotate, alpha),
             scale: lerp2(a.scale, b.scale, alpha),
+            shear: lerp2(a.shear, b.shear, alpha),
         };
         out.points.insert(name.clone(), point);
     }

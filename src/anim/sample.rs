@@ -142,6 +142,7 @@ impl Animation {
             for (field, keys) in [
                 (&mut point.translate, &timelines.translate),
                 (&mut point.scale, &timelines.scale),
+                (&mut point.shear, &timelines.shear),
             ] {
                 if let Some(v) = keys.as_deref().and_then(|k| sample_keys(k, t)) {
                     *field = v;

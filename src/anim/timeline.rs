@@ -152,6 +152,9 @@ pub struct PointTimelines {
     pub rotate: Option<Vec<Key<f64>>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub scale: Option<Vec<Key<[f64; 2]>>>,
+    /// Degrees: x axis, y axis.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shear: Option<Vec<Key<[f64; 2]>>>,
 }
 
 /// A part's timelines, as [`crate::rig::pose::PartPose`].
@@ -387,7 +390,11 @@ impl Animation {
             if let Some(keys) = &t.rotate {
                 check_keys(keys).map_err(fail(path("rotate")))?;
             }
-            for (what, keys) in [("translate", &t.translate), ("scale", &t.scale)] {
+            for (what, keys) in [
+                ("translate", &t.translate),
+                ("scale", &t.scale),
+                ("shear", &t.shear),
+            ] {
                 if let Some(keys) = keys {
                     check_keys(keys).map_err(fail(path(what)))?;
                 }
@@ -435,7 +442,7 @@ impl Animation {
         }
         for t in self.points.values() {
             see(t.rotate.as_deref().map_or(0.0, |k| last(k, key)));
-            for keys in [&t.translate, &t.scale] {
+            for keys in [&t.translate, &t.scale, &t.shear] {
                 see(keys.as_deref().map_or(0.0, |k| last(k, key2)));
             }
         }
@@ -499,7 +506,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                         let probed = match (section.as_str(), timeline.as_str()) {
                             ("bones" | "points", "rotate") => probe_keys::<Key<f64>>(keys),
                             ("bones", "translate" | "scale" | "shear")
-                            | ("points", "translate" | "scale") => {
+                            | ("points", "translate" | "scale" | "shear") => {
                                 probe_keys::<Key<[f64; 2]>>(keys)
                             }
                             ("parts", "color") => probe_keys::<Key<Rgba>>(keys),
@@ -507,7 +514,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                             _ => {
                                 let expected = match section.as_str() {
                                     "bones" => "rotate, translate, scale or shear",
-                                    "points" => "translate, rotate or scale",
+                                    "points" => "translate, rotate, scale or shear",
                                     _ => "color or visible",
                                 };
                                 return Some(fail(

@@ -106,6 +106,13 @@ pub struct PointPose {
     /// Degrees, counter-clockwise on screen.
     pub rotate: f64,
     pub scale: [f64; 2],
+    /// Degrees: x axis, y axis (as a bone's), so that any affine map of a point is a pose.
+    #[serde(skip_serializing_if = "is_zero2")]
+    pub shear: [f64; 2],
+}
+
+fn is_zero2(v: &[f64; 2]) -> bool {
+    *v == [0.0, 0.0]
 }
 
 impl Default for PointPose {
@@ -114,6 +121,7 @@ impl Default for PointPose {
             translate: [0.0, 0.0],
             rotate: 0.0,
             scale: [1.0, 1.0],
+            shear: [0.0, 0.0],
         }
     }
 }
@@ -425,13 +433,14 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
             p.rotate,
             p.scale[0],
             p.scale[1],
+            p.shear[0],
+            p.shear[1],
         ]) {
             return Err(PoseError::NonFinite(point.name.clone()));
         }
         // About the rest position: move there, turn and scale, move back, then translate.
         let at = Vec2::new(point.at[0], point.at[1]);
-        let linear =
-            rotation(p.rotate) * Matrix2::from_diagonal(&Vec2::new(p.scale[0], p.scale[1]));
+        let linear = local_linear(p.rotate, p.scale, p.shear);
         out.push(Affine {
             linear,
             translation: at - linear * at + Vec2::new(p.translate[0], p.translate[1]),
@@ -467,6 +476,110 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
     }
     out.extend(handles.regions.iter().map(|_| Affine::identity()));
     Ok(out)
+}
+
+/// The pose whose forward kinematics gives `transforms` (one per handle column, as
+/// [`handle_transforms`] returns them): the inverse of forward kinematics, for baking solved
+/// transformations into keys. Bones get rotate, translate, scale and shear with shear x = 0
+/// (any affine map with a non-zero determinant has such a form); points likewise about their rest
+/// position; cages get the polygon their vertices' translations make (exact for translation-only
+/// cage vertices, the default). Regions have no pose and are left out. Constrained bones (bone
+/// IK) are baked like any other, so the result needs no constraint to reproduce them.
+pub fn pose_from_transforms(handles: &Handles, transforms: &[Affine]) -> Result<Pose, PoseError> {
+    let mut pose = Pose::default();
+    let rest: Vec<Affine> = handles
+        .bones
+        .iter()
+        .map(|b| bone_rest_frame(b.head, b.tail))
+        .collect();
+    let index = |name: &str| handles.bones.iter().position(|b| b.name == name);
+    for (i, bone) in handles.bones.iter().enumerate() {
+        let singular = || PoseError::Singular(bone.name.clone());
+        let world_from_bone = transforms[i].then_after(&rest[i]);
+        let (world_from_parent, parent_from_bone_rest) =
+            match bone.parent.as_deref().and_then(index) {
+                Some(p) => (
+                    transforms[p].then_after(&rest[p]),
+                    rest[p].inverse().ok_or_else(singular)?.then_after(&rest[i]),
+                ),
+                None => (Affine::identity(), rest[i]),
+            };
+        let parent_from_bone = world_from_parent
+            .inverse()
+            .ok_or_else(singular)?
+            .then_after(&world_from_bone);
+        let rest_angle = screen_angle_deg(parent_from_bone_rest.linear.column(0).into());
+        let (rotate, scale, shear) =
+            decompose_linear(&parent_from_bone.linear).ok_or_else(singular)?;
+        let offset = parent_from_bone.translation - parent_from_bone_rest.translation;
+        pose.bones.insert(
+            bone.name.clone(),
+            BonePose {
+                rotate: wrap_deg(rotate - rest_angle),
+                translate: [offset.x, offset.y],
+                scale,
+                shear,
+            },
+        );
+    }
+    let mut j = handles.bones.len();
+    for point in &handles.points {
+        let t = &transforms[j];
+        let (rotate, scale, shear) =
+            decompose_linear(&t.linear).ok_or_else(|| PoseError::Singular(point.name.clone()))?;
+        let at = Vec2::new(point.at[0], point.at[1]);
+        let translate = t.translation - at + t.linear * at;
+        pose.points.insert(
+            point.name.clone(),
+            PointPose {
+                translate: [translate.x, translate.y],
+                rotate,
+                scale,
+                shear,
+            },
+        );
+        j += 1;
+    }
+    for cage in &handles.cages {
+        let polygon = cage
+            .polygon
+            .iter()
+            .enumerate()
+            .map(|(k, v)| {
+                let p = transforms[j + k].apply(Point::new(v[0], v[1]));
+                [p.x, p.y]
+            })
+            .collect();
+        pose.cages.insert(cage.name.clone(), CagePose { polygon });
+        j += cage.polygon.len();
+    }
+    Ok(pose)
+}
+
+fn wrap_deg(a: f64) -> f64 {
+    (a + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// (rotate°, scale, shear°) with shear x = 0 such that [`local_linear`] gives back `l`, or `None`
+/// for a singular `l`. A reflection gets a negative y scale.
+fn decompose_linear(l: &Matrix2<f64>) -> Option<(f64, [f64; 2], [f64; 2])> {
+    let (x, y) = (
+        Vec2::new(l[(0, 0)], l[(1, 0)]),
+        Vec2::new(l[(0, 1)], l[(1, 1)]),
+    );
+    let det = l.determinant();
+    if x.norm() == 0.0 || det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let rotate = screen_angle_deg(x);
+    let (sy, y_dir) = if det < 0.0 {
+        (-y.norm(), -y)
+    } else {
+        (y.norm(), y)
+    };
+    // rotation(θ)·(0, 1) points at screen angle θ − 90°.
+    let shear_y = wrap_deg(screen_angle_deg(y_dir) + 90.0 - rotate);
+    Some((rotate, [x.norm(), sy], [0.0, shear_y]))
 }
 
 /// The weight columns of a rig, in order: each bone, each point, each cage vertex
@@ -584,6 +697,12 @@ mod tests {
             },
         );
         let t = handle_transforms(&arm(), &pose).unwrap();
+        let back = handle_transforms(&arm(), &pose_from_transforms(&arm(), &t).unwrap()).unwrap();
+        assert!(t
+            .iter()
+            .zip(&back)
+            .all(|(a, b)| (a.linear - b.linear).norm() < 1e-12
+                && (a.translation - b.translation).norm() < 1e-9));
         assert!(close(t[2].apply(Point::new(5.0, 5.0)), [6.0, 5.0]));
         assert!(close(t[2].apply(Point::new(6.0, 5.0)), [5.0, 5.0]));
         pose.bones.insert("nope".into(), BonePose::default());
