@@ -90,6 +90,7 @@ fn problem(mesh: &SkinnedMesh, drag_to: [f64; 2]) -> Problem {
             },
         ],
         anchor: vec![Affine::identity(); HANDLES],
+        inertia: Vec::new(),
     }
 }
 

@@ -400,7 +400,7 @@ fn render_with_progress_bar(
         bar.set_style(style);
     }
     let poses = playback::poses_at(animation, times);
-    let frames = playback::render_poses(scene, &poses, blend, view, &|| bar.inc(1));
+    let frames = playback::render_poses(scene, &poses, times, blend, view, &|| bar.inc(1));
     bar.finish_and_clear();
     Ok(frames?)
 }
@@ -505,7 +505,7 @@ fn demo(args: &DemoArgs) -> Result<()> {
         let t = Instant::now();
         let times = playback::frame_times(animation.duration_s(), DEMO_FPS)?;
         let poses = playback::poses_at(animation, &times);
-        let frames = playback::render_poses(&scene, &poses, Blend::Linear, &view, &|| {})?;
+        let frames = playback::render_poses(&scene, &poses, &times, Blend::Linear, &view, &|| {})?;
         render_s += t.elapsed().as_secs_f64();
         frame_count += frames.len();
         let t = Instant::now();

@@ -424,25 +424,39 @@ impl Scene {
         self.positions_from_transforms(&transforms, pose, blend)
     }
 
-    /// The skinning transformations of a sequence of poses (an animation's frames), solved in
-    /// order so that each IK solve starts from the previous frame's result.
-    pub fn sequence_transforms(&self, poses: &[Pose]) -> Result<Vec<Vec<Affine>>, PipelineError> {
+    /// The skinning transformations of a sequence of poses (an animation's frames at
+    /// `times_s`), solved in order: each IK solve starts from the previous frame's result, and
+    /// handles with momentum ([`crate::ik::IkOptions::momentum`]) carry their motion from frame
+    /// to frame.
+    pub fn sequence_transforms(
+        &self,
+        poses: &[Pose],
+        times_s: &[f64],
+    ) -> Result<Vec<Vec<Affine>>, PipelineError> {
+        let dynamic = !self.doc.options.ik.momentum.is_empty();
         let mut ik: Option<RigIk> = None;
-        poses
-            .iter()
-            .map(|pose| {
-                if pose.ik.is_empty() {
-                    return Ok(handle_transforms(&self.doc.handles, pose)?);
-                }
-                if ik.is_none() {
-                    ik = Some(self.rig_ik()?);
-                }
-                match ik.as_mut() {
-                    Some(solver) => Ok(solver.transforms(pose)?.transforms),
-                    None => Err(PipelineError::Ik(crate::ik::IkError::Singular)),
-                }
-            })
-            .collect()
+        let mut out = Vec::with_capacity(poses.len());
+        for (k, pose) in poses.iter().enumerate() {
+            if pose.ik.is_empty() && !dynamic {
+                out.push(handle_transforms(&self.doc.handles, pose)?);
+                continue;
+            }
+            if ik.is_none() {
+                ik = Some(self.rig_ik()?);
+            }
+            let frame_time_s = match (
+                k.checked_sub(1).and_then(|p| times_s.get(p)),
+                times_s.get(k),
+            ) {
+                (Some(before), Some(now)) => now - before,
+                _ => 0.0,
+            };
+            let solver = ik
+                .as_mut()
+                .ok_or(PipelineError::Ik(crate::ik::IkError::Singular))?;
+            out.push(solver.step(pose, frame_time_s)?.transforms);
+        }
+        Ok(out)
     }
 
     /// The rig's meshes as the skinning IK sees them: parts with weights, back to front, their

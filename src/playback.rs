@@ -162,17 +162,18 @@ pub fn draw_pose(
     scene.draw_parts(canvas, &draws, output_from_canvas)
 }
 
-/// Renders every pose through `view`; `on_frame` is called once per finished frame (for a
+/// Renders every pose (shown at `times_s`) through `view`; `on_frame` is called once per finished frame (for a
 /// progress bar). Skinning IK solves the poses in order first, each frame warm-started from the
 /// one before (so a sequence is deterministic and smooth); drawing then runs in parallel.
 pub fn render_poses(
     scene: &Scene,
     poses: &[Pose],
+    times_s: &[f64],
     blend: Blend,
     view: &FrameView,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<Vec<RgbaImage>, PipelineError> {
-    let transforms = scene.sequence_transforms(poses)?;
+    let transforms = scene.sequence_transforms(poses, times_s)?;
     poses
         .par_iter()
         .zip(transforms.par_iter())
@@ -202,7 +203,7 @@ pub fn bake(
         .iter()
         .map(|&t| animation.sample(t, false))
         .collect();
-    let transforms = scene.sequence_transforms(&poses)?;
+    let transforms = scene.sequence_transforms(&poses, times_s)?;
     let baked: Vec<Pose> = transforms
         .iter()
         .map(|t| crate::rig::pose::pose_from_transforms(handles, t))

@@ -404,6 +404,7 @@ fn baking_reproduces_ik_driven_motion_with_plain_keys() {
                 .iter()
                 .map(|&t| lift.sample(t, false))
                 .collect::<Vec<_>>(),
+            &times,
         )
         .unwrap();
     let mut worst: f64 = 0.0;
@@ -423,4 +424,56 @@ fn baking_reproduces_ik_driven_motion_with_plain_keys() {
         worst < 1e-6,
         "baked keys miss the solved frames by {worst} px"
     );
+}
+
+#[test]
+fn momentum_handles_lag_swing_and_settle() {
+    let (lag, swing, settled) = tail_after_hip_jump(0.01);
+    println!("tail tip: lags up to {lag:.1} px, swings to {swing:.1} px, ends {settled:.2} px off");
+    assert!(lag > 20.0, "the tail tip should trail the hip (lag {lag})");
+    assert!(
+        swing < -2.0,
+        "the tail tip should swing past (swing {swing})"
+    );
+    assert!(settled < 1.0, "the tail should settle ({settled} px off)");
+    let (stiff_lag, _, _) = tail_after_hip_jump(0.0);
+    assert!(
+        stiff_lag < 1.0,
+        "without momentum the tail follows ({stiff_lag} px)"
+    );
+}
+
+/// The tail tip's offset from where a rigid tail would carry it, frame by frame, as the hip
+/// jumps 60 px left over a quarter second and then stands still: (largest lag, farthest swing
+/// past, final offset), px.
+fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
+    let meshes = scene().skinned_meshes().unwrap();
+    let handles = &scene().doc.handles;
+    let mut options = IkOptions::default();
+    for name in ["tail_4", "tail_5", "tail_6"] {
+        options.momentum.insert(name.into(), inertia_s);
+    }
+    let mut ik = RigIk::precompute(handles, meshes, options).unwrap();
+    let columns = handle_columns(handles);
+    let tip_bone = columns.iter().position(|c| c == "tail_6").unwrap();
+    let tail_tip = Point::new(452.0, 214.0);
+    let fps = 30.0;
+    let mut offsets = Vec::new();
+    for k in 0..=75 {
+        let t = k as f64 / fps;
+        let x = -60.0 * (t / 0.25).min(1.0);
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "hip".into(),
+            sinew::rig::pose::BonePose {
+                translate: [x, 0.0],
+                ..Default::default()
+            },
+        );
+        let solution = ik.step(&pose, 1.0 / fps).unwrap();
+        offsets.push(solution.transforms[tip_bone].apply(tail_tip).x - (tail_tip.x + x));
+    }
+    let lag = offsets[..10].iter().cloned().fold(0.0, f64::max);
+    let swing = offsets[8..].iter().cloned().fold(0.0, f64::min);
+    (lag, swing, offsets.last().unwrap().abs())
 }

@@ -68,6 +68,9 @@ pub struct Problem {
     pub drags: Vec<DragRow>,
     /// Where each column sits when nothing else decides (the forward-kinematics pose).
     pub anchor: Vec<Affine>,
+    /// Momentum terms: (free column, weight relative to the ARAP energy, where its motion would
+    /// carry it). The column is pulled toward the prediction through its own mass block of G.
+    pub inertia: Vec<(usize, f64, Affine)>,
 }
 
 impl Problem {
@@ -84,6 +87,12 @@ impl Problem {
                 });
         dofs_match
             && self.joints == other.joints
+            && self.inertia.len() == other.inertia.len()
+            && self
+                .inertia
+                .iter()
+                .zip(&other.inertia)
+                .all(|(a, b)| a.0 == b.0 && a.1 == b.1)
             && self.drags.len() == other.drags.len()
             && self
                 .drags
@@ -122,6 +131,8 @@ struct System {
     /// Free rigid columns: (column, z offset, λ).
     rigid: Vec<(usize, usize, f64)>,
     anchor_weight: f64,
+    /// tr(A) / tr(G): converts mass-weighted distances into energy units.
+    energy_per_gram: f64,
 }
 
 /// The skinning-IK solver of one rig: precompute once, then solve per frame or per drag.
@@ -271,6 +282,17 @@ impl FastIk {
             0.0
         };
         q_t += &self.subspace.gram * anchor_weight;
+        let energy_per_gram = if trace_g > 0.0 {
+            trace_a / trace_g
+        } else {
+            0.0
+        };
+        for &(j, weight, _) in &problem.inertia {
+            let block =
+                self.subspace.gram.view((3 * j, 3 * j), (3, 3)) * (weight * energy_per_gram);
+            let mut target = q_t.view_mut((3 * j, 3 * j), (3, 3));
+            target += block;
+        }
         let stiffness = self.handle_stiffness();
         let mut hard: Vec<Vec<f64>> = Vec::new();
         for joint in &problem.joints {
@@ -322,12 +344,22 @@ impl FastIk {
             x_pt_b,
             rigid,
             anchor_weight,
+            energy_per_gram,
         })
     }
 
     /// Solves `problem`, reusing the last factorization when the structure is unchanged and the
     /// last solution as the starting point.
     pub fn solve(&mut self, problem: &Problem) -> Result<IkSolution, IkError> {
+        self.solve_limited(problem, None)
+    }
+
+    /// [`FastIk::solve`] with another iteration limit for a warm-started solve.
+    pub fn solve_limited(
+        &mut self,
+        problem: &Problem,
+        warm_iterations: Option<usize>,
+    ) -> Result<IkSolution, IkError> {
         let reuse = matches!(&self.system, Some(s) if s.problem.same_structure(problem));
         if !reuse {
             self.system = Some(self.factor(problem)?);
@@ -354,6 +386,19 @@ impl FastIk {
         let anchor = stack(&problem.anchor);
         let stiffness = self.handle_stiffness();
         let mut f_const = &self.subspace.gram * &anchor * system.anchor_weight - &system.q_t * &q;
+        for (j, weight, predicted) in &problem.inertia {
+            let block =
+                self.subspace.gram.view((3 * j, 3 * j), (3, 3)) * (weight * system.energy_per_gram);
+            let mut rows = DMatrix::<f64>::zeros(3, 2);
+            for c in 0..2 {
+                rows[(0, c)] = predicted.linear[(c, 0)];
+                rows[(1, c)] = predicted.linear[(c, 1)];
+                rows[(2, c)] = predicted.translation[c];
+            }
+            let pull = block * rows;
+            let mut target = f_const.view_mut((3 * j, 0), (3, 2));
+            target += pull;
+        }
         let mut targets = Vec::with_capacity(system.e_t.nrows());
         targets.extend(problem.joints.iter().map(|_| [0.0, 0.0]));
         for drag in &problem.drags {
@@ -373,7 +418,10 @@ impl FastIk {
         let z_const = &system.x * system.p.tr_mul(&f_const) + &system.y * &e;
 
         let (mut t, iteration_limit) = match &self.previous {
-            Some(prev) if prev.nrows() == dim => (prev.clone(), self.options.iterations),
+            Some(prev) if prev.nrows() == dim => (
+                prev.clone(),
+                warm_iterations.unwrap_or(self.options.iterations),
+            ),
             _ => (anchor.clone(), self.options.cold_iterations),
         };
         let r_count = self.subspace.cluster_count;

@@ -11,7 +11,8 @@
 //! - [`subspace`]: the energy reduced to the handles' affine parameters (precomputed per rig).
 //! - [`fast`]: the local/global solver over the reduced energy (factorized per constraint set,
 //!   solved per frame).
-//! - [`rig`]: a rig and a pose → which handles are free, fixed or following, joints, drags.
+//! - [`rig`]: a rig and a pose → which handles are free, fixed or following, joints, drags,
+//!   momentum (secondary motion across the frames of a sequence).
 //! - [`reference`]: the full per-vertex ARAP deformation, the quality bound tests compare with.
 
 pub mod arap;
@@ -26,6 +27,7 @@ pub use rig::RigIk;
 pub use subspace::SkinnedMesh;
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// How a free handle that is not a bone may move.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -79,6 +81,18 @@ pub struct IkOptions {
     /// Pull toward the forward-kinematics pose, relative to the ARAP energy; it only decides
     /// motions that nothing else decides (a rig with no drag stays in its FK pose). Default 1e-6.
     pub anchor: f64,
+    /// Secondary motion: handle column name (as `handle_columns` lists them) → inertia, s. A
+    /// handle named here and not keyed by the pose is left free in every frame of a sequence
+    /// and carries momentum: each frame minimizes the ARAP energy plus (inertia / frame time)²
+    /// times its mass-weighted distance from where its motion would carry it (implicit Euler),
+    /// so it lags, swings and settles when the driven parts move. Default: none.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub momentum: BTreeMap<String, f64>,
+    /// Share of a momentum handle's velocity lost per frame, in [0, 1]. Default 0.1.
+    pub momentum_damping: f64,
+    /// Local/global iterations per frame when momentum is in play: the balance of inertia and
+    /// elasticity needs a converged frame, or the motion comes out overdamped. Default 32.
+    pub momentum_iterations: usize,
     /// How far outside every part an ik drag's `at` may lie and still grip the nearest
     /// triangle, px. Default 2.
     pub grip_tolerance_px: f64,
@@ -100,6 +114,9 @@ impl Default for IkOptions {
             connect_joints: true,
             anchor: 1e-6,
             grip_tolerance_px: 2.0,
+            momentum: BTreeMap::new(),
+            momentum_damping: 0.1,
+            momentum_iterations: 32,
         }
     }
 }
@@ -125,6 +142,8 @@ pub enum IkError {
     BadFollow { column: usize, parent: usize },
     #[error("the skinning IK system is singular (a handle that moves no vertex?)")]
     Singular,
-    #[error("classic IK: {0}")]
-    Bone(String),
+    #[error("momentum names '{0}', which is not a handle column of the rig")]
+    UnknownMomentumHandle(String),
+    #[error("momentum of '{0}' must be a finite number ≥ 0 s")]
+    BadMomentum(String),
 }

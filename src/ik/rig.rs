@@ -27,6 +27,10 @@ pub struct RigIk {
     /// Shared between clones: solvers of one rig differ only in their warm start.
     pub meshes: std::sync::Arc<Vec<SkinnedMesh>>,
     pub solver: FastIk,
+    /// Per column: inertia from [`IkOptions::momentum`], s (0: none).
+    inertia_s: Vec<f64>,
+    /// The last two results of [`RigIk::step`], oldest first: the momentum handles' motion.
+    history: Vec<Vec<Affine>>,
 }
 
 impl RigIk {
@@ -37,13 +41,60 @@ impl RigIk {
         meshes: Vec<SkinnedMesh>,
         options: IkOptions,
     ) -> Result<Self, IkError> {
-        let columns = handle_columns(handles).len();
-        let solver = FastIk::precompute(&meshes, columns, options)?;
+        let names = handle_columns(handles);
+        let mut inertia_s = vec![0.0; names.len()];
+        for (name, &tau) in &options.momentum {
+            let j = names
+                .iter()
+                .position(|c| c == name)
+                .ok_or_else(|| IkError::UnknownMomentumHandle(name.clone()))?;
+            if !(tau.is_finite() && tau >= 0.0) {
+                return Err(IkError::BadMomentum(name.clone()));
+            }
+            inertia_s[j] = tau;
+        }
+        let solver = FastIk::precompute(&meshes, names.len(), options)?;
         Ok(RigIk {
             handles: handles.clone(),
             meshes: std::sync::Arc::new(meshes),
             solver,
+            inertia_s,
+            history: Vec::new(),
         })
+    }
+
+    /// Forgets the warm start and the momentum handles' motion (the sequence jumps).
+    pub fn reset(&mut self) {
+        self.solver.reset();
+        self.history.clear();
+    }
+
+    /// One frame of a sequence, `frame_time_s` after the previous one: [`RigIk::transforms`]
+    /// plus secondary motion — handles with momentum are solved even when the pose has no
+    /// drags, pulled toward where their motion over the last frames carries them.
+    pub fn step(&mut self, pose: &Pose, frame_time_s: f64) -> Result<IkSolution, IkError> {
+        let dynamic = self.inertia_s.iter().any(|&t| t > 0.0)
+            && frame_time_s > 0.0
+            && frame_time_s.is_finite();
+        let problem = self.problem_with(pose, dynamic.then_some(frame_time_s))?;
+        let solution = if problem.drags.is_empty() && problem.inertia.is_empty() {
+            IkSolution {
+                transforms: problem.anchor,
+                iterations: 0,
+                drag_error_px: 0.0,
+                energy: f64::NAN,
+            }
+        } else if problem.inertia.is_empty() {
+            self.solver.solve(&problem)?
+        } else {
+            let limit = self.solver.options.momentum_iterations;
+            self.solver.solve_limited(&problem, Some(limit))?
+        };
+        self.history.push(solution.transforms.clone());
+        if self.history.len() > 2 {
+            self.history.remove(0);
+        }
+        Ok(solution)
     }
 
     /// The skinning transformations for `pose`: forward kinematics if it has no drags, the
@@ -63,7 +114,16 @@ impl RigIk {
 
     /// The problem `pose` poses (see the module doc).
     pub fn problem(&self, pose: &Pose) -> Result<Problem, IkError> {
+        self.problem_with(pose, None)
+    }
+
+    /// [`RigIk::problem`]; with a frame time, handles with momentum are free and carry it.
+    fn problem_with(&self, pose: &Pose, frame_time_s: Option<f64>) -> Result<Problem, IkError> {
         let handles = &self.handles;
+        let dragged = !pose.ik.is_empty();
+        // A handle the solver may move: unkeyed, and either drags move everything free or it
+        // carries momentum in this frame.
+        let movable = |j: usize| dragged || (frame_time_s.is_some() && self.inertia_s[j] > 0.0);
         let options = &self.solver.options;
         // Bones that bone IK constraints turn are decided, like keyed ones.
         let pose = &crate::rig::bone_ik::constrained_pose(handles, pose)?;
@@ -71,7 +131,8 @@ impl RigIk {
         let mut columns: Vec<ColumnDofs> = Vec::with_capacity(fk.len());
         let mut joints = Vec::new();
         let bone_index = |name: &str| handles.bones.iter().position(|b| b.name == name);
-        let keyed = |i: usize| pose.bones.contains_key(&handles.bones[i].name);
+        // A bone is decided (by the pose or by forward kinematics) unless it may move.
+        let keyed = |i: usize| pose.bones.contains_key(&handles.bones[i].name) || !movable(i);
         for (i, bone) in handles.bones.iter().enumerate() {
             let parent = bone.parent.as_deref().and_then(bone_index);
             if !keyed(i) {
@@ -117,7 +178,7 @@ impl RigIk {
         };
         for point in &handles.points {
             let j = columns.len();
-            columns.push(if pose.points.contains_key(&point.name) {
+            columns.push(if pose.points.contains_key(&point.name) || !movable(j) {
                 ColumnDofs::Fixed(fk[j])
             } else {
                 free(options.points)
@@ -135,8 +196,13 @@ impl RigIk {
             }
         }
         for _ in &handles.regions {
-            columns.push(ColumnDofs::Affine {
-                rigidity: options.region_rigidity,
+            let j = columns.len();
+            columns.push(if movable(j) {
+                ColumnDofs::Affine {
+                    rigidity: options.region_rigidity,
+                }
+            } else {
+                ColumnDofs::Fixed(fk[j])
             });
         }
         let drags = pose
@@ -144,11 +210,38 @@ impl RigIk {
             .iter()
             .map(|d| self.drag_row(d))
             .collect::<Result<Vec<_>, _>>()?;
+        let mut inertia = Vec::new();
+        if let (Some(h), Some(now)) = (frame_time_s, self.history.last()) {
+            let before = self
+                .history
+                .first()
+                .filter(|_| self.history.len() == 2)
+                .unwrap_or(now);
+            let keep = 1.0 - options.momentum_damping.clamp(0.0, 1.0);
+            for (j, c) in columns.iter().enumerate() {
+                let tau = self.inertia_s[j];
+                if tau <= 0.0
+                    || !matches!(
+                        c,
+                        ColumnDofs::Affine { .. } | ColumnDofs::Translation { .. }
+                    )
+                {
+                    continue;
+                }
+                let predicted = Affine {
+                    linear: now[j].linear + (now[j].linear - before[j].linear) * keep,
+                    translation: now[j].translation
+                        + (now[j].translation - before[j].translation) * keep,
+                };
+                inertia.push((j, (tau / h).powi(2), predicted));
+            }
+        }
         Ok(Problem {
             columns,
             joints,
             drags,
             anchor: fk,
+            inertia,
         })
     }
 
