@@ -77,7 +77,7 @@ pub enum PipelineError {
     Weights { path: PathBuf, source: WeightError },
     #[error("pose: {0}")]
     Pose(#[from] PoseError),
-    #[error("ik: {0}")]
+    #[error(transparent)]
     Ik(#[from] crate::ik::IkError),
     #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
     UnknownWeightHandle { part: String, handle: String },
