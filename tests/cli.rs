@@ -338,6 +338,40 @@ fn demo_writes_rig_animations_gifs_and_sheets_and_render_and_pose_play_them() {
         "a walk frame must differ from rest"
     );
 
+    // A pose with skinning-IK drags: the pinned feet stay, the dragged hand arrives.
+    let lift = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character/poses/lift.json");
+    let vertices = dir.join("lift_vertices.json");
+    let out = sinew(&[
+        "pose",
+        s(&rig),
+        "--pose",
+        s(&lift),
+        "--vertices",
+        s(&vertices),
+        "-o",
+        s(&dir.join("lift.png")),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("lift.png").is_file() && vertices.is_file());
+    let bad_drag = dir.join("bad_drag.json");
+    std::fs::write(&bad_drag, r#"{"ik": [{"at": [2, 2], "to": [50, 50]}]}"#).unwrap();
+    assert_bad_input(
+        &[
+            "pose",
+            s(&rig),
+            "--pose",
+            s(&bad_drag),
+            "-o",
+            s(&dir.join("no.png")),
+        ],
+        "does not grip the drawing",
+    );
+    assert!(!dir.join("no.png").exists());
+
     // Bad requests: one line, exit 2, nothing written.
     assert_bad_input(
         &[

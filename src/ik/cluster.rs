@@ -52,16 +52,20 @@ pub fn weight_space_clusters(
     }
     let k = centers.len() / dim;
 
+    // Nearest center by ‖x − c‖² = ‖x‖² − 2 x·c + ‖c‖², the dot products as one matrix product
+    // (n × dim times dim × k): the clustering's cost is all here.
+    let x = nalgebra::DMatrix::from_row_slice(n, dim, points);
     let assign = |centers: &[f64]| -> Vec<u32> {
+        let c = nalgebra::DMatrix::from_row_slice(k, dim, centers);
+        let dots = &x * c.transpose();
+        let norms: Vec<f64> = (0..k).map(|j| c.row(j).norm_squared()).collect();
         (0..n)
-            .into_par_iter()
             .map(|i| {
-                let p = point(i);
                 let mut best = (0u32, f64::INFINITY);
-                for c in 0..k {
-                    let d = distance2(p, &centers[c * dim..(c + 1) * dim]);
+                for (j, norm) in norms.iter().enumerate() {
+                    let d = norm - 2.0 * dots[(i, j)];
                     if d < best.1 {
-                        best = (c as u32, d);
+                        best = (j as u32, d);
                     }
                 }
                 best.0

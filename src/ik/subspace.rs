@@ -69,19 +69,18 @@ pub fn reduce(
 ) -> Subspace {
     let n: usize = meshes.iter().map(|m| m.rest.len()).sum();
     let dim = 3 * column_count;
-    let mut m_dense = DMatrix::<f64>::zeros(n, dim);
-    let mut lm = DMatrix::<f64>::zeros(n, dim);
-    let mut mass_m = DMatrix::<f64>::zeros(n, dim);
+    // Stored transposed (one column per vertex) so that a vertex's row Mᵢ is contiguous: the
+    // edge loops below touch two vertices at a time.
+    let mut m_t = DMatrix::<f64>::zeros(dim, n);
+    let mut lm_t = DMatrix::<f64>::zeros(dim, n);
+    let mut mass_m_t = DMatrix::<f64>::zeros(dim, n);
     let mut b = DMatrix::<f64>::zeros(dim, 2 * cluster_count);
     let mut energy_constant = 0.0;
-    let mut row = vec![0.0; dim];
+    let mut difference = vec![0.0; dim];
     let mut base = 0;
     for mesh in meshes {
         for (i, (p, w)) in mesh.rest.iter().zip(&mesh.weights).enumerate() {
-            skinning_row(*p, w, &mut row);
-            for (k, &x) in row.iter().enumerate() {
-                m_dense[(base + i, k)] = x;
-            }
+            skinning_row(*p, w, m_t.column_mut(base + i).as_mut_slice());
         }
         let mut mass = vec![0.0; mesh.rest.len()];
         for t in &mesh.triangles {
@@ -92,9 +91,8 @@ pub fn reduce(
             }
         }
         for (i, m) in mass.iter().enumerate() {
-            for k in 0..dim {
-                mass_m[(base + i, k)] = m * m_dense[(base + i, k)];
-            }
+            let row = m_t.column(base + i) * *m;
+            mass_m_t.set_column(base + i, &row);
         }
         for e in cotangent_edges(&mesh.rest, &mesh.triangles) {
             if e.weight == 0.0 {
@@ -104,29 +102,35 @@ pub fn reduce(
             let (gi, gj) = (base + i, base + j);
             let edge = mesh.rest[i] - mesh.rest[j];
             energy_constant += 2.0 * e.weight * edge.norm_squared();
+            {
+                let (mi, mj) = (m_t.column(gi), m_t.column(gj));
+                for (k, d) in difference.iter_mut().enumerate() {
+                    *d = e.weight * (mi[k] - mj[k]);
+                }
+            }
+            for (k, &d) in difference.iter().enumerate() {
+                lm_t[(k, gi)] += d;
+                lm_t[(k, gj)] -= d;
+            }
             // Directed i→j uses g(i)'s rotation with (Mᵢ − Mⱼ) and eᵢⱼ; j→i uses g(j)'s with the
             // opposite signs of both, so the same product.
-            let (ci, cj) = (2 * clusters[gi] as usize, 2 * clusters[gj] as usize);
-            for k in 0..dim {
-                let d = m_dense[(gi, k)] - m_dense[(gj, k)];
-                if d == 0.0 {
-                    continue;
+            for cluster in [clusters[gi] as usize, clusters[gj] as usize] {
+                let mut bx = b.column_mut(2 * cluster);
+                for (k, &d) in difference.iter().enumerate() {
+                    bx[k] += d * edge.x;
                 }
-                lm[(gi, k)] += e.weight * d;
-                lm[(gj, k)] -= e.weight * d;
-                let (wx, wy) = (e.weight * d * edge.x, e.weight * d * edge.y);
-                b[(k, ci)] += wx;
-                b[(k, ci + 1)] += wy;
-                b[(k, cj)] += wx;
-                b[(k, cj + 1)] += wy;
+                let mut by = b.column_mut(2 * cluster + 1);
+                for (k, &d) in difference.iter().enumerate() {
+                    by[k] += d * edge.y;
+                }
             }
         }
         base += mesh.rest.len();
     }
     // Directed edges count each undirected edge twice: A = 2 Mᵀ L M.
-    let a = m_dense.tr_mul(&lm) * 2.0;
+    let a = (&m_t * lm_t.transpose()) * 2.0;
     let a = (&a + a.transpose()) * 0.5;
-    let gram = m_dense.tr_mul(&mass_m);
+    let gram = &m_t * mass_m_t.transpose();
     let gram = (&gram + gram.transpose()) * 0.5;
     Subspace {
         column_count,
