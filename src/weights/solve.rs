@@ -17,6 +17,7 @@
 //! Every vertex of every connected piece of the domain must be reached by some handle vertex;
 //! otherwise the systems are singular and the solve reports [`SolveError::Unreachable`].
 
+use super::dual_active_set::{solve_box_qps, solve_columns, DualActiveSetOptions};
 use super::laplacian::{cotangent_stiffness, squared_edge_lengths, voronoi_mass};
 use super::sparse::{mat_vec, sandwich_diagonal, SharedPattern, SolveError, SubmatrixCholesky};
 use rayon::prelude::*;
@@ -142,26 +143,45 @@ impl WeightMatrix {
 /// A row summing to less than this has no meaningful direction to normalize.
 pub const EMPTY_ROW_SUM: f64 = 1e-9;
 
-/// Parameters of the bounded biharmonic solve (a primal–dual interior-point method).
+/// Which algorithm solves the per-handle bounded QPs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BbwSolver {
+    /// Goldfarb–Idnani dual active set over one shared factorization ([`super::dual_active_set`]);
+    /// handles it gives up on fall back to the interior point. The default.
+    #[default]
+    DualActiveSet,
+    /// Mehrotra's interior point per handle: one numeric factorization per iteration.
+    InteriorPoint,
+}
+
+/// Parameters of the bounded biharmonic solve.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BbwOptions {
+    /// Default: the dual active-set method.
+    pub solver: BbwSolver,
+    /// The dual active-set method's parameters.
+    pub active_set: DualActiveSetOptions,
     /// Interior-point iterations per handle before giving up (the iterate is then clamped to
     /// the bounds and the handle reported as unconverged). Default 50.
     pub max_iterations: usize,
-    /// Converged when the mean complementarity (x·z + (1−x)·w) / 2n falls below this, in the
-    /// problem scaled so that the linear term's largest entry is 1. Default 1e-13.
+    /// Interior point: converged when the mean complementarity (x·z + (1−x)·w) / 2n falls
+    /// below this, in the problem scaled so that the linear term's largest entry is 1.
+    /// Default 1e-13.
     pub complementarity_tolerance: f64,
     /// … and the scaled gradient residual ‖Hx + g − z + w‖∞ below this. Default 1e-10.
     pub residual_tolerance: f64,
-    /// Weights this close to a bound are snapped onto it, so clamped regions are exactly 0 (or
-    /// 1). Default 1e-8.
+    /// Interior point: weights this close to a bound are snapped onto it, so clamped regions
+    /// are exactly 0 (or 1). Default 1e-8.
     pub snap_to_bound: f64,
 }
 
 impl Default for BbwOptions {
     fn default() -> Self {
         BbwOptions {
+            solver: BbwSolver::default(),
+            active_set: DualActiveSetOptions::default(),
             max_iterations: 50,
             complementarity_tolerance: 1e-13,
             residual_tolerance: 1e-10,
@@ -173,10 +193,16 @@ impl Default for BbwOptions {
 /// How the bounded solve went, for reports and tests.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BbwReport {
-    /// Active-set iterations per handle.
+    /// Per handle: dual active-set steps, or interior-point iterations for the handles in
+    /// `fallback` (and all of them with [`BbwSolver::InteriorPoint`]).
     pub iterations: Vec<usize>,
-    /// Handles whose active set had not settled within the iteration limit.
+    /// Handles whose interior point had not converged within the iteration limit.
     pub unconverged: Vec<usize>,
+    /// Handles the dual active-set method gave up on, solved by the interior point instead.
+    pub fallback: Vec<usize>,
+    /// Dual active set: vertices whose H⁻¹ columns were computed, and in how many rounds.
+    pub columns: usize,
+    pub rounds: usize,
 }
 
 /// Free vertices (not fixed by a handle), in ascending order.
@@ -264,10 +290,12 @@ pub fn biharmonic_weights(
 /// Bounded biharmonic weights (not yet normalized: see [`WeightMatrix::normalize_rows`]).
 ///
 /// Per handle, the box-constrained QP min ½ xᵀ H x + gᵀ x, 0 ≤ x ≤ 1 over the free vertices
-/// (H = Q[F, F], g = Q[F, fixed] · fixed values) is solved by Mehrotra's predictor–corrector
-/// interior-point method. Every Newton system is H plus a positive diagonal, so one symbolic
-/// Cholesky analysis serves all handles and iterations; each iteration is one numeric
-/// factorization and two solves.
+/// (H = Q[F, F], g = Q[F, fixed] · fixed values). By default H is factored once and every
+/// handle's QP is solved by the dual active-set method of [`super::dual_active_set`] from its
+/// unconstrained minimum; handles it gives up on (and all of them with
+/// [`BbwSolver::InteriorPoint`]) are solved by Mehrotra's predictor–corrector interior-point
+/// method, whose Newton systems are H plus a positive diagonal: one symbolic Cholesky analysis
+/// serves all of them, each iteration is one numeric factorization and two solves.
 pub fn bounded_biharmonic_weights(
     domain: &Domain,
     bc: &BoundaryConditions,
@@ -275,39 +303,88 @@ pub fn bounded_biharmonic_weights(
 ) -> Result<(WeightMatrix, BbwReport), SolveError> {
     let q = domain.bilaplacian();
     let n = q.rows();
+    let m = bc.handle_count;
     check_reachable(&q, bc)?;
     let free = free_vertices(n, bc);
-    let pattern = SharedPattern::new(&q, &free)?;
-    let unconstrained = pattern.factor(&pattern.values)?;
-    let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = (0..bc.handle_count)
-        .into_par_iter()
-        .map(|j| {
-            let mut w = fixed_column(n, bc, j);
-            if w.iter().all(|&x| x == 0.0) {
-                // Zero boundary values: zero is optimal and feasible.
-                return Ok((w, 0, true));
-            }
-            let qw = mat_vec(&q, &w);
-            let g: Vec<f64> = free.iter().map(|&i| qw[i]).collect();
-            let mut start: Vec<f64> = g.iter().map(|v| -v).collect();
-            unconstrained.solve_in_place(&mut start);
-            let (x, iterations, converged) = box_qp_interior_point(&pattern, &g, &start, options)?;
-            for (k, &i) in free.iter().enumerate() {
-                w[i] = x[k];
-            }
-            Ok((w, iterations, converged))
+    let f = free.len();
+    let fixed: Vec<Vec<f64>> = (0..m).map(|j| fixed_column(n, bc, j)).collect();
+    let g: Vec<Vec<f64>> = fixed
+        .par_iter()
+        .map(|w| {
+            let qw = mat_vec(&q, w);
+            free.iter().map(|&i| qw[i]).collect()
         })
         .collect();
-    let mut columns = Vec::with_capacity(bc.handle_count);
-    let mut report = BbwReport::default();
-    for (j, r) in results.into_iter().enumerate() {
-        let (w, iterations, converged) = r?;
-        columns.push(w);
-        report.iterations.push(iterations);
-        if !converged {
-            report.unconverged.push(j);
+    let mut report = BbwReport {
+        iterations: vec![0; m],
+        ..Default::default()
+    };
+    let mut solutions: Vec<Option<Vec<f64>>> = vec![None; m];
+    // Unconstrained minimizers, the interior point's starts (computed when first needed).
+    let mut starts: Option<Vec<f64>> = None;
+    if options.solver == BbwSolver::DualActiveSet {
+        let chol = SubmatrixCholesky::new(&q, &free)?;
+        let mut x0: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
+        solve_columns(&chol, &mut x0);
+        let columns: Vec<Vec<f64>> = if f == 0 {
+            vec![Vec::new(); m]
+        } else {
+            x0.chunks(f).map(<[f64]>::to_vec).collect()
+        };
+        let (results, stats) = solve_box_qps(&chol, columns, &options.active_set);
+        report.columns = stats.columns;
+        report.rounds = stats.rounds;
+        for (j, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(solution) => {
+                    report.iterations[j] = solution.steps;
+                    solutions[j] = Some(solution.x);
+                }
+                Err(_) => report.fallback.push(j),
+            }
+        }
+        starts = Some(x0);
+    }
+    let remaining: Vec<usize> = (0..m).filter(|&j| solutions[j].is_none()).collect();
+    if !remaining.is_empty() {
+        let pattern = SharedPattern::new(&q, &free)?;
+        let starts = match starts {
+            Some(x0) => x0,
+            None => {
+                let unconstrained = pattern.factor(&pattern.values)?;
+                let mut x0: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
+                x0.par_chunks_mut(f.max(1))
+                    .for_each(|c| unconstrained.solve_in_place(c));
+                x0
+            }
+        };
+        let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = remaining
+            .par_iter()
+            .map(|&j| {
+                box_qp_interior_point(&pattern, &g[j], &starts[j * f..(j + 1) * f], options)
+            })
+            .collect();
+        for (&j, r) in remaining.iter().zip(results) {
+            let (x, iterations, converged) = r?;
+            report.iterations[j] = iterations;
+            if !converged {
+                report.unconverged.push(j);
+            }
+            solutions[j] = Some(x);
         }
     }
+    let columns: Vec<Vec<f64>> = fixed
+        .into_iter()
+        .zip(solutions)
+        .map(|(mut w, x)| {
+            if let Some(x) = x {
+                for (k, &i) in free.iter().enumerate() {
+                    w[i] = x[k];
+                }
+            }
+            w
+        })
+        .collect();
     Ok((WeightMatrix::from_columns(n, &columns), report))
 }
 
