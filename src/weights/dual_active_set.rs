@@ -2,7 +2,7 @@
 //! sparse factorization: the default solver of bounded biharmonic weights.
 //!
 //! In: a factored SPD matrix H (the bi-Laplacian restricted to the free vertices, n_F × n_F,
-//! [`SubmatrixCholesky`]) and, per handle, the unconstrained minimizer x₀ = −H⁻¹g of
+//! [`PatternCholesky`]) and, per handle, the unconstrained minimizer x₀ = −H⁻¹g of
 //! ½ xᵀHx + gᵀx. Out: per handle the minimizer subject to 0 ≤ x ≤ 1 (weights, unitless), the
 //! bounds it holds active, and how many steps it took — or the reason it gave up, so the caller
 //! can fall back to the interior-point method.
@@ -29,7 +29,7 @@
 //! (one numeric factorization per iteration, ~17 per handle), primal–dual active set (cycles:
 //! H is not an M-matrix), ADMM over one factorization (slow tail), local support.
 
-use super::sparse::SubmatrixCholesky;
+use super::sparse::PatternCholesky;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -108,7 +108,7 @@ const SOLVE_CHUNK: usize = 16;
 
 /// Solves H X = B in place for the columns of `b` (column-major, `chol.len()` rows), in
 /// fixed-size chunks spread over rayon's threads.
-pub(crate) fn solve_columns(chol: &SubmatrixCholesky, b: &mut [f64]) {
+pub(crate) fn solve_columns(chol: &PatternCholesky, b: &mut [f64]) {
     let len = chol.len();
     if len == 0 {
         return;
@@ -151,7 +151,7 @@ impl InverseBlock {
     }
 
     /// Adds `batch` (free vertices not yet in W) with one batched solve for their columns.
-    fn extend(&mut self, chol: &SubmatrixCholesky, batch: &[usize]) {
+    fn extend(&mut self, chol: &PatternCholesky, batch: &[usize]) {
         let n = chol.len();
         let old = self.len();
         let new = old + batch.len();
@@ -201,7 +201,7 @@ struct HandleState {
     watch: Vec<usize>,
     /// The free vertex of each watched position.
     watch_vertex: Vec<usize>,
-    /// Per free vertex: whether it is in `watch`.
+    /// Per free vertex: whether it is in `watch` or `pending`.
     watched: Vec<bool>,
     /// Free vertices to add to `watch` once their columns exist.
     pending: Vec<usize>,
@@ -223,14 +223,18 @@ struct HandleState {
 }
 
 impl HandleState {
-    fn new(x0: Vec<f64>) -> Self {
+    fn new(x0: Vec<f64>, seed: Vec<usize>) -> Self {
+        let mut watched = vec![false; x0.len()];
+        for &v in &seed {
+            watched[v] = true;
+        }
         HandleState {
             x: x0.clone(),
-            watched: vec![false; x0.len()],
+            watched,
             x0,
             watch: Vec::new(),
             watch_vertex: Vec::new(),
-            pending: Vec::new(),
+            pending: seed,
             x_w: Vec::new(),
             active: Vec::new(),
             sign: Vec::new(),
@@ -267,13 +271,16 @@ impl HandleState {
             }
         }
         // Violated watched vertices that are active are at their bounds up to round-off.
-        if any && violated.is_empty() {
+        if any && violated.is_empty() && self.pending.is_empty() {
             any = self.active_free_violation(tolerance);
         }
         self.feasible = !any;
         violated.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         violated.truncate(count);
-        self.pending = violated.into_iter().map(|(_, i)| i).collect();
+        for (_, i) in violated {
+            self.watched[i] = true;
+            self.pending.push(i);
+        }
     }
 
     /// Whether some watched, inactive vertex violates a bound.
@@ -294,7 +301,6 @@ impl HandleState {
     /// the watched vertices from the full iterate (the dual steps accumulate round-off).
     fn sync(&mut self, block: &InverseBlock) {
         for &v in &self.pending {
-            self.watched[v] = true;
             self.watch.push(block.position[v]);
             self.watch_vertex.push(v);
         }
@@ -473,13 +479,18 @@ impl HandleState {
 /// (each of length `chol.len()`), H factored in `chol`. Handles solve in parallel; columns of
 /// H⁻¹ are shared between them.
 pub fn solve_box_qps(
-    chol: &SubmatrixCholesky,
+    chol: &PatternCholesky,
     x0: Vec<Vec<f64>>,
+    seeds: Vec<Vec<usize>>,
     options: &DualActiveSetOptions,
 ) -> (Vec<Result<BoxSolution, DualActiveSetError>>, DualActiveSetStats) {
     let n = chol.len();
     let mut block = InverseBlock::new(n);
-    let mut states: Vec<HandleState> = x0.into_iter().map(HandleState::new).collect();
+    let mut states: Vec<HandleState> = x0
+        .into_iter()
+        .zip(seeds)
+        .map(|(x0, seed)| HandleState::new(x0, seed))
+        .collect();
     let mut stats = DualActiveSetStats::default();
     loop {
         // New vertices for W: the most violated outside it, per handle.

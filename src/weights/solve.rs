@@ -163,6 +163,11 @@ pub struct BbwOptions {
     pub solver: BbwSolver,
     /// The dual active-set method's parameters.
     pub active_set: DualActiveSetOptions,
+    /// Dual active set: interior-point iterations per handle run first only to guess which
+    /// bounds end up active (x < z or 1 − x < w); the dual method starts with those vertices'
+    /// columns, so it does not wander through bounds that are violated at the unconstrained
+    /// minimum but inactive at the solution. 0: no guess. Default 8.
+    pub guess_iterations: usize,
     /// Interior-point iterations per handle before giving up (the iterate is then clamped to
     /// the bounds and the handle reported as unconverged). Default 50.
     pub max_iterations: usize,
@@ -182,6 +187,7 @@ impl Default for BbwOptions {
         BbwOptions {
             solver: BbwSolver::default(),
             active_set: DualActiveSetOptions::default(),
+            guess_iterations: 8,
             max_iterations: 50,
             complementarity_tolerance: 1e-13,
             residual_tolerance: 1e-10,
@@ -320,18 +326,31 @@ pub fn bounded_biharmonic_weights(
         ..Default::default()
     };
     let mut solutions: Vec<Option<Vec<f64>>> = vec![None; m];
-    // Unconstrained minimizers, the interior point's starts (computed when first needed).
-    let mut starts: Option<Vec<f64>> = None;
+    let pattern = SharedPattern::new(&q, &free)?;
+    let unconstrained = pattern.factor(&pattern.values)?;
+    // Unconstrained minimizers: the starts of both methods.
+    let mut starts: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
+    solve_columns(&unconstrained, &mut starts);
+    let start = |j: usize| &starts[j * f..(j + 1) * f];
     if options.solver == BbwSolver::DualActiveSet {
-        let chol = SubmatrixCholesky::new(&q, &free)?;
-        let mut x0: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
-        solve_columns(&chol, &mut x0);
-        let columns: Vec<Vec<f64>> = if f == 0 {
-            vec![Vec::new(); m]
-        } else {
-            x0.chunks(f).map(<[f64]>::to_vec).collect()
+        let guess_options = BbwOptions {
+            max_iterations: options.guess_iterations,
+            ..options.clone()
         };
-        let (results, stats) = solve_box_qps(&chol, columns, &options.active_set);
+        let seeds: Vec<Vec<usize>> = (0..m)
+            .into_par_iter()
+            .map(|j| {
+                if options.guess_iterations == 0 {
+                    return Ok(Vec::new());
+                }
+                let it = box_qp_interior_point(&pattern, &g[j], start(j), &guess_options)?;
+                Ok((0..f)
+                    .filter(|&i| it.x[i] < it.z[i] || it.t[i] < it.w[i])
+                    .collect())
+            })
+            .collect::<Result<_, SolveError>>()?;
+        let x0: Vec<Vec<f64>> = (0..m).map(|j| start(j).to_vec()).collect();
+        let (results, stats) = solve_box_qps(&unconstrained, x0, seeds, &options.active_set);
         report.columns = stats.columns;
         report.rounds = stats.rounds;
         for (j, r) in results.into_iter().enumerate() {
@@ -343,35 +362,19 @@ pub fn bounded_biharmonic_weights(
                 Err(_) => report.fallback.push(j),
             }
         }
-        starts = Some(x0);
     }
     let remaining: Vec<usize> = (0..m).filter(|&j| solutions[j].is_none()).collect();
-    if !remaining.is_empty() {
-        let pattern = SharedPattern::new(&q, &free)?;
-        let starts = match starts {
-            Some(x0) => x0,
-            None => {
-                let unconstrained = pattern.factor(&pattern.values)?;
-                let mut x0: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
-                x0.par_chunks_mut(f.max(1))
-                    .for_each(|c| unconstrained.solve_in_place(c));
-                x0
-            }
-        };
-        let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = remaining
-            .par_iter()
-            .map(|&j| {
-                box_qp_interior_point(&pattern, &g[j], &starts[j * f..(j + 1) * f], options)
-            })
-            .collect();
-        for (&j, r) in remaining.iter().zip(results) {
-            let (x, iterations, converged) = r?;
-            report.iterations[j] = iterations;
-            if !converged {
-                report.unconverged.push(j);
-            }
-            solutions[j] = Some(x);
+    let results: Vec<Result<IpmIterate, SolveError>> = remaining
+        .par_iter()
+        .map(|&j| box_qp_interior_point(&pattern, &g[j], start(j), options))
+        .collect();
+    for (&j, r) in remaining.iter().zip(results) {
+        let it = r?;
+        report.iterations[j] = it.iterations;
+        if !it.converged {
+            report.unconverged.push(j);
         }
+        solutions[j] = Some(it.snapped(options.snap_to_bound));
     }
     let columns: Vec<Vec<f64>> = fixed
         .into_iter()
@@ -419,21 +422,54 @@ fn step_length(
         .min(max_step((0..n).map(|i| (w[i], dw[i]))))
 }
 
-/// min ½ xᵀ H x + gᵀ x subject to 0 ≤ x ≤ 1, H given by `pattern` (SPD). Returns x, the
-/// iterations taken and whether the tolerances were met.
+/// An interior-point iterate: x, its upper slack t = 1 − x, the multipliers z of x ≥ 0 and
+/// w of x ≤ 1 (in the scaled problem), the iterations taken and whether the tolerances were met.
+struct IpmIterate {
+    x: Vec<f64>,
+    t: Vec<f64>,
+    z: Vec<f64>,
+    w: Vec<f64>,
+    iterations: usize,
+    converged: bool,
+}
+
+impl IpmIterate {
+    /// x with weights within `snap` of a bound put on it.
+    fn snapped(self, snap: f64) -> Vec<f64> {
+        let mut x = self.x;
+        for v in &mut x {
+            if *v < snap {
+                *v = 0.0;
+            } else if *v > 1.0 - snap {
+                *v = 1.0;
+            }
+        }
+        x
+    }
+}
+
+/// min ½ xᵀ H x + gᵀ x subject to 0 ≤ x ≤ 1, H given by `pattern` (SPD), from `start`
+/// (pushed inside the box), for at most `options.max_iterations` iterations.
 fn box_qp_interior_point(
     pattern: &SharedPattern,
     g: &[f64],
     start: &[f64],
     options: &BbwOptions,
-) -> Result<(Vec<f64>, usize, bool), SolveError> {
+) -> Result<IpmIterate, SolveError> {
     let n = g.len();
     // Scale so the linear term's largest entry is 1: gradients and multipliers are then of
     // order one, and the absolute tolerances mean the same on any mesh and canvas size.
     let g_max = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if g_max == 0.0 {
         // H is positive definite: with no pull from the fixed values, zero is the optimum.
-        return Ok((vec![0.0; n], 0, true));
+        return Ok(IpmIterate {
+            x: vec![0.0; n],
+            t: vec![1.0; n],
+            z: vec![0.0; n],
+            w: vec![0.0; n],
+            iterations: 0,
+            converged: true,
+        });
     }
     let scale = 1.0 / g_max;
     let h: Vec<f64> = pattern.values.iter().map(|v| v * scale).collect();
@@ -512,16 +548,14 @@ fn box_qp_interior_point(
             w[i] += alpha * dw[i];
         }
     }
-    for v in &mut x {
-        *v = if *v < options.snap_to_bound {
-            0.0
-        } else if *v > 1.0 - options.snap_to_bound {
-            1.0
-        } else {
-            *v
-        };
-    }
-    Ok((x, iterations, converged))
+    Ok(IpmIterate {
+        x,
+        t,
+        z,
+        w,
+        iterations,
+        converged,
+    })
 }
 
 #[cfg(test)]
