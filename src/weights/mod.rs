@@ -9,7 +9,6 @@
 //! - [`part`]: one part end to end: boundary conditions, solve, normalize, sparsify.
 
 pub mod boundary;
-pub mod dual_active_set;
 pub mod laplacian;
 pub mod monotone;
 pub mod part;
@@ -22,8 +21,7 @@ pub use monotone::{
 };
 pub use part::{part_weights, PartWeights, WeightError, WeightMethod, WeightOptions};
 pub use solve::{
-    biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions, BbwReport, BbwSolver,
+    biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions, BbwReport,
     BoundaryConditions, Domain, WeightMatrix,
 };
-pub use dual_active_set::DualActiveSetOptions;
 pub use sparse::SolveError;

@@ -17,7 +17,6 @@
 //! Every vertex of every connected piece of the domain must be reached by some handle vertex;
 //! otherwise the systems are singular and the solve reports [`SolveError::Unreachable`].
 
-use super::dual_active_set::{solve_box_qps, solve_columns, DualActiveSetOptions};
 use super::laplacian::{cotangent_stiffness, squared_edge_lengths, voronoi_mass};
 use super::sparse::{mat_vec, sandwich_diagonal, SharedPattern, SolveError, SubmatrixCholesky};
 use rayon::prelude::*;
@@ -143,51 +142,26 @@ impl WeightMatrix {
 /// A row summing to less than this has no meaningful direction to normalize.
 pub const EMPTY_ROW_SUM: f64 = 1e-9;
 
-/// Which algorithm solves the per-handle bounded QPs.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum BbwSolver {
-    /// Goldfarb–Idnani dual active set over one shared factorization ([`super::dual_active_set`]);
-    /// handles it gives up on fall back to the interior point. The default.
-    #[default]
-    DualActiveSet,
-    /// Mehrotra's interior point per handle: one numeric factorization per iteration.
-    InteriorPoint,
-}
-
-/// Parameters of the bounded biharmonic solve.
+/// Parameters of the bounded biharmonic solve (a primal–dual interior-point method).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BbwOptions {
-    /// Default: the dual active-set method.
-    pub solver: BbwSolver,
-    /// The dual active-set method's parameters.
-    pub active_set: DualActiveSetOptions,
-    /// Dual active set: interior-point iterations per handle run first only to guess which
-    /// bounds end up active (x < z or 1 − x < w); the dual method starts with those vertices'
-    /// columns, so it does not wander through bounds that are violated at the unconstrained
-    /// minimum but inactive at the solution. 0: no guess. Default 8.
-    pub guess_iterations: usize,
     /// Interior-point iterations per handle before giving up (the iterate is then clamped to
     /// the bounds and the handle reported as unconverged). Default 50.
     pub max_iterations: usize,
-    /// Interior point: converged when the mean complementarity (x·z + (1−x)·w) / 2n falls
-    /// below this, in the problem scaled so that the linear term's largest entry is 1.
-    /// Default 1e-13.
+    /// Converged when the mean complementarity (x·z + (1−x)·w) / 2n falls below this, in the
+    /// problem scaled so that the linear term's largest entry is 1. Default 1e-13.
     pub complementarity_tolerance: f64,
     /// … and the scaled gradient residual ‖Hx + g − z + w‖∞ below this. Default 1e-10.
     pub residual_tolerance: f64,
-    /// Interior point: weights this close to a bound are snapped onto it, so clamped regions
-    /// are exactly 0 (or 1). Default 1e-8.
+    /// Weights this close to a bound are snapped onto it, so clamped regions are exactly 0 (or
+    /// 1). Default 1e-8.
     pub snap_to_bound: f64,
 }
 
 impl Default for BbwOptions {
     fn default() -> Self {
         BbwOptions {
-            solver: BbwSolver::default(),
-            active_set: DualActiveSetOptions::default(),
-            guess_iterations: 8,
             max_iterations: 50,
             complementarity_tolerance: 1e-13,
             residual_tolerance: 1e-10,
@@ -199,16 +173,10 @@ impl Default for BbwOptions {
 /// How the bounded solve went, for reports and tests.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BbwReport {
-    /// Per handle: dual active-set steps, or interior-point iterations for the handles in
-    /// `fallback` (and all of them with [`BbwSolver::InteriorPoint`]).
+    /// Active-set iterations per handle.
     pub iterations: Vec<usize>,
-    /// Handles whose interior point had not converged within the iteration limit.
+    /// Handles whose active set had not settled within the iteration limit.
     pub unconverged: Vec<usize>,
-    /// Handles the dual active-set method gave up on, solved by the interior point instead.
-    pub fallback: Vec<usize>,
-    /// Dual active set: vertices whose H⁻¹ columns were computed, and in how many rounds.
-    pub columns: usize,
-    pub rounds: usize,
 }
 
 /// Free vertices (not fixed by a handle), in ascending order.
@@ -296,12 +264,10 @@ pub fn biharmonic_weights(
 /// Bounded biharmonic weights (not yet normalized: see [`WeightMatrix::normalize_rows`]).
 ///
 /// Per handle, the box-constrained QP min ½ xᵀ H x + gᵀ x, 0 ≤ x ≤ 1 over the free vertices
-/// (H = Q[F, F], g = Q[F, fixed] · fixed values). By default H is factored once and every
-/// handle's QP is solved by the dual active-set method of [`super::dual_active_set`] from its
-/// unconstrained minimum; handles it gives up on (and all of them with
-/// [`BbwSolver::InteriorPoint`]) are solved by Mehrotra's predictor–corrector interior-point
-/// method, whose Newton systems are H plus a positive diagonal: one symbolic Cholesky analysis
-/// serves all of them, each iteration is one numeric factorization and two solves.
+/// (H = Q[F, F], g = Q[F, fixed] · fixed values) is solved by Mehrotra's predictor–corrector
+/// interior-point method. Every Newton system is H plus a positive diagonal, so one symbolic
+/// Cholesky analysis serves all handles and iterations; each iteration is one numeric
+/// factorization and two solves.
 pub fn bounded_biharmonic_weights(
     domain: &Domain,
     bc: &BoundaryConditions,
@@ -309,85 +275,39 @@ pub fn bounded_biharmonic_weights(
 ) -> Result<(WeightMatrix, BbwReport), SolveError> {
     let q = domain.bilaplacian();
     let n = q.rows();
-    let m = bc.handle_count;
     check_reachable(&q, bc)?;
     let free = free_vertices(n, bc);
-    let f = free.len();
-    let fixed: Vec<Vec<f64>> = (0..m).map(|j| fixed_column(n, bc, j)).collect();
-    let g: Vec<Vec<f64>> = fixed
-        .par_iter()
-        .map(|w| {
-            let qw = mat_vec(&q, w);
-            free.iter().map(|&i| qw[i]).collect()
-        })
-        .collect();
-    let mut report = BbwReport {
-        iterations: vec![0; m],
-        ..Default::default()
-    };
-    let mut solutions: Vec<Option<Vec<f64>>> = vec![None; m];
     let pattern = SharedPattern::new(&q, &free)?;
     let unconstrained = pattern.factor(&pattern.values)?;
-    // Unconstrained minimizers: the starts of both methods.
-    let mut starts: Vec<f64> = g.iter().flatten().map(|v| -v).collect();
-    solve_columns(&unconstrained, &mut starts);
-    let start = |j: usize| &starts[j * f..(j + 1) * f];
-    if options.solver == BbwSolver::DualActiveSet {
-        let guess_options = BbwOptions {
-            max_iterations: options.guess_iterations,
-            ..options.clone()
-        };
-        let seeds: Vec<Vec<usize>> = (0..m)
-            .into_par_iter()
-            .map(|j| {
-                if options.guess_iterations == 0 {
-                    return Ok(Vec::new());
-                }
-                let it = box_qp_interior_point(&pattern, &g[j], start(j), &guess_options)?;
-                Ok((0..f)
-                    .filter(|&i| it.x[i] < it.z[i] || it.t[i] < it.w[i])
-                    .collect())
-            })
-            .collect::<Result<_, SolveError>>()?;
-        let x0: Vec<Vec<f64>> = (0..m).map(|j| start(j).to_vec()).collect();
-        let (results, stats) = solve_box_qps(&unconstrained, x0, seeds, &options.active_set);
-        report.columns = stats.columns;
-        report.rounds = stats.rounds;
-        for (j, r) in results.into_iter().enumerate() {
-            match r {
-                Ok(solution) => {
-                    report.iterations[j] = solution.steps;
-                    solutions[j] = Some(solution.x);
-                }
-                Err(_) => report.fallback.push(j),
+    let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = (0..bc.handle_count)
+        .into_par_iter()
+        .map(|j| {
+            let mut w = fixed_column(n, bc, j);
+            if w.iter().all(|&x| x == 0.0) {
+                // Zero boundary values: zero is optimal and feasible.
+                return Ok((w, 0, true));
             }
-        }
-    }
-    let remaining: Vec<usize> = (0..m).filter(|&j| solutions[j].is_none()).collect();
-    let results: Vec<Result<IpmIterate, SolveError>> = remaining
-        .par_iter()
-        .map(|&j| box_qp_interior_point(&pattern, &g[j], start(j), options))
-        .collect();
-    for (&j, r) in remaining.iter().zip(results) {
-        let it = r?;
-        report.iterations[j] = it.iterations;
-        if !it.converged {
-            report.unconverged.push(j);
-        }
-        solutions[j] = Some(it.snapped(options.snap_to_bound));
-    }
-    let columns: Vec<Vec<f64>> = fixed
-        .into_iter()
-        .zip(solutions)
-        .map(|(mut w, x)| {
-            if let Some(x) = x {
-                for (k, &i) in free.iter().enumerate() {
-                    w[i] = x[k];
-                }
+            let qw = mat_vec(&q, &w);
+            let g: Vec<f64> = free.iter().map(|&i| qw[i]).collect();
+            let mut start: Vec<f64> = g.iter().map(|v| -v).collect();
+            unconstrained.solve_in_place(&mut start);
+            let (x, iterations, converged) = box_qp_interior_point(&pattern, &g, &start, options)?;
+            for (k, &i) in free.iter().enumerate() {
+                w[i] = x[k];
             }
-            w
+            Ok((w, iterations, converged))
         })
         .collect();
+    let mut columns = Vec::with_capacity(bc.handle_count);
+    let mut report = BbwReport::default();
+    for (j, r) in results.into_iter().enumerate() {
+        let (w, iterations, converged) = r?;
+        columns.push(w);
+        report.iterations.push(iterations);
+        if !converged {
+            report.unconverged.push(j);
+        }
+    }
     Ok((WeightMatrix::from_columns(n, &columns), report))
 }
 
@@ -422,54 +342,21 @@ fn step_length(
         .min(max_step((0..n).map(|i| (w[i], dw[i]))))
 }
 
-/// An interior-point iterate: x, its upper slack t = 1 − x, the multipliers z of x ≥ 0 and
-/// w of x ≤ 1 (in the scaled problem), the iterations taken and whether the tolerances were met.
-struct IpmIterate {
-    x: Vec<f64>,
-    t: Vec<f64>,
-    z: Vec<f64>,
-    w: Vec<f64>,
-    iterations: usize,
-    converged: bool,
-}
-
-impl IpmIterate {
-    /// x with weights within `snap` of a bound put on it.
-    fn snapped(self, snap: f64) -> Vec<f64> {
-        let mut x = self.x;
-        for v in &mut x {
-            if *v < snap {
-                *v = 0.0;
-            } else if *v > 1.0 - snap {
-                *v = 1.0;
-            }
-        }
-        x
-    }
-}
-
-/// min ½ xᵀ H x + gᵀ x subject to 0 ≤ x ≤ 1, H given by `pattern` (SPD), from `start`
-/// (pushed inside the box), for at most `options.max_iterations` iterations.
+/// min ½ xᵀ H x + gᵀ x subject to 0 ≤ x ≤ 1, H given by `pattern` (SPD). Returns x, the
+/// iterations taken and whether the tolerances were met.
 fn box_qp_interior_point(
     pattern: &SharedPattern,
     g: &[f64],
     start: &[f64],
     options: &BbwOptions,
-) -> Result<IpmIterate, SolveError> {
+) -> Result<(Vec<f64>, usize, bool), SolveError> {
     let n = g.len();
     // Scale so the linear term's largest entry is 1: gradients and multipliers are then of
     // order one, and the absolute tolerances mean the same on any mesh and canvas size.
     let g_max = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if g_max == 0.0 {
         // H is positive definite: with no pull from the fixed values, zero is the optimum.
-        return Ok(IpmIterate {
-            x: vec![0.0; n],
-            t: vec![1.0; n],
-            z: vec![0.0; n],
-            w: vec![0.0; n],
-            iterations: 0,
-            converged: true,
-        });
+        return Ok((vec![0.0; n], 0, true));
     }
     let scale = 1.0 / g_max;
     let h: Vec<f64> = pattern.values.iter().map(|v| v * scale).collect();
@@ -548,14 +435,16 @@ fn box_qp_interior_point(
             w[i] += alpha * dw[i];
         }
     }
-    Ok(IpmIterate {
-        x,
-        t,
-        z,
-        w,
-        iterations,
-        converged,
-    })
+    for v in &mut x {
+        *v = if *v < options.snap_to_bound {
+            0.0
+        } else if *v > 1.0 - options.snap_to_bound {
+            1.0
+        } else {
+            *v
+        };
+    }
+    Ok((x, iterations, converged))
 }
 
 #[cfg(test)]

@@ -181,21 +181,12 @@ pub struct PatternCholesky {
 }
 
 impl PatternCholesky {
-    /// Solves in place for every column of `b` (column-major, `len` rows).
+    /// Solves in place for one right-hand side.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         if self.len > 0 {
-            let cols = b.len() / self.len;
             self.llt
-                .solve_in_place(MatMut::from_column_major_slice_mut(b, self.len, cols));
+                .solve_in_place(MatMut::from_column_major_slice_mut(b, self.len, 1));
         }
-    }
-
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
     }
 }
 
