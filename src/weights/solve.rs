@@ -14,6 +14,13 @@
 //!   was tried first: on the bi-Laplacian, which is not an M-matrix, it cycled.) Handles solve
 //!   in parallel (rayon).
 //!
+//! Also tried and measured slower (see ARCHITECTURE.md, "weights: what did not pay"): a
+//! Goldfarb–Idnani dual active-set method over one shared factorization of H with the columns
+//! of H⁻¹ it needs (it needs thousands: the unconstrained minimum violates a bound on about
+//! half the vertices, and the dual path visits far more bounds than end up active), also
+//! seeded from a few interior-point iterations; a forced simplicial factorization; a
+//! breadth-first nested-dissection ordering instead of faer's AMD.
+//!
 //! Every vertex of every connected piece of the domain must be reached by some handle vertex;
 //! otherwise the systems are singular and the solve reports [`SolveError::Unreachable`].
 
