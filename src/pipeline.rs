@@ -11,7 +11,9 @@ use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, W
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
 use crate::render::{self, MeshRenderer, PartDraw, RenderError, RenderPart, Texture};
 use crate::rig::pose::bone_stretches;
-use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
+use crate::rig::{
+    handle_columns, handle_transforms, Affine, HandleError, Handles, Pose, PoseError,
+};
 use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
 use crate::weights::{self, WeightError};
@@ -396,6 +398,16 @@ impl Scene {
             .collect()
     }
 
+    /// One transformation per handle column (in [`handle_columns`] order) for `pose`: the one
+    /// path from a pose to what skinning blends, used for drawing and for the Spine export's
+    /// baking alike. Forward kinematics today; IK drags are refused until the solver lands here.
+    pub fn handle_transforms(&self, pose: &Pose) -> Result<Vec<Affine>, PipelineError> {
+        if !pose.ik.is_empty() {
+            return Err(PipelineError::IkUnsupported);
+        }
+        Ok(handle_transforms(&self.doc.handles, pose)?)
+    }
+
     /// Every part's vertex positions in `pose` (forward kinematics, then linear blend
     /// skinning). Parts without weights stay at rest.
     pub fn pose_positions(&self, pose: &Pose) -> Result<Vec<Vec<Point>>, PipelineError> {
@@ -408,10 +420,7 @@ impl Scene {
         pose: &Pose,
         blend: Blend,
     ) -> Result<Vec<Vec<Point>>, PipelineError> {
-        if !pose.ik.is_empty() {
-            return Err(PipelineError::IkUnsupported);
-        }
-        let transforms = handle_transforms(&self.doc.handles, pose)?;
+        let transforms = self.handle_transforms(pose)?;
         // Bones come first among the columns, so bone i's stretch is column i's.
         let stretches = match blend {
             Blend::Stretch => bone_stretches(&self.doc.handles, pose)?,
