@@ -11,7 +11,8 @@
 
 use serde::Deserialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
-use sinew::export::spine::{export_spine, SpineExport, SpineOptions};
+use sinew::export::spine::bake::bake_times;
+use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions};
 use sinew::geom::Point;
 use sinew::io::{self, RigDocument};
 use sinew::pipeline::Scene;
@@ -160,11 +161,29 @@ fn times_for(doc: &RigDocument, name: &str, duration: f64) -> Vec<f64> {
     times
 }
 
-/// Exports `rig` with the CLI into `dir` and checks it against the runtime; returns the
-/// worst deviations (runtime-matching, exact) over all animations.
-fn check_rig(rig: &Path, dir: &Path, extra: &[&str]) -> (f64, f64) {
+/// What the runtime's animation vertices are held to.
+#[derive(Clone, Copy, PartialEq)]
+enum Compare {
+    /// sinew's `--match-runtime spine` playback, at many times, within 0.01 px.
+    RuntimeMode,
+    /// Everything baked at this rate: sinew's exact playback at the bake times, within 0.01 px.
+    ExactAtBakeTimes(f64),
+    /// Coarser weights: deviations are printed, not bounded.
+    ReportOnly,
+}
+
+/// Exports `rig` with the CLI (`flags`, which `options` must mirror) into `dir` and checks it
+/// against the runtime; returns the worst deviations (runtime-matching, exact) over all
+/// animations.
+fn check_rig(
+    rig: &Path,
+    dir: &Path,
+    flags: &[&str],
+    options: &SpineOptions,
+    compare: Compare,
+) -> (f64, f64) {
     let mut args = vec!["export", "spine", s(rig), "-o", s(dir), "--name", "rig"];
-    args.extend_from_slice(extra);
+    args.extend_from_slice(flags);
     sinew(&args);
     let scene = Scene::load(rig).unwrap();
     let doc = scene.doc.clone();
@@ -174,16 +193,36 @@ fn check_rig(rig: &Path, dir: &Path, extra: &[&str]) -> (f64, f64) {
         .map(|p| io::load_png(&RigDocument::image_path(rig, p)).unwrap())
         .collect();
     // The same export in-process, for its vertex order; it must be the CLI's byte for byte.
-    let export = export_spine(&scene, &images, "rig", &SpineOptions::default()).unwrap();
-    assert_eq!(
-        std::fs::read_to_string(dir.join("rig.json")).unwrap(),
-        export.json,
-        "export is not deterministic"
+    let export = export_spine(&scene, &images, "rig", options).unwrap();
+    assert!(
+        std::fs::read_to_string(dir.join("rig.json")).unwrap() == export.json,
+        "{flags:?}: the CLI's export differs from the same export in-process"
     );
+    if let Some(n) = options.max_vertices {
+        for (part, exported) in doc.parts.iter().zip(&export.parts) {
+            let fine = part.mesh.vertices.len();
+            assert!(
+                exported.mesh.uvs.len() <= n || exported.mesh.uvs.len() < fine,
+                "{}: {} of {fine} vertices kept for --max-vertices {n}",
+                part.name,
+                exported.mesh.uvs.len()
+            );
+        }
+    }
     let animations = anim::load_animations(&doc).unwrap();
     let times: BTreeMap<String, Vec<f64>> = animations
         .iter()
-        .map(|(name, a)| (name.clone(), times_for(&doc, name, a.duration_s())))
+        .map(|(name, a)| {
+            let times = match compare {
+                Compare::ExactAtBakeTimes(fps) => {
+                    let mut t = bake_times(a.duration_s(), fps);
+                    t.retain(|&t| t < a.duration_s());
+                    t
+                }
+                _ => times_for(&doc, name, a.duration_s()),
+            };
+            (name.clone(), times)
+        })
         .collect();
     let oracle = run_oracle(dir, "rig", &times);
     assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
@@ -211,10 +250,20 @@ fn check_rig(rig: &Path, dir: &Path, extra: &[&str]) -> (f64, f64) {
             let pose = animation.sample_with(t, true, &runtime);
             let positions = scene.pose_positions(&pose).unwrap();
             let d = deviation(&export, &doc, &frame.slots, &positions);
-            assert!(d <= ANIMATION_TOLERANCE_PX, "{name} at {t} s: {d} px");
             worst_runtime = worst_runtime.max(d);
             let exact = scene.pose_positions(&animation.sample(t, true)).unwrap();
-            worst_exact = worst_exact.max(deviation(&export, &doc, &frame.slots, &exact));
+            let d_exact = deviation(&export, &doc, &frame.slots, &exact);
+            worst_exact = worst_exact.max(d_exact);
+            match compare {
+                Compare::RuntimeMode => {
+                    assert!(d <= ANIMATION_TOLERANCE_PX, "{name} at {t} s: {d} px")
+                }
+                Compare::ExactAtBakeTimes(_) => assert!(
+                    d_exact <= ANIMATION_TOLERANCE_PX,
+                    "baked {name} at {t} s: {d_exact} px"
+                ),
+                Compare::ReportOnly => {}
+            }
             // Draw order, attachments and colours.
             let order: Vec<&str> = frame.slots.iter().map(|s| s.name.as_str()).collect();
             let expected: Vec<&str> = match &pose.draw_order {
@@ -239,7 +288,7 @@ fn check_rig(rig: &Path, dir: &Path, extra: &[&str]) -> (f64, f64) {
                 }
             }
             // Some times through the command line, as a user previews them.
-            if i % cli_every == 0 {
+            if compare == Compare::RuntimeMode && i % cli_every == 0 {
                 let v = dir.join("v.json");
                 let time = format!("{t}");
                 sinew(&[
@@ -277,9 +326,10 @@ fn check_rig(rig: &Path, dir: &Path, extra: &[&str]) -> (f64, f64) {
             }
         }
     }
+    let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
     println!(
-        "{}: runtime vs sinew --match-runtime spine: max {worst_runtime:.2e} px; vs exact \
-         playback: max {worst_exact:.3} px",
+        "{} {flags:?} ({vertices} vertices): runtime vs sinew --match-runtime spine: max \
+         {worst_runtime:.2e} px; vs exact playback: max {worst_exact:.3} px",
         rig.display()
     );
     (worst_runtime, worst_exact)
@@ -292,7 +342,15 @@ fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
     // The demo's own export loads too.
     let oracle = run_oracle(&dir.join("spine"), "character", &BTreeMap::new());
     assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
-    let (_, exact) = check_rig(&dir.join("character.json"), &dir.join("export"), &[]);
+    let rig = dir.join("character.json");
+    let defaults = SpineOptions::default();
+    let (_, exact) = check_rig(
+        &rig,
+        &dir.join("export"),
+        &[],
+        &defaults,
+        Compare::RuntimeMode,
+    );
     // The runtime's polyline does differ from the exact curves: the mode is not idle.
     assert!(
         exact > ANIMATION_TOLERANCE_PX,
@@ -409,6 +467,51 @@ fn generated_rig(dir: &Path) -> PathBuf {
 fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
     let dir = scratch("generated");
     let rig = generated_rig(&dir);
-    check_rig(&rig, &dir.join("export"), &[]);
+    let defaults = SpineOptions::default();
+    check_rig(
+        &rig,
+        &dir.join("export"),
+        &[],
+        &defaults,
+        Compare::RuntimeMode,
+    );
+    // Everything baked: exact at the keys.
+    let baked = SpineOptions {
+        bake: BakeMode::All,
+        bake_fps: 20.0,
+        ..SpineOptions::default()
+    };
+    let flags = ["--bake", "all", "--fps", "20"];
+    check_rig(
+        &rig,
+        &dir.join("baked"),
+        &flags,
+        &baked,
+        Compare::ExactAtBakeTimes(20.0),
+    );
+    // A coarser mesh keeps its vertices' weights, so those vertices still play exactly.
+    let coarse = SpineOptions {
+        max_vertices: Some(40),
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("coarse"),
+        &["--max-vertices", "40"],
+        &coarse,
+        Compare::RuntimeMode,
+    );
+    // Fewer influences: loads, setup pose exact; the deviation is printed.
+    let few = SpineOptions {
+        max_influences: Some(2),
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("few"),
+        &["--max-influences", "2"],
+        &few,
+        Compare::ReportOnly,
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -18,7 +18,7 @@
 use crate::geom::Point;
 use crate::mesh::Mesh;
 use std::cmp::Ordering;
-use std::collections::{BTreeSet, BinaryHeap, HashMap};
+use std::collections::{BTreeMap, BTreeSet, BinaryHeap};
 
 /// Edge length (px) weight that breaks ties towards short edges.
 pub const SHORT_EDGE_PREFERENCE: f64 = 0.01;
@@ -30,9 +30,10 @@ fn double_area(a: Point, b: Point, c: Point) -> f64 {
     (b - a).perp(&(c - a))
 }
 
-/// Distance between two sparse weight rows (Euclidean over columns).
+/// Distance between two sparse weight rows (Euclidean over columns), summed in column order so
+/// that it is the same number on every run.
 fn weight_distance(a: &[(usize, f64)], b: &[(usize, f64)]) -> f64 {
-    let mut d: HashMap<usize, f64> = HashMap::new();
+    let mut d: BTreeMap<usize, f64> = BTreeMap::new();
     for &(j, w) in a {
         *d.entry(j).or_default() += w;
     }

@@ -527,8 +527,8 @@ fn skeleton_json(
         "animations": animations,
     });
     // serde_json writes f64 as the shortest text that reads back exactly: lossless, and the
-    // same bytes for the same rig.
-    serde_json::to_string_pretty(&out).unwrap_or_default() + "\n"
+    // same bytes for the same rig. Compact: the weighted vertex arrays are long.
+    serde_json::to_string(&out).unwrap_or_default() + "\n"
 }
 
 /// A content hash for tools (`skeleton.hash`; runtimes only store it): FNV-1a over the data.
