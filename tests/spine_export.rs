@@ -46,11 +46,12 @@ fn rig(dir: &Path, layers: &[PathBuf], extra: serde_json::Value) -> PathBuf {
     if let (Some(h), Some(e)) = (handles.as_object_mut(), extra.as_object()) {
         h.extend(e.clone());
     }
-    std::fs::write(dir.join("h.json"), handles.to_string()).unwrap();
+    let handles_path = dir.join("h.json");
+    std::fs::write(&handles_path, handles.to_string()).unwrap();
     let rig = dir.join("rig.json");
     let mut args: Vec<&str> = vec!["rig"];
     args.extend(layers.iter().map(|p| s(p)));
-    args.extend(["--handles", s(&dir.join("h.json")), "-o", s(&rig)]);
+    args.extend(["--handles", s(&handles_path), "-o", s(&rig)]);
     let out = sinew(&args);
     assert!(
         out.status.success(),

@@ -225,6 +225,20 @@ fn check_rig(
         })
         .collect();
     let oracle = run_oracle(dir, "rig", &times);
+    // The pages are premultiplied, as the atlas says: no colour channel above alpha.
+    let atlas = std::fs::read_to_string(dir.join("rig.atlas")).unwrap();
+    assert!(atlas.contains("pma: true\n"), "{atlas}");
+    for (file, _) in &export.pages {
+        let page = image::open(dir.join(file)).unwrap().to_rgba8();
+        assert!(
+            page.pixels().all(|p| p.0[..3].iter().all(|&c| c <= p.0[3])),
+            "{file}"
+        );
+        assert!(
+            page.pixels().any(|p| p.0[3] > 0 && p.0[3] < 255),
+            "{file}: no soft edge?"
+        );
+    }
     assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
 
     // Setup pose = rest meshes.
