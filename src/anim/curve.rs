@@ -293,7 +293,7 @@ mod tests {
     }
 
     #[test]
-    fn spine_runtime_polyline_matches_the_oracle_figure() {
+    fn spine_runtime_polyline_lies_on_the_curve_and_is_straight_between() {
         // The polyline's defining property: its points lie on the exact curve at s = 0.1 … 0.9
         // (forward differences accumulate only rounding). The end-to-end check against the
         // runtime itself is tests/spine_runtime.rs.

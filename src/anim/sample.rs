@@ -366,6 +366,35 @@ mod tests {
     }
 
     #[test]
+    fn spine_runtime_sampling_stores_f32_and_walks_the_polyline() {
+        let rt = CurveEvaluation::SpineRuntime;
+        // Linear and stepped keys: the same as exact, up to f32 storage of times and values.
+        let keys = vec![
+            key(0.1, 10.3, Curve::Linear),
+            key(0.7, -4.9, Curve::Stepped),
+            key(1.0, 2.0, Curve::Linear),
+        ];
+        for t in [0.0, 0.25, 0.5, 0.8, 1.5] {
+            let (a, b) = (
+                sample_keys(&keys, t).unwrap(),
+                sample_keys_with(&keys, t, rt).unwrap(),
+            );
+            assert!((a - b).abs() < 1e-5, "{t}: {a} {b}");
+        }
+        assert_eq!(sample_keys_with(&keys, 0.0, rt), Some(f32_stored(10.3)));
+        // A Bézier key: exact at the keys, off the exact cubic in between (the runtime's
+        // polyline), and on the polyline's straight segment between two of its points.
+        let eased = vec![
+            key(0.0, 0.0, Curve::Bezier(vec![0.5, 0.0, 0.5, 90.0])),
+            key(1.0, 90.0, Curve::Linear),
+        ];
+        let exact = sample_keys(&eased, 0.3).unwrap();
+        let runtime = sample_keys_with(&eased, 0.3, rt).unwrap();
+        assert!((exact - runtime).abs() > 1e-3 && (exact - runtime).abs() < 2.0);
+        assert_eq!(sample_keys_with(&eased, 1.0, rt), Some(90.0));
+    }
+
+    #[test]
     fn cage_bezier_is_one_fraction_for_every_vertex() {
         let keys = vec![
             key(

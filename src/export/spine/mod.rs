@@ -570,8 +570,9 @@ impl SpineExport {
     }
 
     /// Writes every file into `dir` (created if missing): each goes to a hidden temporary file
-    /// first, and only when all are written are they renamed into place, so a failure leaves
-    /// `dir` without any new or half-written file. Returns the paths written.
+    /// first, and only when all are written are they renamed into place, so a failure while
+    /// writing (disk full, no permission) leaves `dir` without any new or half-written file.
+    /// The renames themselves are atomic one by one, not as a set. Returns the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, SpineError> {
         let fail = |path: &Path| {
             let path = path.to_path_buf();
