@@ -20,9 +20,10 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm >&2
 fi
 
-# Reinstall when the lock file changed since the last install.
+# Reinstall when the lock file changed since the last install, or the package is gone.
 stamp="$here/node_modules/.sinew-lock"
-if ! cmp -s "$here/package-lock.json" "$stamp" 2>/dev/null; then
+installed="$here/node_modules/@esotericsoftware/spine-core/package.json"
+if ! cmp -s "$here/package-lock.json" "$stamp" 2>/dev/null || [ ! -f "$installed" ]; then
   (cd "$here" && npm ci --no-audit --no-fund --loglevel=error >&2) || { echo "spine-check: npm ci failed" >&2; exit 3; }
   cp "$here/package-lock.json" "$stamp"
 fi
