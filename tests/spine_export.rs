@@ -129,7 +129,7 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
     // A part whose image is missing.
     let good = scratch("good");
     let arm = layer(&good, "arm");
-    let rig_good = rig(&good, &[arm.clone()], serde_json::json!({}));
+    let rig_good = rig(&good, std::slice::from_ref(&arm), serde_json::json!({}));
     std::fs::rename(&arm, good.join("moved.png")).unwrap();
     assert_refused(
         &["export", "spine", s(&rig_good), "-o", s(&out)],

@@ -109,10 +109,7 @@ fn boundary_loops(triangles: &[[u32; 3]]) -> Vec<Vec<usize>> {
     while let Some((&start, _)) = next.iter().find(|(_, v)| !v.is_empty()) {
         let mut ring = vec![start as usize];
         let mut at = start;
-        loop {
-            let Some(b) = next.get_mut(&at).and_then(|v| v.pop()) else {
-                break;
-            };
+        while let Some(b) = next.get_mut(&at).and_then(|v| v.pop()) {
             if b == start {
                 break;
             }
@@ -124,17 +121,28 @@ fn boundary_loops(triangles: &[[u32; 3]]) -> Vec<Vec<usize>> {
     loops
 }
 
-/// Builds the attachment of one part. `rows[i]` are vertex i's (column, weight) pairs.
+/// A part's mesh with its weights: canvas px, and `rows[i]` = vertex i's (column, weight) pairs.
+#[derive(Clone, Copy, Debug)]
+pub struct WeightedMesh<'a> {
+    pub vertices: &'a [Point],
+    pub triangles: &'a [[u32; 3]],
+    pub rows: &'a [Vec<(usize, f64)>],
+}
+
+/// Builds the attachment of one part.
 pub fn mesh_attachment(
     part: &str,
-    vertices: &[Point],
-    triangles: &[[u32; 3]],
-    rows: &[Vec<(usize, f64)>],
+    mesh: WeightedMesh,
     skeleton: &Skeleton,
     frame: &SpineFrame,
     region: &RegionRect,
     max_influences: Option<usize>,
 ) -> Result<MeshAttachment, SpineError> {
+    let WeightedMesh {
+        vertices,
+        triangles,
+        rows,
+    } = mesh;
     let loops = boundary_loops(triangles);
     let hull_loop = loops
         .iter()
@@ -168,7 +176,7 @@ pub fn mesh_attachment(
             row.truncate(k);
         }
         let total: f64 = row.iter().map(|&(_, w)| w).sum();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             return Err(SpineError::UnweightedVertex {
                 part: part.to_string(),
                 vertex: v,

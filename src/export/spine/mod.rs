@@ -36,7 +36,7 @@ use crate::io::{self, RigDocument};
 use crate::pipeline::{PipelineError, Scene};
 use crate::rig::{handle_columns, Pose};
 use image::RgbaImage;
-use mesh::{mesh_attachment, MeshAttachment, RegionRect};
+use mesh::{mesh_attachment, MeshAttachment, RegionRect, WeightedMesh};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 use skeleton::{build_skeleton, Skeleton};
@@ -300,9 +300,11 @@ pub fn export_spine(
         let region = RegionRect::around(&vertices, options.region_margin_px);
         let mut mesh = mesh_attachment(
             &part.name,
-            &vertices,
-            &triangles,
-            &kept_rows,
+            WeightedMesh {
+                vertices: &vertices,
+                triangles: &triangles,
+                rows: &kept_rows,
+            },
             &skeleton,
             &frame,
             &region,
@@ -338,7 +340,11 @@ pub fn export_spine(
             &corners,
             options.bake_tolerance_px,
         )?;
-        let (mut bones, slots, draw_order) = timelines::native_timelines(
+        let timelines::NativeTimelines {
+            mut bones,
+            slots,
+            draw_order,
+        } = timelines::native_timelines(
             animation,
             &doc.handles,
             &part_names,

@@ -171,6 +171,16 @@ fn hex(rgba: &crate::anim::Rgba) -> Value {
     serde_json::to_value(rgba).unwrap_or(Value::Null)
 }
 
+/// One animation's native sections, as JSON.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NativeTimelines {
+    /// Bone name → timeline name → keys.
+    pub bones: BTreeMap<String, Map<String, Value>>,
+    /// Slot name → timeline name → keys.
+    pub slots: Map<String, Value>,
+    pub draw_order: Option<Value>,
+}
+
 /// The `bones`, `slots` and `drawOrder` sections of one animation, without the bones in
 /// `baked` (by skeleton index).
 pub fn native_timelines(
@@ -180,11 +190,7 @@ pub fn native_timelines(
     skeleton: &Skeleton,
     frame: &SpineFrame,
     baked: &BTreeSet<usize>,
-) -> (
-    BTreeMap<String, Map<String, Value>>,
-    Map<String, Value>,
-    Option<Value>,
-) {
+) -> NativeTimelines {
     let mut bones: BTreeMap<String, Map<String, Value>> = BTreeMap::new();
     let bone_of = |name: &str| skeleton.bones.iter().position(|b| b.name == name);
     let mut put = |bone: &str, timeline: &str, value: Value| {
@@ -285,7 +291,11 @@ pub fn native_timelines(
                 .collect(),
         )
     });
-    (bones, slots, draw_order)
+    NativeTimelines {
+        bones,
+        slots,
+        draw_order,
+    }
 }
 
 #[cfg(test)]
