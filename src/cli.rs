@@ -3,7 +3,8 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
-use crate::anim;
+use crate::anim::{self, CurveEvaluation, SampleOptions};
+use crate::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
 use crate::io::{self, BuildOptions, RigDocument};
 use crate::mesh::MeshOptions;
 use crate::pipeline::{self, PartReport, Scene};
@@ -40,6 +41,63 @@ pub enum Command {
     Render(RenderArgs),
     /// Run the whole pipeline on the bundled character.
     Demo(DemoArgs),
+    /// Export a rig for a game runtime.
+    Export(ExportArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    #[command(subcommand)]
+    pub format: ExportFormat,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum ExportFormat {
+    /// Spine skeleton JSON + .atlas + page PNGs (DIR/NAME.json, DIR/NAME.atlas, DIR/NAME.png).
+    Spine(SpineArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct SpineArgs {
+    /// The rig document (every part must have weights).
+    pub rig: PathBuf,
+    /// The folder to write into (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Spine editor line to write for: 4.2 (or 4.1).
+    #[arg(long, default_value = "4.2")]
+    pub spine_version: String,
+    /// Keys per second for motion Spine cannot express natively (baked).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    /// Keep the K strongest weights per vertex, renormalized.
+    #[arg(long, value_name = "K")]
+    pub max_influences: Option<usize>,
+    /// Decimate each part's mesh to at most N vertices (weights carried from the fine mesh).
+    #[arg(long, value_name = "N")]
+    pub max_vertices: Option<usize>,
+    /// auto: bake only what native timelines cannot express; all: bake every bone.
+    #[arg(long, value_enum, default_value_t = BakeMode::Auto)]
+    pub bake: BakeMode,
+    /// Base name of the files (default: the rig file's name).
+    #[arg(long)]
+    pub name: Option<String>,
+}
+
+/// A runtime whose playback `--match-runtime` reproduces.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum RuntimeMatch {
+    /// Spine's official runtimes: f32 keys, each Bézier key as a 10-segment polyline.
+    Spine,
+}
+
+fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
+    SampleOptions {
+        curves: match runtime {
+            Some(RuntimeMatch::Spine) => CurveEvaluation::SpineRuntime,
+            None => CurveEvaluation::Exact,
+        },
+    }
 }
 
 #[derive(Args, Debug)]
@@ -64,6 +122,9 @@ pub struct RenderArgs {
     /// How handle transformations blend.
     #[arg(long, value_enum, default_value_t = Blend::Linear)]
     pub blend: Blend,
+    /// Play curves as this runtime does instead of exactly (see README, "Spine export").
+    #[arg(long, value_enum)]
+    pub match_runtime: Option<RuntimeMatch>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
     /// OUT.json beside it).
     #[arg(short, long)]
@@ -205,6 +266,9 @@ pub struct PoseArgs {
     /// (LBS with stretchable bones).
     #[arg(long, value_enum, default_value_t = Blend::Linear)]
     pub blend: Blend,
+    /// With --anim: sample curves as this runtime plays them instead of exactly.
+    #[arg(long, value_enum, requires = "anim")]
+    pub match_runtime: Option<RuntimeMatch>,
 }
 
 #[derive(Args, Debug)]
@@ -224,6 +288,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Pose(args) => pose(&args),
         Command::Render(args) => render_animation(&args),
         Command::Demo(args) => demo(&args),
+        Command::Export(ExportArgs {
+            format: ExportFormat::Spine(args),
+        }) => export_spine(&args),
     }
 }
 
@@ -336,7 +403,11 @@ fn pose(args: &PoseArgs) -> Result<()> {
             if !time_s.is_finite() {
                 bail!("--time must be a finite number of seconds");
             }
-            animation(&scene.doc, name)?.sample(time_s, true)
+            animation(&scene.doc, name)?.sample_with(
+                time_s,
+                true,
+                &sample_options(args.match_runtime),
+            )
         }
         (None, None) => Pose::default(),
     };
@@ -371,7 +442,14 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     let times = playback::frame_times(animation.duration_s(), args.fps)?;
     // Check the target before rendering: an unknown extension fails at once.
     io::sequence::format_for_path(&args.output)?;
-    let frames = render_with_progress_bar(&scene, &animation, &times, args.blend, &view)?;
+    let frames = render_with_progress_bar(
+        &scene,
+        &animation,
+        &times,
+        args.blend,
+        &view,
+        &sample_options(args.match_runtime),
+    )?;
     let report =
         io::sequence::write_sequence(&frames, args.fps, &args.output, &Default::default())?;
     println!(
@@ -392,6 +470,7 @@ fn render_with_progress_bar(
     times: &[f64],
     blend: Blend,
     view: &FrameView,
+    sampling: &SampleOptions,
 ) -> Result<Vec<image::RgbaImage>> {
     let bar = indicatif::ProgressBar::new(times.len() as u64);
     if let Ok(style) =
@@ -399,7 +478,7 @@ fn render_with_progress_bar(
     {
         bar.set_style(style);
     }
-    let poses = playback::poses_at(animation, times);
+    let poses = playback::poses_at_with(animation, times, sampling);
     let frames = playback::render_poses(scene, &poses, times, blend, view, &|| bar.inc(1));
     bar.finish_and_clear();
     Ok(frames?)
@@ -497,6 +576,11 @@ fn demo(args: &DemoArgs) -> Result<()> {
     io::save_png(&preview_path, &preview_image(&scene)?)?;
     written.extend([rest_path, preview_path]);
 
+    let t = Instant::now();
+    let export = spine::export_spine(&scene, &images, "character", &SpineOptions::default())?;
+    written.extend(export.write(&args.output.join("spine"))?);
+    let spine_s = t.elapsed().as_secs_f64();
+
     let view = FrameView::new(doc.canvas, 1.0, None, None)?;
     let mut render_s = 0.0;
     let mut write_s = 0.0;
@@ -539,6 +623,7 @@ fn demo(args: &DemoArgs) -> Result<()> {
         rig_s * 1e3
     );
     println!("  rest pose     {:>8.1} ms", rest_s * 1e3);
+    println!("  spine export  {:>8.1} ms", spine_s * 1e3);
     println!(
         "  animate       {:>8.1} ms ({frame_count} frames at {DEMO_FPS} fps, sampled and rendered)",
         render_s * 1e3
@@ -555,6 +640,62 @@ fn demo(args: &DemoArgs) -> Result<()> {
         started.elapsed().as_secs_f64() * 1e3
     );
     Ok(())
+}
+
+/// Loads a rig document and its parts' images.
+fn load_rig_with_images(path: &Path) -> Result<(RigDocument, Vec<image::RgbaImage>)> {
+    let doc = RigDocument::load(path)?;
+    let images = doc
+        .parts
+        .iter()
+        .map(|part| io::load_png(&RigDocument::image_path(path, part)))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((doc, images))
+}
+
+fn export_spine(args: &SpineArgs) -> Result<()> {
+    let options = SpineOptions {
+        version: SpineVersion::parse(&args.spine_version)?,
+        bake_fps: args.fps,
+        bake: args.bake,
+        max_influences: args.max_influences,
+        max_vertices: args.max_vertices,
+        ..SpineOptions::default()
+    };
+    let (doc, images) = load_rig_with_images(&args.rig)?;
+    let scene = Scene::new(doc, &images)?;
+    let name = match &args.name {
+        Some(n) => n.clone(),
+        None => args
+            .rig
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "skeleton".into()),
+    };
+    let export = spine::export_spine(&scene, &images, &name, &options)?;
+    let written = export.write(&args.output)?;
+    report_spine_export(&export, &written);
+    Ok(())
+}
+
+fn report_spine_export(export: &spine::SpineExport, written: &[PathBuf]) {
+    let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
+    println!(
+        "spine {}: {} bones, {} slots, {vertices} mesh vertices",
+        export.name,
+        export.skeleton.bones.len(),
+        export.parts.len()
+    );
+    for (animation, baked) in &export.baked {
+        if baked.is_empty() {
+            println!("  {animation}: native timelines");
+        } else {
+            println!("  {animation}: baked {}", baked.join(", "));
+        }
+    }
+    for path in written {
+        println!("  wrote {}", path.display());
+    }
 }
 
 /// Frame rate of the demo's renders.

@@ -7,6 +7,7 @@
 
 pub mod anim;
 pub mod cli;
+pub mod export;
 pub mod geom;
 pub mod ik;
 pub mod io;

@@ -403,6 +403,17 @@ impl Scene {
             .collect()
     }
 
+    /// One transformation per handle column (in [`handle_columns`] order) for `pose`: the one
+    /// path from a pose to what skinning blends, used for drawing and for the Spine export's
+    /// baking alike: forward kinematics (bone IK constraints included), then the skinning IK
+    /// when the pose has drags, solved from the forward-kinematics pose (no warm start).
+    pub fn handle_transforms(&self, pose: &Pose) -> Result<Vec<Affine>, PipelineError> {
+        if pose.ik.is_empty() {
+            return Ok(handle_transforms(&self.doc.handles, pose)?);
+        }
+        Ok(self.rig_ik()?.transforms(pose)?.transforms)
+    }
+
     /// Every part's vertex positions in `pose` (forward kinematics, then linear blend
     /// skinning; skinning IK first when the pose has drags). Parts without weights stay at rest.
     pub fn pose_positions(&self, pose: &Pose) -> Result<Vec<Vec<Point>>, PipelineError> {
@@ -416,11 +427,7 @@ impl Scene {
         pose: &Pose,
         blend: Blend,
     ) -> Result<Vec<Vec<Point>>, PipelineError> {
-        let transforms = if pose.ik.is_empty() {
-            handle_transforms(&self.doc.handles, pose)?
-        } else {
-            self.rig_ik()?.transforms(pose)?.transforms
-        };
+        let transforms = self.handle_transforms(pose)?;
         self.positions_from_transforms(&transforms, pose, blend)
     }
 

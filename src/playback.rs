@@ -11,7 +11,7 @@
 //! [`bake`] turns an animation into plain keys (bones, points, cages at every frame time) from
 //! the transformations playback solves: what a runtime that knows no skinning IK can play.
 
-use crate::anim::Animation;
+use crate::anim::{Animation, SampleOptions};
 use crate::pipeline::{PipelineError, Scene};
 use crate::render;
 use crate::rig::Pose;
@@ -93,7 +93,15 @@ const FRAME_TIME_SLACK: f64 = 1e-9;
 
 /// The poses of `animation` at `times_s`, looping.
 pub fn poses_at(animation: &Animation, times_s: &[f64]) -> Vec<Pose> {
-    times_s.iter().map(|&t| animation.sample(t, true)).collect()
+    poses_at_with(animation, times_s, &SampleOptions::default())
+}
+
+/// [`poses_at`] with a choice of curve evaluation (e.g. as Spine's runtimes play it).
+pub fn poses_at_with(animation: &Animation, times_s: &[f64], options: &SampleOptions) -> Vec<Pose> {
+    times_s
+        .iter()
+        .map(|&t| animation.sample_with(t, true, options))
+        .collect()
 }
 
 /// Renders one pose through `view`.

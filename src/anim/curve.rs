@@ -8,6 +8,11 @@
 //! the keys themselves. Its time coordinate x(s) is inverted exactly (Newton safeguarded by
 //! bisection, to machine precision), where Spine's runtimes walk a 10-segment polyline instead
 //! (differences of ~0.1° on a typical rotate key; see /work/shared/spine-format.md §7).
+//!
+//! [`CurveEvaluation::SpineRuntime`] reproduces the runtime instead, for previews that must show
+//! what a game shows: [`spine_runtime_bezier_value`] is spine-core 4.2's
+//! `CurveTimeline.setBezier` (forward differences at s = 0.1 … 0.9, stored as 32-bit floats) and
+//! `getBezierValue` (linear in time between those points and the keys).
 
 use serde::de::{self, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -35,6 +40,87 @@ pub const BEZIER_PARAMETER_TOLERANCE: f64 = 2.0 * f64::EPSILON;
 
 /// Iteration cap of the solver; bisection alone reaches machine precision in 53 steps.
 pub const BEZIER_MAX_ITERATIONS: usize = 100;
+
+/// How Bézier keys (and key storage) are evaluated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveEvaluation {
+    /// The exact cubic, in f64: what the animator drew.
+    #[default]
+    Exact,
+    /// What Spine's official runtimes play: key times, values and the curve's sample points
+    /// stored as 32-bit floats, each Bézier walked as a 10-segment polyline.
+    SpineRuntime,
+}
+
+/// Rounds to the nearest 32-bit float, as the runtime's `Float32Array` storage does.
+pub fn f32_stored(x: f64) -> f64 {
+    x as f32 as f64
+}
+
+/// Points of the polyline the runtime walks per Bézier: parameters 0.1 … 0.9.
+pub const SPINE_BEZIER_POINTS: usize = 9;
+
+/// The runtime's polyline of one Bézier channel from key (t0, v0) to key (t1, v1) with
+/// `[cx1, cy1, cx2, cy2]`: the curve at s = 0.1 … 0.9 as (time, value) pairs, by spine-core's
+/// forward differences (its constants 0.03, 0.006, 0.16666667 included), stored as f32.
+pub fn spine_bezier_polyline(
+    t0: f64,
+    v0: f64,
+    [cx1, cy1, cx2, cy2]: [f64; 4],
+    t1: f64,
+    v1: f64,
+) -> [[f64; 2]; SPINE_BEZIER_POINTS] {
+    let tmpx = (t0 - cx1 * 2.0 + cx2) * 0.03;
+    let tmpy = (v0 - cy1 * 2.0 + cy2) * 0.03;
+    let dddx = ((cx1 - cx2) * 3.0 - t0 + t1) * 0.006;
+    let dddy = ((cy1 - cy2) * 3.0 - v0 + v1) * 0.006;
+    let (mut ddx, mut ddy) = (tmpx * 2.0 + dddx, tmpy * 2.0 + dddy);
+    let mut dx = (cx1 - t0) * 0.3 + tmpx + dddx * 0.16666667;
+    let mut dy = (cy1 - v0) * 0.3 + tmpy + dddy * 0.16666667;
+    let (mut x, mut y) = (t0 + dx, v0 + dy);
+    let mut out = [[0.0; 2]; SPINE_BEZIER_POINTS];
+    for point in &mut out {
+        *point = [f32_stored(x), f32_stored(y)];
+        dx += ddx;
+        dy += ddy;
+        ddx += dddx;
+        ddy += dddy;
+        x += dx;
+        y += dy;
+    }
+    out
+}
+
+/// The value of one Bézier channel at time t as the runtime computes it: (t0, v0) and
+/// (t1, v1) are the keys as stored (f32), `handles` and the unrounded key values `exact_v0`,
+/// `exact_v1` and times feed the polyline as the JSON loader does (it passes the parsed f64
+/// numbers to `setBezier`).
+pub fn spine_runtime_bezier_value(
+    exact: ([f64; 2], [f64; 2]),
+    stored: ([f64; 2], [f64; 2]),
+    handles: &[f64],
+    t: f64,
+) -> f64 {
+    let ([et0, ev0], [et1, ev1]) = exact;
+    let ([t0, v0], [t1, v1]) = stored;
+    let h = match handles {
+        &[a, b, c, d] => [a, b, c, d],
+        _ => return v0 + (t - t0) / (t1 - t0) * (v1 - v0),
+    };
+    let points = spine_bezier_polyline(et0, ev0, h, et1, ev1);
+    if points[0][0] > t {
+        return v0 + (t - t0) / (points[0][0] - t0) * (points[0][1] - v0);
+    }
+    for pair in points.windows(2) {
+        if pair[1][0] >= t {
+            let [x, y] = pair[0];
+            return y + (t - x) / (pair[1][0] - x) * (pair[1][1] - y);
+        }
+    }
+    let [x, y] = points[SPINE_BEZIER_POINTS - 1];
+    y + (t - x) / (t1 - x) * (v1 - y)
+}
 
 impl Curve {
     pub fn is_linear(&self) -> bool {
@@ -204,6 +290,37 @@ mod tests {
                 assert!((cubic(x, s) - t).abs() <= 8.0 * f64::EPSILON * x[3].abs().max(1.0));
             }
         }
+    }
+
+    #[test]
+    fn spine_runtime_polyline_lies_on_the_curve_and_is_straight_between() {
+        // The polyline's defining property: its points lie on the exact curve at s = 0.1 … 0.9
+        // (forward differences accumulate only rounding). The end-to-end check against the
+        // runtime itself is tests/spine_runtime.rs.
+        let h = [0.3, -20.0, 0.5, 130.0];
+        let points = spine_bezier_polyline(0.0, 0.0, h, 1.0, 90.0);
+        for (k, p) in points.iter().enumerate() {
+            let s = (k + 1) as f64 / 10.0;
+            let x = cubic([0.0, 0.3, 0.5, 1.0], s);
+            let y = cubic([0.0, -20.0, 130.0, 90.0], s);
+            assert!(
+                (p[0] - x).abs() < 1e-6 && (p[1] - y).abs() < 1e-4,
+                "{k} {p:?} {x} {y}"
+            );
+        }
+        // Between the points the runtime is linear, so it differs from the exact curve.
+        let ends = (([0.0, 0.0], [1.0, 90.0]), ([0.0, 0.0], [1.0, 90.0]));
+        let t = 0.55;
+        let runtime = spine_runtime_bezier_value(ends.0, ends.1, &h, t);
+        let exact = bezier_value(0.0, 0.0, &h, 1.0, 90.0, t);
+        assert!((runtime - exact).abs() > 1e-3, "{runtime} {exact}");
+        assert!((runtime - exact).abs() < 1.0, "{runtime} {exact}");
+        // On a sample point it agrees with the exact curve up to f32 storage.
+        let on = spine_runtime_bezier_value(ends.0, ends.1, &h, points[4][0]);
+        assert!((on - points[4][1]).abs() < 1e-9);
+        // Before the first point and after the last: straight to the keys.
+        let first = spine_runtime_bezier_value(ends.0, ends.1, &h, points[0][0] / 2.0);
+        assert!((first - points[0][1] / 2.0).abs() < 1e-9);
     }
 
     #[test]

@@ -20,7 +20,9 @@ pub mod timeline;
 
 pub use check::load_animations;
 pub use curve::Curve;
+pub use curve::CurveEvaluation;
 pub use mix::{mix_poses, sample_mix, Playhead, STEPPED_MIX_THRESHOLD};
+pub use sample::SampleOptions;
 pub use timeline::{
     parse_animations, Animation, BoneTimelines, IkTimeline, Key, PartTimelines, PointTimelines,
     Rgba, StepKey, TimelineError,

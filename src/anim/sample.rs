@@ -7,10 +7,14 @@
 //! setup pose before a timeline's first key; author a key at 0 to get the same). Sampled values
 //! replace the rest values of the pose's fields; whatever has no timeline stays at rest (is absent
 //! from the pose).
+//!
+//! [`SampleOptions::curves`] chooses between the exact curves and what Spine's runtimes play
+//! ([`CurveEvaluation::SpineRuntime`]: f32 key storage, Bézier keys as 10-segment polylines).
 
-use super::curve::{bezier_value, Curve};
+use super::curve::{bezier_value, f32_stored, spine_runtime_bezier_value, Curve, CurveEvaluation};
 use super::timeline::{Animation, Channels, Key, StepKey};
 use crate::rig::pose::{BonePose, CagePose, IkDrag, PartPose, PointPose, Pose};
+use serde::{Deserialize, Serialize};
 
 /// Where a time falls among a timeline's keys.
 enum Place {
@@ -41,8 +45,88 @@ fn place(times: impl Fn(usize) -> f64, len: usize, t: f64) -> Place {
     Place::Between(lo)
 }
 
+/// How an animation is sampled.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SampleOptions {
+    /// Exact curves (default) or the Spine runtime's evaluation.
+    pub curves: CurveEvaluation,
+}
+
 /// The value of a keyed timeline at time `t`; `None` for a timeline without keys.
 pub fn sample_keys<V: Channels>(keys: &[Key<V>], t: f64) -> Option<V> {
+    sample_keys_with(keys, t, CurveEvaluation::Exact)
+}
+
+/// [`sample_keys`] with a choice of curve evaluation.
+pub fn sample_keys_with<V: Channels>(
+    keys: &[Key<V>],
+    t: f64,
+    curves: CurveEvaluation,
+) -> Option<V> {
+    match curves {
+        CurveEvaluation::Exact => sample_keys_exact(keys, t),
+        CurveEvaluation::SpineRuntime => sample_keys_spine_runtime(keys, t),
+    }
+}
+
+/// What spine-core 4.2 computes for a timeline at `t` (`CurveTimeline1/2.getCurveValue`, the
+/// color timelines alike): times and values as stored in its `Float32Array`s, the Bézier
+/// polyline from the keys' unrounded numbers. One-curve timelines (cages) are eased by their
+/// 0..1 curve the same way; the exporter's per-channel rewrite of that curve is the same
+/// polyline up to f32 rounding.
+fn sample_keys_spine_runtime<V: Channels>(keys: &[Key<V>], t: f64) -> Option<V> {
+    let stored = |v: &V| {
+        let mut out = v.clone();
+        for x in out.numbers_mut() {
+            *x = f32_stored(*x);
+        }
+        out
+    };
+    let i = match place(|i| f32_stored(keys[i].time), keys.len(), t) {
+        Place::Hold(i) => return keys.get(i).map(|k| stored(&k.value)),
+        Place::Between(i) => i,
+    };
+    let (a, b) = (&keys[i], &keys[i + 1]);
+    let (t0, t1) = (f32_stored(a.time), f32_stored(b.time));
+    let mut out = stored(&a.value);
+    let pairs = a.value.numbers().iter().zip(b.value.numbers());
+    match &a.curve {
+        Curve::Stepped => {}
+        Curve::Linear => {
+            for (o, (va, vb)) in out.numbers_mut().iter_mut().zip(pairs) {
+                let (va, vb) = (f32_stored(*va), f32_stored(*vb));
+                *o = va + (t - t0) / (t1 - t0) * (vb - va);
+            }
+        }
+        Curve::Bezier(handles) if V::CURVE_PER_CHANNEL => {
+            for (c, (o, (va, vb))) in out.numbers_mut().iter_mut().zip(pairs).enumerate() {
+                let h = handles.get(4 * c..4 * c + 4).unwrap_or(&[]);
+                *o = spine_runtime_bezier_value(
+                    ([a.time, *va], [b.time, *vb]),
+                    ([t0, f32_stored(*va)], [t1, f32_stored(*vb)]),
+                    h,
+                    t,
+                );
+            }
+        }
+        Curve::Bezier(handles) => {
+            let eased = spine_runtime_bezier_value(
+                ([a.time, 0.0], [b.time, 1.0]),
+                ([t0, 0.0], [t1, 1.0]),
+                handles,
+                t,
+            );
+            for (o, (va, vb)) in out.numbers_mut().iter_mut().zip(pairs) {
+                let (va, vb) = (f32_stored(*va), f32_stored(*vb));
+                *o = va + (vb - va) * eased;
+            }
+        }
+    }
+    Some(out)
+}
+
+fn sample_keys_exact<V: Channels>(keys: &[Key<V>], t: f64) -> Option<V> {
     let i = match place(|i| keys[i].time, keys.len(), t) {
         Place::Hold(i) => return keys.get(i).map(|k| k.value.clone()),
         Place::Between(i) => i,
@@ -109,12 +193,22 @@ pub fn local_time_s(duration_s: f64, time_s: f64, looping: bool) -> f64 {
 impl Animation {
     /// The pose at `time_s` seconds.
     pub fn sample(&self, time_s: f64, looping: bool) -> Pose {
+        self.sample_with(time_s, looping, &SampleOptions::default())
+    }
+
+    /// [`Animation::sample`] with a choice of curve evaluation.
+    pub fn sample_with(&self, time_s: f64, looping: bool, options: &SampleOptions) -> Pose {
+        let curves = options.curves;
         let t = local_time_s(self.duration_s(), time_s, looping);
         let mut pose = Pose::default();
         for (name, timelines) in &self.bones {
             let mut bone = BonePose::default();
             let mut keyed = false;
-            if let Some(v) = timelines.rotate.as_deref().and_then(|k| sample_keys(k, t)) {
+            if let Some(v) = timelines
+                .rotate
+                .as_deref()
+                .and_then(|k| sample_keys_with(k, t, curves))
+            {
                 bone.rotate = v;
                 keyed = true;
             }
@@ -123,7 +217,7 @@ impl Animation {
                 (&mut bone.scale, &timelines.scale),
                 (&mut bone.shear, &timelines.shear),
             ] {
-                if let Some(v) = keys.as_deref().and_then(|k| sample_keys(k, t)) {
+                if let Some(v) = keys.as_deref().and_then(|k| sample_keys_with(k, t, curves)) {
                     *field = v;
                     keyed = true;
                 }
@@ -135,7 +229,11 @@ impl Animation {
         for (name, timelines) in &self.points {
             let mut point = PointPose::default();
             let mut keyed = false;
-            if let Some(v) = timelines.rotate.as_deref().and_then(|k| sample_keys(k, t)) {
+            if let Some(v) = timelines
+                .rotate
+                .as_deref()
+                .and_then(|k| sample_keys_with(k, t, curves))
+            {
                 point.rotate = v;
                 keyed = true;
             }
@@ -144,7 +242,7 @@ impl Animation {
                 (&mut point.scale, &timelines.scale),
                 (&mut point.shear, &timelines.shear),
             ] {
-                if let Some(v) = keys.as_deref().and_then(|k| sample_keys(k, t)) {
+                if let Some(v) = keys.as_deref().and_then(|k| sample_keys_with(k, t, curves)) {
                     *field = v;
                     keyed = true;
                 }
@@ -154,14 +252,18 @@ impl Animation {
             }
         }
         for (name, keys) in &self.cages {
-            if let Some(polygon) = sample_keys(keys, t) {
+            if let Some(polygon) = sample_keys_with(keys, t, curves) {
                 pose.cages.insert(name.clone(), CagePose { polygon });
             }
         }
         for (name, timelines) in &self.parts {
             let mut part = PartPose::default();
             let mut keyed = false;
-            if let Some(c) = timelines.color.as_deref().and_then(|k| sample_keys(k, t)) {
+            if let Some(c) = timelines
+                .color
+                .as_deref()
+                .and_then(|k| sample_keys_with(k, t, curves))
+            {
                 part.color = c.0;
                 keyed = true;
             }
@@ -182,7 +284,7 @@ impl Animation {
             .ik
             .iter()
             .filter_map(|drag| {
-                sample_keys(&drag.to, t).map(|to| IkDrag {
+                sample_keys_with(&drag.to, t, curves).map(|to| IkDrag {
                     at: drag.at,
                     to,
                     weight: drag.weight,
@@ -266,6 +368,35 @@ mod tests {
         assert!(close(v[0], 5.0) && close(v[1], 3.0), "{v:?}");
         let v = sample_keys(&keys, 0.5).unwrap();
         assert!(v[0] < 1.25 && close(v[1], 1.5), "{v:?}");
+    }
+
+    #[test]
+    fn spine_runtime_sampling_stores_f32_and_walks_the_polyline() {
+        let rt = CurveEvaluation::SpineRuntime;
+        // Linear and stepped keys: the same as exact, up to f32 storage of times and values.
+        let keys = vec![
+            key(0.1, 10.3, Curve::Linear),
+            key(0.7, -4.9, Curve::Stepped),
+            key(1.0, 2.0, Curve::Linear),
+        ];
+        for t in [0.0, 0.25, 0.5, 0.8, 1.5] {
+            let (a, b) = (
+                sample_keys(&keys, t).unwrap(),
+                sample_keys_with(&keys, t, rt).unwrap(),
+            );
+            assert!((a - b).abs() < 1e-5, "{t}: {a} {b}");
+        }
+        assert_eq!(sample_keys_with(&keys, 0.0, rt), Some(f32_stored(10.3)));
+        // A Bézier key: exact at the keys, off the exact cubic in between (the runtime's
+        // polyline), and on the polyline's straight segment between two of its points.
+        let eased = vec![
+            key(0.0, 0.0, Curve::Bezier(vec![0.5, 0.0, 0.5, 90.0])),
+            key(1.0, 90.0, Curve::Linear),
+        ];
+        let exact = sample_keys(&eased, 0.3).unwrap();
+        let runtime = sample_keys_with(&eased, 0.3, rt).unwrap();
+        assert!((exact - runtime).abs() > 1e-3 && (exact - runtime).abs() < 2.0);
+        assert_eq!(sample_keys_with(&eased, 1.0, rt), Some(90.0));
     }
 
     #[test]

@@ -133,7 +133,13 @@ struct System {
     anchor_weight: f64,
     /// tr(A) / tr(G): converts mass-weighted distances into energy units.
     energy_per_gram: f64,
+    /// The per-entry pull toward the anchor ([`COLUMN_HOLD`] × mean diagonal of A).
+    column_hold: f64,
 }
+
+/// Pull of every handle parameter toward its anchor, relative to A's mean diagonal: negligible
+/// for any column that moves vertices, decisive for one that moves none.
+pub const COLUMN_HOLD: f64 = 1e-9;
 
 /// The skinning-IK solver of one rig: precompute once, then solve per frame or per drag.
 #[derive(Clone, Debug)]
@@ -282,6 +288,11 @@ impl FastIk {
             0.0
         };
         q_t += &self.subspace.gram * anchor_weight;
+        // A column that moves (almost) no vertex has (almost) no G: hold it at its anchor too.
+        let column_hold = COLUMN_HOLD * trace_a / dim.max(1) as f64;
+        for k in 0..dim {
+            q_t[(k, k)] += column_hold;
+        }
         let energy_per_gram = if trace_g > 0.0 {
             trace_a / trace_g
         } else {
@@ -345,6 +356,7 @@ impl FastIk {
             rigid,
             anchor_weight,
             energy_per_gram,
+            column_hold,
         })
     }
 
@@ -385,7 +397,9 @@ impl FastIk {
         }
         let anchor = stack(&problem.anchor);
         let stiffness = self.handle_stiffness();
-        let mut f_const = &self.subspace.gram * &anchor * system.anchor_weight - &system.q_t * &q;
+        let mut f_const = &self.subspace.gram * &anchor * system.anchor_weight
+            + &anchor * system.column_hold
+            - &system.q_t * &q;
         for (j, weight, predicted) in &problem.inertia {
             let block =
                 self.subspace.gram.view((3 * j, 3 * j), (3, 3)) * (weight * system.energy_per_gram);
@@ -594,7 +608,7 @@ impl FastIk {
             super::cluster::weight_space_clusters(
                 &points,
                 column_count,
-                options.clusters_per_handle * column_count,
+                options.clusters_per_handle.saturating_mul(column_count),
                 options.cluster_iterations,
             )
         };

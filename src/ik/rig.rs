@@ -78,6 +78,8 @@ impl RigIk {
             && frame_time_s.is_finite();
         let problem = self.problem_with(pose, dynamic.then_some(frame_time_s))?;
         let solution = if problem.drags.is_empty() && problem.inertia.is_empty() {
+            // Not solved: the next solved frame must not start from a stale result.
+            self.solver.reset();
             IkSolution {
                 transforms: problem.anchor,
                 iterations: 0,
@@ -125,9 +127,10 @@ impl RigIk {
         // carries momentum in this frame.
         let movable = |j: usize| dragged || (frame_time_s.is_some() && self.inertia_s[j] > 0.0);
         let options = &self.solver.options;
-        // Bones that bone IK constraints turn are decided, like keyed ones.
-        let pose = &crate::rig::bone_ik::constrained_pose(handles, pose)?;
+        // Forward kinematics applies the bone IK constraints itself; the constrained pose only
+        // says which bones they decide (like keyed ones), so they are not applied twice.
         let fk = handle_transforms(handles, pose)?;
+        let pose = &crate::rig::bone_ik::constrained_pose(handles, pose)?;
         let mut columns: Vec<ColumnDofs> = Vec::with_capacity(fk.len());
         let mut joints = Vec::new();
         let bone_index = |name: &str| handles.bones.iter().position(|b| b.name == name);
@@ -188,7 +191,7 @@ impl RigIk {
             let posed = pose.cages.contains_key(&cage.name);
             for _ in &cage.polygon {
                 let j = columns.len();
-                columns.push(if posed {
+                columns.push(if posed || !movable(j) {
                     ColumnDofs::Fixed(fk[j])
                 } else {
                     free(options.cage_vertices)

@@ -1,0 +1,61 @@
+//! Spine export of the bundled character: `export::spine::export_spine` in memory (skeleton,
+//! 12 weighted meshes of ~10k vertices in all, atlas packing and PNG encoding of the page,
+//! walk and wave timelines with the bake check at 30 keys/s), and the same with
+//! `--max-vertices 200` (decimation).
+//!
+//! Setup (not timed): the character is rigged once as `sinew demo` does (default options,
+//! `assets/character/handles.json`, `animations.json`) and its scene built.
+//!
+//! No target was set by the issue; the lead's reference figure is the one to keep under.
+//!
+//! `cargo bench --bench spine`
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use sinew::export::spine::{export_spine, SpineOptions};
+use sinew::io::BuildOptions;
+use sinew::pipeline::{self, Scene};
+use sinew::rig::Handles;
+use std::path::{Path, PathBuf};
+
+fn character() -> (Scene, Vec<image::RgbaImage>) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    let read = |file: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(file)).expect("bundled file"))
+            .expect("bundled JSON")
+    };
+    let paths: Vec<PathBuf> = read("layers.json")["layers"]
+        .as_array()
+        .expect("a layer list")
+        .iter()
+        .map(|n| dir.join(format!("{}.png", n.as_str().expect("a layer name"))))
+        .collect();
+    let layers = pipeline::load_layers(&paths).expect("bundled layers load");
+    let handles: Handles = serde_json::from_value(read("handles.json")).expect("handles parse");
+    let (mut doc, _) = pipeline::build_rig(&layers, &dir, &BuildOptions::default(), &handles)
+        .expect("the character rigs");
+    doc.animations = serde_json::from_value(read("animations.json")).expect("animations parse");
+    let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+    let scene = Scene::new(doc, &images).expect("the scene loads");
+    (scene, images)
+}
+
+fn bench(c: &mut Criterion) {
+    let (scene, images) = character();
+    let mut group = c.benchmark_group("spine");
+    group.sample_size(20);
+    let full = SpineOptions::default();
+    group.bench_function("export/character", |b| {
+        b.iter(|| export_spine(&scene, &images, "character", &full).expect("exports"))
+    });
+    let coarse = SpineOptions {
+        max_vertices: Some(200),
+        ..SpineOptions::default()
+    };
+    group.bench_function("export/character/max_vertices_200", |b| {
+        b.iter(|| export_spine(&scene, &images, "character", &coarse).expect("exports"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

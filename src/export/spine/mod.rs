@@ -1,0 +1,612 @@
+//! Spine export: a rig as Spine 4.2 skeleton JSON, a `.atlas` and its page PNGs, which the
+//! official runtimes play where sinew draws the rig.
+//!
+//! In: a loaded [`Scene`] (the rig document, every part with weights), the parts' images
+//! (straight-alpha RGBA8 on the canvas), a base name and [`SpineOptions`]. Out: a
+//! [`SpineExport`] held in memory — `NAME.json`, `NAME.atlas`, `NAME.png` (and `NAME_2.png`, …)
+//! — which [`SpineExport::write`] puts into a folder all at once or not at all.
+//!
+//! Stages, one module each:
+//! - [`frame`]: canvas (y down) ↔ Spine world (y up), Spine's bone matrix;
+//! - [`skeleton`]: every handle a bone, parents first, setup pose;
+//! - [`mesh`]: a weighted mesh attachment per part (hull first, uvs, binds, influences);
+//! - [`decimate`]: coarser runtime meshes carrying the fine mesh's weights;
+//! - [`atlas`]: trimmed regions packed into pages, premultiplied, and the atlas text;
+//! - [`timelines`]: sinew timelines as native Spine timelines with their curves;
+//! - [`bake`]: what Spine cannot express, sampled at `bake_fps` through the one pose path.
+//!
+//! Spine facts relied on are in `/work/shared/spine-format.md` (section numbers cited there);
+//! `tests/spine_runtime.rs` checks the result against the official `spine-core` runtime.
+
+pub mod atlas;
+pub mod bake;
+pub mod decimate;
+pub mod frame;
+pub mod mesh;
+pub mod skeleton;
+pub mod timelines;
+
+pub use atlas::AtlasOptions;
+pub use bake::BakeMode;
+pub use frame::SpineFrame;
+
+use crate::anim::{self, AnimError};
+use crate::geom::Point;
+use crate::io::{self, RigDocument};
+use crate::pipeline::{PipelineError, Scene};
+use crate::rig::{handle_columns, Pose};
+use image::RgbaImage;
+use mesh::{mesh_attachment, MeshAttachment, RegionRect, WeightedMesh};
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Map, Value};
+use skeleton::{build_skeleton, Skeleton};
+use std::path::{Path, PathBuf};
+use timelines::num;
+
+/// The Spine editor line the JSON is written for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SpineVersion {
+    /// 4.1: the same subset; only the version string differs.
+    #[serde(rename = "4.1")]
+    V4_1,
+    /// 4.2 (default): what most engines ship today.
+    #[default]
+    #[serde(rename = "4.2")]
+    V4_2,
+}
+
+impl SpineVersion {
+    /// Parses `4.1` or `4.2` (what `--spine-version` takes).
+    pub fn parse(text: &str) -> Result<Self, SpineError> {
+        match text.trim() {
+            "4.1" => Ok(SpineVersion::V4_1),
+            "4.2" => Ok(SpineVersion::V4_2),
+            other => Err(SpineError::UnsupportedVersion(other.to_string())),
+        }
+    }
+
+    /// The `skeleton.spine` string. Runtimes check major.minor only (spine-format.md §1).
+    pub fn version_string(self) -> &'static str {
+        match self {
+            SpineVersion::V4_1 => "4.1.0",
+            SpineVersion::V4_2 => "4.2.0",
+        }
+    }
+}
+
+/// How a rig is exported.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpineOptions {
+    /// Default 4.2.
+    pub version: SpineVersion,
+    /// Keys per second of baked motion. Default 30.
+    pub bake_fps: f64,
+    /// What is baked. Default [`BakeMode::Auto`].
+    pub bake: BakeMode,
+    /// How far (px, at the corners of the rig's bounding box) the pose path may move a handle
+    /// away from forward kinematics of the keyed pose before the handle is baked. Default 1e-6.
+    pub bake_tolerance_px: f64,
+    /// Keep the K strongest weights per vertex, renormalized. Default: all.
+    pub max_influences: Option<usize>,
+    /// Decimate each part's mesh to at most this many vertices. Default: the fine mesh.
+    pub max_vertices: Option<usize>,
+    /// Transparent px around each mesh's box in its atlas region. Default 2.
+    pub region_margin_px: u32,
+    pub atlas: AtlasOptions,
+    /// Name of the root bone every skeleton hangs from. Default `root`.
+    pub root_bone: String,
+}
+
+impl Default for SpineOptions {
+    fn default() -> Self {
+        SpineOptions {
+            version: SpineVersion::default(),
+            bake_fps: 30.0,
+            bake: BakeMode::default(),
+            bake_tolerance_px: 1e-6,
+            max_influences: None,
+            max_vertices: None,
+            region_margin_px: 2,
+            atlas: AtlasOptions::default(),
+            root_bone: "root".into(),
+        }
+    }
+}
+
+/// Highest bake rate accepted; a typo (`--fps 3000`) would otherwise write huge files.
+pub const MAX_BAKE_FPS: f64 = 240.0;
+
+/// What stops an export.
+#[derive(Debug, thiserror::Error)]
+pub enum SpineError {
+    #[error("part '{0}' has no weights: rig it with handles (sinew rig --handles) before exporting to Spine")]
+    NoWeights(String),
+    #[error("part '{part}': vertex {vertex} has no positive weight")]
+    UnweightedVertex { part: String, vertex: usize },
+    #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
+    UnknownWeightHandle { part: String, handle: String },
+    #[error("{kind} name {name:?} cannot be used in Spine: {reason}")]
+    BadName {
+        kind: &'static str,
+        name: String,
+        reason: &'static str,
+    },
+    #[error("two Spine bones would be named '{name}' (the root bone, or a cage vertex 'cage.k')")]
+    NameTaken { name: String },
+    #[error("Spine version '{0}' is not supported (4.1 or 4.2; 4.3 moved constraints into one typed array and is not written yet)")]
+    UnsupportedVersion(String),
+    #[error("the bake rate must be a number in (0, {MAX_BAKE_FPS}] keys per second, not {0}")]
+    Fps(f64),
+    #[error("--max-influences must be at least 1")]
+    MaxInfluences,
+    #[error("--max-vertices must be at least 3, not {0}")]
+    MaxVertices(usize),
+    #[error("part '{part}' needs a {}×{} px atlas region, larger than a page ({max_page_px} px)", size[0], size[1])]
+    RegionTooLarge {
+        part: String,
+        size: [u32; 2],
+        max_page_px: u32,
+    },
+    #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
+    ImageSize {
+        part: String,
+        got: [u32; 2],
+        canvas: [u32; 2],
+    },
+    #[error("the transformation of '{0}' is singular")]
+    Singular(String),
+    #[error(transparent)]
+    Anim(#[from] AnimError),
+    #[error("baking: {0}")]
+    Pose(PipelineError),
+    #[error("cannot encode atlas page {0}: {1}")]
+    Png(String, String),
+    #[error("{path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// One exported part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportedPart {
+    /// Slot, attachment and atlas region name: the part's name.
+    pub name: String,
+    pub mesh: MeshAttachment,
+}
+
+/// A finished export, in memory.
+#[derive(Clone, Debug)]
+pub struct SpineExport {
+    /// File base name (`NAME.json`, `NAME.atlas`).
+    pub name: String,
+    pub frame: SpineFrame,
+    pub skeleton: Skeleton,
+    pub parts: Vec<ExportedPart>,
+    /// Per animation, the bones whose motion was baked.
+    pub baked: Vec<(String, Vec<String>)>,
+    pub json: String,
+    pub atlas: String,
+    /// Page file names and PNG bytes.
+    pub pages: Vec<(String, Vec<u8>)>,
+}
+
+/// Names go into JSON strings and atlas lines: no control characters, no surrounding blanks, and
+/// for atlas lines (part and file names) no `:`, which would read as an atlas entry
+/// (spine-format.md §12).
+fn check_name(kind: &'static str, name: &str, in_atlas: bool) -> Result<(), SpineError> {
+    let bad = |reason| {
+        Err(SpineError::BadName {
+            kind,
+            name: name.to_string(),
+            reason,
+        })
+    };
+    if name.is_empty() {
+        return bad("it is empty");
+    }
+    if name.chars().any(char::is_control) {
+        return bad("it contains a control character (a line break?)");
+    }
+    if name.trim() != name {
+        return bad("it starts or ends with a blank");
+    }
+    if in_atlas && name.contains(':') {
+        return bad("the atlas format reads ':' as a key/value separator");
+    }
+    Ok(())
+}
+
+/// Exports `scene` as `name`. `images` are the parts' images in part order.
+pub fn export_spine(
+    scene: &Scene,
+    images: &[RgbaImage],
+    name: &str,
+    options: &SpineOptions,
+) -> Result<SpineExport, SpineError> {
+    let doc = &scene.doc;
+    if !(options.bake_fps.is_finite() && options.bake_fps > 0.0 && options.bake_fps <= MAX_BAKE_FPS)
+    {
+        return Err(SpineError::Fps(options.bake_fps));
+    }
+    if options.max_influences == Some(0) {
+        return Err(SpineError::MaxInfluences);
+    }
+    if let Some(n) = options.max_vertices.filter(|&n| n < 3) {
+        return Err(SpineError::MaxVertices(n));
+    }
+    check_name("file", name, true)?;
+    check_name("root bone", &options.root_bone, false)?;
+    for part in &doc.parts {
+        check_name("part", &part.name, true)?;
+        if part.weights.is_none() {
+            return Err(SpineError::NoWeights(part.name.clone()));
+        }
+    }
+    for column in handle_columns(&doc.handles) {
+        check_name("handle", &column, false)?;
+    }
+    for animation in doc.animations.keys() {
+        check_name("animation", animation, false)?;
+    }
+    let frame = SpineFrame::for_canvas(doc.canvas);
+    let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
+    let columns = handle_columns(&doc.handles);
+
+    // Meshes and regions.
+    let mut parts = Vec::with_capacity(doc.parts.len());
+    let mut regions = Vec::with_capacity(doc.parts.len());
+    for (part, image) in doc.parts.iter().zip(images) {
+        let got = [image.width(), image.height()];
+        if got != doc.canvas {
+            return Err(SpineError::ImageSize {
+                part: part.name.clone(),
+                got,
+                canvas: doc.canvas,
+            });
+        }
+        let Some(weights) = &part.weights else {
+            return Err(SpineError::NoWeights(part.name.clone()));
+        };
+        // The document names its columns; map them onto the rig's column order.
+        let mut to_column = Vec::with_capacity(weights.handles.len());
+        for handle in &weights.handles {
+            let j = columns.iter().position(|c| c == handle).ok_or_else(|| {
+                SpineError::UnknownWeightHandle {
+                    part: part.name.clone(),
+                    handle: handle.clone(),
+                }
+            })?;
+            to_column.push(j);
+        }
+        let rows: Vec<Vec<(usize, f64)>> = weights
+            .rows
+            .iter()
+            .map(|row| {
+                row.iter()
+                    .map(|&(h, w)| (to_column[h as usize], w))
+                    .collect()
+            })
+            .collect();
+        let fine = part.mesh.to_mesh();
+        let (kept, triangles) = match options.max_vertices {
+            Some(n) if n < fine.vertices.len() => decimate::decimate(&fine, &rows, n),
+            _ => ((0..fine.vertices.len()).collect(), fine.triangles.clone()),
+        };
+        let vertices: Vec<Point> = kept.iter().map(|&v| fine.vertices[v]).collect();
+        let kept_rows: Vec<Vec<(usize, f64)>> = kept.iter().map(|&v| rows[v].clone()).collect();
+        let region = RegionRect::around(&vertices, options.region_margin_px);
+        let mut mesh = mesh_attachment(
+            &part.name,
+            WeightedMesh {
+                vertices: &vertices,
+                triangles: &triangles,
+                rows: &kept_rows,
+            },
+            &skeleton,
+            &frame,
+            &region,
+            options.max_influences,
+        )?;
+        // Vertex sources are indices into the fine mesh.
+        for v in &mut mesh.vertex_source {
+            *v = kept[*v];
+        }
+        regions.push((part.name.clone(), image, region));
+        parts.push(ExportedPart {
+            name: part.name.clone(),
+            mesh,
+        });
+    }
+    let atlas = atlas::pack_atlas(name, &regions, &options.atlas)?;
+
+    // Animations: native timelines, and baked keys for what they cannot express.
+    let animations = anim::load_animations(doc)?;
+    let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
+    let corners = rig_corners(doc);
+    let path = |pose: &Pose| scene.handle_transforms(pose);
+    let mut animations_json = Map::new();
+    let mut baked_report = Vec::new();
+    for (anim_name, animation) in &animations {
+        let times = bake::bake_times(animation.duration_s(), options.bake_fps);
+        let samples = bake::sample_path(animation, &times, &path).map_err(SpineError::Pose)?;
+        let baked = bake::bones_to_bake(
+            options.bake,
+            &doc.handles,
+            &skeleton,
+            &samples,
+            &corners,
+            options.bake_tolerance_px,
+        )?;
+        let timelines::NativeTimelines {
+            mut bones,
+            slots,
+            draw_order,
+        } = timelines::native_timelines(
+            animation,
+            &doc.handles,
+            &part_names,
+            &skeleton,
+            &frame,
+            &baked,
+        );
+        bones.extend(bake::baked_timelines(
+            &skeleton, &frame, &baked, &times, &samples,
+        )?);
+        let mut a = Map::new();
+        if !bones.is_empty() {
+            a.insert(
+                "bones".into(),
+                Value::Object(
+                    bones
+                        .into_iter()
+                        .map(|(k, v)| (k, Value::Object(v)))
+                        .collect(),
+                ),
+            );
+        }
+        if !slots.is_empty() {
+            a.insert("slots".into(), Value::Object(slots));
+        }
+        if let Some(d) = draw_order {
+            a.insert("drawOrder".into(), d);
+        }
+        animations_json.insert(anim_name.clone(), Value::Object(a));
+        baked_report.push((
+            anim_name.clone(),
+            baked
+                .iter()
+                .map(|&b| skeleton.bones[b].name.clone())
+                .collect(),
+        ));
+    }
+
+    let json = skeleton_json(
+        doc,
+        name,
+        options,
+        &frame,
+        &skeleton,
+        &parts,
+        &atlas,
+        animations_json,
+    );
+    let mut pages = Vec::with_capacity(atlas.pages.len());
+    for page in &atlas.pages {
+        pages.push((
+            page.file_name.clone(),
+            png_bytes(&page.image, &page.file_name)?,
+        ));
+    }
+    Ok(SpineExport {
+        name: name.to_string(),
+        frame,
+        skeleton,
+        parts,
+        baked: baked_report,
+        json,
+        atlas: atlas.text(),
+        pages,
+    })
+}
+
+/// The corners of the box around every part's rest mesh (canvas px): where a handle's
+/// transformation is compared when deciding what to bake.
+fn rig_corners(doc: &RigDocument) -> Vec<Point> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
+        lo = [lo[0].min(v[0]), lo[1].min(v[1])];
+        hi = [hi[0].max(v[0]), hi[1].max(v[1])];
+    }
+    if !lo[0].is_finite() {
+        return vec![Point::origin()];
+    }
+    vec![
+        Point::new(lo[0], lo[1]),
+        Point::new(hi[0], lo[1]),
+        Point::new(hi[0], hi[1]),
+        Point::new(lo[0], hi[1]),
+    ]
+}
+
+fn png_bytes(image: &RgbaImage, file: &str) -> Result<Vec<u8>, SpineError> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    image
+        .write_to(&mut out, image::ImageFormat::Png)
+        .map_err(|e| SpineError::Png(file.to_string(), e.to_string()))?;
+    Ok(out.into_inner())
+}
+
+/// The skeleton JSON (spine-format.md §2–§7).
+#[allow(clippy::too_many_arguments)]
+fn skeleton_json(
+    doc: &RigDocument,
+    name: &str,
+    options: &SpineOptions,
+    frame: &SpineFrame,
+    skeleton: &Skeleton,
+    parts: &[ExportedPart],
+    atlas: &atlas::Atlas,
+    animations: Map<String, Value>,
+) -> String {
+    // Bounds of the setup pose: the rest meshes in Spine's world.
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
+        let q = frame.spine_from_canvas(*v);
+        lo = [lo[0].min(q[0]), lo[1].min(q[1])];
+        hi = [hi[0].max(q[0]), hi[1].max(q[1])];
+    }
+    if !lo[0].is_finite() {
+        (lo, hi) = ([0.0; 2], [0.0; 2]);
+    }
+    let bones: Vec<Value> = skeleton
+        .bones
+        .iter()
+        .map(|b| {
+            let mut m = Map::new();
+            m.insert("name".into(), json!(b.name));
+            if let Some(p) = b.parent {
+                m.insert("parent".into(), json!(skeleton.bones[p].name));
+            }
+            let s = &b.setup;
+            for (key, value, default) in [
+                ("length", b.length, 0.0),
+                ("x", s.x, 0.0),
+                ("y", s.y, 0.0),
+                ("rotation", s.rotation_deg, 0.0),
+                ("scaleX", s.scale_x, 1.0),
+                ("scaleY", s.scale_y, 1.0),
+                ("shearX", s.shear_x_deg, 0.0),
+                ("shearY", s.shear_y_deg, 0.0),
+            ] {
+                if value != default {
+                    m.insert(key.into(), num(value));
+                }
+            }
+            Value::Object(m)
+        })
+        .collect();
+    let root = &skeleton.bones[0].name;
+    let slots: Vec<Value> = parts
+        .iter()
+        .map(|p| json!({"name": p.name, "bone": root, "attachment": p.name}))
+        .collect();
+    let mut attachments = Map::new();
+    for part in parts {
+        let m = &part.mesh;
+        let region = atlas.regions.iter().find(|r| r.name == part.name);
+        let mut vertices = Vec::new();
+        for influences in &m.influences {
+            vertices.push(json!(influences.len()));
+            for i in influences {
+                vertices.extend([json!(i.bone), num(i.bind[0]), num(i.bind[1]), num(i.weight)]);
+            }
+        }
+        let mesh = json!({
+            "type": "mesh",
+            "uvs": m.uvs.iter().flat_map(|uv| [num(uv[0]), num(uv[1])]).collect::<Vec<_>>(),
+            "triangles": m.triangles,
+            "vertices": vertices,
+            "hull": m.hull,
+            "edges": m.edges,
+            "width": region.map_or(0, |r| r.width),
+            "height": region.map_or(0, |r| r.height),
+        });
+        attachments.insert(part.name.clone(), json!({ part.name.clone(): mesh }));
+    }
+    let out = json!({
+        "skeleton": {
+            "spine": options.version.version_string(),
+            "x": num(lo[0]),
+            "y": num(lo[1]),
+            "width": num(hi[0] - lo[0]),
+            "height": num(hi[1] - lo[1]),
+            "images": "./",
+            "fps": num(options.bake_fps),
+            "hash": content_hash(name, &bones, &attachments, &animations),
+        },
+        "bones": bones,
+        "slots": slots,
+        "skins": [{"name": "default", "attachments": attachments}],
+        "animations": animations,
+    });
+    // serde_json writes f64 as the shortest text that reads back exactly: lossless, and the
+    // same bytes for the same rig. Compact: the weighted vertex arrays are long.
+    serde_json::to_string(&out).unwrap_or_default() + "\n"
+}
+
+/// A content hash for tools (`skeleton.hash`; runtimes only store it): FNV-1a over the data.
+fn content_hash(
+    name: &str,
+    bones: &[Value],
+    attachments: &Map<String, Value>,
+    animations: &Map<String, Value>,
+) -> String {
+    let text = format!(
+        "{name}{}{}{}",
+        Value::from(bones.to_vec()),
+        Value::Object(attachments.clone()),
+        Value::Object(animations.clone())
+    );
+    let mut h: u64 = 0xcbf29ce484222325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    format!("{h:016x}")
+}
+
+impl SpineExport {
+    /// The files of the export: name and bytes.
+    pub fn files(&self) -> Vec<(String, Vec<u8>)> {
+        let mut files = vec![
+            (
+                format!("{}.json", self.name),
+                self.json.clone().into_bytes(),
+            ),
+            (
+                format!("{}.atlas", self.name),
+                self.atlas.clone().into_bytes(),
+            ),
+        ];
+        files.extend(self.pages.iter().cloned());
+        files
+    }
+
+    /// Writes every file into `dir` (created if missing): each goes to a hidden temporary file
+    /// first, and only when all are written are they renamed into place, so a failure while
+    /// writing (disk full, no permission) leaves `dir` without any new or half-written file.
+    /// The renames themselves are atomic one by one, not as a set. Returns the paths written.
+    pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, SpineError> {
+        let fail = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| SpineError::Write { path, source }
+        };
+        std::fs::create_dir_all(dir).map_err(fail(dir))?;
+        let files = self.files();
+        let mut temporaries = Vec::with_capacity(files.len());
+        let result = (|| {
+            for (file, bytes) in &files {
+                let tmp = dir.join(format!(".{file}.{}.tmp", std::process::id()));
+                temporaries.push(tmp.clone());
+                io::write_atomic(&tmp, bytes).map_err(fail(&tmp))?;
+            }
+            Ok(())
+        })();
+        if let Err(e) = result {
+            for tmp in &temporaries {
+                let _ = std::fs::remove_file(tmp);
+            }
+            return Err(e);
+        }
+        let mut written = Vec::with_capacity(files.len());
+        for ((file, _), tmp) in files.iter().zip(&temporaries) {
+            let target = dir.join(file);
+            std::fs::rename(tmp, &target).map_err(fail(&target))?;
+            written.push(target);
+        }
+        Ok(written)
+    }
+}

@@ -1,0 +1,531 @@
+//! The Spine export played by the official runtime (`@esotericsoftware/spine-core`, pinned in
+//! tools/spine-check/package-lock.json and installed by tools/spine-check/run.sh): at many times
+//! of every animation, the runtime's world vertices of every mesh must lie within 0.01 px of
+//! sinew's own (`--match-runtime spine`), its setup pose within 0.001 px of the rest meshes,
+//! its draw order, attachments and slot colours must be sinew's, and the loader must find
+//! nothing it would ignore. The deviation from sinew's exact playback is printed.
+//!
+//! Rigs: the bundled character as `sinew demo` writes it (bones, a point; Bézier keys), and a
+//! generated rig with two skeletons, a point, a cage, a region, colour, visibility and
+//! draw-order keys, stepped keys and timelines that start after 0 s.
+
+use serde::Deserialize;
+use sinew::anim::{self, CurveEvaluation, SampleOptions};
+use sinew::export::spine::bake::bake_times;
+use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions};
+use sinew::geom::Point;
+use sinew::io::{self, RigDocument};
+use sinew::pipeline::Scene;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Runtime vs sinew's runtime-matching playback, px.
+const ANIMATION_TOLERANCE_PX: f64 = 0.01;
+/// Runtime setup pose vs sinew's rest meshes, px.
+const SETUP_TOLERANCE_PX: f64 = 0.001;
+/// Slot colour channels (0..1): f32 storage only.
+const COLOR_TOLERANCE: f64 = 1e-4;
+/// Times sampled per animation, evenly, besides every key time.
+const TIMES_PER_ANIMATION: usize = 60;
+/// Of those, how many go through `sinew pose --vertices` (the rest are compared in-process).
+const CLI_TIMES_PER_ANIMATION: usize = 5;
+
+fn sinew(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .output()
+        .expect("run sinew");
+    assert!(
+        out.status.success(),
+        "sinew {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinew-spine-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[derive(Deserialize)]
+struct SlotState {
+    name: String,
+    attachment: Option<String>,
+    color: [f64; 4],
+    vertices: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+struct Frame {
+    time: f64,
+    slots: Vec<SlotState>,
+}
+
+#[derive(Deserialize)]
+struct Played {
+    duration: f64,
+    frames: Vec<Frame>,
+}
+
+#[derive(Deserialize)]
+struct Oracle {
+    setup: Vec<SlotState>,
+    animations: BTreeMap<String, Played>,
+    warnings: Vec<String>,
+}
+
+/// Loads `dir/name.json` + `.atlas` in spine-core and plays it at `times`.
+fn run_oracle(dir: &Path, name: &str, times: &BTreeMap<String, Vec<f64>>) -> Oracle {
+    let request = dir.join(format!("{name}.request.json"));
+    let out = dir.join(format!("{name}.oracle.json"));
+    std::fs::write(&request, serde_json::json!({ "times": times }).to_string()).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/spine-check/run.sh");
+    let status = Command::new(script)
+        .args([
+            s(&dir.join(format!("{name}.json"))),
+            s(&dir.join(format!("{name}.atlas"))),
+            s(&request),
+            s(&out),
+        ])
+        .status()
+        .expect("run tools/spine-check/run.sh (needs bash, node and npm, or root to install them)");
+    assert!(
+        status.success(),
+        "spine-core refused the export in {}",
+        dir.display()
+    );
+    serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
+}
+
+/// Largest distance between the runtime's mesh vertices (Spine world) and sinew's (canvas px),
+/// over the slots the runtime draws.
+fn deviation(
+    export: &SpineExport,
+    doc: &RigDocument,
+    slots: &[SlotState],
+    sinew: &[Vec<Point>],
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for slot in slots {
+        let Some(vertices) = &slot.vertices else {
+            continue;
+        };
+        let part = doc.parts.iter().position(|p| p.name == slot.name).unwrap();
+        let mesh = &export.parts[part].mesh;
+        assert_eq!(
+            vertices.len(),
+            2 * mesh.vertex_source.len(),
+            "{}",
+            slot.name
+        );
+        for (k, &v) in mesh.vertex_source.iter().enumerate() {
+            let c = export
+                .frame
+                .canvas_from_spine([vertices[2 * k], vertices[2 * k + 1]]);
+            let d = (Point::new(c[0], c[1]) - sinew[part][v]).norm();
+            worst = worst.max(d);
+        }
+    }
+    worst
+}
+
+/// Times to compare at: every key time of the animation's document JSON and an even spread,
+/// all inside [0, duration).
+fn times_for(doc: &RigDocument, name: &str, duration: f64) -> Vec<f64> {
+    let mut times: Vec<f64> = (0..TIMES_PER_ANIMATION)
+        .map(|k| duration * k as f64 / TIMES_PER_ANIMATION as f64 + 0.0031)
+        .collect();
+    fn keys(v: &serde_json::Value, out: &mut Vec<f64>) {
+        match v {
+            serde_json::Value::Object(m) => {
+                if let Some(t) = m.get("time").and_then(|t| t.as_f64()) {
+                    out.push(t);
+                }
+                m.values().for_each(|x| keys(x, out));
+            }
+            serde_json::Value::Array(a) => a.iter().for_each(|x| keys(x, out)),
+            _ => {}
+        }
+    }
+    keys(&doc.animations[name], &mut times);
+    times.retain(|&t| t < duration);
+    times.sort_by(f64::total_cmp);
+    times.dedup();
+    times
+}
+
+/// What the runtime's animation vertices are held to.
+#[derive(Clone, Copy, PartialEq)]
+enum Compare {
+    /// sinew's `--match-runtime spine` playback, at many times, within 0.01 px.
+    RuntimeMode,
+    /// Everything baked at this rate: sinew's exact playback at the bake times, within 0.01 px.
+    ExactAtBakeTimes(f64),
+    /// Coarser weights: deviations are printed, not bounded.
+    ReportOnly,
+}
+
+/// Exports `rig` with the CLI (`flags`, which `options` must mirror) into `dir` and checks it
+/// against the runtime; returns the worst deviations (runtime-matching, exact) over all
+/// animations.
+fn check_rig(
+    rig: &Path,
+    dir: &Path,
+    flags: &[&str],
+    options: &SpineOptions,
+    compare: Compare,
+) -> (f64, f64) {
+    let mut args = vec!["export", "spine", s(rig), "-o", s(dir), "--name", "rig"];
+    args.extend_from_slice(flags);
+    sinew(&args);
+    let scene = Scene::load(rig).unwrap();
+    let doc = scene.doc.clone();
+    let images: Vec<_> = doc
+        .parts
+        .iter()
+        .map(|p| io::load_png(&RigDocument::image_path(rig, p)).unwrap())
+        .collect();
+    // The same export in-process, for its vertex order; it must be the CLI's byte for byte.
+    let export = export_spine(&scene, &images, "rig", options).unwrap();
+    assert!(
+        std::fs::read_to_string(dir.join("rig.json")).unwrap() == export.json,
+        "{flags:?}: the CLI's export differs from the same export in-process"
+    );
+    if let Some(n) = options.max_vertices {
+        for (part, exported) in doc.parts.iter().zip(&export.parts) {
+            let fine = part.mesh.vertices.len();
+            assert!(
+                exported.mesh.uvs.len() <= n || exported.mesh.uvs.len() < fine,
+                "{}: {} of {fine} vertices kept for --max-vertices {n}",
+                part.name,
+                exported.mesh.uvs.len()
+            );
+        }
+    }
+    let animations = anim::load_animations(&doc).unwrap();
+    let times: BTreeMap<String, Vec<f64>> = animations
+        .iter()
+        .map(|(name, a)| {
+            let times = match compare {
+                Compare::ExactAtBakeTimes(fps) => {
+                    let mut t = bake_times(a.duration_s(), fps);
+                    t.retain(|&t| t < a.duration_s());
+                    t
+                }
+                _ => times_for(&doc, name, a.duration_s()),
+            };
+            (name.clone(), times)
+        })
+        .collect();
+    let oracle = run_oracle(dir, "rig", &times);
+    // The pages are premultiplied, as the atlas says: no colour channel above alpha.
+    let atlas = std::fs::read_to_string(dir.join("rig.atlas")).unwrap();
+    assert!(atlas.contains("pma: true\n"), "{atlas}");
+    for (file, _) in &export.pages {
+        let page = image::open(dir.join(file)).unwrap().to_rgba8();
+        assert!(
+            page.pixels().all(|p| p.0[..3].iter().all(|&c| c <= p.0[3])),
+            "{file}"
+        );
+        assert!(
+            page.pixels().any(|p| p.0[3] > 0 && p.0[3] < 255),
+            "{file}: no soft edge?"
+        );
+    }
+    assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
+
+    // Setup pose = rest meshes.
+    let setup = deviation(&export, &doc, &oracle.setup, &scene.rest_positions());
+    println!("{}: setup pose deviation {setup:.2e} px", rig.display());
+    assert!(setup <= SETUP_TOLERANCE_PX, "setup pose off by {setup} px");
+
+    let runtime = SampleOptions {
+        curves: CurveEvaluation::SpineRuntime,
+    };
+    let (mut worst_runtime, mut worst_exact) = (0.0_f64, 0.0_f64);
+    for (name, animation) in &animations {
+        let played = &oracle.animations[name];
+        assert!(
+            (played.duration - animation.duration_s()).abs() < 1e-6,
+            "{name}: runtime duration {} vs {}",
+            played.duration,
+            animation.duration_s()
+        );
+        let cli_every = (played.frames.len() / CLI_TIMES_PER_ANIMATION).max(1);
+        for (i, frame) in played.frames.iter().enumerate() {
+            let t = frame.time;
+            let pose = animation.sample_with(t, true, &runtime);
+            let positions = scene.pose_positions(&pose).unwrap();
+            let d = deviation(&export, &doc, &frame.slots, &positions);
+            worst_runtime = worst_runtime.max(d);
+            let exact = scene.pose_positions(&animation.sample(t, true)).unwrap();
+            let d_exact = deviation(&export, &doc, &frame.slots, &exact);
+            worst_exact = worst_exact.max(d_exact);
+            match compare {
+                Compare::RuntimeMode => {
+                    assert!(d <= ANIMATION_TOLERANCE_PX, "{name} at {t} s: {d} px")
+                }
+                Compare::ExactAtBakeTimes(_) => assert!(
+                    d_exact <= ANIMATION_TOLERANCE_PX,
+                    "baked {name} at {t} s: {d_exact} px"
+                ),
+                Compare::ReportOnly => {}
+            }
+            // Draw order, attachments and colours.
+            let order: Vec<&str> = frame.slots.iter().map(|s| s.name.as_str()).collect();
+            let expected: Vec<&str> = match &pose.draw_order {
+                Some(o) => o.iter().map(String::as_str).collect(),
+                None => doc.parts.iter().map(|p| p.name.as_str()).collect(),
+            };
+            assert_eq!(order, expected, "{name} at {t} s: draw order");
+            for slot in &frame.slots {
+                let state = pose.parts.get(&slot.name).cloned().unwrap_or_default();
+                assert_eq!(
+                    slot.attachment.is_some(),
+                    state.visible,
+                    "{name} {t} {}",
+                    slot.name
+                );
+                for (a, b) in slot.color.iter().zip(state.color) {
+                    assert!(
+                        (a - b).abs() <= COLOR_TOLERANCE,
+                        "{name} {t} {}: colour",
+                        slot.name
+                    );
+                }
+            }
+            // Some times through the command line, as a user previews them.
+            if compare == Compare::RuntimeMode && i % cli_every == 0 {
+                let v = dir.join("v.json");
+                let time = format!("{t}");
+                sinew(&[
+                    "pose",
+                    s(rig),
+                    "--anim",
+                    name,
+                    "--time",
+                    &time,
+                    "--match-runtime",
+                    "spine",
+                    "--vertices",
+                    s(&v),
+                ]);
+                #[derive(Deserialize)]
+                struct Part {
+                    vertices: Vec<[f64; 2]>,
+                }
+                #[derive(Deserialize)]
+                struct Posed {
+                    parts: Vec<Part>,
+                }
+                let posed: Posed =
+                    serde_json::from_str(&std::fs::read_to_string(&v).unwrap()).unwrap();
+                let from_cli: Vec<Vec<Point>> = posed
+                    .parts
+                    .iter()
+                    .map(|p| p.vertices.iter().map(|v| Point::new(v[0], v[1])).collect())
+                    .collect();
+                let d = deviation(&export, &doc, &frame.slots, &from_cli);
+                assert!(
+                    d <= ANIMATION_TOLERANCE_PX,
+                    "sinew pose {name} --time {t}: {d} px"
+                );
+            }
+        }
+    }
+    let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
+    println!(
+        "{} {flags:?} ({vertices} vertices): runtime vs sinew --match-runtime spine: max \
+         {worst_runtime:.2e} px; vs exact playback: max {worst_exact:.3} px",
+        rig.display()
+    );
+    (worst_runtime, worst_exact)
+}
+
+#[test]
+fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
+    let dir = scratch("demo");
+    sinew(&["demo", "-o", s(&dir)]);
+    // The demo's own export loads too.
+    let oracle = run_oracle(&dir.join("spine"), "character", &BTreeMap::new());
+    assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
+    let rig = dir.join("character.json");
+    let defaults = SpineOptions::default();
+    let (_, exact) = check_rig(
+        &rig,
+        &dir.join("export"),
+        &[],
+        &defaults,
+        Compare::RuntimeMode,
+    );
+    // The runtime's polyline does differ from the exact curves: the mode is not idle.
+    assert!(
+        exact > ANIMATION_TOLERANCE_PX,
+        "exact-mode deviation only {exact} px"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A filled shape on a transparent 160×120 canvas.
+fn layer(path: &Path, fill: impl Fn(&mut tiny_skia::PathBuilder), rgb: [u8; 3]) {
+    let mut pixmap = tiny_skia::Pixmap::new(160, 120).unwrap();
+    let mut pb = tiny_skia::PathBuilder::new();
+    fill(&mut pb);
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
+    paint.anti_alias = true;
+    pixmap.fill_path(
+        &pb.finish().unwrap(),
+        &paint,
+        tiny_skia::FillRule::Winding,
+        tiny_skia::Transform::identity(),
+        None,
+    );
+    sinew::io::save_png(path, &sinew::render::rgba_from_pixmap(&pixmap)).unwrap();
+}
+
+/// Two skeletons, a point, a cage and a region over three layers, and animations that use
+/// every kind of timeline the export writes.
+fn generated_rig(dir: &Path) -> PathBuf {
+    let rect = |x: f32, y: f32, w: f32, h: f32| {
+        move |pb: &mut tiny_skia::PathBuilder| {
+            pb.push_rect(tiny_skia::Rect::from_xywh(x, y, w, h).unwrap())
+        }
+    };
+    layer(
+        &dir.join("body.png"),
+        rect(20.0, 25.0, 80.0, 70.0),
+        [230, 120, 40],
+    );
+    layer(
+        &dir.join("arm.png"),
+        rect(95.0, 48.0, 55.0, 18.0),
+        [60, 120, 220],
+    );
+    layer(
+        &dir.join("blob.png"),
+        |pb| pb.push_circle(130.0, 98.0, 13.0),
+        [90, 200, 90],
+    );
+    let handles = serde_json::json!({
+        "bones": [
+            {"name": "arm_b", "parent": "spine_b", "head": [100, 57], "tail": [145, 57]},
+            {"name": "spine_b", "head": [60, 88], "tail": [60, 32]},
+            {"name": "blob_b", "head": [122, 98], "tail": [138, 98]}
+        ],
+        "points": [{"name": "nose", "at": [35, 40]}],
+        "cages": [{"name": "belly", "polygon": [[45, 62], [78, 62], [78, 84], [45, 84]]}],
+        "regions": [{"name": "patch", "polygon": [[82, 30], [94, 30], [94, 42], [82, 42]]}],
+        "bind": {"blob_b": ["blob"], "arm_b": ["arm", "body"]}
+    });
+    std::fs::write(dir.join("handles.json"), handles.to_string()).unwrap();
+    let rig = dir.join("rig.json");
+    sinew(&[
+        "rig",
+        s(&dir.join("body.png")),
+        s(&dir.join("arm.png")),
+        s(&dir.join("blob.png")),
+        "--handles",
+        s(&dir.join("handles.json")),
+        "-o",
+        s(&rig),
+    ]);
+    let animations = serde_json::json!({
+        "move": {
+            "bones": {
+                "spine_b": {"rotate": [
+                    {"time": 0.2, "value": 0, "curve": [0.3, 0, 0.5, 25]},
+                    {"time": 0.8, "value": 20, "curve": "stepped"},
+                    {"time": 1.0, "value": -10}]},
+                "arm_b": {
+                    "translate": [{"time": 0, "value": [0, 0], "curve": [0.1, 3, 0.4, 5, 0.2, -4, 0.3, 2]},
+                                  {"time": 0.5, "value": [4, -6]}],
+                    "scale": [{"time": 0, "value": [1, 1]}, {"time": 1, "value": [1.2, 0.8]}],
+                    "shear": [{"time": 0.1, "value": [0, 0]}, {"time": 0.9, "value": [5, -8]}]},
+                "blob_b": {"rotate": [{"time": 0, "value": 0}, {"time": 1.0, "value": 350}]}
+            },
+            "points": {"nose": {
+                "translate": [{"time": 0, "value": [0, 0], "curve": [0.2, 4, 0.3, 6, 0.2, 0, 0.3, -3]},
+                              {"time": 0.6, "value": [6, -5]}],
+                "rotate": [{"time": 0, "value": 0}, {"time": 0.6, "value": 30}],
+                "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.3, 0.7]}]}},
+            "cages": {"belly": [
+                {"time": 0, "value": [[45, 62], [78, 62], [78, 84], [45, 84]], "curve": [0.2, 0, 0.3, 1]},
+                {"time": 0.7, "value": [[43, 60], [82, 63], [80, 88], [44, 86]]}]},
+            "parts": {
+                "arm": {"color": [{"time": 0, "value": "ffffffff", "curve": [0.2, 1, 0.3, 0.5, 0.2, 1, 0.3, 0.5, 0.2, 1, 0.3, 1, 0.2, 1, 0.3, 0.8]},
+                                  {"time": 0.6, "value": "ff8040cc"}]},
+                "blob": {"visible": [{"time": 0.1, "value": true}, {"time": 0.5, "value": false},
+                                     {"time": 0.9, "value": true}]}
+            },
+            "draw_order": [{"time": 0.3, "value": ["arm", "body", "blob"]},
+                           {"time": 0.75, "value": ["body", "arm", "blob"]}]
+        },
+        "idle": {"bones": {"spine_b": {"rotate": [{"time": 0.5, "value": 12}]}}}
+    });
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = animations;
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    rig
+}
+
+#[test]
+fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
+    let dir = scratch("generated");
+    let rig = generated_rig(&dir);
+    let defaults = SpineOptions::default();
+    check_rig(
+        &rig,
+        &dir.join("export"),
+        &[],
+        &defaults,
+        Compare::RuntimeMode,
+    );
+    // Everything baked: exact at the keys.
+    let baked = SpineOptions {
+        bake: BakeMode::All,
+        bake_fps: 20.0,
+        ..SpineOptions::default()
+    };
+    let flags = ["--bake", "all", "--fps", "20"];
+    check_rig(
+        &rig,
+        &dir.join("baked"),
+        &flags,
+        &baked,
+        Compare::ExactAtBakeTimes(20.0),
+    );
+    // A coarser mesh keeps its vertices' weights, so those vertices still play exactly.
+    let coarse = SpineOptions {
+        max_vertices: Some(40),
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("coarse"),
+        &["--max-vertices", "40"],
+        &coarse,
+        Compare::RuntimeMode,
+    );
+    // Fewer influences: loads, setup pose exact; the deviation is printed.
+    let few = SpineOptions {
+        max_influences: Some(2),
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("few"),
+        &["--max-influences", "2"],
+        &few,
+        Compare::ReportOnly,
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

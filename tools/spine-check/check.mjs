@@ -1,0 +1,173 @@
+// Loads a Spine export in the official runtime (@esotericsoftware/spine-core, pinned in
+// package.json) and reports what it draws: per slot in draw order, its attachment, colour and
+// world vertices, in the setup pose and at requested times of animations. Also lints the JSON
+// against what the 4.2 loader reads, so content the runtime would silently ignore or misread
+// shows up as a warning.
+//
+//   node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json
+//
+// REQUEST.json: {"times": {"<animation>": [t, ...]}}. OUT.json: {"setup": Snapshot,
+// "animations": {"<name>": {"duration": d, "frames": [{"time": t, "slots": Snapshot}]}},
+// "warnings": [...]}; Snapshot = [{"name", "attachment", "color": [r, g, b, a],
+// "vertices": [x0, y0, ...]}] in draw order (vertices only for meshes).
+// Exit status: 0 when loaded (warnings are reported, not fatal), 2 when the runtime refuses it.
+import * as spine from "@esotericsoftware/spine-core";
+import fs from "node:fs";
+
+const [skeletonPath, atlasPath, requestPath, outPath] = process.argv.slice(2);
+if (!outPath) {
+  console.error("usage: node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json");
+  process.exit(2);
+}
+
+const raw = JSON.parse(fs.readFileSync(skeletonPath, "utf8"));
+const atlas = new spine.TextureAtlas(fs.readFileSync(atlasPath, "utf8"));
+const request = JSON.parse(fs.readFileSync(requestPath, "utf8"));
+const warnings = lint(raw, atlas);
+
+let data;
+try {
+  data = new spine.SkeletonJson(new spine.AtlasAttachmentLoader(atlas)).readSkeletonData(raw);
+} catch (e) {
+  console.error(`spine-core refused ${skeletonPath}: ${e.message}`);
+  process.exit(2);
+}
+const skeleton = new spine.Skeleton(data);
+
+function snapshot() {
+  skeleton.updateWorldTransform(spine.Physics.none);
+  return skeleton.drawOrder.map((slot) => {
+    const a = slot.getAttachment();
+    const c = slot.color;
+    const entry = { name: slot.data.name, attachment: a ? a.name : null, color: [c.r, c.g, c.b, c.a] };
+    if (a instanceof spine.MeshAttachment) {
+      const out = new Array(a.worldVerticesLength);
+      a.computeWorldVertices(slot, 0, a.worldVerticesLength, out, 0, 2);
+      entry.vertices = out;
+    }
+    return entry;
+  });
+}
+
+skeleton.setToSetupPose();
+const result = { setup: snapshot(), animations: {}, warnings };
+for (const [name, times] of Object.entries(request.times || {})) {
+  const animation = data.findAnimation(name);
+  if (!animation) {
+    console.error(`no animation '${name}' in ${skeletonPath}`);
+    process.exit(2);
+  }
+  const frames = times.map((time) => {
+    skeleton.setToSetupPose();
+    animation.apply(skeleton, time, time, false, [], 1, spine.MixBlend.setup, spine.MixDirection.mixIn);
+    return { time, slots: snapshot() };
+  });
+  result.animations[name] = { duration: animation.duration, frames };
+}
+fs.writeFileSync(outPath, JSON.stringify(result));
+
+// What SkeletonJson.js (4.2) reads; anything else it ignores without a word.
+function lint(json, atlas) {
+  const out = [];
+  const only = (where, obj, keys) => {
+    for (const k of Object.keys(obj || {})) if (!keys.includes(k)) out.push(`${where}: key '${k}' is not read by the 4.2 runtime`);
+  };
+  only("top level", json, ["skeleton", "bones", "slots", "ik", "transform", "path", "physics", "skins", "events", "animations"]);
+  only("skeleton", json.skeleton, ["hash", "spine", "x", "y", "width", "height", "referenceScale", "fps", "images", "audio"]);
+  const boneIndex = new Map();
+  (json.bones || []).forEach((b, i) => {
+    only(`bone ${b.name}`, b, ["name", "parent", "length", "x", "y", "rotation", "scaleX", "scaleY", "shearX", "shearY", "inherit", "skin", "color"]);
+    if (b.parent !== undefined && !boneIndex.has(b.parent)) out.push(`bone ${b.name}: parent '${b.parent}' is not listed before it`);
+    if (boneIndex.has(b.name)) out.push(`bone ${b.name}: listed twice`);
+    boneIndex.set(b.name, i);
+  });
+  const slots = new Map();
+  for (const s of json.slots || []) {
+    only(`slot ${s.name}`, s, ["name", "bone", "color", "dark", "attachment", "blend", "visible"]);
+    slots.set(s.name, s);
+  }
+  if (!Array.isArray(json.skins)) out.push("skins: not an array (3.7 layout): no skins load");
+  const attachmentsOf = new Map();
+  for (const skin of json.skins || []) {
+    only(`skin ${skin.name}`, skin, ["name", "bones", "ik", "transform", "path", "physics", "attachments"]);
+    for (const [slotName, entries] of Object.entries(skin.attachments || {})) {
+      for (const [key, a] of Object.entries(entries)) {
+        const where = `skin ${skin.name}, ${slotName}/${key}`;
+        attachmentsOf.set(`${slotName}/${key}`, a);
+        const type = a.type || "region";
+        if (type !== "mesh") { out.push(`${where}: type '${type}' (sinew writes meshes only)`); continue; }
+        only(where, a, ["type", "name", "path", "uvs", "triangles", "vertices", "hull", "edges", "width", "height", "color", "sequence"]);
+        const region = a.path || a.name || key;
+        if (!atlas.findRegion(region)) out.push(`${where}: region '${region}' is not in the atlas`);
+        const n = a.uvs.length / 2;
+        if (a.vertices.length === a.uvs.length) { out.push(`${where}: unweighted`); continue; }
+        let i = 0, count = 0;
+        while (i < a.vertices.length) {
+          const bones = a.vertices[i++];
+          let sum = 0;
+          for (let k = 0; k < bones; k++, i += 4) {
+            if (!(a.vertices[i] >= 0 && a.vertices[i] < json.bones.length)) out.push(`${where}: vertex ${count} names bone ${a.vertices[i]}`);
+            sum += a.vertices[i + 3];
+          }
+          if (Math.abs(sum - 1) > 1e-6) out.push(`${where}: vertex ${count} weights sum to ${sum}`);
+          count++;
+        }
+        if (count !== n) out.push(`${where}: ${count} weighted vertices but ${n} uvs`);
+        if (a.triangles.some((v) => v >= n)) out.push(`${where}: triangle index out of range`);
+        if (a.hull > n) out.push(`${where}: hull ${a.hull} > ${n} vertices`);
+      }
+    }
+  }
+  for (const s of json.slots || []) {
+    if (s.attachment && !attachmentsOf.has(`${s.name}/${s.attachment}`)) out.push(`slot ${s.name}: setup attachment '${s.attachment}' is not in a skin`);
+  }
+  const curveOk = (where, key, next, channels) => {
+    if (key.curve === undefined || key.curve === "stepped") return;
+    if (!Array.isArray(key.curve) || key.curve.length !== 4 * channels) { out.push(`${where}: curve of ${key.curve.length} numbers, expected ${4 * channels}`); return; }
+    for (let c = 0; c < channels; c++) {
+      const [cx1, , cx2] = key.curve.slice(4 * c, 4 * c + 4);
+      if (next && !(cx1 >= (key.time || 0) && cx2 <= next.time && cx1 <= cx2 + 1e-9)) out.push(`${where}: curve handles outside the segment`);
+    }
+  };
+  const keysOk = (where, keys, fields, channels) => {
+    let last = -Infinity;
+    keys.forEach((k, i) => {
+      only(`${where} key ${i}`, k, ["time", "curve", ...fields]);
+      const t = k.time || 0;
+      if (!(t >= last)) out.push(`${where} key ${i}: time goes back`);
+      last = t;
+      curveOk(`${where} key ${i}`, k, keys[i + 1], channels);
+    });
+  };
+  for (const [name, a] of Object.entries(json.animations || {})) {
+    only(`animation ${name}`, a, ["slots", "bones", "ik", "transform", "path", "physics", "attachments", "drawOrder", "events"]);
+    for (const [bone, timelines] of Object.entries(a.bones || {})) {
+      if (!boneIndex.has(bone)) out.push(`animation ${name}: unknown bone ${bone}`);
+      for (const [kind, keys] of Object.entries(timelines)) {
+        const where = `animation ${name}, bone ${bone}, ${kind}`;
+        if (kind === "rotate") keysOk(where, keys, ["value"], 1);
+        else if (["translate", "scale", "shear"].includes(kind)) keysOk(where, keys, ["x", "y"], 2);
+        else out.push(`${where}: timeline sinew does not write`);
+      }
+    }
+    for (const [slot, timelines] of Object.entries(a.slots || {})) {
+      if (!slots.has(slot)) out.push(`animation ${name}: unknown slot ${slot}`);
+      for (const [kind, keys] of Object.entries(timelines)) {
+        const where = `animation ${name}, slot ${slot}, ${kind}`;
+        if (kind === "rgba") keysOk(where, keys, ["color"], 4);
+        else if (kind === "attachment") keysOk(where, keys, ["name"], 0);
+        else out.push(`${where}: timeline sinew does not write`);
+      }
+    }
+    for (const [i, k] of (a.drawOrder || []).entries()) {
+      only(`animation ${name}, drawOrder key ${i}`, k, ["time", "offsets"]);
+      let previous = -1;
+      for (const o of k.offsets || []) {
+        const index = (json.slots || []).findIndex((s) => s.name === o.slot);
+        if (index <= previous) out.push(`animation ${name}, drawOrder key ${i}: offsets not in setup order`);
+        previous = index;
+      }
+    }
+  }
+  return out;
+}
