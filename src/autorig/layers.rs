@@ -101,8 +101,17 @@ fn inside_reach(shape: &Shape, axis: &PrincipalAxis, t_from: f64, t_to: f64) -> 
             hi = mid;
         }
     }
-    Some(t_from + lo * (t_to - t_from))
+    // Back off from the outline, so that rounding the coordinates keeps the end inside.
+    let t = t_from + lo * (t_to - t_from);
+    Some(t - END_MARGIN_PX.min(0.5 * (t - t_from).abs()) * (t_to - t_from).signum())
 }
+
+/// How far a bone end found by bisection stays back from the outline, px.
+const END_MARGIN_PX: f64 = 0.5;
+
+/// A straight bone must span at least this fraction of its part's extent along the axis;
+/// otherwise the part is too curved for one and gets its medial-axis bones.
+const STRAIGHT_SPAN_FRACTION: f64 = 0.8;
 
 /// A part with its overlap relations.
 pub struct Part<'a> {
@@ -176,36 +185,37 @@ pub fn layered_skeleton(
         let Some(axis) = axes[i] else { continue };
         let parent_bone = parent[i].and_then(|p| part_bone[p]);
         let joint = parent[i].map(|p| Point::from(overlap[i][p].1));
-        // Head: the joint's projection (children) or the lower end (roots).
-        let [t0, t1] = axis.extent;
-        let t_head = match joint {
-            Some(j) => axis.project(j).clamp(t0, t1),
-            None if axis.at(t0).y >= axis.at(t1).y => t0,
-            None => t1,
-        };
-        let t_tail = if (t_head - t0).abs() > (t1 - t_head).abs() {
-            t0
-        } else {
-            t1
-        };
+        // The axis line clipped to the part around the centroid: a straight bone needs it to
+        // span most of the part's extent.
         let shape = parts[i].shape;
-        let straight = inside_reach(shape, &axis, t_head, t_tail)
-            .filter(|&t| (t - t_head).abs() >= 0.8 * (t_tail - t_head).abs())
-            .filter(|&t| (t - t_head).abs() >= skeleton.min_bone_px);
+        let [t0, t1] = axis.extent;
+        let span = inside_reach(shape, &axis, 0.0, t0)
+            .zip(inside_reach(shape, &axis, 0.0, t1))
+            .filter(|&(lo, hi)| hi - lo >= STRAIGHT_SPAN_FRACTION * (t1 - t0))
+            .filter(|&(lo, hi)| hi - lo >= skeleton.min_bone_px);
+        // Head: the joint's projection (children) or the lower end (roots); tail: the far end.
+        let straight = span.map(|(lo, hi)| {
+            let t_head = match joint {
+                Some(j) => axis.project(j).clamp(lo, hi),
+                None if axis.at(lo).y >= axis.at(hi).y => lo,
+                None => hi,
+            };
+            let t_tail = if t_head - lo > hi - t_head { lo } else { hi };
+            (t_head, t_tail)
+        });
         let first = bones.len();
         match straight {
-            Some(t) => bones.push(ProtoBone {
+            Some((t_head, t_tail)) => bones.push(ProtoBone {
                 head: axis.at(t_head),
-                tail: axis.at(t),
+                tail: axis.at(t_tail),
                 parent: parent_bone,
                 name: None,
             }),
             None => {
-                let anchor = joint.unwrap_or(axis.at(t_head));
-                let mut grown = medial_bones(shape, anchor, parent_bone, medial, skeleton)?;
+                let anchor = joint.unwrap_or(axis.centroid);
+                let mut grown = medial_bones(shape, anchor, medial, skeleton)?;
                 for b in &mut grown {
                     b.parent = match b.parent {
-                        Some(p) if p == usize::MAX => parent_bone,
                         Some(p) => Some(p + first),
                         None => parent_bone,
                     };
@@ -234,7 +244,6 @@ pub fn layered_skeleton(
 fn medial_bones(
     shape: &Shape,
     anchor: Point,
-    _parent: Option<usize>,
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, MedialError> {

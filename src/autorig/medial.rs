@@ -325,6 +325,11 @@ fn merge_junctions(graph: AxisGraph, ratio: f64) -> AxisGraph {
     }
 }
 
+/// Extending a leaf stops at an edge whose residue is below this many times the radius at
+/// the current node: a quarter of a circle around it, so the extension ends at the center of a
+/// round tip (where the trunk's residue is about π r) and runs out to a sharp one.
+const TIP_RESIDUE_RATIO: f64 = std::f64::consts::FRAC_PI_2;
+
 #[derive(Clone, Copy, Debug)]
 struct AxisEdge {
     a: usize,
@@ -394,6 +399,11 @@ fn prune(nodes: Vec<AxisNode>, edges: &[AxisEdge], threshold_px: f64) -> AxisGra
                         .then(y.cmp(&x))
                 });
             let Some(k) = next else { break };
+            // At the center of a round tip the trunk's generators span the cap (residue ≈ π r);
+            // what leaves from there toward the outline is a spur of the cap's own samples.
+            if edges[k].residue_px < TIP_RESIDUE_RATIO * nodes[at].radius_px {
+                break;
+            }
             extended[k] = true;
             at = if edges[k].a == at {
                 edges[k].b

@@ -184,7 +184,12 @@ pub fn fit_template(
             Some(build_humanoid(axis, shape, options, &fit))
         }
         Template::Quadruped => {
-            let fit = fit_quadruped(&leaves, &lca, &frame, &pos)?;
+            let thickness: Vec<(usize, f64)> = leaves
+                .iter()
+                .map(|&v| (v, end_thickness(axis, v, END_WALK_FRACTION * frame.h)))
+                .collect();
+            let thick = |v: usize| thickness.iter().find(|t| t.0 == v).map_or(0.0, |t| t.1);
+            let fit = fit_quadruped(&leaves, &lca, &frame, &pos, &thick)?;
             Some(build_quadruped(axis, shape, options, &fit))
         }
     }
@@ -512,65 +517,101 @@ fn build_humanoid(
     nb.extras()
 }
 
-/// (pelvis, chest, head, tail, front feet [l, r], back feet [l, r]).
-type QuadrupedFit = (usize, usize, usize, usize, [usize; 2], [usize; 2]);
+/// A quadruped fit (axis nodes): head, tail, front feet [l, r] and back feet [l, r], and
+/// where each leg meets the spine (its attachment), in the same order as the feet.
+struct QuadrupedFit {
+    head: usize,
+    tail: usize,
+    feet: [usize; 4],
+    attachments: [usize; 4],
+}
+
+/// How far from a leaf its end's thickness is measured, as a fraction of the drawing's height.
+const END_WALK_FRACTION: f64 = 0.1;
+
+/// The largest radius within `walk_px` (along the axis) of `leaf`: how thick that end is.
+fn end_thickness(axis: &AxisGraph, leaf: usize, walk_px: f64) -> f64 {
+    let mut best = axis.nodes[leaf].radius_px;
+    let mut stack = vec![(leaf, usize::MAX, 0.0)];
+    while let Some((v, from, d)) = stack.pop() {
+        best = best.max(axis.nodes[v].radius_px);
+        for &w in &axis.adjacency[v] {
+            let step = (axis.nodes[w].pos - axis.nodes[v].pos).norm();
+            if w != from && d + step <= walk_px {
+                stack.push((w, v, d + step));
+            }
+        }
+    }
+    best
+}
 
 fn fit_quadruped(
     leaves: &[usize],
     lca: &Lca,
     frame: &Frame,
     pos: &dyn Fn(usize) -> Point,
+    thick: &dyn Fn(usize) -> f64,
 ) -> Option<QuadrupedFit> {
     let mut best: Option<(f64, QuadrupedFit)> = None;
     let u = |v: usize| frame.unit(pos(v));
-    // Feet: the lowest leaves first.
     for &head in leaves {
         for &tail in leaves {
             if tail == head {
                 continue;
             }
-            for &fl in leaves {
-                for &fr in leaves {
-                    if [head, tail].contains(&fl)
-                        || [head, tail].contains(&fr)
-                        || fl == fr
-                        || pos(fl).x <= pos(fr).x
-                    {
+            let spine = lca.dist(head, tail);
+            // Where a foot's path meets the spine, and how far along it from the head.
+            let attach = |f: usize| {
+                let a = lca.median(f, head, tail);
+                (a, lca.dist(head, a))
+            };
+            let others: Vec<usize> = leaves
+                .iter()
+                .copied()
+                .filter(|&v| v != head && v != tail)
+                .collect();
+            for &fl in &others {
+                for &fr in &others {
+                    if fl == fr || pos(fl).x <= pos(fr).x {
                         continue;
                     }
-                    let chest = lca.median(fl, fr, head);
-                    for &bl in leaves {
-                        for &br in leaves {
-                            let taken = [head, tail, fl, fr];
-                            if taken.contains(&bl)
-                                || taken.contains(&br)
-                                || bl == br
-                                || pos(bl).x <= pos(br).x
-                            {
+                    for &bl in &others {
+                        for &br in &others {
+                            let feet = [fl, fr, bl, br];
+                            let distinct = (0..4).all(|i| (0..i).all(|j| feet[i] != feet[j]));
+                            if !distinct || pos(bl).x <= pos(br).x {
                                 continue;
                             }
-                            let pelvis = lca.median(bl, br, tail);
-                            let valid = chest != pelvis
-                                && lca.on_path(chest, pelvis, head)
-                                && lca.on_path(pelvis, chest, tail)
-                                && lca.on_path(chest, pelvis, fl)
-                                && lca.on_path(chest, pelvis, fr)
-                                && lca.on_path(pelvis, chest, bl)
-                                && lca.on_path(pelvis, chest, br);
-                            if !valid {
+                            let att = feet.map(attach);
+                            // Legs leave the spine strictly between head and tail, front legs
+                            // nearer the head than back legs.
+                            let inner = att
+                                .iter()
+                                .all(|&(a, d)| a != head && a != tail && d > 0.0 && d < spine);
+                            let ordered = att[0].1.max(att[1].1) < att[2].1.min(att[3].1);
+                            if !inner || !ordered {
                                 continue;
                             }
-                            let feet_low: f64 =
-                                [fl, fr, bl, br].iter().map(|&f| 1.0 - u(f).1).sum();
-                            let (front_l, front_r) = (lca.dist(chest, fl), lca.dist(chest, fr));
-                            let (back_l, back_r) = (lca.dist(pelvis, bl), lca.dist(pelvis, br));
-                            let score = 2.0 * feet_low - (u(head).0 - u(tail).0).abs()
+                            let feet_low: f64 = feet.iter().map(|&f| 1.0 - u(f).1).sum();
+                            let leg = |i: usize| lca.dist(att[i].0, feet[i]);
+                            let (front_l, front_r, back_l, back_r) =
+                                (leg(0), leg(1), leg(2), leg(3));
+                            // The head end is thicker than the tail's.
+                            let (th, tt) = (thick(head), thick(tail));
+                            let score = 2.0 * feet_low
+                                - (u(head).0 - u(tail).0).abs()
+                                - (th - tt) / (th + tt).max(1e-9)
                                 + (front_l - front_r).abs() / (front_l + front_r).max(1e-9)
                                 + (back_l - back_r).abs() / (back_l + back_r).max(1e-9)
                                 - 0.5 * (front_l + front_r + back_l + back_r) / frame.h;
                             if best.as_ref().is_none_or(|b| score < b.0) {
-                                best =
-                                    Some((score, (pelvis, chest, head, tail, [fl, fr], [bl, br])));
+                                let fit = QuadrupedFit {
+                                    head,
+                                    tail,
+                                    feet,
+                                    attachments: att.map(|a| a.0),
+                                };
+                                best = Some((score, fit));
                             }
                         }
                     }
@@ -587,36 +628,44 @@ fn build_quadruped(
     options: &SkeletonOptions,
     fit: &QuadrupedFit,
 ) -> Vec<ProtoBone> {
-    let &(pelvis, chest, head, tail, front, back) = fit;
+    let depth = |tree: &NodeTree, v: usize| {
+        let mut d = 0;
+        let mut at = v;
+        while let Some(p) = tree.parent[at] {
+            at = p;
+            d += 1;
+        }
+        d
+    };
+    // The chest is the front attachment nearer the head, the pelvis the back one nearer the
+    // tail (legs of one pair may leave the spine at different points in a side view).
+    let probe = NodeTree::new(axis, fit.tail);
+    let a = fit.attachments;
+    let chest = if depth(&probe, a[0]) >= depth(&probe, a[1]) {
+        a[0]
+    } else {
+        a[1]
+    };
+    let pelvis = if depth(&probe, a[2]) <= depth(&probe, a[3]) {
+        a[2]
+    } else {
+        a[3]
+    };
     let tree = NodeTree::new(axis, pelvis);
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
     let spine = nb.even_chain(pelvis, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
-    nb.even_chain(chest, head, &["head"], chest_bone);
-    nb.even_chain(pelvis, tail, &["tail_1", "tail_2"], hip);
-    nb.limb(
-        chest,
-        front[0],
+    nb.even_chain(chest, fit.head, &["head"], chest_bone);
+    nb.even_chain(pelvis, fit.tail, &["tail_1", "tail_2"], hip);
+    let names = [
         ["leg_front_upper_l", "leg_front_lower_l"],
-        chest_bone,
-    );
-    nb.limb(
-        chest,
-        front[1],
         ["leg_front_upper_r", "leg_front_lower_r"],
-        chest_bone,
-    );
-    nb.limb(
-        pelvis,
-        back[0],
         ["leg_back_upper_l", "leg_back_lower_l"],
-        hip,
-    );
-    nb.limb(
-        pelvis,
-        back[1],
         ["leg_back_upper_r", "leg_back_lower_r"],
-        hip,
-    );
+    ];
+    for (i, names) in names.into_iter().enumerate() {
+        let parent = if i < 2 { chest_bone } else { hip };
+        nb.limb(a[i], fit.feet[i], names, parent);
+    }
     nb.extras()
 }
