@@ -113,18 +113,21 @@ pub fn propose_cage(
     if ring_signed_area(&ring) < 0.0 {
         ring.reverse();
     }
-    let mut cage = grow_simplify(ring.clone(), max_vertices, true);
-    if cage.len() > max_vertices {
-        // Stuck on a concave outline: its convex hull still contains it and always simplifies.
-        cage = grow_simplify(convex_hull(ring), max_vertices, false);
-    }
-    if cage.len() > max_vertices {
-        return Err(CageError::CannotReach {
+    // Simplify the outline itself, and its convex hull (which always simplifies, and with few
+    // vertices can enclose less than a concave polygon forced around every limb): keep the
+    // smaller of those that reach the budget.
+    let concave = grow_simplify(ring.clone(), max_vertices, true);
+    let convex = grow_simplify(convex_hull(ring), max_vertices, false);
+    let fits = |c: &Vec<Point>| c.len() <= max_vertices && c.len() >= 3;
+    match (fits(&concave), fits(&convex)) {
+        (true, true) if ring_signed_area(&convex) < ring_signed_area(&concave) => Ok(convex),
+        (true, _) => Ok(concave),
+        (false, true) => Ok(convex),
+        (false, false) => Err(CageError::CannotReach {
             allowed: max_vertices,
-            reached: cage.len(),
-        });
+            reached: concave.len().min(convex.len()),
+        }),
     }
-    Ok(cage)
 }
 
 /// The convex hull (Andrew's monotone chain), positive shoelace area, no collinear points.
