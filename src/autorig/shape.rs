@@ -14,6 +14,9 @@ use image::RgbaImage;
 /// Side of the cells that bucket outline edges for segment queries, px.
 const EDGE_CELL_PX: f64 = 8.0;
 
+/// Default [`Shape::clearance_px`].
+pub const SEGMENT_CLEARANCE_PX: f64 = 0.75;
+
 /// A traced silhouette with fast inside queries.
 #[derive(Clone, Debug)]
 pub struct Shape {
@@ -24,6 +27,10 @@ pub struct Shape {
     pub inside: Vec<bool>,
     /// Number of pixels inside, px².
     pub area_px2: f64,
+    /// How far [`Shape::segment_inside`] keeps segments from the outline, px: a bone grazing
+    /// the outline would leave sliver triangles where the mesher embeds it. Default
+    /// [`SEGMENT_CLEARANCE_PX`].
+    pub clearance_px: f64,
     edges: EdgeGrid,
 }
 
@@ -64,6 +71,7 @@ impl Shape {
             outlines,
             inside,
             area_px2,
+            clearance_px: SEGMENT_CLEARANCE_PX,
             edges,
         }
     }
@@ -86,10 +94,10 @@ impl Shape {
             == 1
     }
 
-    /// Whether the whole segment `a`–`b` lies inside the outlines: `a` inside and no outline
-    /// edge touching the segment.
+    /// Whether the whole segment `a`–`b` lies inside the outlines, at least
+    /// [`Shape::clearance_px`] from them: `a` inside and no outline edge that near.
     pub fn segment_inside(&self, a: Point, b: Point) -> bool {
-        self.contains(a) && !self.edges.touches_segment(a, b)
+        self.contains(a) && !self.edges.near_segment(a, b, self.clearance_px)
     }
 
     /// Every ring (outer rings and holes).
@@ -179,7 +187,7 @@ impl EdgeGrid {
             edges: Vec::new(),
         };
         for (k, e) in edges.iter().enumerate() {
-            let [c0, r0, c1, r1] = grid.cell_box(e[0], e[1]);
+            let [c0, r0, c1, r1] = grid.cell_box(e[0], e[1], 0.0);
             for r in r0..=r1 {
                 for c in c0..=c1 {
                     grid.cells[r * columns + c].push(k as u32);
@@ -190,20 +198,22 @@ impl EdgeGrid {
         grid
     }
 
-    /// The cells (clamped to the grid) covering the box of `a`–`b`: [c0, r0, c1, r1].
-    fn cell_box(&self, a: Point, b: Point) -> [usize; 4] {
+    /// The cells (clamped to the grid) covering the box of `a`–`b` grown by `grow`:
+    /// [c0, r0, c1, r1].
+    fn cell_box(&self, a: Point, b: Point, grow: f64) -> [usize; 4] {
         let cell = |v: f64, o: f64, n: usize| {
             (((v - o) / EDGE_CELL_PX).floor().max(0.0) as usize).min(n - 1)
         };
         [
-            cell(a.x.min(b.x), self.origin[0], self.columns),
-            cell(a.y.min(b.y), self.origin[1], self.rows),
-            cell(a.x.max(b.x), self.origin[0], self.columns),
-            cell(a.y.max(b.y), self.origin[1], self.rows),
+            cell(a.x.min(b.x) - grow, self.origin[0], self.columns),
+            cell(a.y.min(b.y) - grow, self.origin[1], self.rows),
+            cell(a.x.max(b.x) + grow, self.origin[0], self.columns),
+            cell(a.y.max(b.y) + grow, self.origin[1], self.rows),
         ]
     }
 
-    fn touches_segment(&self, a: Point, b: Point) -> bool {
+    /// Whether an edge comes within `clearance` of segment `a`–`b` (or touches it).
+    fn near_segment(&self, a: Point, b: Point, clearance: f64) -> bool {
         if self.edges.is_empty() {
             return false;
         }
@@ -213,7 +223,7 @@ impl EdgeGrid {
         for s in 0..steps {
             let p = a + (b - a) * (s as f64 / steps as f64);
             let q = a + (b - a) * ((s + 1) as f64 / steps as f64);
-            let [c0, r0, c1, r1] = self.cell_box(p, q);
+            let [c0, r0, c1, r1] = self.cell_box(p, q, clearance);
             for r in r0..=r1 {
                 for c in c0..=c1 {
                     for &k in &self.cells[r * self.columns + c] {
@@ -221,7 +231,9 @@ impl EdgeGrid {
                             continue;
                         }
                         let e = self.edges[k as usize];
-                        if segments_touch(a, b, e[0], e[1]) {
+                        if segments_touch(a, b, e[0], e[1])
+                            || segment_gap(a, b, e[0], e[1]) < clearance
+                        {
                             return true;
                         }
                         tested.push(k);
@@ -234,6 +246,22 @@ impl EdgeGrid {
         }
         false
     }
+}
+
+/// The distance between segments `a`–`b` and `c`–`d` when they do not cross (the smallest
+/// distance from an endpoint of one to the other).
+fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
+    let to = |p: Point, s: Point, t: Point| {
+        let st = t - s;
+        let len2 = st.norm_squared();
+        let u = if len2 > 0.0 {
+            ((p - s).dot(&st) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (s + st * u)).norm()
+    };
+    to(a, c, d).min(to(b, c, d)).min(to(c, a, b)).min(to(d, a, b))
 }
 
 /// Whether closed segments `a`–`b` and `c`–`d` share a point.
