@@ -461,3 +461,97 @@ fn resample(ring: &[Point], length: f64, spacing: f64, id: u32, out: &mut Vec<Sa
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::Outline;
+
+    /// A stadium (capsule) from (x0, y) to (x1, y) of radius r, as a polygon.
+    fn capsule(x0: f64, x1: f64, y: f64, r: f64) -> Vec<Point> {
+        let mut ring = Vec::new();
+        for k in 0..=32 {
+            let a = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / 32.0;
+            ring.push(Point::new(x1 + r * a.cos(), y + r * a.sin()));
+        }
+        for k in 0..=32 {
+            let a = std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * k as f64 / 32.0;
+            ring.push(Point::new(x0 + r * a.cos(), y + r * a.sin()));
+        }
+        ring
+    }
+
+    #[test]
+    fn a_capsule_axis_is_its_center_segment_out_to_the_cap_centers() {
+        let shape = Shape::from_outlines(
+            vec![Outline {
+                outer: capsule(30.0, 170.0, 50.0, 15.0),
+                holes: vec![],
+            }],
+            200,
+            100,
+        );
+        let axis = medial_axis(&shape, &MedialOptions::default()).unwrap();
+        let live: Vec<usize> = axis.live_nodes().collect();
+        assert!(!live.is_empty());
+        for &v in &live {
+            let n = axis.nodes[v];
+            // On the center line, with the capsule's radius.
+            assert!((n.pos.y - 50.0).abs() < 1.0, "{n:?}");
+            assert!((n.radius_px - 15.0).abs() < 1.0, "{n:?}");
+        }
+        let xs: Vec<f64> = live.iter().map(|&v| axis.nodes[v].pos.x).collect();
+        let (lo, hi) = xs
+            .iter()
+            .fold((f64::MAX, f64::MIN), |a, &x| (a.0.min(x), a.1.max(x)));
+        assert!(
+            (lo - 30.0).abs() < 2.0 && (hi - 170.0).abs() < 2.0,
+            "{lo} {hi}"
+        );
+        // One path: two leaves, no junction, no loop.
+        let degrees: Vec<usize> = live.iter().map(|&v| axis.adjacency[v].len()).collect();
+        assert_eq!(degrees.iter().filter(|&&d| d == 1).count(), 2);
+        assert!(degrees.iter().all(|&d| d <= 2));
+        assert_eq!(axis.edge_count(), live.len() - 1);
+        // Subdivided: no edge longer than the option.
+        for &v in &live {
+            for &w in &axis.adjacency[v] {
+                assert!((axis.nodes[v].pos - axis.nodes[w].pos).norm() <= 2.0 + 1e-9);
+            }
+        }
+    }
+
+    /// An image opaque within `r` px of any of the segments.
+    fn sticks(segments: &[((f64, f64), (f64, f64), f64)]) -> image::RgbaImage {
+        image::RgbaImage::from_fn(200, 120, |x, y| {
+            let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
+            let inside = segments.iter().any(|&(a, b, r)| {
+                let (a, b) = (Point::new(a.0, a.1), Point::new(b.0, b.1));
+                crate::autorig::skeleton::distance_to_segment(p, a, b) <= r
+            });
+            image::Rgba([0, 0, 0, if inside { 255 } else { 0 }])
+        })
+    }
+
+    fn junctions(image: &image::RgbaImage) -> usize {
+        let shape = Shape::trace(image, &crate::trace::TraceOptions::default())
+            .unwrap()
+            .unwrap();
+        let axis = medial_axis(&shape, &MedialOptions::default()).unwrap();
+        axis.live_nodes()
+            .filter(|&v| axis.adjacency[v].len() >= 3)
+            .count()
+    }
+
+    #[test]
+    fn a_bump_is_pruned_and_a_branch_is_kept() {
+        let body = ((30.0, 60.0), (170.0, 60.0), 14.0);
+        assert_eq!(junctions(&sticks(&[body])), 0);
+        // A bump 4 px high on the side: no branch.
+        let bump = ((100.0, 74.0), (100.0, 74.0), 4.0);
+        assert_eq!(junctions(&sticks(&[body, bump])), 0);
+        // An arm 40 px beyond the body: one joint.
+        let arm = ((100.0, 60.0), (100.0, 114.0), 6.0);
+        assert_eq!(junctions(&sticks(&[body, arm])), 1);
+    }
+}

@@ -261,7 +261,10 @@ fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
         };
         (p - (s + st * u)).norm()
     };
-    to(a, c, d).min(to(b, c, d)).min(to(c, a, b)).min(to(d, a, b))
+    to(a, c, d)
+        .min(to(b, c, d))
+        .min(to(c, a, b))
+        .min(to(d, a, b))
 }
 
 /// Whether closed segments `a`–`b` and `c`–`d` share a point.

@@ -669,3 +669,67 @@ fn build_quadruped(
     }
     nb.extras()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::autorig::medial::AxisNode;
+
+    /// A tree of nodes on a line with a branch: 0-1-2-3 and 1-4-5.
+    fn graph() -> AxisGraph {
+        let p = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (2.0, 0.0),
+            (3.0, 0.0),
+            (1.0, 1.0),
+            (1.0, 2.0),
+        ];
+        let nodes = p
+            .iter()
+            .map(|&(x, y)| AxisNode {
+                pos: Point::new(x, y),
+                radius_px: 1.0,
+            })
+            .collect();
+        let adjacency = vec![
+            vec![1],
+            vec![0, 2, 4],
+            vec![1, 3],
+            vec![2],
+            vec![1, 5],
+            vec![4],
+        ];
+        AxisGraph { nodes, adjacency }
+    }
+
+    #[test]
+    fn lca_medians_and_paths_on_a_small_tree() {
+        let axis = graph();
+        for root in 0..6 {
+            let tree = NodeTree::new(&axis, root);
+            let lca = Lca::new(&tree, &axis);
+            assert_eq!(lca.median(0, 3, 5), 1, "root {root}");
+            assert_eq!(lca.median(0, 2, 3), 2, "root {root}");
+            assert!((lca.dist(3, 5) - 4.0).abs() < 1e-12);
+            assert!(lca.on_path(1, 0, 5) && lca.on_path(2, 0, 3) && !lca.on_path(4, 0, 3));
+        }
+    }
+
+    #[test]
+    fn limb_joints_split_at_bends_in_the_middle_else_half_way() {
+        let straight: Vec<Point> = (0..=10).map(|k| Point::new(k as f64, 0.0)).collect();
+        assert_eq!(bend_index(&straight, 0.1), 5);
+        // An elbow at 40 % of the length.
+        let mut elbow: Vec<Point> = (0..=4).map(|k| Point::new(k as f64, 0.0)).collect();
+        elbow.extend((1..=6).map(|k| Point::new(4.0, k as f64)));
+        assert_eq!(bend_index(&elbow, 0.1), 4);
+        // An ankle at 90 %: not a knee.
+        let mut ankle: Vec<Point> = (0..=9).map(|k| Point::new(0.0, k as f64)).collect();
+        ankle.push(Point::new(1.0, 9.0));
+        assert_eq!(bend_index(&ankle, 0.1), half_index(&ankle));
+        // A wrist where the radius grows past the forearm's.
+        assert_eq!(limb_end(&[9.0, 8.0, 6.0, 6.0, 6.0, 8.0, 9.0]), 5);
+        assert_eq!(limb_end(&[6.0; 8]), 7);
+    }
+}
