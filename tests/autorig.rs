@@ -47,8 +47,11 @@ impl Lcg {
     }
 }
 
+/// A segment (from, to), canvas px.
+type Segment = ((f32, f32), (f32, f32));
+
 /// Small round bumps (radius `r`) along the outline of `capsule`s: outline noise.
-fn bumps(p: &mut Pixmap, segments: &[((f32, f32), (f32, f32))], half_width: f32, r: f32) {
+fn bumps(p: &mut Pixmap, segments: &[Segment], half_width: f32, r: f32) {
     let mut rng = Lcg(7);
     for &((ax, ay), (bx, by)) in segments {
         let (dx, dy) = (bx - ax, by - ay);
@@ -67,7 +70,7 @@ fn bumps(p: &mut Pixmap, segments: &[((f32, f32), (f32, f32))], half_width: f32,
     }
 }
 
-fn capsules(p: &mut Pixmap, segments: &[((f32, f32), (f32, f32))], width: f32) {
+fn capsules(p: &mut Pixmap, segments: &[Segment], width: f32) {
     for &(a, b) in segments {
         let mut pb = PathBuilder::new();
         pb.move_to(a.0, a.1);
@@ -127,7 +130,7 @@ fn star(noise: bool) -> (RgbaImage, Vec<Point>) {
         let (e, f) = (k / 12, (k % 12) as f32 / 12.0);
         let vertex = |e: usize| {
             let a = -PI / 2.0 + e as f32 * PI / 5.0;
-            let r = if e % 2 == 0 { outer } else { inner };
+            let r = if e.is_multiple_of(2) { outer } else { inner };
             (cx + r * a.cos(), cy + r * a.sin())
         };
         let (a, b) = (vertex(e), vertex((e + 1) % 10));
@@ -142,7 +145,7 @@ fn star(noise: bool) -> (RgbaImage, Vec<Point>) {
         } else {
             pb.line_to(x, y);
         }
-        if e % 2 == 0 && k % 12 == 0 {
+        if e.is_multiple_of(2) && k % 12 == 0 {
             tips.push(Point::new(a.0 as f64, a.1 as f64));
         }
     }
@@ -801,6 +804,59 @@ fn autorig_then_rig_then_pose_works_with_no_manual_step() {
             }
         }
     }
+}
+
+#[test]
+fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
+    let dir = scratch("layers");
+    let list: Vec<String> = character_layers().into_iter().map(|l| l.0).collect();
+    let paths: Vec<String> = list
+        .iter()
+        .map(|n| {
+            assets()
+                .join(format!("{n}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    let (handles, rig, posed) = (dir.join("h.json"), dir.join("rig.json"), dir.join("p.png"));
+    let mut args = vec!["autorig".to_string()];
+    args.extend(paths.iter().cloned());
+    args.extend(["-o".into(), handles.to_str().unwrap().into()]);
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&sinew(&argv), "autorig layers");
+    let mut args = vec!["rig".to_string()];
+    args.extend(paths.iter().cloned());
+    args.extend([
+        "--handles".into(),
+        handles.to_str().unwrap().into(),
+        "-o".into(),
+        rig.to_str().unwrap().into(),
+    ]);
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&sinew(&argv), "rig layers");
+    // Turning the lower left arm moves the left hand; the right hand stays.
+    let pose = dir.join("pose.json");
+    std::fs::write(&pose, r#"{"bones": {"arm_lower_l": {"rotate": 70}}}"#).unwrap();
+    let rig_s = rig.to_str().unwrap();
+    ok(
+        &sinew(&[
+            "pose",
+            rig_s,
+            "--pose",
+            pose.to_str().unwrap(),
+            "-o",
+            posed.to_str().unwrap(),
+        ]),
+        "pose layers",
+    );
+    let posed = load(&posed);
+    assert!(
+        posed.get_pixel(358, 343)[3] < 50,
+        "the left hand did not move"
+    );
+    assert!(posed.get_pixel(156, 340)[3] > 200, "the right hand moved");
 }
 
 #[test]

@@ -226,13 +226,13 @@ pub fn layered_skeleton(
         if bones.len() > first {
             part_bone[i] = Some(first);
         }
-        for k in first..bones.len() {
+        for (k, bone) in bones.iter_mut().enumerate().skip(first) {
             let name = if k == first {
                 parts[i].name.to_string()
             } else {
                 format!("{}_{}", parts[i].name, k - first + 1)
             };
-            bones[k].name = Some(name);
+            bone.name = Some(name);
             bone_part.push(i);
         }
     }

@@ -127,13 +127,14 @@ impl MedialOptions {
                 "max_samples must be at least 3".into(),
             ));
         }
-        if !ok(self.min_significance_px)
-            || !ok(self.significance_fraction)
-            || !ok(self.junction_merge_ratio)
-            || !(self.max_edge_px.is_finite() && self.max_edge_px > 0.0)
+        let edge_ok = self.max_edge_px.is_finite() && self.max_edge_px > 0.0;
+        if !(ok(self.min_significance_px)
+            && ok(self.significance_fraction)
+            && ok(self.junction_merge_ratio)
+            && edge_ok)
         {
             return Err(MedialError::InvalidOptions(
-                "significance thresholds must be finite and at least 0".into(),
+                "significance thresholds and junction_merge_ratio must be finite and at least 0, max_edge_px positive".into(),
             ));
         }
         Ok(())
@@ -168,7 +169,7 @@ pub fn medial_axis(shape: &Shape, options: &MedialOptions) -> Result<AxisGraph, 
     for face in dt.inner_faces() {
         let c = face.circumcenter();
         let p = Point::new(c.x, c.y);
-        if !(p.x.is_finite() && p.y.is_finite()) || !shape.pixel_inside(p) {
+        if !(p.x.is_finite() && p.y.is_finite() && shape.pixel_inside(p)) {
             continue;
         }
         let v = face.vertices()[0].data().pos;
@@ -521,8 +522,11 @@ mod tests {
         }
     }
 
+    /// A segment (from, to) with a radius, px.
+    type Stick = ((f64, f64), (f64, f64), f64);
+
     /// An image opaque within `r` px of any of the segments.
-    fn sticks(segments: &[((f64, f64), (f64, f64), f64)]) -> image::RgbaImage {
+    fn sticks(segments: &[Stick]) -> image::RgbaImage {
         image::RgbaImage::from_fn(200, 120, |x, y| {
             let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
             let inside = segments.iter().any(|&(a, b, r)| {

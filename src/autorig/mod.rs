@@ -104,9 +104,8 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
         return Err(AutorigError::SizeMismatch(l.name.to_string()));
     }
     let so = &options.skeleton;
-    if !(so.bend_ratio.is_finite() && so.bend_ratio > 0.0)
-        || !(so.min_bone_px.is_finite() && so.min_bone_px >= 0.0)
-    {
+    let positive = so.bend_ratio.is_finite() && so.bend_ratio > 0.0;
+    if !(positive && so.min_bone_px.is_finite() && so.min_bone_px >= 0.0) {
         return Err(AutorigError::InvalidOptions(
             "bend_ratio must be positive and min_bone_px at least 0".into(),
         ));

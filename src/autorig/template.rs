@@ -445,7 +445,7 @@ impl<'a> NamedBuilder<'a> {
         let Some(&upper) = upper.first() else { return };
         let limit = self.lower_limb_ratio * self.builder.bones[upper].length_px();
         let mut end = reached;
-        while end + 1 <= wrist && (points[end + 1] - points[reached]).norm() <= limit {
+        while end < wrist && (points[end + 1] - points[reached]).norm() <= limit {
             end += 1;
         }
         self.bones_along(&path, reached, &[end], &names[1..], Some(upper));
