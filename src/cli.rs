@@ -43,6 +43,8 @@ pub enum Command {
     Demo(DemoArgs),
     /// Export a rig for a game runtime.
     Export(ExportArgs),
+    /// Propose handles (a skeleton, a cage, points) from the drawing.
+    Autorig(AutorigArgs),
 }
 
 #[derive(Args, Debug)]
@@ -98,6 +100,31 @@ fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
             None => CurveEvaluation::Exact,
         },
     }
+}
+
+#[derive(Args, Debug)]
+pub struct AutorigArgs {
+    /// Layer images (PNG, all the same size), back to front.
+    #[arg(required = true)]
+    pub images: Vec<PathBuf>,
+    /// The handles file to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// At most this many bones.
+    #[arg(long, value_name = "N")]
+    pub bones: Option<usize>,
+    /// Also propose a cage of at most N vertices.
+    #[arg(long, value_name = "N")]
+    pub cage: Option<usize>,
+    /// Also propose N point handles.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub points: usize,
+    /// Fit a known skeleton, naming and parenting its limbs.
+    #[arg(long, value_enum)]
+    pub template: Option<crate::autorig::Template>,
+    /// Also draw the proposed rig over the images as a PNG.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -197,6 +224,9 @@ pub struct BuildArgs {
     /// Monotone bounded biharmonic weights: no spurious local extrema (slower).
     #[arg(long)]
     pub monotone: bool,
+    /// With `--weights rigid`: width of the blend band around joints, px.
+    #[arg(long = "blend", value_name = "PX", default_value_t = 0.0)]
+    pub rigid_blend_px: f64,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq)]
@@ -232,6 +262,7 @@ impl BuildArgs {
             content_aware: self.content_aware,
             max_influences: self.max_influences,
             monotone: self.monotone,
+            rigid_blend_px: self.rigid_blend_px,
             ..WeightOptions::default()
         };
         BuildOptions {
@@ -291,7 +322,53 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Export(ExportArgs {
             format: ExportFormat::Spine(args),
         }) => export_spine(&args),
+        Command::Autorig(args) => autorig(&args),
     }
+}
+
+fn autorig(args: &AutorigArgs) -> Result<()> {
+    use crate::autorig::{self as ar, AutorigOptions, LayerRef};
+    let layers = pipeline::load_layers(&args.images)?;
+    let mut options = AutorigOptions {
+        template: args.template,
+        cage_vertices: args.cage,
+        point_count: args.points,
+        ..AutorigOptions::default()
+    };
+    options.skeleton.max_bones = args.bones;
+    let refs: Vec<LayerRef> = layers
+        .iter()
+        .map(|l| LayerRef {
+            name: &l.name,
+            image: &l.image,
+        })
+        .collect();
+    let proposal = ar::autorig(&refs, &options)?;
+    let text = serde_json::to_string_pretty(&proposal.handles)? + "\n";
+    let preview = match &args.preview {
+        Some(_) => {
+            let images: Vec<_> = layers.iter().map(|l| &l.image).collect();
+            Some(ar::draw_preview(&images, &proposal.handles)?)
+        }
+        None => None,
+    };
+    io::write_atomic(&args.output, text.as_bytes())
+        .with_context(|| format!("{}: cannot write", args.output.display()))?;
+    if let (Some(path), Some(image)) = (&args.preview, preview) {
+        io::save_png(path, &image)?;
+    }
+    let h = &proposal.handles;
+    println!(
+        "{}: {} bones, {} points, {} cages",
+        args.output.display(),
+        h.bones.len(),
+        h.points.len(),
+        h.cages.len()
+    );
+    for note in &proposal.notes {
+        println!("  {note}");
+    }
+    Ok(())
 }
 
 /// Reads a JSON file into `T`, naming the file in every error.

@@ -6,6 +6,7 @@
 //! together; [`cli`] is the `sinew` command.
 
 pub mod anim;
+pub mod autorig;
 pub mod cli;
 pub mod export;
 pub mod geom;

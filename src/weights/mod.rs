@@ -6,6 +6,7 @@
 //! - [`monotone`]: bounded biharmonic weights without spurious extrema (Jacobson et al. 2012).
 //! - [`reference`]: the same bounded QP by clarabel, the yardstick in tests.
 //! - [`boundary`]: handles → fixed weights on the mesh vertices that carry their geometry.
+//! - [`rigid`]: rigid cutout weights (nearest handle inside the shape, blend band at joints).
 //! - [`part`]: one part end to end: boundary conditions, solve, normalize, sparsify.
 
 pub mod boundary;
@@ -13,6 +14,7 @@ pub mod laplacian;
 pub mod monotone;
 pub mod part;
 pub mod reference;
+pub mod rigid;
 pub mod solve;
 pub mod sparse;
 

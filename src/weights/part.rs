@@ -31,6 +31,9 @@ pub enum WeightMethod {
     Harmonic,
     /// Unconstrained biharmonic weights: smooth but not bounded nor local (for comparison).
     Biharmonic,
+    /// Rigid cutout weights: the nearest handle inside the shape, blended over
+    /// `rigid_blend_px` around joints (see [`super::rigid`]).
+    Rigid,
 }
 
 /// How weights are computed. Shared by the command line, the editor and the rig document.
@@ -52,6 +55,8 @@ pub struct WeightOptions {
     /// (row normalization may add tiny ones), at the cost of an interior-point QP per handle
     /// (clarabel) with edge constraints per handle. Default: off.
     pub monotone: bool,
+    /// With method `rigid`: width of the blend band around joints, px. Default 0 (no blend).
+    pub rigid_blend_px: f64,
 }
 
 impl Default for WeightOptions {
@@ -63,6 +68,7 @@ impl Default for WeightOptions {
             max_influences: None,
             min_weight: 1e-6,
             monotone: false,
+            rigid_blend_px: 0.0,
         }
     }
 }
@@ -231,6 +237,19 @@ pub fn bound_part_weights(
         }
         WeightMethod::Harmonic => harmonic_weights(&domain, &bc)?,
         WeightMethod::Biharmonic => biharmonic_weights(&domain, &bc)?,
+        WeightMethod::Rigid => {
+            if !(options.rigid_blend_px.is_finite() && options.rigid_blend_px >= 0.0) {
+                return Err(WeightError::InvalidOptions(
+                    "the rigid blend width must be finite and at least 0".into(),
+                ));
+            }
+            super::rigid::rigid_weights(
+                &mesh.vertices,
+                &mesh.triangles,
+                &bc,
+                options.rigid_blend_px,
+            )
+        }
     };
     let empty = w.normalize_rows();
     fill_empty_rows(&mut w, &empty, mesh, handles, binding);

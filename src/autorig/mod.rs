@@ -1,0 +1,256 @@
+//! Automatic rigging: skeletons, cages and point handles proposed from the drawing.
+//!
+//! In: one or more straight-alpha RGBA layers on one canvas (with their part names) and
+//! [`AutorigOptions`]. Out: a [`Proposal`]: a [`Handles`] value (the handles file of DESIGN.md,
+//! canvas px, validated) that a person can edit and pass to `sinew rig --handles`, plus notes
+//! for the person.
+//!
+//! - One image, or any images with a template: the union silhouette is traced as `sinew rig`
+//!   traces it ([`shape`]), its medial axis is computed and pruned ([`medial`]) and turned into
+//!   a bone tree ([`skeleton`]) or fitted to a humanoid/quadruped template ([`template`]).
+//! - Several images without a template: one bone per part along its principal axis, parented
+//!   through overlaps ([`layers`]); each part's bones are bound to that part (`bind`), as in
+//!   cutout animation.
+//! - `cage_vertices`: a containing cage of the union ([`cage`]); `point_count`: point handles by
+//!   geodesic farthest-point sampling ([`points`]). [`preview`] draws the result.
+
+pub mod cage;
+pub mod layers;
+pub mod medial;
+pub mod points;
+pub mod preview;
+pub mod shape;
+pub mod skeleton;
+pub mod template;
+
+pub use cage::{CageError, CageOptions};
+pub use medial::{MedialError, MedialOptions};
+pub use points::PointOptions;
+pub use preview::draw_preview;
+pub use skeleton::{ProtoBone, SkeletonOptions};
+pub use template::Template;
+
+use crate::geom::Point;
+use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle};
+use crate::trace::{TraceError, TraceOptions};
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+use shape::Shape;
+use std::collections::{BTreeMap, HashSet};
+
+/// Everything autorig can be asked for. Defaults: bones only, traced as `sinew rig` traces.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AutorigOptions {
+    /// Tracing, as the rig will be traced (default: the rig's defaults), so that proposed
+    /// handles lie inside the rig's meshes.
+    pub trace: TraceOptions,
+    pub medial: MedialOptions,
+    /// Bone splitting and the bone budget (`max_bones`).
+    pub skeleton: SkeletonOptions,
+    /// Fit this topology to the union silhouette. Default: none.
+    pub template: Option<Template>,
+    /// Propose a cage of at most this many vertices. Default: none.
+    pub cage_vertices: Option<usize>,
+    pub cage: CageOptions,
+    /// Propose this many point handles. Default 0.
+    pub point_count: usize,
+    pub points: PointOptions,
+}
+
+/// One input layer.
+#[derive(Clone, Copy, Debug)]
+pub struct LayerRef<'a> {
+    pub name: &'a str,
+    pub image: &'a RgbaImage,
+}
+
+/// What autorig proposes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Proposal {
+    pub handles: Handles,
+    /// Remarks for the person (a part with nothing to trace, a fallback taken).
+    pub notes: Vec<String>,
+}
+
+/// What went wrong.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum AutorigError {
+    #[error("no input images")]
+    NoLayers,
+    #[error("layer '{0}' is not the size of the first layer")]
+    SizeMismatch(String),
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    #[error("no opaque region of at least {0} px² to rig")]
+    NoShape(f64),
+    #[error(transparent)]
+    Medial(#[from] MedialError),
+    #[error("the drawing does not match the {0:?} template (no assignment of its limbs to the shape's extremities fits)")]
+    TemplateMismatch(Template),
+    #[error("cage: {0}")]
+    Cage(#[from] CageError),
+    #[error("the proposed handles are invalid: {0}")]
+    Handles(#[from] HandleError),
+    #[error("invalid autorig option: {0}")]
+    InvalidOptions(String),
+}
+
+/// Proposes handles for `layers` (back to front, one canvas).
+pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal, AutorigError> {
+    let first = layers.first().ok_or(AutorigError::NoLayers)?;
+    let size = first.image.dimensions();
+    if let Some(l) = layers.iter().find(|l| l.image.dimensions() != size) {
+        return Err(AutorigError::SizeMismatch(l.name.to_string()));
+    }
+    let so = &options.skeleton;
+    let positive = so.bend_ratio.is_finite() && so.bend_ratio > 0.0;
+    if !(positive && so.min_bone_px.is_finite() && so.min_bone_px >= 0.0) {
+        return Err(AutorigError::InvalidOptions(
+            "bend_ratio must be positive and min_bone_px at least 0".into(),
+        ));
+    }
+    if so.max_bones == Some(0) {
+        return Err(AutorigError::InvalidOptions(
+            "the bone budget must be at least 1".into(),
+        ));
+    }
+    let images: Vec<&RgbaImage> = layers.iter().map(|l| l.image).collect();
+    let union = shape::union_alpha(&images);
+    let silhouette = Shape::trace(&union, &options.trace)?
+        .ok_or(AutorigError::NoShape(options.trace.min_area_px2))?;
+    let mut notes = Vec::new();
+    let mut bind: BTreeMap<String, Vec<String>> = BTreeMap::new();
+
+    let mut bones = if layers.len() == 1 || options.template.is_some() {
+        let axis = medial::medial_axis(&silhouette, &options.medial)?;
+        match options.template {
+            Some(t) => template::fit_template(&axis, &silhouette, t, so)
+                .ok_or(AutorigError::TemplateMismatch(t))?,
+            None => skeleton::medial_skeleton(&axis, &silhouette, so),
+        }
+    } else {
+        let mut shapes = Vec::new();
+        for layer in layers {
+            match Shape::trace(layer.image, &options.trace) {
+                Ok(Some(s)) => shapes.push((layer.name, s)),
+                Ok(None) | Err(TraceError::NoOpaquePixels { .. }) => notes.push(format!(
+                    "layer '{}' has nothing to trace: no bone",
+                    layer.name
+                )),
+                Err(e) => return Err(e.into()),
+            }
+        }
+        let parts: Vec<layers::Part> = shapes
+            .iter()
+            .map(|(name, shape)| layers::Part { name, shape })
+            .collect();
+        let (bones, bone_part) = layers::layered_skeleton(&parts, &options.medial, so)?;
+        for (b, &p) in bones.iter().zip(&bone_part) {
+            if let Some(name) = &b.name {
+                bind.insert(name.clone(), vec![parts[p].name.to_string()]);
+            }
+        }
+        bones
+    };
+    if bones.is_empty() {
+        // A round blob has no significant axis: one bone along its principal axis.
+        if let Some(b) = principal_bone(&silhouette) {
+            notes.push("no significant medial axis: one bone along the principal axis".into());
+            bones.push(b);
+        }
+    }
+    skeleton::limit_bones(&mut bones, so.max_bones, &silhouette);
+    let bones = name_bones(bones);
+    bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
+
+    let points = points::propose_points(&silhouette, options.point_count, &options.points)
+        .into_iter()
+        .enumerate()
+        .map(|(k, p)| PointHandle {
+            name: format!("point_{}", k + 1),
+            at: [p.x, p.y],
+        })
+        .collect();
+    let cages = match options.cage_vertices {
+        Some(n) => {
+            let ring = cage::propose_cage(&union, options.trace.alpha_threshold, n, &options.cage)?;
+            vec![Cage {
+                name: "cage".into(),
+                polygon: ring.iter().map(|p| [p.x, p.y]).collect(),
+            }]
+        }
+        None => Vec::new(),
+    };
+    let handles = Handles {
+        bones,
+        points,
+        cages,
+        regions: Vec::new(),
+        bind,
+        ik: Vec::new(),
+    };
+    handles.validate()?;
+    Ok(Proposal { handles, notes })
+}
+
+/// One bone along the principal axis of `shape`, through its centroid, shortened to stay
+/// inside.
+fn principal_bone(shape: &Shape) -> Option<ProtoBone> {
+    let axis = layers::principal_axis(shape)?;
+    let [t0, t1] = axis.extent;
+    // Shrink both ends toward the centroid until the segment lies inside.
+    let mut scale = 0.9;
+    while scale > 0.05 {
+        let (a, b) = (axis.at(scale * t0), axis.at(scale * t1));
+        if (b - a).norm() > 1e-6 && shape.segment_inside(a, b) {
+            let (head, tail) = if a.y >= b.y { (a, b) } else { (b, a) };
+            return Some(ProtoBone {
+                head,
+                tail,
+                parent: None,
+                name: None,
+            });
+        }
+        scale *= 0.8;
+    }
+    None
+}
+
+/// Gives unnamed bones `bone_N` names (unique) and resolves parents to names.
+fn name_bones(bones: Vec<ProtoBone>) -> Vec<Bone> {
+    let mut used: HashSet<String> = bones.iter().filter_map(|b| b.name.clone()).collect();
+    let mut counter = 0;
+    let names: Vec<String> = bones
+        .iter()
+        .map(|b| match &b.name {
+            Some(n) => n.clone(),
+            None => loop {
+                counter += 1;
+                let candidate = format!("bone_{counter}");
+                if used.insert(candidate.clone()) {
+                    break candidate;
+                }
+            },
+        })
+        .collect();
+    bones
+        .iter()
+        .zip(&names)
+        .map(|(b, name)| Bone {
+            name: name.clone(),
+            parent: b.parent.map(|p| names[p].clone()),
+            head: round_px(b.head),
+            tail: round_px(b.tail),
+        })
+        .collect()
+}
+
+/// Coordinates rounded to 1/1000 px, so files stay readable (and stay inside: the rounding is
+/// far below the distance of any axis point to the outline).
+fn round_px(p: Point) -> [f64; 2] {
+    [
+        (p.x * 1000.0).round() / 1000.0,
+        (p.y * 1000.0).round() / 1000.0,
+    ]
+}

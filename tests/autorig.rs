@@ -1,0 +1,958 @@
+//! Automatic rigging on generated shapes (a star, a letter with a hole, stick figures, a blob,
+//! each also with noise on its outline) and on the bundled character: bones inside the shape,
+//! limb tips at bone ends, noise adds no bones, the humanoid template names and parents the
+//! character's limbs, cages contain every opaque pixel, points start at extremities; then
+//! `sinew autorig` → `sinew rig --handles` → `sinew pose` with no manual step, and a golden
+//! image of the proposed rig over the character.
+
+use image::RgbaImage;
+use sinew::autorig::shape::{segments_touch, Shape};
+use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
+use sinew::geom::{point_in_ring, Point};
+use sinew::rig::Handles;
+use sinew::trace::TraceOptions;
+use std::collections::HashMap;
+use std::f32::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use tiny_skia::{Color, FillRule, LineCap, Paint, PathBuilder, Pixmap, Stroke, Transform};
+
+// ---------------------------------------------------------------- generated shapes
+
+fn to_rgba(p: &Pixmap) -> RgbaImage {
+    let mut img = RgbaImage::new(p.width(), p.height());
+    for (dst, src) in img.pixels_mut().zip(p.pixels()) {
+        let c = src.demultiply();
+        *dst = image::Rgba([c.red(), c.green(), c.blue(), c.alpha()]);
+    }
+    img
+}
+
+fn paint() -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color(Color::from_rgba8(200, 90, 40, 255));
+    p.anti_alias = true;
+    p
+}
+
+/// A deterministic pseudo-random sequence in [0, 1) (an LCG), for noise.
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// A segment (from, to), canvas px.
+type Segment = ((f32, f32), (f32, f32));
+
+/// Small round bumps (radius `r`) along the outline of `capsule`s: outline noise.
+fn bumps(p: &mut Pixmap, segments: &[Segment], half_width: f32, r: f32) {
+    let mut rng = Lcg(7);
+    for &((ax, ay), (bx, by)) in segments {
+        let (dx, dy) = (bx - ax, by - ay);
+        let len = (dx * dx + dy * dy).sqrt();
+        let (nx, ny) = (-dy / len, dx / len);
+        let mut t = 6.0;
+        while t < len - 6.0 {
+            let side = if rng.next() < 0.5 { -1.0 } else { 1.0 };
+            let (cx, cy) = (ax + dx * t / len, ay + dy * t / len);
+            let (x, y) = (cx + side * nx * half_width, cy + side * ny * half_width);
+            if let Some(c) = PathBuilder::from_circle(x, y, r) {
+                p.fill_path(&c, &paint(), FillRule::Winding, Transform::identity(), None);
+            }
+            t += 5.0 + 6.0 * rng.next();
+        }
+    }
+}
+
+fn capsules(p: &mut Pixmap, segments: &[Segment], width: f32) {
+    for &(a, b) in segments {
+        let mut pb = PathBuilder::new();
+        pb.move_to(a.0, a.1);
+        pb.line_to(b.0, b.1);
+        let stroke = Stroke {
+            width,
+            line_cap: LineCap::Round,
+            ..Stroke::default()
+        };
+        if let Some(path) = pb.finish() {
+            p.stroke_path(&path, &paint(), &stroke, Transform::identity(), None);
+        }
+    }
+}
+
+/// The stick figure's limbs: spine, two arms, two legs (canvas 256², y down).
+const STICK: [((f32, f32), (f32, f32)); 5] = [
+    ((128.0, 60.0), (128.0, 150.0)),
+    ((128.0, 85.0), (70.0, 140.0)),
+    ((128.0, 85.0), (186.0, 140.0)),
+    ((128.0, 150.0), (95.0, 232.0)),
+    ((128.0, 150.0), (161.0, 232.0)),
+];
+const STICK_HALF_WIDTH: f32 = 8.0;
+const HEAD: (f32, f32, f32) = (128.0, 40.0, 22.0);
+
+/// A stick figure: a round head and capsule limbs; with `noise`, bumps along the limbs.
+fn stick_figure(noise: bool) -> RgbaImage {
+    let mut p = Pixmap::new(256, 256).unwrap();
+    capsules(&mut p, &STICK, 2.0 * STICK_HALF_WIDTH);
+    if let Some(c) = PathBuilder::from_circle(HEAD.0, HEAD.1, HEAD.2) {
+        p.fill_path(&c, &paint(), FillRule::Winding, Transform::identity(), None);
+    }
+    if noise {
+        bumps(&mut p, &STICK[1..], STICK_HALF_WIDTH, 2.5);
+    }
+    to_rgba(&p)
+}
+
+/// The stick figure's limb tips (hands, feet), canvas px.
+fn stick_tips() -> Vec<Point> {
+    STICK[1..]
+        .iter()
+        .map(|s| Point::new(s.1 .0 as f64, s.1 .1 as f64))
+        .collect()
+}
+
+/// A five-pointed star centered on a 256² canvas; with `noise`, its outline jittered.
+fn star(noise: bool) -> (RgbaImage, Vec<Point>) {
+    let (cx, cy, outer, inner) = (128.0f32, 132.0f32, 110.0f32, 42.0f32);
+    let mut rng = Lcg(3);
+    let mut pb = PathBuilder::new();
+    let mut tips = Vec::new();
+    let steps = 10 * 12;
+    for k in 0..steps {
+        // Between the 10 star vertices, 12 points along each edge (jittered with noise).
+        let (e, f) = (k / 12, (k % 12) as f32 / 12.0);
+        let vertex = |e: usize| {
+            let a = -PI / 2.0 + e as f32 * PI / 5.0;
+            let r = if e.is_multiple_of(2) { outer } else { inner };
+            (cx + r * a.cos(), cy + r * a.sin())
+        };
+        let (a, b) = (vertex(e), vertex((e + 1) % 10));
+        let mut x = a.0 + (b.0 - a.0) * f;
+        let mut y = a.1 + (b.1 - a.1) * f;
+        if noise && f > 0.0 {
+            x += 3.0 * (rng.next() - 0.5);
+            y += 3.0 * (rng.next() - 0.5);
+        }
+        if k == 0 {
+            pb.move_to(x, y);
+        } else {
+            pb.line_to(x, y);
+        }
+        if e.is_multiple_of(2) && k % 12 == 0 {
+            tips.push(Point::new(a.0 as f64, a.1 as f64));
+        }
+    }
+    pb.close();
+    let mut p = Pixmap::new(256, 256).unwrap();
+    p.fill_path(
+        &pb.finish().unwrap(),
+        &paint(),
+        FillRule::Winding,
+        Transform::identity(),
+        None,
+    );
+    (to_rgba(&p), tips)
+}
+
+/// A letter-like "P": a stem with a ring-shaped bowl (a hole).
+fn letter_p() -> (RgbaImage, Vec<Point>) {
+    let mut p = Pixmap::new(256, 256).unwrap();
+    capsules(&mut p, &[((80.0, 40.0), (80.0, 220.0))], 32.0);
+    let mut ring = PathBuilder::new();
+    ring.push_circle(120.0, 95.0, 58.0);
+    ring.push_circle(120.0, 95.0, 28.0);
+    p.fill_path(
+        &ring.finish().unwrap(),
+        &paint(),
+        FillRule::EvenOdd,
+        Transform::identity(),
+        None,
+    );
+    // The stem's foot is the one limb tip.
+    (to_rgba(&p), vec![Point::new(80.0, 220.0)])
+}
+
+/// An ellipse-like blob; with `noise`, a jittered outline.
+fn blob(noise: bool) -> RgbaImage {
+    let mut rng = Lcg(11);
+    let mut pb = PathBuilder::new();
+    let n = 180;
+    for k in 0..n {
+        let a = k as f32 * 2.0 * PI / n as f32;
+        let jitter = if noise { 4.0 * (rng.next() - 0.5) } else { 0.0 };
+        let (x, y) = (
+            128.0 + (95.0 + jitter) * a.cos(),
+            128.0 + (60.0 + jitter) * a.sin(),
+        );
+        if k == 0 {
+            pb.move_to(x, y);
+        } else {
+            pb.line_to(x, y);
+        }
+    }
+    pb.close();
+    let mut p = Pixmap::new(256, 256).unwrap();
+    p.fill_path(
+        &pb.finish().unwrap(),
+        &paint(),
+        FillRule::Winding,
+        Transform::identity(),
+        None,
+    );
+    to_rgba(&p)
+}
+
+/// A quadruped seen from the side: a horizontal body, a head up front (left), a tail at the
+/// back, four legs.
+fn quadruped() -> RgbaImage {
+    let mut p = Pixmap::new(256, 256).unwrap();
+    capsules(&mut p, &[((80.0, 110.0), (180.0, 110.0))], 44.0);
+    capsules(
+        &mut p,
+        &[
+            ((70.0, 100.0), (45.0, 60.0)),
+            ((185.0, 100.0), (235.0, 70.0)),
+            ((75.0, 120.0), (70.0, 215.0)),
+            ((95.0, 120.0), (100.0, 215.0)),
+            ((165.0, 120.0), (160.0, 215.0)),
+            ((185.0, 120.0), (192.0, 215.0)),
+        ],
+        14.0,
+    );
+    if let Some(c) = PathBuilder::from_circle(40.0, 50.0, 22.0) {
+        p.fill_path(&c, &paint(), FillRule::Winding, Transform::identity(), None);
+    }
+    to_rgba(&p)
+}
+
+// ---------------------------------------------------------------- helpers
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn assets() -> PathBuf {
+    root().join("assets/character")
+}
+
+fn load(path: &Path) -> RgbaImage {
+    sinew::io::load_png(path).expect("a PNG")
+}
+
+fn propose(images: &[(&str, &RgbaImage)], options: &AutorigOptions) -> Handles {
+    let layers: Vec<LayerRef> = images
+        .iter()
+        .map(|(name, image)| LayerRef { name, image })
+        .collect();
+    autorig(&layers, options).expect("autorig").handles
+}
+
+fn one(image: &RgbaImage) -> Handles {
+    propose(&[("shape", image)], &AutorigOptions::default())
+}
+
+/// With `SINEW_AUTORIG_DUMP=DIR`, writes the proposal drawn over `image` to DIR/`name`.png
+/// (to look at a failing case).
+fn dump(name: &str, image: &RgbaImage, handles: &Handles) {
+    if let Some(dir) = std::env::var_os("SINEW_AUTORIG_DUMP") {
+        let picture = sinew::autorig::draw_preview(&[image], handles).unwrap();
+        sinew::io::save_png(&Path::new(&dir).join(format!("{name}.png")), &picture).unwrap();
+    }
+}
+
+fn traced(image: &RgbaImage) -> Shape {
+    Shape::trace(image, &TraceOptions::default())
+        .expect("traces")
+        .expect("a shape")
+}
+
+fn pt(a: [f64; 2]) -> Point {
+    Point::new(a[0], a[1])
+}
+
+/// Every bone, sampled every half pixel, lies inside the traced outlines.
+fn assert_bones_inside(handles: &Handles, shape: &Shape, what: &str) {
+    assert!(!handles.bones.is_empty(), "{what}: no bones");
+    for b in &handles.bones {
+        let (h, t) = (pt(b.head), pt(b.tail));
+        let steps = ((t - h).norm() * 2.0).ceil() as usize + 1;
+        for s in 0..=steps {
+            let p = h + (t - h) * (s as f64 / steps as f64);
+            assert!(
+                shape.contains(p),
+                "{what}: bone {} leaves the shape at {p:?}",
+                b.name
+            );
+        }
+    }
+}
+
+/// Distance from `p` to the nearest bone end (head or tail).
+fn nearest_bone_end(handles: &Handles, p: Point) -> f64 {
+    handles
+        .bones
+        .iter()
+        .flat_map(|b| [pt(b.head), pt(b.tail)])
+        .map(|e| (e - p).norm())
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Limb tips are the centers of round caps or sharp corners: bone ends are within this, px.
+const TIP_TOLERANCE_PX: f64 = 6.0;
+
+fn assert_tips_at_bone_ends(handles: &Handles, tips: &[Point], what: &str) {
+    for &tip in tips {
+        let d = nearest_bone_end(handles, tip);
+        assert!(
+            d <= TIP_TOLERANCE_PX,
+            "{what}: limb tip {tip:?} is {d:.1} px from the nearest bone end"
+        );
+    }
+}
+
+// ---------------------------------------------------------------- skeletons
+
+#[test]
+fn stick_figure_bones_inside_with_a_bone_end_at_every_limb_tip() {
+    let image = stick_figure(false);
+    let h = one(&image);
+    dump("stick", &image, &h);
+    assert_bones_inside(&h, &traced(&image), "stick figure");
+    assert_tips_at_bone_ends(&h, &stick_tips(), "stick figure");
+    h.validate().unwrap();
+}
+
+#[test]
+fn star_bones_reach_every_point_of_the_star() {
+    for noise in [false, true] {
+        let (image, tips) = star(noise);
+        let h = one(&image);
+        let what = if noise { "noisy star" } else { "star" };
+        dump(what, &image, &h);
+        assert_bones_inside(&h, &traced(&image), what);
+        assert_tips_at_bone_ends(&h, &tips, what);
+    }
+}
+
+#[test]
+fn letter_with_a_hole_keeps_bones_off_the_hole() {
+    let (image, tips) = letter_p();
+    let shape = traced(&image);
+    assert_eq!(shape.outlines[0].holes.len(), 1, "the P has its hole");
+    let h = one(&image);
+    dump("letter", &image, &h);
+    assert_bones_inside(&h, &shape, "letter P");
+    assert_tips_at_bone_ends(&h, &tips, "letter P");
+    // The bowl is rigged all around its hole: some bone passes on each side of it.
+    let sides = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
+    for (dx, dy) in sides {
+        let probe = Point::new(120.0 + 43.0 * dx, 95.0 + 43.0 * dy);
+        let near = h.bones.iter().any(|b| {
+            sinew::weights::boundary::segment_distance(probe, pt(b.head), pt(b.tail)).0 < 12.0
+        });
+        assert!(near, "no bone in the bowl near {probe:?}");
+    }
+}
+
+#[test]
+fn outline_noise_adds_no_bones() {
+    let clean = one(&stick_figure(false));
+    let noisy = one(&stick_figure(true));
+    let noisy_image = stick_figure(true);
+    dump("noisy stick", &noisy_image, &noisy);
+    dump("blob", &blob(false), &one(&blob(false)));
+    dump("noisy blob", &blob(true), &one(&blob(true)));
+    assert_bones_inside(&noisy, &traced(&noisy_image), "noisy stick figure");
+    assert_tips_at_bone_ends(&noisy, &stick_tips(), "noisy stick figure");
+    assert_eq!(
+        noisy.bones.len(),
+        clean.bones.len(),
+        "the noisy stick figure has other bones than the clean one"
+    );
+    let (clean_blob, noisy_blob) = (one(&blob(false)), one(&blob(true)));
+    assert_eq!(noisy_blob.bones.len(), clean_blob.bones.len(), "noisy blob");
+    assert_bones_inside(&noisy_blob, &traced(&blob(true)), "noisy blob");
+    let (clean_star, noisy_star) = (one(&star(false).0), one(&star(true).0));
+    assert_eq!(noisy_star.bones.len(), clean_star.bones.len(), "noisy star");
+}
+
+#[test]
+fn the_bone_budget_is_respected() {
+    let image = star(false).0;
+    for max in [1, 3, 5, 8] {
+        let mut options = AutorigOptions::default();
+        options.skeleton.max_bones = Some(max);
+        let h = propose(&[("star", &image)], &options);
+        assert!(
+            h.bones.len() <= max,
+            "{} bones for a budget of {max}",
+            h.bones.len()
+        );
+        assert!(!h.bones.is_empty());
+        assert_bones_inside(&h, &traced(&image), "star with a budget");
+    }
+}
+
+fn character_flat() -> RgbaImage {
+    load(&assets().join("flat.png"))
+}
+
+fn humanoid(image: &RgbaImage) -> Handles {
+    let options = AutorigOptions {
+        template: Some(Template::Humanoid),
+        ..AutorigOptions::default()
+    };
+    propose(&[("flat", image)], &options)
+}
+
+#[test]
+fn humanoid_template_names_and_parents_the_characters_limbs() {
+    let image = character_flat();
+    let h = humanoid(&image);
+    assert_bones_inside(&h, &traced(&image), "character");
+    let by_name: HashMap<&str, &sinew::rig::Bone> =
+        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    let expected_parents = [
+        ("hip", None),
+        ("chest", Some("hip")),
+        ("head", Some("chest")),
+        ("arm_upper_l", Some("chest")),
+        ("arm_lower_l", Some("arm_upper_l")),
+        ("arm_upper_r", Some("chest")),
+        ("arm_lower_r", Some("arm_upper_r")),
+        ("leg_upper_l", Some("hip")),
+        ("leg_lower_l", Some("leg_upper_l")),
+        ("leg_upper_r", Some("hip")),
+        ("leg_lower_r", Some("leg_upper_r")),
+    ];
+    for (name, parent) in expected_parents {
+        let bone = by_name
+            .get(name)
+            .unwrap_or_else(|| panic!("no bone '{name}'"));
+        assert_eq!(bone.parent.as_deref(), parent, "parent of {name}");
+    }
+    // The limbs are where the character's hand-made rig has them (assets/character/handles.json):
+    // every elbow, knee, hand and ankle within 16 px.
+    let truth: Handles =
+        serde_json::from_str(&std::fs::read_to_string(assets().join("handles.json")).unwrap())
+            .unwrap();
+    for limb in [
+        "arm_upper_l",
+        "arm_lower_l",
+        "arm_upper_r",
+        "arm_lower_r",
+        "leg_upper_l",
+        "leg_lower_l",
+        "leg_upper_r",
+        "leg_lower_r",
+    ] {
+        let ours = pt(by_name[limb].tail);
+        let theirs = pt(truth.bones.iter().find(|b| b.name == limb).unwrap().tail);
+        let d = (ours - theirs).norm();
+        assert!(d < 16.0, "{limb} ends {d:.1} px from the hand-made rig's");
+    }
+    // The character's left (screen right) is "_l".
+    assert!(by_name["arm_lower_l"].tail[0] > by_name["arm_lower_r"].tail[0]);
+}
+
+#[test]
+fn quadruped_template_finds_head_tail_and_four_legs() {
+    let image = quadruped();
+    let options = AutorigOptions {
+        template: Some(Template::Quadruped),
+        ..AutorigOptions::default()
+    };
+    dump("dog", &image, &one(&image));
+    let h = propose(&[("dog", &image)], &options);
+    dump("dog template", &image, &h);
+    assert_bones_inside(&h, &traced(&image), "quadruped");
+    let by_name: HashMap<&str, &sinew::rig::Bone> =
+        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    for (name, parent) in [
+        ("hip", None),
+        ("chest", Some("hip")),
+        ("head", Some("chest")),
+        ("tail_1", Some("hip")),
+        ("leg_front_upper_l", Some("chest")),
+        ("leg_front_upper_r", Some("chest")),
+        ("leg_back_upper_l", Some("hip")),
+        ("leg_back_upper_r", Some("hip")),
+        ("leg_back_lower_r", Some("leg_back_upper_r")),
+    ] {
+        let bone = by_name
+            .get(name)
+            .unwrap_or_else(|| panic!("no bone '{name}'"));
+        assert_eq!(bone.parent.as_deref(), parent, "parent of {name}");
+    }
+    // The head is the round end up front (the head bone or the extra bones it carries reach
+    // its center), the tail at the back.
+    let head_center = Point::new(40.0, 50.0);
+    let nearest = h
+        .bones
+        .iter()
+        .min_by(|a, b| {
+            (pt(a.tail) - head_center)
+                .norm()
+                .total_cmp(&(pt(b.tail) - head_center).norm())
+        })
+        .unwrap();
+    assert!((pt(nearest.tail) - head_center).norm() < TIP_TOLERANCE_PX);
+    let mut at = Some(nearest.name.as_str());
+    while at.is_some_and(|n| n != "head") {
+        at = by_name[at.unwrap()].parent.as_deref();
+    }
+    assert_eq!(
+        at,
+        Some("head"),
+        "the head's center is not on the head's chain"
+    );
+    assert!(by_name["tail_1"].tail[0] > 180.0);
+    // Front legs are near the head's end, back legs near the tail's.
+    for leg in ["leg_front_lower_l", "leg_front_lower_r"] {
+        assert!(by_name[leg].tail[0] < 128.0, "{leg}");
+        assert!(by_name[leg].tail[1] > 180.0, "{leg} does not reach down");
+    }
+    for leg in ["leg_back_lower_l", "leg_back_lower_r"] {
+        assert!(by_name[leg].tail[0] > 128.0, "{leg}");
+    }
+}
+
+fn character_layers() -> Vec<(String, RgbaImage)> {
+    let list: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(assets().join("layers.json")).unwrap())
+            .unwrap();
+    list["layers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| {
+            let name = n.as_str().unwrap().to_string();
+            let image = load(&assets().join(format!("{name}.png")));
+            (name, image)
+        })
+        .collect()
+}
+
+#[test]
+fn layers_give_one_bone_per_part_parented_through_overlaps() {
+    let layers = character_layers();
+    let refs: Vec<(&str, &RgbaImage)> = layers.iter().map(|(n, i)| (n.as_str(), i)).collect();
+    let h = propose(&refs, &AutorigOptions::default());
+    let by_name: HashMap<&str, &sinew::rig::Bone> =
+        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    for (name, image) in &layers {
+        let bone = by_name
+            .get(name.as_str())
+            .unwrap_or_else(|| panic!("part {name} has no bone"));
+        // Each part's bones lie inside it and are bound to it.
+        let shape = traced(image);
+        for b in h
+            .bones
+            .iter()
+            .filter(|b| h.bind[&b.name] == vec![name.clone()])
+        {
+            let (p, q) = (pt(b.head), pt(b.tail));
+            assert!(
+                shape.segment_inside(p, q),
+                "bone {} leaves part {name}",
+                b.name
+            );
+        }
+        assert_eq!(h.bind[&bone.name], vec![name.clone()]);
+    }
+    let parent = |n: &str| by_name[n].parent.as_deref();
+    assert_eq!(parent("arm_lower_l"), Some("arm_upper_l"));
+    assert_eq!(parent("arm_lower_r"), Some("arm_upper_r"));
+    assert_eq!(parent("leg_lower_l"), Some("leg_upper_l"));
+    assert_eq!(parent("leg_lower_r"), Some("leg_upper_r"));
+    assert_eq!(
+        parent("bag"),
+        Some("arm_lower_r"),
+        "the lantern hangs from the hand"
+    );
+    assert_eq!(parent("arm_upper_l"), Some("torso"));
+    assert_eq!(parent("leg_upper_r"), Some("torso"));
+    // One skeleton, rooted at the largest part.
+    let roots: Vec<&str> = h
+        .bones
+        .iter()
+        .filter(|b| b.parent.is_none())
+        .map(|b| b.name.as_str())
+        .collect();
+    let largest = layers
+        .iter()
+        .max_by(|a, b| traced(&a.1).area_px2.total_cmp(&traced(&b.1).area_px2))
+        .unwrap();
+    assert_eq!(roots, vec![largest.0.as_str()]);
+}
+
+#[test]
+fn parts_that_overlap_nothing_start_their_own_skeleton() {
+    let mut a = Pixmap::new(200, 100).unwrap();
+    capsules(&mut a, &[((20.0, 50.0), (80.0, 50.0))], 20.0);
+    let mut b = Pixmap::new(200, 100).unwrap();
+    capsules(&mut b, &[((120.0, 30.0), (180.0, 70.0))], 20.0);
+    let (a, b) = (to_rgba(&a), to_rgba(&b));
+    let h = propose(&[("a", &a), ("b", &b)], &AutorigOptions::default());
+    assert_eq!(h.bones.len(), 2);
+    assert!(h.bones.iter().all(|b| b.parent.is_none()));
+    // Along the principal axis: the capsules' axes.
+    let bb = h.bones.iter().find(|x| x.name == "b").unwrap();
+    let dir = pt(bb.tail) - pt(bb.head);
+    assert!((dir.y / dir.x - 40.0 / 60.0).abs() < 0.05, "{dir:?}");
+}
+
+// ---------------------------------------------------------------- cages and points
+
+fn assert_cage_contains_every_opaque_pixel(
+    image: &RgbaImage,
+    ring: &[Point],
+    max: usize,
+    what: &str,
+) {
+    assert!(ring.len() <= max, "{what}: {} vertices > {max}", ring.len());
+    for (x, y, px) in image.enumerate_pixels() {
+        if px[3] == 0 {
+            continue;
+        }
+        for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+            let p = Point::new(x as f64 + dx, y as f64 + dy);
+            assert!(
+                point_in_ring(p, ring),
+                "{what}: pixel corner {p:?} outside the cage"
+            );
+        }
+    }
+    // Simple: no two non-adjacent edges touch.
+    let n = ring.len();
+    for i in 0..n {
+        for j in (i + 2)..n {
+            if i == 0 && j == n - 1 {
+                continue;
+            }
+            assert!(
+                !segments_touch(ring[i], ring[(i + 1) % n], ring[j], ring[(j + 1) % n]),
+                "{what}: cage edges {i} and {j} cross"
+            );
+        }
+    }
+}
+
+#[test]
+fn cages_contain_every_opaque_pixel_with_at_most_n_vertices() {
+    let flat = character_flat();
+    let mut cases: Vec<(&str, RgbaImage)> = vec![
+        ("character", flat),
+        ("star", star(true).0),
+        ("letter", letter_p().0),
+        ("stick figure", stick_figure(true)),
+    ];
+    cases.push(("blob", blob(true)));
+    for (what, image) in &cases {
+        for max in [6, 12, 24] {
+            let options = AutorigOptions {
+                cage_vertices: Some(max),
+                ..AutorigOptions::default()
+            };
+            let h = propose(&[("x", image)], &options);
+            let ring: Vec<Point> = h.cages[0].polygon.iter().map(|&p| pt(p)).collect();
+            assert_cage_contains_every_opaque_pixel(image, &ring, max, what);
+        }
+    }
+    // The cage hugs the shape: the star's 12-vertex cage is far smaller than its bounding box.
+    let options = AutorigOptions {
+        cage_vertices: Some(12),
+        ..AutorigOptions::default()
+    };
+    let h = propose(&[("star", &star(false).0)], &options);
+    let ring: Vec<Point> = h.cages[0].polygon.iter().map(|&p| pt(p)).collect();
+    let area = sinew::geom::ring_signed_area(&ring).abs();
+    assert!(area < 0.75 * 220.0 * 210.0, "star cage area {area:.0} px²");
+}
+
+#[test]
+fn first_points_land_on_the_extremities_and_all_lie_inside() {
+    let (image, tips) = star(false);
+    let options = AutorigOptions {
+        point_count: 9,
+        ..AutorigOptions::default()
+    };
+    let h = propose(&[("star", &image)], &options);
+    assert_eq!(h.points.len(), 9);
+    let shape = traced(&image);
+    for p in &h.points {
+        assert!(shape.contains(pt(p.at)), "{} outside", p.name);
+    }
+    // The first five are the star's five points (within 20 px of each tip, one per tip).
+    for tip in &tips {
+        let d = h.points[..5]
+            .iter()
+            .map(|p| (pt(p.at) - tip).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 20.0, "no early point near tip {tip:?} ({d:.1} px)");
+    }
+}
+
+#[test]
+fn proposals_are_deterministic() {
+    let image = character_flat();
+    let options = AutorigOptions {
+        template: Some(Template::Humanoid),
+        cage_vertices: Some(16),
+        point_count: 5,
+        ..AutorigOptions::default()
+    };
+    let a = serde_json::to_string(&propose(&[("flat", &image)], &options)).unwrap();
+    let b = serde_json::to_string(&propose(&[("flat", &image)], &options)).unwrap();
+    assert_eq!(a, b);
+}
+
+// ---------------------------------------------------------------- end to end and golden
+
+fn sinew(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .output()
+        .expect("runs sinew")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinew-autorig-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn ok(out: &std::process::Output, what: &str) {
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn autorig_then_rig_then_pose_works_with_no_manual_step() {
+    let dir = scratch("e2e");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let flat = s(&assets().join("flat.png"));
+    let handles = dir.join("handles.json");
+    let handles_s = s(&handles);
+    let out = sinew(&[
+        "autorig",
+        &flat,
+        "-o",
+        &s(&handles),
+        "--template",
+        "humanoid",
+    ]);
+    ok(&out, "autorig");
+    for weights in [
+        &["--weights", "bbw"][..],
+        &["--weights", "rigid", "--blend", "8"][..],
+    ] {
+        let rig = dir.join("rig.json");
+        let mut args = vec!["rig", &flat, "--handles", &handles_s, "-o"];
+        let rig_s = s(&rig);
+        args.push(&rig_s);
+        args.extend(weights);
+        ok(&sinew(&args), "rig");
+        let pose = dir.join("pose.json");
+        std::fs::write(
+            &pose,
+            r#"{"bones": {"arm_upper_l": {"rotate": 40}, "arm_lower_l": {"rotate": 30},
+                          "leg_upper_r": {"rotate": -15}, "head": {"rotate": 8}}}"#,
+        )
+        .unwrap();
+        let (posed, rest, vertices) = (
+            dir.join("posed.png"),
+            dir.join("rest.png"),
+            dir.join("v.json"),
+        );
+        ok(
+            &sinew(&[
+                "pose",
+                &rig_s,
+                "--pose",
+                &s(&pose),
+                "-o",
+                &s(&posed),
+                "--vertices",
+                &s(&vertices),
+            ]),
+            "pose",
+        );
+        ok(&sinew(&["pose", &rig_s, "-o", &s(&rest)]), "rest pose");
+        // The rest pose draws the sprite back; the pose moves the raised forearm's hand away.
+        let (posed, rest) = (load(&posed), load(&rest));
+        let hand = |img: &RgbaImage| img.get_pixel(358, 343)[3];
+        assert!(hand(&rest) > 200, "{weights:?}: the hand at rest");
+        assert!(hand(&posed) < 50, "{weights:?}: the hand did not move");
+        // Skinning IK on the proposed rig: feet pinned, the left hand dragged up and out.
+        let drag = dir.join("drag.json");
+        std::fs::write(
+            &drag,
+            r#"{"ik": [{"at": [305, 440], "to": [305, 440]}, {"at": [207, 440], "to": [207, 440]},
+                       {"at": [356, 340], "to": [410, 260]}]}"#,
+        )
+        .unwrap();
+        let dragged = dir.join("dragged.png");
+        ok(
+            &sinew(&["pose", &rig_s, "--pose", &s(&drag), "-o", &s(&dragged)]),
+            "pose with ik drags",
+        );
+        let dragged = load(&dragged);
+        assert!(
+            hand(&dragged) < 50,
+            "{weights:?}: the dragged hand did not move"
+        );
+        assert!(
+            dragged.get_pixel(410, 260)[3] > 200,
+            "{weights:?}: the hand did not arrive"
+        );
+        assert!(
+            dragged.get_pixel(305, 440)[3] > 200,
+            "{weights:?}: a pinned foot moved"
+        );
+        // Rigid weights: at most two influences per vertex.
+        if weights.contains(&"rigid") {
+            let doc: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+            for row in doc["parts"][0]["weights"]["rows"].as_array().unwrap() {
+                assert!(row.as_array().unwrap().len() <= 2);
+            }
+        }
+    }
+}
+
+#[test]
+fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
+    let dir = scratch("layers");
+    let list: Vec<String> = character_layers().into_iter().map(|l| l.0).collect();
+    let paths: Vec<String> = list
+        .iter()
+        .map(|n| {
+            assets()
+                .join(format!("{n}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    let (handles, rig, posed) = (dir.join("h.json"), dir.join("rig.json"), dir.join("p.png"));
+    let mut args = vec!["autorig".to_string()];
+    args.extend(paths.iter().cloned());
+    args.extend(["-o".into(), handles.to_str().unwrap().into()]);
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&sinew(&argv), "autorig layers");
+    let mut args = vec!["rig".to_string()];
+    args.extend(paths.iter().cloned());
+    args.extend([
+        "--handles".into(),
+        handles.to_str().unwrap().into(),
+        "-o".into(),
+        rig.to_str().unwrap().into(),
+    ]);
+    let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&sinew(&argv), "rig layers");
+    // Turning the lower left arm moves the left hand; the right hand stays.
+    let pose = dir.join("pose.json");
+    std::fs::write(&pose, r#"{"bones": {"arm_lower_l": {"rotate": 70}}}"#).unwrap();
+    let rig_s = rig.to_str().unwrap();
+    ok(
+        &sinew(&[
+            "pose",
+            rig_s,
+            "--pose",
+            pose.to_str().unwrap(),
+            "-o",
+            posed.to_str().unwrap(),
+        ]),
+        "pose layers",
+    );
+    let posed = load(&posed);
+    assert!(
+        posed.get_pixel(358, 343)[3] < 50,
+        "the left hand did not move"
+    );
+    assert!(posed.get_pixel(156, 340)[3] > 200, "the right hand moved");
+}
+
+#[test]
+fn autorig_bad_input_is_one_line_and_exit_2() {
+    let dir = scratch("bad");
+    let bad = dir.join("bad.png");
+    std::fs::write(&bad, b"not a png").unwrap();
+    let out_path = dir.join("h.json");
+    let out = sinew(&[
+        "autorig",
+        bad.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr)
+            .trim_end()
+            .lines()
+            .count(),
+        1
+    );
+    assert!(!out_path.exists());
+    let flat = assets().join("flat.png");
+    let out = sinew(&[
+        "autorig",
+        flat.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+        "--cage",
+        "2",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("at least 3"));
+    assert!(!out_path.exists());
+}
+
+/// Golden tolerance, as in tests/golden.rs: premultiplied max channel difference and PSNR.
+const MAX_CHANNEL_DIFF: u8 = 2;
+const MIN_PSNR_DB: f64 = 50.0;
+
+#[test]
+fn proposed_rig_over_the_character_matches_golden() {
+    let image = character_flat();
+    let options = AutorigOptions {
+        template: Some(Template::Humanoid),
+        cage_vertices: Some(16),
+        point_count: 6,
+        ..AutorigOptions::default()
+    };
+    let h = propose(&[("flat", &image)], &options);
+    let actual = sinew::autorig::draw_preview(&[&image], &h).unwrap();
+    let golden = root().join("golden/autorig_character.png");
+    if std::env::var("SINEW_BLESS").is_ok_and(|v| v == "1") {
+        sinew::io::save_png(&golden, &actual).unwrap();
+        return;
+    }
+    let expected = load(&golden);
+    let max = sinew::render::max_channel_diff(
+        &sinew::render::premultiplied(&actual),
+        &sinew::render::premultiplied(&expected),
+    );
+    let psnr = sinew::render::psnr_premultiplied(&actual, &expected);
+    if max > MAX_CHANNEL_DIFF || psnr < MIN_PSNR_DB {
+        let out = std::env::temp_dir().join("autorig_character.actual.png");
+        sinew::io::save_png(&out, &actual).unwrap();
+        panic!(
+            "the proposed rig differs from {}: max channel difference {max}, PSNR {psnr:.1} dB; actual: {}",
+            golden.display(),
+            out.display()
+        );
+    }
+}
