@@ -96,6 +96,7 @@ fn synthetic() -> (Animation, Handles) {
             translate: Some(keys(next(), |x| [x % 6.0, x % 2.0], 2)),
             rotate: (i < 2).then(|| keys(next(), |x| x * 10.0, 1)),
             scale: None,
+            shear: None,
         };
         points.insert(point.name.clone(), t);
     }

@@ -253,8 +253,19 @@ fn bad_handles_fail_cleanly_without_output() {
         &["pose", s(&out), "--pose", s(&pose), "-o", s(&png)],
         "bone 'nope'",
     );
-    let ik = write("ik.json", r#"{"ik": [{"at": [30, 30], "to": [35, 30]}]}"#);
-    assert_bad_input(&["pose", s(&out), "--pose", s(&ik), "-o", s(&png)], "IK");
+    let ik = write("ik.json", r#"{"ik": [{"at": [30, 30], "to": [35, f]}]}"#);
+    assert_bad_input(
+        &["pose", s(&out), "--pose", s(&ik), "-o", s(&png)],
+        "ik.json",
+    );
+    let outside = write(
+        "outside.json",
+        r#"{"ik": [{"at": [1, 1], "to": [35, 30]}]}"#,
+    );
+    assert_bad_input(
+        &["pose", s(&out), "--pose", s(&outside), "-o", s(&png)],
+        "does not grip the drawing",
+    );
     assert!(!png.exists());
 }
 

@@ -305,7 +305,7 @@ mod tests {
         let animations = parse_animations(&raw).unwrap();
         assert_eq!(
             animations.keys().collect::<Vec<_>>(),
-            ["walk", "wave"].iter().collect::<Vec<_>>()
+            ["lift", "walk", "wave"].iter().collect::<Vec<_>>()
         );
         for (name, anim) in &animations {
             anim.check_rig(name, &handles, &parts).unwrap();
@@ -319,6 +319,7 @@ mod tests {
                 assert_eq!(pose.translate, other.translate, "{name} {bone}");
             }
             assert_eq!(end.points, start.points, "{name}");
+            assert_eq!(end.ik, start.ik, "{name}");
             // Every frame poses the rig.
             for k in 0..24 {
                 let pose = anim.sample(duration * k as f64 / 24.0, true);
