@@ -3,6 +3,8 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+mod colorize;
+
 use crate::anim;
 use crate::io::{self, BuildOptions, RigDocument};
 use crate::mesh::MeshOptions;
@@ -40,6 +42,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Run the whole pipeline on the bundled character.
     Demo(DemoArgs),
+    /// Color line art from a few colored scribbles (content-aware weights over the image).
+    Colorize(colorize::ColorizeArgs),
 }
 
 #[derive(Args, Debug)]
@@ -223,6 +227,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Pose(args) => pose(&args),
         Command::Render(args) => render_animation(&args),
         Command::Demo(args) => demo(&args),
+        Command::Colorize(args) => colorize::run(&args),
     }
 }
 

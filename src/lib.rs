@@ -7,6 +7,7 @@
 
 pub mod anim;
 pub mod cli;
+pub mod colorize;
 pub mod geom;
 pub mod io;
 pub mod mesh;
