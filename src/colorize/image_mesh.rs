@@ -140,10 +140,18 @@ impl ImageMesh {
         let dt: DelaunayTriangulation<Vertex> =
             DelaunayTriangulation::bulk_load_stable(vertices)
                 .map_err(|e| ImageMeshError::Triangulation(format!("{e:?}")))?;
-        let triangles = dt
+        let mut triangles: Vec<[u32; 3]> = dt
             .inner_faces()
             .map(|f| f.vertices().map(|v| v.fix().index() as u32))
             .collect();
+        let darkness: Vec<u32> = pixels
+            .iter()
+            .map(|p| {
+                let c = color[p[1] as usize * w + p[0] as usize];
+                765 - (c[0] as u32 + c[1] as u32 + c[2] as u32)
+            })
+            .collect();
+        orient_square_diagonals(&pixels, &darkness, &mut triangles);
         Ok(ImageMesh {
             width,
             height,
@@ -222,6 +230,54 @@ impl ImageMesh {
                     );
                 }
             }
+        }
+    }
+}
+
+/// Where four vertices form a unit square of pixels, both of its diagonals are Delaunay (the
+/// corners are cocircular) and spade picks one arbitrarily. A one-pixel diagonal line is only
+/// 8-connected: the diagonal joining the two paper pixels across it would let weights leak
+/// through the line. So each unit square takes the diagonal whose endpoints are
+/// darker (the larger of the two pairs' smaller darkness), keeping the line a wall in the mesh.
+fn orient_square_diagonals(pixels: &[[u32; 2]], darkness: &[u32], triangles: &mut [[u32; 3]]) {
+    use std::collections::HashMap;
+    // Unit squares (by their top-left pixel) → the two triangles splitting them.
+    let mut squares: HashMap<[u32; 2], Vec<usize>> = HashMap::new();
+    for (k, t) in triangles.iter().enumerate() {
+        let p = t.map(|v| pixels[v as usize]);
+        let (x0, x1) = (p.iter().map(|q| q[0]).min(), p.iter().map(|q| q[0]).max());
+        let (y0, y1) = (p.iter().map(|q| q[1]).min(), p.iter().map(|q| q[1]).max());
+        if let (Some(x0), Some(x1), Some(y0), Some(y1)) = (x0, x1, y0, y1) {
+            if x1 == x0 + 1 && y1 == y0 + 1 {
+                squares.entry([x0, y0]).or_default().push(k);
+            }
+        }
+    }
+    let mut keys: Vec<[u32; 2]> = squares.keys().copied().collect();
+    keys.sort_unstable(); // HashMap order is random; flips must not depend on it.
+    for key in keys {
+        let pair = &squares[&key];
+        let [a, b] = match pair.as_slice() {
+            [a, b] => [*a, *b],
+            _ => continue,
+        };
+        let (ta, tb) = (triangles[a], triangles[b]);
+        // The shared edge (the current diagonal) and the two opposite corners.
+        let shared: Vec<u32> = ta.iter().copied().filter(|v| tb.contains(v)).collect();
+        let [p, q] = match shared.as_slice() {
+            [p, q] => [*p, *q],
+            _ => continue,
+        };
+        let (Some(&u), Some(&v)) = (
+            ta.iter().find(|x| !tb.contains(x)),
+            tb.iter().find(|x| !ta.contains(x)),
+        ) else {
+            continue;
+        };
+        let strength = |i: u32, j: u32| darkness[i as usize].min(darkness[j as usize]);
+        if strength(u, v) > strength(p, q) {
+            triangles[a] = [u, v, p];
+            triangles[b] = [v, u, q];
         }
     }
 }

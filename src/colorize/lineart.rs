@@ -55,11 +55,6 @@ impl LineArt {
     pub fn line_mask(&self, threshold: f32) -> Vec<bool> {
         self.ink.iter().map(|&k| k >= threshold).collect()
     }
-
-    /// The color in [0, 1] of pixel `i`, for the 5D lift.
-    pub fn unit_color(&self, i: usize) -> [f64; 3] {
-        self.over_white[i].map(|c| c as f64 / 255.0)
-    }
 }
 
 #[cfg(test)]

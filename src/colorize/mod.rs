@@ -11,14 +11,16 @@
 //! 1. [`lineart`]: the drawing composited over white paper, and its ink per pixel.
 //! 2. [`scribbles`]: scribble pixels per color (layer or lyon-tessellated polylines); those
 //!    lying on a line are dropped (a line belongs to no region).
-//! 3. [`image_mesh`]: an adaptive mesh (quadtree vertices, spade Delaunay): one vertex per
+//! 3. [`gap_closing`]: every line casts a fading ridge of ink, so small gaps read as hills
+//!    and one-pixel antialiased lines as walls.
+//! 4. [`image_mesh`]: an adaptive mesh (quadtree vertices, spade Delaunay): one vertex per
 //!    pixel along lines and scribble rims, big triangles over flat paper.
-//! 4. [`weights`]: the mesh lifted to (x, y, s·r, s·g, s·b) by [`crate::weights::lift`], one
+//! 5. [`weights`]: the mesh lifted to (x, y, s·r, s·g, s·b) by [`crate::weights::lift`], one
 //!    harmonic (or bounded biharmonic) weight function per color, the color's scribble pixels
 //!    fixed at 1 and the other colors' at 0. Across a line the lifted mesh is long, so weights
 //!    stay in their region; through a gap of a few pixels the region's own scribble still
 //!    dominates, so a color boundary forms at the gap instead of a flood.
-//! 5. [`fill`]: weights interpolated to every pixel; flat (largest weight wins) or soft
+//! 6. [`fill`]: weights interpolated to every pixel; flat (largest weight wins) or soft
 //!    (blended) colors; the line art on top.
 //!
 //! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
@@ -26,6 +28,7 @@
 
 pub mod fill;
 pub mod flood;
+pub mod gap_closing;
 pub mod image_mesh;
 pub mod lineart;
 pub mod score;
@@ -37,7 +40,7 @@ pub use fill::FillMode;
 pub use image_mesh::{ImageMesh, MeshOptions};
 pub use lineart::LineArt;
 pub use scribbles::{ScribbleError, ScribbleOptions, Scribbles};
-pub use weights::ColorWeights;
+pub use weights::{ColorWeights, LiftedStiffness};
 
 use crate::weights::BbwOptions;
 use image::RgbaImage;
@@ -54,6 +57,12 @@ pub struct ColorizeOptions {
     /// A pixel whose ink (1 − luminance over white) reaches this is a line pixel: scribbles
     /// there are ignored. Default 0.5.
     pub line_threshold: f32,
+    /// Lines cast a ridge of ink fading to nothing over this many px before the lift
+    /// ([`gap_closing`]): a gap of g px keeps 1 − g / (2·fade) of the line's ink, so it
+    /// separates colors instead of letting one flood through. 0 = off. Default 4.
+    pub gap_closing_px: f64,
+    /// How the lifted mesh is measured. Default: edge stretch.
+    pub stiffness: LiftedStiffness,
     /// Default: harmonic.
     pub weights: ColorWeights,
     /// Default: flat.
@@ -72,6 +81,8 @@ impl Default for ColorizeOptions {
         ColorizeOptions {
             scale: DEFAULT_LIFT_SCALE,
             line_threshold: 0.5,
+            gap_closing_px: 4.0,
+            stiffness: LiftedStiffness::EdgeStretch,
             weights: ColorWeights::Harmonic,
             fill: FillMode::Flat,
             mesh: MeshOptions::default(),
@@ -198,22 +209,32 @@ pub fn colorize(
             options.line_threshold
         )));
     }
+    if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
+        return Err(ColorizeError::InvalidOptions(format!(
+            "gap_closing_px must be finite and non-negative, not {}",
+            options.gap_closing_px
+        )));
+    }
     let art = LineArt::new(lineart);
     let (labels, dropped) = effective_labels(&art, scribbles, options.line_threshold)?;
-    let mesh = ImageMesh::new(
+    // The lift and the mesh see the drawing with its gaps closed.
+    let closed = gap_closing::close_gaps(
+        &art.over_white,
         art.width,
         art.height,
-        &art.over_white,
-        &labels,
-        &options.mesh,
-    )?;
+        options.gap_closing_px,
+    );
+    let mesh = ImageMesh::new(art.width, art.height, &closed, &labels, &options.mesh)?;
     let m = scribbles.colors.len();
     let weights = if m == 1 {
         // One color: the whole drawing takes it; nothing to solve.
         None
     } else {
         let vertex_pixels = mesh.pixel_indices();
-        let colors: Vec<[f64; 3]> = vertex_pixels.iter().map(|&i| art.unit_color(i)).collect();
+        let colors: Vec<[f64; 3]> = vertex_pixels
+            .iter()
+            .map(|&i| closed[i].map(|c| c as f64 / 255.0))
+            .collect();
         let vertex_labels: Vec<u16> = vertex_pixels.iter().map(|&i| labels[i]).collect();
         Some(weights::color_weights(
             &mesh,
@@ -221,6 +242,7 @@ pub fn colorize(
             &vertex_labels,
             m,
             options.scale,
+            options.stiffness,
             options.weights,
             &options.bbw,
         )?)

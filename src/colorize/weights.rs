@@ -10,12 +10,13 @@
 //! color, 0 for the others) and [`crate::weights::solve`] does the rest.
 
 use super::image_mesh::ImageMesh;
-use crate::weights::lift::{content_aware_domain, LiftError};
+use crate::weights::lift::{content_aware_domain, lift_points, LiftError};
 use crate::weights::{
-    bounded_biharmonic_weights, harmonic_weights, BbwOptions, BoundaryConditions, SolveError,
-    WeightMatrix,
+    bounded_biharmonic_weights, harmonic_weights, BbwOptions, BoundaryConditions, Domain,
+    SolveError, WeightMatrix,
 };
 use serde::{Deserialize, Serialize};
+use sprs::TriMat;
 
 /// Which energy the color weights minimize.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -26,6 +27,23 @@ pub enum ColorWeights {
     Harmonic,
     /// Bounded biharmonic weights (Jacobson et al. 2011): smoother blends, far slower.
     Bbw,
+}
+
+/// How the lifted mesh is measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum LiftedStiffness {
+    /// The cotangent Laplacian of the mesh lifted to 5D (`Domain::new::<5>`), as `sinew rig
+    /// --content-aware` uses it. Across an antialiased ramp the lifted triangles are needles
+    /// whose large positive and negative cotangent weights cancel only approximately: thin
+    /// (≤ 1.5 px) antialiased curved lines leak (the tests measure it).
+    Cotangent,
+    /// The flat mesh's cotangent weights, each divided by its edge's squared stretch
+    /// |e|²₅D / |e|²₂D under the same lift: every weight stays non-negative (an M-matrix, so
+    /// harmonic weights obey the maximum principle) and an edge across a line conducts
+    /// (1 + 3·s²·Δc²)⁻¹ times less: a ramp is a wall whatever its triangles look like.
+    #[default]
+    EdgeStretch,
 }
 
 /// What went wrong solving for the color weights.
@@ -45,10 +63,19 @@ pub fn color_weights(
     labels: &[u16],
     color_count: usize,
     scale: f64,
+    stiffness: LiftedStiffness,
     method: ColorWeights,
     bbw: &BbwOptions,
 ) -> Result<WeightMatrix, ColorWeightError> {
-    let domain = content_aware_domain(&mesh.positions(), colors, scale, &mesh.triangles)?;
+    let positions = mesh.positions();
+    let domain = match stiffness {
+        LiftedStiffness::Cotangent => {
+            content_aware_domain(&positions, colors, scale, &mesh.triangles)?
+        }
+        LiftedStiffness::EdgeStretch => {
+            edge_stretch_domain(&positions, colors, scale, &mesh.triangles)?
+        }
+    };
     let mut bc = BoundaryConditions {
         handle_count: color_count,
         ..Default::default()
@@ -70,4 +97,65 @@ pub fn color_weights(
     }
     w.normalize_rows();
     Ok(w)
+}
+
+/// The [`LiftedStiffness::EdgeStretch`] domain: flat cotangent weights divided by each edge's
+/// squared stretch under the lift (negative flat weights, on obtuse boundary triangles, are
+/// dropped), and the lifted mesh's mass.
+pub fn edge_stretch_domain(
+    positions: &[[f64; 2]],
+    colors: &[[f64; 3]],
+    scale: f64,
+    triangles: &[[u32; 3]],
+) -> Result<Domain, LiftError> {
+    let lifted = lift_points(positions, colors, scale)?;
+    let flat = Domain::new(positions, triangles);
+    let mass = Domain::new(&lifted, triangles).mass;
+    let d2 = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    let n = positions.len();
+    let mut out = TriMat::with_capacity((n, n), flat.stiffness.nnz());
+    for (i, row) in flat.stiffness.outer_iterator().enumerate() {
+        let mut diagonal = 0.0;
+        for (j, &v) in row.iter() {
+            if j == i || v >= 0.0 {
+                continue;
+            }
+            let stretch = d2(&lifted[i], &lifted[j]) / d2(&positions[i], &positions[j]);
+            let w = v / stretch;
+            out.add_triplet(i, j, w);
+            diagonal -= w;
+        }
+        out.add_triplet(i, i, diagonal);
+    }
+    Ok(Domain {
+        stiffness: out.to_csr(),
+        mass,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stretched_edges_conduct_less_and_rows_sum_to_zero() {
+        let positions = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        let triangles = [[0, 1, 2], [1, 3, 2]];
+        let colors = [[1.0; 3], [1.0; 3], [0.0; 3], [0.0; 3]];
+        let d = edge_stretch_domain(&positions, &colors, 10.0, &triangles).unwrap();
+        let k = d.stiffness.to_dense();
+        // Edge 0–1 (same color) keeps its flat weight ½; edge 0–2 (a full change) is
+        // divided by 1 + 3·10².
+        assert!((k[[0, 1]] + 0.5).abs() < 1e-12);
+        assert!((k[[0, 2]] + 0.5 / 301.0).abs() < 1e-12);
+        for i in 0..4 {
+            assert!(k.row(i).sum().abs() < 1e-12);
+            for j in 0..4 {
+                assert_eq!(k[[i, j]], k[[j, i]]);
+                if i != j {
+                    assert!(k[[i, j]] <= 0.0);
+                }
+            }
+        }
+    }
 }
