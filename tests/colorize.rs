@@ -16,8 +16,8 @@ use sinew::colorize::flood::flood_fill;
 use sinew::colorize::score::score;
 use sinew::colorize::synthetic::{scene, Scene, SceneSpec};
 use sinew::colorize::{
-    self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LineArt, ScribbleOptions,
-    Scribbles,
+    self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
+    ScribbleOptions, Scribbles,
 };
 use sinew::io::{load_png, save_png};
 use std::path::{Path, PathBuf};
@@ -105,10 +105,8 @@ fn closed_shapes_with_aliased_lines() {
 
 #[test]
 fn scribbles_touching_and_crossing_lines() {
-    // Every shape's scribble runs past its outline's right side into the background: the
-    // pixels on the line are dropped; those beyond the line are handle pixels of the wrong
-    // region, which the score must show; those that only touch the line are fine. Here the
-    // strokes end exactly on the outline (touching it).
+    // Every shape's scribble is extended rightwards to end on its outline's right side: its
+    // last pixels lie on the line (dropped as handle pixels) and the rest touch the line.
     let spec = SceneSpec::default();
     let mut s = scene(&spec);
     let size = spec.size as f64;
@@ -125,6 +123,34 @@ fn scribbles_touching_and_crossing_lines() {
     let (ours, flood) = scores(&s, &ColorizeOptions::default());
     println!("scribbles touching lines: weights {ours:.4}, flood fill {flood:.4}");
     assert!(ours >= 0.99, "score {ours:.4}");
+}
+
+#[test]
+fn edge_stretch_holds_thin_lines_where_the_5d_cotangent_laplacian_leaks() {
+    // Why `LiftedStiffness::EdgeStretch` is the default: on 1.5 px antialiased curves the 5D
+    // cotangent weights of the lifted needle triangles let colors through.
+    let s = scene(&SceneSpec {
+        line_width: 1.5,
+        shapes: 6,
+        ..Default::default()
+    });
+    let with = |stiffness| {
+        scores(
+            &s,
+            &ColorizeOptions {
+                stiffness,
+                ..Default::default()
+            },
+        )
+        .0
+    };
+    let (stretch, cotangent) = (
+        with(LiftedStiffness::EdgeStretch),
+        with(LiftedStiffness::Cotangent),
+    );
+    println!("thin black lines: edge stretch {stretch:.4}, 5D cotangent {cotangent:.4}");
+    assert!(stretch >= 0.99, "edge stretch {stretch:.4}");
+    assert!(cotangent < stretch, "5D cotangent {cotangent:.4}");
 }
 
 fn gapped(gap_px: f32) -> (f64, f64) {

@@ -13,7 +13,7 @@
 use super::image_mesh::ImageMesh;
 use super::lineart::LineArt;
 use crate::weights::WeightMatrix;
-use image::{Rgba, RgbaImage};
+use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 
 /// How weights become colors.
@@ -55,10 +55,12 @@ pub fn fill(
         Vec::new()
     };
     let mut shares = vec![0.0f64; m];
+    let fill_raw: &mut [u8] = &mut fill_only;
+    let mut layer_raws: Vec<&mut [u8]> = layers.iter_mut().map(|l| &mut **l).collect();
     let mut paint = |i: usize, shares: &[f64]| {
-        let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+        let best = argmax(shares);
         let color = match mode {
-            FillMode::Flat => palette[argmax(shares)],
+            FillMode::Flat => palette[best],
             FillMode::Soft => {
                 let total: f64 = shares.iter().sum();
                 let mut c = [0.0; 3];
@@ -70,17 +72,14 @@ pub fn fill(
                 c.map(|v| (v / total.max(f64::MIN_POSITIVE)).round().clamp(0.0, 255.0) as u8)
             }
         };
-        fill_only.put_pixel(x, y, Rgba([color[0], color[1], color[2], 255]));
-        if want_layers {
-            let best = argmax(shares);
-            for (j, layer) in layers.iter_mut().enumerate() {
-                let alpha = match mode {
-                    FillMode::Flat => 255 * (j == best) as u8,
-                    FillMode::Soft => (shares[j] * 255.0).round().clamp(0.0, 255.0) as u8,
-                };
-                let p = palette[j];
-                layer.put_pixel(x, y, Rgba([p[0], p[1], p[2], alpha]));
-            }
+        fill_raw[4 * i..4 * i + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
+        for (j, layer) in layer_raws.iter_mut().enumerate() {
+            let alpha = match mode {
+                FillMode::Flat => 255 * (j == best) as u8,
+                FillMode::Soft => (shares[j] * 255.0).round().clamp(0.0, 255.0) as u8,
+            };
+            let p = palette[j];
+            layer[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], alpha]);
         }
     };
     match weights {
@@ -139,6 +138,7 @@ pub fn with_lines_on_top(fill: &RgbaImage, lineart: &RgbaImage, opaque: bool) ->
 #[cfg(test)]
 mod tests {
     use super::*;
+    use image::Rgba;
 
     #[test]
     fn lines_multiply_on_paper_and_cover_on_transparency() {

@@ -343,6 +343,34 @@ mod tests {
     }
 
     #[test]
+    fn a_one_pixel_diagonal_line_stays_a_wall() {
+        // A diagonal of black pixels on white, only 8-connected: no mesh edge may join two
+        // white pixels on opposite sides of it.
+        let n = 12u32;
+        let color: Vec<[u8; 3]> = (0..n * n)
+            .map(|i| if i % n == i / n { [0; 3] } else { [255; 3] })
+            .collect();
+        let mesh = ImageMesh::new(
+            n,
+            n,
+            &color,
+            &vec![0; (n * n) as usize],
+            &MeshOptions::default(),
+        )
+        .unwrap();
+        let side = |p: [u32; 2]| (p[0] as i64 - p[1] as i64).signum();
+        for t in &mesh.triangles {
+            for k in 0..3 {
+                let (a, b) = (
+                    mesh.pixels[t[k] as usize],
+                    mesh.pixels[t[(k + 1) % 3] as usize],
+                );
+                assert!(side(a) * side(b) >= 0, "edge {a:?}–{b:?} crosses the line");
+            }
+        }
+    }
+
+    #[test]
     fn tiny_images_are_errors() {
         assert_eq!(
             ImageMesh::new(1, 5, &[[0; 3]; 5], &[0; 5], &MeshOptions::default()),

@@ -10,13 +10,13 @@
 //! color, 0 for the others) and [`crate::weights::solve`] does the rest.
 
 use super::image_mesh::ImageMesh;
+use crate::weights::laplacian::{cotangent_stiffness, squared_edge_lengths, voronoi_mass};
 use crate::weights::lift::{content_aware_domain, lift_points, LiftError};
 use crate::weights::{
     bounded_biharmonic_weights, harmonic_weights, BbwOptions, BoundaryConditions, Domain,
     SolveError, WeightMatrix,
 };
 use serde::{Deserialize, Serialize};
-use sprs::TriMat;
 
 /// Which energy the color weights minimize.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -101,7 +101,7 @@ pub fn color_weights(
 
 /// The [`LiftedStiffness::EdgeStretch`] domain: flat cotangent weights divided by each edge's
 /// squared stretch under the lift (negative flat weights, on obtuse boundary triangles, are
-/// dropped), and the lifted mesh's mass.
+/// dropped), and the lifted mesh's mixed-Voronoi mass.
 pub fn edge_stretch_domain(
     positions: &[[f64; 2]],
     colors: &[[f64; 3]],
@@ -109,28 +109,34 @@ pub fn edge_stretch_domain(
     triangles: &[[u32; 3]],
 ) -> Result<Domain, LiftError> {
     let lifted = lift_points(positions, colors, scale)?;
-    let flat = Domain::new(positions, triangles);
-    let mass = Domain::new(&lifted, triangles).mass;
-    let d2 = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
     let n = positions.len();
-    let mut out = TriMat::with_capacity((n, n), flat.stiffness.nnz());
-    for (i, row) in flat.stiffness.outer_iterator().enumerate() {
+    let mass = voronoi_mass(n, triangles, &squared_edge_lengths(&lifted, triangles));
+    // The flat stiffness's pattern, values rewritten in place (no second assembly and sort).
+    let mut stiffness =
+        cotangent_stiffness(n, triangles, &squared_edge_lengths(positions, triangles));
+    let d2 = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+    let indptr = stiffness.indptr().to_proper().into_owned();
+    let indices = stiffness.indices().to_vec();
+    let data = stiffness.data_mut();
+    for i in 0..n {
         let mut diagonal = 0.0;
-        for (j, &v) in row.iter() {
-            if j == i || v >= 0.0 {
-                continue;
+        let mut diagonal_at = None;
+        for k in indptr[i]..indptr[i + 1] {
+            let j = indices[k];
+            if j == i {
+                diagonal_at = Some(k);
+            } else if data[k] < 0.0 {
+                data[k] /= d2(&lifted[i], &lifted[j]) / d2(&positions[i], &positions[j]);
+                diagonal -= data[k];
+            } else {
+                data[k] = 0.0;
             }
-            let stretch = d2(&lifted[i], &lifted[j]) / d2(&positions[i], &positions[j]);
-            let w = v / stretch;
-            out.add_triplet(i, j, w);
-            diagonal -= w;
         }
-        out.add_triplet(i, i, diagonal);
+        if let Some(k) = diagonal_at {
+            data[k] = diagonal;
+        }
     }
-    Ok(Domain {
-        stiffness: out.to_csr(),
-        mass,
-    })
+    Ok(Domain { stiffness, mass })
 }
 
 #[cfg(test)]
