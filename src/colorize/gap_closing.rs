@@ -16,7 +16,7 @@
 /// The colors with every line's ridge of ink added. `fade_px` ≤ 0 returns the colors as
 /// they are.
 pub fn close_gaps(colors: &[[u8; 3]], width: u32, height: u32, fade_px: f64) -> Vec<[u8; 3]> {
-    if !(fade_px > 0.0) || !fade_px.is_finite() {
+    if fade_px.is_nan() || fade_px <= 0.0 || fade_px.is_infinite() {
         return colors.to_vec();
     }
     let (w, h) = (width as usize, height as usize);

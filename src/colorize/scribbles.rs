@@ -52,6 +52,9 @@ impl Default for ScribbleOptions {
     }
 }
 
+/// Stroke coordinates and widths beyond this (px) are rejected: lyon tessellates in f32.
+pub const MAX_COORDINATE_PX: f64 = 1.0e6;
+
 /// The scribbles over the canvas.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scribbles {
@@ -220,6 +223,13 @@ impl Scribbles {
             }
             if stroke.points.iter().flatten().any(|c| !c.is_finite()) {
                 return Err(bad("has a coordinate that is not a number".into()));
+            }
+            // lyon works in f32: keep coordinates where f32 still resolves a pixel.
+            let limit = MAX_COORDINATE_PX;
+            if stroke.width > limit || stroke.points.iter().flatten().any(|c| c.abs() > limit) {
+                return Err(bad(format!(
+                    "a coordinate or the width lies beyond ±{limit} px"
+                )));
             }
             let label = match colors.iter().position(|&c| c == color) {
                 Some(k) => k as u16 + 1,
@@ -398,6 +408,10 @@ mod tests {
                 "no points",
             ),
             (r#"{"lines": []}"#, "unknown field"),
+            (
+                r##"{"strokes": [{"color": "#ff0000", "width": 2, "points": [[1e30, 1]]}]}"##,
+                "beyond",
+            ),
         ] {
             let e = Scribbles::from_json(text, 8, 8, &o)
                 .unwrap_err()
