@@ -27,11 +27,9 @@ pub fn close_gaps(colors: &[[u8; 3]], width: u32, height: u32, fade_px: f64) -> 
         .max(1.0) as i32;
     let mut dark: Vec<[i32; 3]> = colors.iter().map(|c| c.map(|v| 255 - v as i32)).collect();
     let relax = |dark: &mut Vec<[i32; 3]>, i: usize, j: usize, step: i32| {
-        for k in 0..3 {
-            let v = dark[j][k] - step;
-            if v > dark[i][k] {
-                dark[i][k] = v;
-            }
+        let from = dark[j];
+        for (d, f) in dark[i].iter_mut().zip(from) {
+            *d = (*d).max(f - step);
         }
     };
     // Forward: from the left and the row above.

@@ -308,8 +308,8 @@ mod tests {
         let mesh = ImageMesh::new(w, h, &color, &label, &MeshOptions::default()).unwrap();
         let is_vertex: std::collections::HashSet<[u32; 2]> = mesh.pixels.iter().copied().collect();
         // Every line pixel is a vertex.
-        for i in 0..(w * h) as usize {
-            if color[i] == [0; 3] {
+        for (i, c) in color.iter().enumerate() {
+            if *c == [0; 3] {
                 assert!(is_vertex.contains(&[i as u32 % w, i as u32 / w]));
             }
         }

@@ -241,10 +241,12 @@ pub fn colorize(
             &colors,
             &vertex_labels,
             m,
-            options.scale,
-            options.stiffness,
-            options.weights,
-            &options.bbw,
+            &weights::ColorWeightOptions {
+                scale: options.scale,
+                stiffness: options.stiffness,
+                method: options.weights,
+                bbw: options.bbw.clone(),
+            },
         )?)
     };
     let filled = fill::fill(

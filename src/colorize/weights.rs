@@ -55,6 +55,16 @@ pub enum ColorWeightError {
     Solve(#[from] SolveError),
 }
 
+/// How the color weights are solved for (the relevant part of `ColorizeOptions`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColorWeightOptions {
+    /// Lift scale, px per unit of color.
+    pub scale: f64,
+    pub stiffness: LiftedStiffness,
+    pub method: ColorWeights,
+    pub bbw: BbwOptions,
+}
+
 /// Solves for the weights. `colors[v]` and `labels[v]` belong to mesh vertex v; `color_count`
 /// is the number of scribble colors (at least one vertex of each must be labeled).
 pub fn color_weights(
@@ -62,11 +72,14 @@ pub fn color_weights(
     colors: &[[f64; 3]],
     labels: &[u16],
     color_count: usize,
-    scale: f64,
-    stiffness: LiftedStiffness,
-    method: ColorWeights,
-    bbw: &BbwOptions,
+    options: &ColorWeightOptions,
 ) -> Result<WeightMatrix, ColorWeightError> {
+    let ColorWeightOptions {
+        scale,
+        stiffness,
+        method,
+        ref bbw,
+    } = *options;
     let positions = mesh.positions();
     let domain = match stiffness {
         LiftedStiffness::Cotangent => {
