@@ -3,6 +3,8 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+mod colorize;
+
 use crate::anim::{self, CurveEvaluation, SampleOptions};
 use crate::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
 use crate::io::{self, BuildOptions, RigDocument};
@@ -45,6 +47,8 @@ pub enum Command {
     Export(ExportArgs),
     /// Propose handles (a skeleton, a cage, points) from the drawing.
     Autorig(AutorigArgs),
+    /// Color line art from a few colored scribbles (content-aware weights over the image).
+    Colorize(colorize::ColorizeArgs),
 }
 
 #[derive(Args, Debug)]
@@ -323,6 +327,7 @@ pub fn run(cli: Cli) -> Result<()> {
             format: ExportFormat::Spine(args),
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
+        Command::Colorize(args) => colorize::run(&args),
     }
 }
 

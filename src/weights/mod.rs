@@ -1,6 +1,7 @@
 //! Skinning weights: one function per handle column over a part's mesh.
 //!
 //! - [`laplacian`]: cotangent stiffness and mixed-Voronoi mass from edge lengths (flat or lifted).
+//! - [`lift`]: the content-aware 5D lift (x, y, s·r, s·g, s·b), shared with `colorize`.
 //! - [`sparse`]: principal sub-matrix Cholesky (faer) and products shared by the solvers.
 //! - [`solve`]: harmonic, biharmonic and bounded biharmonic weights (interior point).
 //! - [`monotone`]: bounded biharmonic weights without spurious extrema (Jacobson et al. 2012).
@@ -11,6 +12,7 @@
 
 pub mod boundary;
 pub mod laplacian;
+pub mod lift;
 pub mod monotone;
 pub mod part;
 pub mod reference;

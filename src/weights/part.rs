@@ -10,6 +10,7 @@
 //! an unweighted attachment to one bone.
 
 use super::boundary::{bound_boundary_conditions, centroid, nearest_column};
+use super::lift::{content_aware_domain, LiftError};
 use super::monotone::{monotone_bounded_biharmonic_weights, MonotoneOptions};
 use super::solve::{
     biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions,
@@ -201,28 +202,17 @@ pub fn bound_part_weights(
     let mesh = &embedded.domain;
     let (mut bc, touched) = bound_boundary_conditions(&mesh.vertices, handles, binding);
     let bound_to_nearest = bind_free_pieces(embedded, handles, binding, &mut bc);
+    let positions: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
     let domain = match options.content_aware {
-        None => Domain::new(
-            &mesh.vertices.iter().map(|p| [p.x, p.y]).collect::<Vec<_>>(),
-            &mesh.triangles,
-        ),
+        None => Domain::new(&positions, &mesh.triangles),
         Some(scale) => {
-            if !(scale.is_finite() && scale >= 0.0) {
-                return Err(WeightError::InvalidOptions(
-                    "the content-aware scale must be finite and non-negative".into(),
-                ));
-            }
             let colors = colors.ok_or(WeightError::ColorCount(0, mesh.vertices.len()))?;
-            if colors.len() != mesh.vertices.len() {
-                return Err(WeightError::ColorCount(colors.len(), mesh.vertices.len()));
-            }
-            let lifted: Vec<[f64; 5]> = mesh
-                .vertices
-                .iter()
-                .zip(colors)
-                .map(|(p, c)| [p.x, p.y, scale * c[0], scale * c[1], scale * c[2]])
-                .collect();
-            Domain::new(&lifted, &mesh.triangles)
+            content_aware_domain(&positions, colors, scale, &mesh.triangles).map_err(
+                |e| match e {
+                    LiftError::InvalidScale(_) => WeightError::InvalidOptions(e.to_string()),
+                    LiftError::ColorCount(c, n) => WeightError::ColorCount(c, n),
+                },
+            )?
         }
     };
     let mut unconverged = Vec::new();

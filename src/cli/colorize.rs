@@ -1,0 +1,90 @@
+//! `sinew colorize LINEART.png --scribbles S.png|S.json -o OUT.png`: argument parsing and glue.
+
+use crate::colorize::{self, ColorWeights, ColorizeOptions, FillMode, Scribbles};
+use crate::io;
+use anyhow::{Context, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Args, Debug)]
+pub struct ColorizeArgs {
+    /// The line art (PNG): lines on white or on transparency.
+    pub lineart: PathBuf,
+    /// The scribbles: an RGBA PNG layer of the same size (strokes on transparency; one handle
+    /// per color), or a JSON file of polylines (`{"strokes": [{"color", "width", "points"}]}`).
+    #[arg(long)]
+    pub scribbles: PathBuf,
+    /// The colored image to write (PNG).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// flat: each pixel takes its largest weight's color; soft: colors blended by weight.
+    #[arg(long, value_enum, default_value_t = FillMode::Flat)]
+    pub fill: FillMode,
+    /// Also write one mask PNG per scribble color into this folder (NN-rrggbb.png).
+    #[arg(long, value_name = "DIR")]
+    pub layers: Option<PathBuf>,
+    /// The weights' energy.
+    #[arg(long, value_enum, default_value_t = ColorWeights::Harmonic)]
+    pub weights: ColorWeights,
+    /// Lift scale: a full color change counts as S px.
+    #[arg(long, value_name = "S", default_value_t = colorize::DEFAULT_LIFT_SCALE)]
+    pub scale: f64,
+}
+
+/// Whether the scribble file is the JSON polyline format (by extension).
+fn is_json(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("json"))
+}
+
+pub fn run(args: &ColorizeArgs) -> Result<()> {
+    let start = Instant::now();
+    let options = ColorizeOptions {
+        scale: args.scale,
+        weights: args.weights,
+        fill: args.fill,
+        ..Default::default()
+    };
+    let lineart = io::load_png(&args.lineart)?;
+    let scribbles_path = args.scribbles.display();
+    let scribbles = if is_json(&args.scribbles) {
+        let text = std::fs::read_to_string(&args.scribbles)
+            .with_context(|| format!("{scribbles_path}: cannot read"))?;
+        Scribbles::from_json(&text, lineart.width(), lineart.height(), &options.scribbles)
+            .with_context(|| format!("{scribbles_path}"))?
+    } else {
+        let layer = io::load_png(&args.scribbles)?;
+        Scribbles::from_layer(&layer, &options.scribbles)
+            .with_context(|| format!("{scribbles_path}"))?
+    };
+    let result = colorize::colorize(&lineart, &scribbles, &options, args.layers.is_some())
+        .with_context(|| format!("{scribbles_path}"))?;
+    // Everything is computed; now write, each file atomically.
+    if let Some(dir) = &args.layers {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
+        for (k, (layer, color)) in result.layers.iter().zip(&result.palette).enumerate() {
+            let path = dir.join(format!("{k:02}-{}.png", colorize::scribbles::hex(*color)));
+            io::save_png(&path, layer)?;
+        }
+    }
+    io::save_png(&args.output, &result.image)?;
+    let s = &result.stats;
+    println!(
+        "colorized {}×{} px with {} colors: {} mesh vertices, {} triangles, {:.2} s",
+        lineart.width(),
+        lineart.height(),
+        result.palette.len(),
+        s.vertices,
+        s.triangles,
+        start.elapsed().as_secs_f64()
+    );
+    if s.scribble_pixels_on_lines > 0 {
+        println!(
+            "  {} scribble pixels lie on lines and were ignored",
+            s.scribble_pixels_on_lines
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,273 @@
+//! Scribble colorization: line art + a few colored scribbles → a colored drawing.
+//!
+//! In: the line art (RGBA8: lines on white or on transparency), [`Scribbles`] of the same size
+//! (a label per pixel, a palette) and [`ColorizeOptions`]. Out: [`Colorized`]: the colored
+//! image (line art on top), the fill alone, and optionally one mask layer per color.
+//!
+//! The method is content-aware weights (Jacobson, Baran, Popović & Sorkine 2011; Jacobson's
+//! thesis 2013 § 3.4 shows this very application), the same machinery `sinew rig
+//! --content-aware` uses, run over the image itself:
+//!
+//! 1. [`lineart`]: the drawing composited over white paper, and its ink per pixel.
+//! 2. [`scribbles`]: scribble pixels per color (layer or lyon-tessellated polylines); those
+//!    lying on a line are dropped (a line belongs to no region).
+//! 3. [`gap_closing`]: every line casts a fading ridge of ink, so small gaps read as hills
+//!    and one-pixel antialiased lines as walls.
+//! 4. [`image_mesh`]: an adaptive mesh (quadtree vertices, spade Delaunay): one vertex per
+//!    pixel along lines and scribble rims, big triangles over flat paper.
+//! 5. [`weights`]: the mesh lifted to (x, y, s·r, s·g, s·b) by [`crate::weights::lift`], one
+//!    harmonic (or bounded biharmonic) weight function per color, the color's scribble pixels
+//!    fixed at 1 and the other colors' at 0. Across a line the lifted mesh is long, so weights
+//!    stay in their region; through a gap of a few pixels the region's own scribble still
+//!    dominates, so a color boundary forms at the gap instead of a flood.
+//! 6. [`fill`]: weights interpolated to every pixel; flat (largest weight wins) or soft
+//!    (blended) colors; the line art on top.
+//!
+//! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
+//! [`synthetic`] draws test line art with known true colorings.
+
+pub mod fill;
+pub mod flood;
+pub mod gap_closing;
+pub mod image_mesh;
+pub mod lineart;
+pub mod score;
+pub mod scribbles;
+pub mod synthetic;
+pub mod weights;
+
+pub use fill::FillMode;
+pub use image_mesh::{ImageMesh, MeshOptions};
+pub use lineart::LineArt;
+pub use scribbles::{ScribbleError, ScribbleOptions, Scribbles};
+pub use weights::{ColorWeights, LiftedStiffness};
+
+use crate::weights::BbwOptions;
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+
+/// How to colorize. Every field has a documented default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ColorizeOptions {
+    /// Lift scale s: a full change of one color channel counts as s px. Large enough that
+    /// crossing a line costs more than going around inside a region, small enough to keep
+    /// the stiffness matrix well conditioned. Default [`DEFAULT_LIFT_SCALE`].
+    pub scale: f64,
+    /// A pixel whose ink (1 − luminance over white) reaches this is a line pixel: scribbles
+    /// there are ignored. Default 0.5.
+    pub line_threshold: f32,
+    /// Lines cast a ridge of ink fading to nothing over this many px before the lift
+    /// ([`gap_closing`]): a gap of g px keeps 1 − g / (2·fade) of the line's ink, so it
+    /// separates colors instead of letting one flood through. 0 = off. Default 4.
+    pub gap_closing_px: f64,
+    /// How the lifted mesh is measured. Default: edge stretch.
+    pub stiffness: LiftedStiffness,
+    /// Default: harmonic.
+    pub weights: ColorWeights,
+    /// Default: flat.
+    pub fill: FillMode,
+    pub mesh: MeshOptions,
+    pub scribbles: ScribbleOptions,
+    /// Used with `weights: bbw`.
+    pub bbw: BbwOptions,
+}
+
+/// The default lift scale, px per unit of color.
+pub const DEFAULT_LIFT_SCALE: f64 = 1000.0;
+
+impl Default for ColorizeOptions {
+    fn default() -> Self {
+        ColorizeOptions {
+            scale: DEFAULT_LIFT_SCALE,
+            line_threshold: 0.5,
+            gap_closing_px: 4.0,
+            stiffness: LiftedStiffness::EdgeStretch,
+            weights: ColorWeights::Harmonic,
+            fill: FillMode::Flat,
+            mesh: MeshOptions::default(),
+            scribbles: ScribbleOptions::default(),
+            bbw: BbwOptions::default(),
+        }
+    }
+}
+
+/// What was wrong with a colorization request.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ColorizeError {
+    #[error("the scribbles are {scribbles_w}×{scribbles_h} px but the line art is {art_w}×{art_h} px; they must match")]
+    SizeMismatch {
+        art_w: u32,
+        art_h: u32,
+        scribbles_w: u32,
+        scribbles_h: u32,
+    },
+    #[error("no scribbles: draw at least one colored stroke")]
+    NoScribbles,
+    #[error("scribble color #{0} has no pixel on the canvas")]
+    OffCanvas(String),
+    #[error("scribble color #{0} lies entirely on line pixels; draw it inside a region")]
+    OnLines(String),
+    #[error("invalid colorize option: {0}")]
+    InvalidOptions(String),
+    #[error("{0}")]
+    Mesh(#[from] image_mesh::ImageMeshError),
+    #[error("{0}")]
+    Weights(#[from] weights::ColorWeightError),
+}
+
+/// The result of a colorization.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Colorized {
+    /// The colored drawing, line art on top.
+    pub image: RgbaImage,
+    /// The fill alone (opaque).
+    pub fill_only: RgbaImage,
+    /// One mask layer per palette color when asked for; empty otherwise.
+    pub layers: Vec<RgbaImage>,
+    /// The scribble colors, in handle order.
+    pub palette: Vec<[u8; 3]>,
+    pub stats: ColorizeStats,
+}
+
+/// Sizes, for reports and benchmarks.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ColorizeStats {
+    pub pixels: usize,
+    pub vertices: usize,
+    pub triangles: usize,
+    /// Scribble pixels dropped because they lie on a line.
+    pub scribble_pixels_on_lines: usize,
+}
+
+/// The scribble labels with those on line pixels removed; fails when a color is left with
+/// no pixel.
+pub fn effective_labels(
+    art: &LineArt,
+    scribbles: &Scribbles,
+    line_threshold: f32,
+) -> Result<(Vec<u16>, usize), ColorizeError> {
+    if scribbles.colors.is_empty() {
+        return Err(ColorizeError::NoScribbles);
+    }
+    let before = scribbles.pixel_counts();
+    let mut dropped = 0;
+    let labels: Vec<u16> = scribbles
+        .labels
+        .iter()
+        .zip(&art.ink)
+        .map(|(&l, &ink)| {
+            if l > 0 && ink >= line_threshold {
+                dropped += 1;
+                0
+            } else {
+                l
+            }
+        })
+        .collect();
+    let mut after = vec![0usize; scribbles.colors.len()];
+    for &l in &labels {
+        if l > 0 {
+            after[l as usize - 1] += 1;
+        }
+    }
+    for (k, color) in scribbles.colors.iter().enumerate() {
+        if before[k] == 0 {
+            return Err(ColorizeError::OffCanvas(scribbles::hex(*color)));
+        }
+        if after[k] == 0 {
+            return Err(ColorizeError::OnLines(scribbles::hex(*color)));
+        }
+    }
+    Ok((labels, dropped))
+}
+
+/// Colorizes `lineart` from `scribbles`. With `want_layers`, also one mask per color.
+pub fn colorize(
+    lineart: &RgbaImage,
+    scribbles: &Scribbles,
+    options: &ColorizeOptions,
+    want_layers: bool,
+) -> Result<Colorized, ColorizeError> {
+    if (scribbles.width, scribbles.height) != lineart.dimensions() {
+        return Err(ColorizeError::SizeMismatch {
+            art_w: lineart.width(),
+            art_h: lineart.height(),
+            scribbles_w: scribbles.width,
+            scribbles_h: scribbles.height,
+        });
+    }
+    if !(options.scale.is_finite() && options.scale >= 0.0) {
+        return Err(ColorizeError::InvalidOptions(format!(
+            "the lift scale must be finite and non-negative, not {}",
+            options.scale
+        )));
+    }
+    if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
+        return Err(ColorizeError::InvalidOptions(format!(
+            "line_threshold must lie in (0, 1], not {}",
+            options.line_threshold
+        )));
+    }
+    if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
+        return Err(ColorizeError::InvalidOptions(format!(
+            "gap_closing_px must be finite and non-negative, not {}",
+            options.gap_closing_px
+        )));
+    }
+    let art = LineArt::new(lineart);
+    let (labels, dropped) = effective_labels(&art, scribbles, options.line_threshold)?;
+    // The lift and the mesh see the drawing with its gaps closed.
+    let closed = gap_closing::close_gaps(
+        &art.over_white,
+        art.width,
+        art.height,
+        options.gap_closing_px,
+    );
+    let mesh = ImageMesh::new(art.width, art.height, &closed, &labels, &options.mesh)?;
+    let m = scribbles.colors.len();
+    let weights = if m == 1 {
+        // One color: the whole drawing takes it; nothing to solve.
+        None
+    } else {
+        let vertex_pixels = mesh.pixel_indices();
+        let colors: Vec<[f64; 3]> = vertex_pixels
+            .iter()
+            .map(|&i| closed[i].map(|c| c as f64 / 255.0))
+            .collect();
+        let vertex_labels: Vec<u16> = vertex_pixels.iter().map(|&i| labels[i]).collect();
+        Some(weights::color_weights(
+            &mesh,
+            &colors,
+            &vertex_labels,
+            m,
+            &weights::ColorWeightOptions {
+                scale: options.scale,
+                stiffness: options.stiffness,
+                method: options.weights,
+                bbw: options.bbw.clone(),
+            },
+        )?)
+    };
+    let filled = fill::fill(
+        &mesh,
+        weights.as_ref(),
+        &scribbles.colors,
+        &art,
+        lineart,
+        options.fill,
+        want_layers,
+    );
+    Ok(Colorized {
+        image: filled.image,
+        fill_only: filled.fill_only,
+        layers: filled.layers,
+        palette: scribbles.colors.clone(),
+        stats: ColorizeStats {
+            pixels: art.pixel_count(),
+            vertices: mesh.vertex_count(),
+            triangles: mesh.triangles.len(),
+            scribble_pixels_on_lines: dropped,
+        },
+    })
+}

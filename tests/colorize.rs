@@ -1,0 +1,643 @@
+//! Scribble colorization on generated line art with known true colorings
+//! (`sinew::colorize::synthetic`): the score (share of non-line pixels within 16/255 of the
+//! truth) is ≥ 0.99 where the lines close every region, and clearly above the paint-bucket
+//! flood fill where they don't (gaps, undrawn color boundaries); bad input; the command end to
+//! end; golden images of a few results.
+//!
+//! Golden images follow `tests/golden.rs`: `golden/colorize-*.png`, compared with a largest
+//! channel difference of [`MAX_CHANNEL_DIFF`] on fewer than [`MAX_DIFFERING_SHARE`] of the
+//! pixels (a flat fill flips whole pixels where two weights tie, so a few may differ across
+//! machines); failures write `target/golden-failures/<name>.{actual,diff}.png`;
+//! `SINEW_BLESS=1 cargo test --test colorize` rewrites them (look at every one before
+//! committing).
+
+use image::{Rgba, RgbaImage};
+use sinew::colorize::flood::flood_fill;
+use sinew::colorize::score::score;
+use sinew::colorize::synthetic::{scene, Scene, SceneSpec};
+use sinew::colorize::{
+    self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
+    ScribbleOptions, Scribbles,
+};
+use sinew::io::{load_png, save_png};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn scribbles(s: &Scene) -> Scribbles {
+    Scribbles::from_strokes(
+        &s.strokes,
+        s.lineart.width(),
+        s.lineart.height(),
+        &ScribbleOptions::default(),
+    )
+    .expect("the scene's strokes rasterize")
+}
+
+/// (score of the colorization, score of the flood fill).
+fn scores(s: &Scene, options: &ColorizeOptions) -> (f64, f64) {
+    let scribbles = scribbles(s);
+    let result = colorize::colorize(&s.lineart, &scribbles, options, false).expect("colorizes");
+    let art = LineArt::new(&s.lineart);
+    let (labels, _) = colorize::effective_labels(&art, &scribbles, options.line_threshold)
+        .expect("scribbles off the lines");
+    let flood = flood_fill(
+        art.width,
+        art.height,
+        &art.line_mask(options.line_threshold),
+        &labels,
+        &scribbles.colors,
+    );
+    let flood = colorize::fill::with_lines_on_top(&flood, &s.lineart, art.opaque);
+    (
+        score(&result.image, &s.truth, &s.is_line),
+        score(&flood, &s.truth, &s.is_line),
+    )
+}
+
+fn closed(spec: SceneSpec, what: &str) {
+    let s = scene(&spec);
+    let (ours, flood) = scores(&s, &ColorizeOptions::default());
+    println!("{what}: weights {ours:.4}, flood fill {flood:.4}");
+    assert!(ours >= 0.99, "{what}: score {ours:.4} < 0.99");
+}
+
+#[test]
+fn closed_shapes_black_lines_on_white() {
+    closed(SceneSpec::default(), "closed, black on white");
+}
+
+#[test]
+fn closed_shapes_thin_gray_antialiased_lines() {
+    closed(
+        SceneSpec {
+            line_width: 1.5,
+            line_gray: 80,
+            shapes: 6,
+            ..Default::default()
+        },
+        "closed, thin gray lines",
+    );
+}
+
+#[test]
+fn closed_shapes_on_transparency() {
+    closed(
+        SceneSpec {
+            transparent: true,
+            shapes: 5,
+            ..Default::default()
+        },
+        "closed, on transparency",
+    );
+}
+
+#[test]
+fn closed_shapes_with_aliased_lines() {
+    closed(
+        SceneSpec {
+            antialias: false,
+            line_width: 2.0,
+            ..Default::default()
+        },
+        "closed, aliased lines",
+    );
+}
+
+#[test]
+fn scribbles_touching_and_crossing_lines() {
+    // Every shape's scribble is extended rightwards to end on its outline's right side: its
+    // last pixels lie on the line (dropped as handle pixels) and the rest touch the line.
+    let spec = SceneSpec::default();
+    let mut s = scene(&spec);
+    let size = spec.size as f64;
+    let margin = size / 8.0;
+    let cell = (size - 2.0 * margin) / 2.0;
+    for stroke in s.strokes.iter_mut().skip(1) {
+        // Shapes sit in a 2 × 2 grid; extend each stroke right to the outline's x.
+        let [x0, y] = stroke.points[0];
+        let cx = (stroke.points[0][0] + stroke.points[1][0]) / 2.0;
+        let col = ((cx - margin) / cell).floor();
+        let right = margin + cell * (col + 0.5) + cell * 0.36;
+        stroke.points = vec![[x0, y], [right, y]];
+    }
+    let (ours, flood) = scores(&s, &ColorizeOptions::default());
+    println!("scribbles touching lines: weights {ours:.4}, flood fill {flood:.4}");
+    assert!(ours >= 0.99, "score {ours:.4}");
+}
+
+#[test]
+fn edge_stretch_holds_thin_lines_where_the_5d_cotangent_laplacian_leaks() {
+    // Why `LiftedStiffness::EdgeStretch` is the default: on 1.5 px antialiased curves the 5D
+    // cotangent weights of the lifted needle triangles let colors through.
+    let s = scene(&SceneSpec {
+        line_width: 1.5,
+        shapes: 6,
+        ..Default::default()
+    });
+    let with = |stiffness| {
+        scores(
+            &s,
+            &ColorizeOptions {
+                stiffness,
+                ..Default::default()
+            },
+        )
+        .0
+    };
+    let (stretch, cotangent) = (
+        with(LiftedStiffness::EdgeStretch),
+        with(LiftedStiffness::Cotangent),
+    );
+    println!("thin black lines: edge stretch {stretch:.4}, 5D cotangent {cotangent:.4}");
+    assert!(stretch >= 0.99, "edge stretch {stretch:.4}");
+    assert!(cotangent < stretch, "5D cotangent {cotangent:.4}");
+}
+
+fn gapped(gap_px: f32) -> (f64, f64) {
+    let s = scene(&SceneSpec {
+        gap_px: Some(gap_px),
+        ..Default::default()
+    });
+    scores(&s, &ColorizeOptions::default())
+}
+
+#[test]
+fn gaps_of_two_to_six_px_form_a_boundary_instead_of_a_flood() {
+    // The background's bucket runs through every gap into every shape (a fifth of the
+    // non-line pixels); the weights keep each shape's color inside it.
+    for gap in [2.0, 4.0, 6.0] {
+        let (ours, flood) = gapped(gap);
+        println!("gap {gap} px: weights {ours:.4}, flood fill {flood:.4}");
+        assert!(
+            ours >= 0.99 && ours >= flood + 0.1,
+            "gap {gap} px: weights {ours:.4} vs flood {flood:.4}"
+        );
+    }
+}
+
+#[test]
+fn an_undrawn_color_boundary_splits_between_the_scribbles() {
+    let s = scene(&SceneSpec {
+        split_background: true,
+        ..Default::default()
+    });
+    let (ours, flood) = scores(&s, &ColorizeOptions::default());
+    println!("undrawn boundary: weights {ours:.4}, flood fill {flood:.4}");
+    assert!(
+        ours >= flood + 0.2 && ours >= 0.9,
+        "weights {ours:.4} vs flood {flood:.4}"
+    );
+}
+
+#[test]
+fn bounded_biharmonic_weights_colorize_too() {
+    let s = scene(&SceneSpec {
+        size: 128,
+        shapes: 4,
+        line_width: 2.0,
+        ..Default::default()
+    });
+    let options = ColorizeOptions {
+        weights: ColorWeights::Bbw,
+        ..Default::default()
+    };
+    let (ours, flood) = scores(&s, &options);
+    println!("bbw, closed 128²: weights {ours:.4}, flood fill {flood:.4}");
+    assert!(ours >= 0.99, "score {ours:.4}");
+}
+
+#[test]
+fn soft_fill_blends_and_layers_partition_the_image() {
+    let s = scene(&SceneSpec {
+        size: 128,
+        gap_px: Some(4.0),
+        ..Default::default()
+    });
+    let scribbles = scribbles(&s);
+    for mode in [FillMode::Flat, FillMode::Soft] {
+        let options = ColorizeOptions {
+            fill: mode,
+            ..Default::default()
+        };
+        let result = colorize::colorize(&s.lineart, &scribbles, &options, true).unwrap();
+        assert_eq!(result.layers.len(), scribbles.colors.len());
+        for i in 0..(128 * 128) as u32 {
+            let (x, y) = (i % 128, i / 128);
+            let alphas: Vec<u32> = result
+                .layers
+                .iter()
+                .map(|l| l.get_pixel(x, y)[3] as u32)
+                .collect();
+            let sum: u32 = alphas.iter().sum();
+            match mode {
+                FillMode::Flat => {
+                    assert_eq!(sum, 255, "pixel ({x}, {y}): {alphas:?}");
+                    assert_eq!(alphas.iter().filter(|&&a| a == 255).count(), 1);
+                }
+                // Each alpha is rounded on its own.
+                FillMode::Soft => assert!(
+                    sum.abs_diff(255) <= alphas.len() as u32,
+                    "pixel ({x}, {y}): {alphas:?}"
+                ),
+            }
+        }
+        // A soft fill blends near the gaps and is flat far from them: blended pixels exist
+        // but are a minority.
+        if mode == FillMode::Soft {
+            let pure = result
+                .fill_only
+                .pixels()
+                .filter(|p| scribbles.colors.iter().any(|c| c[..] == p.0[..3]))
+                .count();
+            let total = 128 * 128;
+            assert!(pure < total, "soft fill is not blended anywhere");
+        }
+    }
+}
+
+#[test]
+fn one_color_takes_the_whole_drawing() {
+    let s = scene(&SceneSpec {
+        size: 64,
+        shapes: 1,
+        ..Default::default()
+    });
+    let mut strokes = s.strokes.clone();
+    strokes.truncate(1);
+    let scribbles = Scribbles::from_strokes(&strokes, 64, 64, &ScribbleOptions::default()).unwrap();
+    let result = colorize::colorize(&s.lineart, &scribbles, &ColorizeOptions::default(), false)
+        .expect("one color is fine");
+    let c = scribbles.colors[0];
+    assert!(result
+        .fill_only
+        .pixels()
+        .all(|p| p.0 == [c[0], c[1], c[2], 255]));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let s = scene(&SceneSpec {
+        size: 64,
+        shapes: 1,
+        ..Default::default()
+    });
+    let o = ColorizeOptions::default();
+    // Sizes differ.
+    let small = Scribbles::from_strokes(&s.strokes, 32, 64, &ScribbleOptions::default()).unwrap();
+    let e = colorize::colorize(&s.lineart, &small, &o, false).unwrap_err();
+    assert!(matches!(e, ColorizeError::SizeMismatch { .. }), "{e}");
+    assert!(e.to_string().contains("32×64"), "{e}");
+    // No scribbles.
+    let none = Scribbles::from_layer(&RgbaImage::new(64, 64), &ScribbleOptions::default()).unwrap();
+    assert_eq!(
+        colorize::colorize(&s.lineart, &none, &o, false).unwrap_err(),
+        ColorizeError::NoScribbles
+    );
+    // A scribble entirely on a line: the other color is fine, this one is named.
+    let art = LineArt::new(&s.lineart);
+    let line_pixel = art.ink.iter().position(|&k| k >= 0.99).unwrap();
+    let mut layer = RgbaImage::new(64, 64);
+    layer.put_pixel(2, 2, Rgba([255, 0, 0, 255]));
+    layer.put_pixel(
+        (line_pixel % 64) as u32,
+        (line_pixel / 64) as u32,
+        Rgba([0, 0, 255, 255]),
+    );
+    let on_line = Scribbles::from_layer(&layer, &ScribbleOptions::default()).unwrap();
+    let e = colorize::colorize(&s.lineart, &on_line, &o, false).unwrap_err();
+    assert_eq!(e, ColorizeError::OnLines("0000ff".into()));
+    // A stroke entirely off the canvas.
+    let off = Scribbles::from_json(
+        r##"{"strokes": [{"color": "#ff0000", "width": 3, "points": [[2, 2]]},
+                         {"color": "#00ff00", "width": 3, "points": [[-50, -50]]}]}"##,
+        64,
+        64,
+        &ScribbleOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(
+        colorize::colorize(&s.lineart, &off, &o, false).unwrap_err(),
+        ColorizeError::OffCanvas("00ff00".into())
+    );
+    // Options.
+    for scale in [f64::NAN, -1.0] {
+        let bad = ColorizeOptions {
+            scale,
+            ..Default::default()
+        };
+        assert!(matches!(
+            colorize::colorize(&s.lineart, &scribbles(&s), &bad, false),
+            Err(ColorizeError::InvalidOptions(_))
+        ));
+    }
+}
+
+#[test]
+fn results_are_deterministic() {
+    let s = scene(&SceneSpec {
+        size: 128,
+        gap_px: Some(3.0),
+        ..Default::default()
+    });
+    let sc = scribbles(&s);
+    let o = ColorizeOptions {
+        fill: FillMode::Soft,
+        ..Default::default()
+    };
+    let a = colorize::colorize(&s.lineart, &sc, &o, false).unwrap();
+    let b = colorize::colorize(&s.lineart, &sc, &o, false).unwrap();
+    assert_eq!(a.image, b.image);
+}
+
+// ---- the command -------------------------------------------------------------------------
+
+const EXIT_BAD_INPUT: i32 = 2;
+
+fn sinew(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .output()
+        .expect("run sinew")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinew-colorize-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The scene's scribbles as an RGBA layer (colored strokes on transparency).
+fn scribble_layer(sc: &Scribbles) -> RgbaImage {
+    RgbaImage::from_fn(sc.width, sc.height, |x, y| {
+        match sc.labels[(y * sc.width + x) as usize] {
+            0 => Rgba([0, 0, 0, 0]),
+            l => {
+                let c = sc.colors[l as usize - 1];
+                Rgba([c[0], c[1], c[2], 255])
+            }
+        }
+    })
+}
+
+#[test]
+fn the_command_colors_from_a_layer_or_json_and_writes_layers() {
+    let dir = scratch("ok");
+    let sc = scene(&SceneSpec {
+        size: 128,
+        ..Default::default()
+    });
+    let (art, layer, json, out, out2, masks) = (
+        dir.join("art.png"),
+        dir.join("s.png"),
+        dir.join("s.json"),
+        dir.join("out.png"),
+        dir.join("out2.png"),
+        dir.join("masks"),
+    );
+    save_png(&art, &sc.lineart).unwrap();
+    save_png(&layer, &scribble_layer(&scribbles(&sc))).unwrap();
+    let file = serde_json::json!({ "strokes": sc.strokes });
+    std::fs::write(&json, file.to_string()).unwrap();
+    let run = sinew(&[
+        "colorize",
+        s(&art),
+        "--scribbles",
+        s(&layer),
+        "-o",
+        s(&out),
+        "--layers",
+        s(&masks),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let from_layer = load_png(&out).unwrap();
+    assert!(score(&from_layer, &sc.truth, &sc.is_line) >= 0.99);
+    let masks: Vec<_> = std::fs::read_dir(&masks).unwrap().collect();
+    assert_eq!(masks.len(), sc.colors);
+    let run = sinew(&[
+        "colorize",
+        s(&art),
+        "--scribbles",
+        s(&json),
+        "-o",
+        s(&out2),
+        "--fill",
+        "soft",
+        "--scale",
+        "500",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(load_png(&out2).unwrap().dimensions() == (128, 128));
+}
+
+/// Runs a command that must fail on bad input: one line, exit 2, no output file.
+fn assert_bad_input(args: &[&str], output: &Path, expect_in_message: &str) {
+    let out = sinew(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_BAD_INPUT),
+        "{args:?}: {stderr}"
+    );
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(expect_in_message),
+        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
+    );
+    assert!(!output.exists(), "{args:?} wrote {}", output.display());
+}
+
+#[test]
+fn the_command_rejects_bad_input() {
+    let dir = scratch("bad");
+    let sc = scene(&SceneSpec {
+        size: 64,
+        shapes: 1,
+        ..Default::default()
+    });
+    let (art, empty, small, bad_json, out) = (
+        dir.join("art.png"),
+        dir.join("empty.png"),
+        dir.join("small.png"),
+        dir.join("bad.json"),
+        dir.join("out.png"),
+    );
+    save_png(&art, &sc.lineart).unwrap();
+    save_png(&empty, &RgbaImage::new(64, 64)).unwrap();
+    save_png(&small, &RgbaImage::new(32, 32)).unwrap();
+    std::fs::write(&bad_json, "{\"strokes\": [{\"color\": \"#12\"}]}").unwrap();
+    let o = s(&out);
+    assert_bad_input(
+        &["colorize", s(&art), "--scribbles", s(&empty), "-o", o],
+        &out,
+        "no scribbles",
+    );
+    assert_bad_input(
+        &["colorize", s(&art), "--scribbles", s(&small), "-o", o],
+        &out,
+        "must match",
+    );
+    assert_bad_input(
+        &["colorize", s(&art), "--scribbles", s(&bad_json), "-o", o],
+        &out,
+        "bad.json",
+    );
+    assert_bad_input(
+        &[
+            "colorize",
+            s(&empty),
+            "--scribbles",
+            s(&dir.join("nothing.png")),
+            "-o",
+            o,
+        ],
+        &out,
+        "nothing.png",
+    );
+    assert_bad_input(
+        &[
+            "colorize",
+            s(&art),
+            "--scribbles",
+            s(&art),
+            "-o",
+            o,
+            "--scale=-3",
+        ],
+        &out,
+        "scale",
+    );
+}
+
+// ---- golden images -----------------------------------------------------------------------
+
+/// Largest channel difference accepted on a pixel, of 255.
+const MAX_CHANNEL_DIFF: u8 = 2;
+/// Share of pixels allowed to differ by more (ties flipping in a flat fill).
+const MAX_DIFFERING_SHARE: f64 = 0.001;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn failures_dir() -> PathBuf {
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"))
+        .join("golden-failures");
+    std::fs::create_dir_all(&dir).expect("creates the failures folder");
+    dir
+}
+
+fn check_golden(name: &str, actual: &RgbaImage) {
+    let golden = root().join("golden").join(format!("{name}.png"));
+    if std::env::var("SINEW_BLESS").is_ok_and(|v| v == "1") {
+        save_png(&golden, actual).expect("writes the golden image");
+        eprintln!("blessed {}", golden.display());
+        return;
+    }
+    let expected = load_png(&golden).unwrap_or_else(|e| {
+        panic!("{e}: no golden image for '{name}'; review it and bless with SINEW_BLESS=1 cargo test --test colorize")
+    });
+    let differing = if actual.dimensions() == expected.dimensions() {
+        actual
+            .pixels()
+            .zip(expected.pixels())
+            .filter(|(a, b)| (0..4).any(|k| a[k].abs_diff(b[k]) > MAX_CHANNEL_DIFF))
+            .count()
+    } else {
+        usize::MAX
+    };
+    let share = differing as f64 / (expected.len() / 4).max(1) as f64;
+    if share <= MAX_DIFFERING_SHARE {
+        return;
+    }
+    let out = failures_dir();
+    let actual_path = out.join(format!("{name}.actual.png"));
+    save_png(&actual_path, actual).expect("writes the actual image");
+    let diff_path = out.join(format!("{name}.diff.png"));
+    if actual.dimensions() == expected.dimensions() {
+        let diff = RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
+            let (a, b) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
+            let d = (0..4).map(|k| a[k].abs_diff(b[k])).max().unwrap_or(0);
+            let v = (d as u16 * 8).min(255) as u8;
+            Rgba([v, v, v, 255])
+        });
+        save_png(&diff_path, &diff).expect("writes the diff");
+    }
+    panic!(
+        "'{name}' differs from {} on {:.3}% of pixels (allowed {:.3}%); actual: {}, diff: {}",
+        golden.display(),
+        100.0 * share,
+        100.0 * MAX_DIFFERING_SHARE,
+        actual_path.display(),
+        diff_path.display()
+    );
+}
+
+#[test]
+fn golden_colorizations() {
+    let cases = [
+        (
+            "colorize-closed-flat",
+            SceneSpec {
+                size: 192,
+                shapes: 6,
+                ..Default::default()
+            },
+            FillMode::Flat,
+        ),
+        (
+            "colorize-gaps-flat",
+            SceneSpec {
+                size: 192,
+                gap_px: Some(5.0),
+                ..Default::default()
+            },
+            FillMode::Flat,
+        ),
+        (
+            "colorize-gaps-soft",
+            SceneSpec {
+                size: 192,
+                gap_px: Some(5.0),
+                ..Default::default()
+            },
+            FillMode::Soft,
+        ),
+        (
+            "colorize-undrawn-transparent",
+            SceneSpec {
+                size: 192,
+                split_background: true,
+                transparent: true,
+                line_width: 2.0,
+                line_gray: 60,
+                ..Default::default()
+            },
+            FillMode::Flat,
+        ),
+    ];
+    for (name, spec, fill) in cases {
+        let sc = scene(&spec);
+        let options = ColorizeOptions {
+            fill,
+            ..Default::default()
+        };
+        let result = colorize::colorize(&sc.lineart, &scribbles(&sc), &options, false).unwrap();
+        check_golden(name, &result.image);
+    }
+}
