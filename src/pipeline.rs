@@ -79,6 +79,8 @@ pub enum PipelineError {
     Pose(#[from] PoseError),
     #[error(transparent)]
     Ik(#[from] crate::ik::IkError),
+    #[error("baking a rig with bone IK constraints ({0}) is not supported: played back, the keys would be constrained a second time")]
+    BakeBoneIk(String),
     #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
     UnknownWeightHandle { part: String, handle: String },
     #[error("canvas {0:?} px is too large to draw")]

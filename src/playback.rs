@@ -207,6 +207,10 @@ pub fn bake(
 ) -> Result<Animation, PipelineError> {
     use crate::anim::timeline::{BoneTimelines, Key, PointTimelines};
     let handles = &scene.doc.handles;
+    if !handles.ik.is_empty() {
+        let names: Vec<&str> = handles.ik.iter().map(|c| c.name.as_str()).collect();
+        return Err(PipelineError::BakeBoneIk(names.join(", ")));
+    }
     let poses: Vec<Pose> = times_s
         .iter()
         .map(|&t| animation.sample(t, false))

@@ -156,6 +156,8 @@ pub enum SpineError {
     },
     #[error("the transformation of '{0}' is singular")]
     Singular(String),
+    #[error("the rig has bone IK constraints ({0}); exporting them as Spine IK constraints is not supported yet")]
+    BoneIkConstraints(String),
     #[error(transparent)]
     Anim(#[from] AnimError),
     #[error("baking: {0}")]
@@ -236,6 +238,12 @@ pub fn export_spine(
     }
     if let Some(n) = options.max_vertices.filter(|&n| n < 3) {
         return Err(SpineError::MaxVertices(n));
+    }
+    // Forward kinematics applies the constraints on both sides of the bake's comparison, so
+    // their motion would neither bake nor export: refuse rather than play differently.
+    if !doc.handles.ik.is_empty() {
+        let names: Vec<&str> = doc.handles.ik.iter().map(|c| c.name.as_str()).collect();
+        return Err(SpineError::BoneIkConstraints(names.join(", ")));
     }
     check_name("file", name, true)?;
     check_name("root bone", &options.root_bone, false)?;
