@@ -220,22 +220,33 @@ pub fn bake(
         .iter()
         .map(|t| crate::rig::pose::pose_from_transforms(handles, t))
         .collect::<Result<_, _>>()?;
-    fn key<V>(time: f64, value: V) -> Key<V> {
-        Key {
-            time,
-            value,
-            curve: crate::anim::Curve::Linear,
-        }
-    }
-    let unwrap = |values: Vec<f64>| -> Vec<f64> {
-        let mut out: Vec<f64> = Vec::with_capacity(values.len());
-        for v in values {
-            out.push(match out.last() {
-                Some(&previous) => previous + ((v - previous + 180.0).rem_euclid(360.0) - 180.0),
-                None => v,
-            });
-        }
-        out
+    // One linear key per frame time.
+    let keys = |values: &mut dyn Iterator<Item = [f64; 2]>| -> Option<Vec<Key<[f64; 2]>>> {
+        Some(
+            times_s
+                .iter()
+                .zip(values)
+                .map(|(&t, v)| linear_key(t, v))
+                .collect(),
+        )
+    };
+    // Rotations unwrapped: each key within 180° of the one before.
+    let rotations = |values: &mut dyn Iterator<Item = f64>| -> Option<Vec<Key<f64>>> {
+        let mut previous: Option<f64> = None;
+        Some(
+            times_s
+                .iter()
+                .zip(values)
+                .map(|(&t, v)| {
+                    let v = match previous {
+                        Some(p) => p + ((v - p + 180.0).rem_euclid(360.0) - 180.0),
+                        None => v,
+                    };
+                    previous = Some(v);
+                    linear_key(t, v)
+                })
+                .collect(),
+        )
     };
     let mut out = Animation {
         parts: animation.parts.clone(),
@@ -244,57 +255,27 @@ pub fn bake(
     };
     for bone in &handles.bones {
         let pose = |k: usize| &baked[k].bones[&bone.name];
-        let rotate = unwrap((0..baked.len()).map(|k| pose(k).rotate).collect());
-        let keys2 = |f: &dyn Fn(usize) -> [f64; 2]| {
-            Some(
-                times_s
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &t)| key(t, f(k)))
-                    .collect(),
-            )
-        };
+        let frames = 0..baked.len();
         out.bones.insert(
             bone.name.clone(),
             BoneTimelines {
-                rotate: Some(
-                    times_s
-                        .iter()
-                        .zip(rotate)
-                        .map(|(&t, r)| key(t, r))
-                        .collect(),
-                ),
-                translate: keys2(&|k| pose(k).translate),
-                scale: keys2(&|k| pose(k).scale),
-                shear: keys2(&|k| pose(k).shear),
+                rotate: rotations(&mut frames.clone().map(|k| pose(k).rotate)),
+                translate: keys(&mut frames.clone().map(|k| pose(k).translate)),
+                scale: keys(&mut frames.clone().map(|k| pose(k).scale)),
+                shear: keys(&mut frames.map(|k| pose(k).shear)),
             },
         );
     }
     for point in &handles.points {
         let pose = |k: usize| &baked[k].points[&point.name];
-        let rotate = unwrap((0..baked.len()).map(|k| pose(k).rotate).collect());
-        let keys2 = |f: &dyn Fn(usize) -> [f64; 2]| {
-            Some(
-                times_s
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &t)| key(t, f(k)))
-                    .collect(),
-            )
-        };
+        let frames = 0..baked.len();
         out.points.insert(
             point.name.clone(),
             PointTimelines {
-                translate: keys2(&|k| pose(k).translate),
-                rotate: Some(
-                    times_s
-                        .iter()
-                        .zip(rotate)
-                        .map(|(&t, r)| key(t, r))
-                        .collect(),
-                ),
-                scale: keys2(&|k| pose(k).scale),
-                shear: keys2(&|k| pose(k).shear),
+                translate: keys(&mut frames.clone().map(|k| pose(k).translate)),
+                rotate: rotations(&mut frames.clone().map(|k| pose(k).rotate)),
+                scale: keys(&mut frames.clone().map(|k| pose(k).scale)),
+                shear: keys(&mut frames.map(|k| pose(k).shear)),
             },
         );
     }
@@ -304,11 +285,19 @@ pub fn bake(
             times_s
                 .iter()
                 .zip(&baked)
-                .map(|(&t, pose)| key(t, pose.cages[&cage.name].polygon.clone()))
+                .map(|(&t, pose)| linear_key(t, pose.cages[&cage.name].polygon.clone()))
                 .collect(),
         );
     }
     Ok(out)
+}
+
+fn linear_key<V>(time: f64, value: V) -> crate::anim::timeline::Key<V> {
+    crate::anim::timeline::Key {
+        time,
+        value,
+        curve: crate::anim::Curve::Linear,
+    }
 }
 
 #[cfg(test)]
