@@ -5,6 +5,9 @@
 //! `sinew autorig` → `sinew rig --handles` → `sinew pose` with no manual step, and a golden
 //! image of the proposed rig over the character.
 
+mod command;
+
+use command::{scratch, sinew};
 use image::RgbaImage;
 use sinew::autorig::shape::{segments_touch, Shape};
 use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
@@ -14,7 +17,6 @@ use sinew::trace::TraceOptions;
 use std::collections::HashMap;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use tiny_skia::{Color, FillRule, LineCap, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
 // ---------------------------------------------------------------- generated shapes
@@ -715,20 +717,6 @@ fn proposals_are_deterministic() {
 }
 
 // ---------------------------------------------------------------- end to end and golden
-
-fn sinew(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_sinew"))
-        .args(args)
-        .output()
-        .expect("runs sinew")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-autorig-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn ok(out: &std::process::Output, what: &str) {
     assert!(

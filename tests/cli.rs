@@ -1,51 +1,12 @@
 //! The `sinew` command end to end: it rigs and poses, and bad input ends in one line on stderr,
 //! exit code 2, no panic and no output file (an existing one left as it was).
 
+mod command;
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use command::{assert_bad_input, s, scratch, sinew};
 
-const EXIT_BAD_INPUT: i32 = 2;
-
-fn sinew(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sinew"))
-        .args(args)
-        .output()
-        .expect("run sinew")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Runs a command that must fail on bad input, and checks how.
-fn assert_bad_input(args: &[&str], expect_in_message: &str) {
-    let out = sinew(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(EXIT_BAD_INPUT),
-        "{args:?}: stderr {stderr}"
-    );
-    assert_eq!(
-        stderr.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {stderr}"
-    );
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    assert!(
-        stderr.contains(expect_in_message),
-        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
-    );
-}
+use std::path::PathBuf;
 
 #[test]
 fn rig_then_pose_writes_rig_preview_image_and_vertices() {

@@ -11,6 +11,9 @@
 //! `SINEW_BLESS=1 cargo test --test colorize` rewrites them (look at every one before
 //! committing).
 
+mod command;
+
+use command::{s, scratch, sinew};
 use image::{Rgba, RgbaImage};
 use sinew::colorize::flood::flood_fill;
 use sinew::colorize::score::score;
@@ -21,7 +24,6 @@ use sinew::colorize::{
 };
 use sinew::io::{load_png, save_png};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 fn scribbles(s: &Scene) -> Scribbles {
     Scribbles::from_strokes(
@@ -351,26 +353,6 @@ fn results_are_deterministic() {
 
 // ---- the command -------------------------------------------------------------------------
 
-const EXIT_BAD_INPUT: i32 = 2;
-
-fn sinew(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sinew"))
-        .args(args)
-        .output()
-        .expect("run sinew")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-colorize-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
 /// The scene's scribbles as an RGBA layer (colored strokes on transparency).
 fn scribble_layer(sc: &Scribbles) -> RgbaImage {
     RgbaImage::from_fn(sc.width, sc.height, |x, y| {
@@ -444,19 +426,7 @@ fn the_command_colors_from_a_layer_or_json_and_writes_layers() {
 
 /// Runs a command that must fail on bad input: one line, exit 2, no output file.
 fn assert_bad_input(args: &[&str], output: &Path, expect_in_message: &str) {
-    let out = sinew(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(EXIT_BAD_INPUT),
-        "{args:?}: {stderr}"
-    );
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    assert!(
-        stderr.contains(expect_in_message),
-        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
-    );
+    command::assert_bad_input(args, expect_in_message);
     assert!(!output.exists(), "{args:?} wrote {}", output.display());
 }
 

@@ -2,28 +2,10 @@
 //! new (or half-written) in the output folder. The runtime checks of good exports are in
 //! tests/spine_runtime.rs.
 
+mod command;
+
+use command::{assert_bad_input, s, scratch, sinew};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-const EXIT_BAD_INPUT: i32 = 2;
-
-fn sinew(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_sinew"))
-        .args(args)
-        .output()
-        .expect("run sinew")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-spine-bad-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// A 64×64 layer with an opaque rectangle, saved as `dir/name.png`.
 fn layer(dir: &Path, name: &str) -> PathBuf {
@@ -66,19 +48,7 @@ fn assert_refused(args: &[&str], out: &Path, expect_in_message: &str) {
     let before: Vec<_> = std::fs::read_dir(out)
         .map(|d| d.map(|e| e.unwrap().file_name()).collect())
         .unwrap_or_default();
-    let result = sinew(args);
-    let stderr = String::from_utf8_lossy(&result.stderr);
-    assert_eq!(
-        result.status.code(),
-        Some(EXIT_BAD_INPUT),
-        "{args:?}: {stderr}"
-    );
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{args:?}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
-    assert!(
-        stderr.contains(expect_in_message),
-        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
-    );
+    assert_bad_input(args, expect_in_message);
     let after: Vec<_> = std::fs::read_dir(out)
         .map(|d| d.map(|e| e.unwrap().file_name()).collect())
         .unwrap_or_default();

@@ -9,6 +9,9 @@
 //! generated rig with two skeletons, a point, a cage, a region, colour, visibility and
 //! draw-order keys, stepped keys and timelines that start after 0 s.
 
+mod command;
+
+use command::{s, scratch};
 use serde::Deserialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::export::spine::bake::bake_times;
@@ -32,26 +35,12 @@ const TIMES_PER_ANIMATION: usize = 60;
 const CLI_TIMES_PER_ANIMATION: usize = 5;
 
 fn sinew(args: &[&str]) {
-    let out = Command::new(env!("CARGO_BIN_EXE_sinew"))
-        .args(args)
-        .output()
-        .expect("run sinew");
+    let out = command::sinew(args);
     assert!(
         out.status.success(),
         "sinew {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-spine-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[derive(Deserialize)]

@@ -1,0 +1,60 @@
+//! Running the `sinew` binary from integration tests: the command, scratch folders, and the
+//! bad-input contract (exit code 2, one line on stderr, no panic).
+//!
+//! Kept apart from `tests/common`, which benchmarks include too: `CARGO_BIN_EXE_sinew` exists
+//! only when integration tests are compiled.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The exit code of every bad-input failure.
+pub const EXIT_BAD_INPUT: i32 = 2;
+
+/// Runs the binary with `args`.
+pub fn sinew(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .output()
+        .expect("run sinew")
+}
+
+/// An empty folder of its own for one test (named after the test file and `name`).
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "sinew-{}-{name}-{}",
+        module_path!().replace("::", "-"),
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Runs a command that must fail on bad input, checks the contract and that the message
+/// mentions `expect_in_message`; returns stderr.
+pub fn assert_bad_input(args: &[&str], expect_in_message: &str) -> String {
+    let out = sinew(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_BAD_INPUT),
+        "{args:?}: stderr {stderr}"
+    );
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(expect_in_message),
+        "{args:?}: '{stderr}' lacks '{expect_in_message}'"
+    );
+    stderr
+}
