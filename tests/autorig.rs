@@ -6,6 +6,7 @@
 //! image of the proposed rig over the character.
 
 mod command;
+mod common;
 
 use command::{scratch, sinew};
 use image::RgbaImage;
@@ -908,10 +909,6 @@ fn autorig_bad_input_is_one_line_and_exit_2() {
     assert!(!out_path.exists());
 }
 
-/// Golden tolerance, as in tests/golden.rs: premultiplied max channel difference and PSNR.
-const MAX_CHANNEL_DIFF: u8 = 2;
-const MIN_PSNR_DB: f64 = 50.0;
-
 #[test]
 fn proposed_rig_over_the_character_matches_golden() {
     let image = character_flat();
@@ -923,24 +920,10 @@ fn proposed_rig_over_the_character_matches_golden() {
     };
     let h = propose(&[("flat", &image)], &options);
     let actual = sinew::autorig::draw_preview(&[&image], &h).unwrap();
-    let golden = root().join("golden/autorig_character.png");
-    if std::env::var("SINEW_BLESS").is_ok_and(|v| v == "1") {
-        sinew::io::save_png(&golden, &actual).unwrap();
-        return;
-    }
-    let expected = load(&golden);
-    let max = sinew::render::max_channel_diff(
-        &sinew::render::premultiplied(&actual),
-        &sinew::render::premultiplied(&expected),
+    common::golden::check(
+        "autorig_character",
+        &actual,
+        "autorig",
+        common::golden::premultiplied_tolerance,
     );
-    let psnr = sinew::render::psnr_premultiplied(&actual, &expected);
-    if max > MAX_CHANNEL_DIFF || psnr < MIN_PSNR_DB {
-        let out = std::env::temp_dir().join("autorig_character.actual.png");
-        sinew::io::save_png(&out, &actual).unwrap();
-        panic!(
-            "the proposed rig differs from {}: max channel difference {max}, PSNR {psnr:.1} dB; actual: {}",
-            golden.display(),
-            out.display()
-        );
-    }
 }

@@ -12,6 +12,7 @@
 //! committing).
 
 mod command;
+mod common;
 
 use command::{s, scratch, sinew};
 use image::{Rgba, RgbaImage};
@@ -23,7 +24,7 @@ use sinew::colorize::{
     ScribbleOptions, Scribbles,
 };
 use sinew::io::{load_png, save_png};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn scribbles(s: &Scene) -> Scribbles {
     Scribbles::from_strokes(
@@ -499,63 +500,25 @@ const MAX_CHANNEL_DIFF: u8 = 2;
 /// Share of pixels allowed to differ by more (ties flipping in a flat fill).
 const MAX_DIFFERING_SHARE: f64 = 0.001;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn failures_dir() -> PathBuf {
-    let dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"))
-        .join("golden-failures");
-    std::fs::create_dir_all(&dir).expect("creates the failures folder");
-    dir
-}
-
+/// Compares `actual` with `golden/<name>.png` (or writes it under `SINEW_BLESS=1`).
 fn check_golden(name: &str, actual: &RgbaImage) {
-    let golden = root().join("golden").join(format!("{name}.png"));
-    if std::env::var("SINEW_BLESS").is_ok_and(|v| v == "1") {
-        save_png(&golden, actual).expect("writes the golden image");
-        eprintln!("blessed {}", golden.display());
-        return;
-    }
-    let expected = load_png(&golden).unwrap_or_else(|e| {
-        panic!("{e}: no golden image for '{name}'; review it and bless with SINEW_BLESS=1 cargo test --test colorize")
-    });
-    let differing = if actual.dimensions() == expected.dimensions() {
-        actual
+    common::golden::check(name, actual, "colorize", |actual, expected| {
+        let differing = actual
             .pixels()
             .zip(expected.pixels())
             .filter(|(a, b)| (0..4).any(|k| a[k].abs_diff(b[k]) > MAX_CHANNEL_DIFF))
-            .count()
-    } else {
-        usize::MAX
-    };
-    let share = differing as f64 / (expected.len() / 4).max(1) as f64;
-    if share <= MAX_DIFFERING_SHARE {
-        return;
-    }
-    let out = failures_dir();
-    let actual_path = out.join(format!("{name}.actual.png"));
-    save_png(&actual_path, actual).expect("writes the actual image");
-    let diff_path = out.join(format!("{name}.diff.png"));
-    if actual.dimensions() == expected.dimensions() {
-        let diff = RgbaImage::from_fn(actual.width(), actual.height(), |x, y| {
-            let (a, b) = (actual.get_pixel(x, y), expected.get_pixel(x, y));
-            let d = (0..4).map(|k| a[k].abs_diff(b[k])).max().unwrap_or(0);
-            let v = (d as u16 * 8).min(255) as u8;
-            Rgba([v, v, v, 255])
-        });
-        save_png(&diff_path, &diff).expect("writes the diff");
-    }
-    panic!(
-        "'{name}' differs from {} on {:.3}% of pixels (allowed {:.3}%); actual: {}, diff: {}",
-        golden.display(),
-        100.0 * share,
-        100.0 * MAX_DIFFERING_SHARE,
-        actual_path.display(),
-        diff_path.display()
-    );
+            .count();
+        let share = differing as f64 / (expected.len() / 4).max(1) as f64;
+        if share <= MAX_DIFFERING_SHARE {
+            Ok(())
+        } else {
+            Err(format!(
+                "{:.3}% of pixels differ (allowed {:.3}%)",
+                100.0 * share,
+                100.0 * MAX_DIFFERING_SHARE
+            ))
+        }
+    });
 }
 
 #[test]

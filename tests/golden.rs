@@ -3,8 +3,8 @@
 //! bundled animations at fixed times, compared with the reviewed PNGs in `golden/`.
 //!
 //! Tolerance: on premultiplied RGBA8 (what compositing shows; the color of invisible pixels
-//! is not compared), the largest channel difference must be at most [`MAX_CHANNEL_DIFF`] and
-//! the PSNR at least [`MIN_PSNR_DB`]. Renders are deterministic, so on the machine that blessed
+//! is not compared), the largest channel difference must be at most 2 and the PSNR at least
+//! 50 dB (`common::golden::premultiplied_tolerance`). Renders are deterministic, so on the machine that blessed
 //! the references the difference is zero; the slack absorbs floating-point differences
 //! between machines. One bone turned by 2° moves edges by whole pixels and fails both
 //! (`a_two_degree_turn_fails`).
@@ -16,21 +16,14 @@
 
 mod common;
 
-use image::{Rgba, RgbaImage};
-use sinew::io::{load_png, save_png};
+use common::golden::{premultiplied_difference, premultiplied_tolerance};
+use image::RgbaImage;
 use sinew::pipeline::Scene;
 use sinew::render;
 use sinew::rig::pose::BonePose;
 use sinew::rig::Pose;
 use std::path::PathBuf;
 use std::sync::OnceLock;
-
-/// Largest premultiplied channel difference accepted, of 255.
-const MAX_CHANNEL_DIFF: u8 = 2;
-/// Smallest premultiplied PSNR accepted, dB.
-const MIN_PSNR_DB: f64 = 50.0;
-/// Scale of the difference image, so that small errors are visible.
-const DIFF_GAIN: u16 = 8;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -46,6 +39,11 @@ fn scene() -> &'static Scene {
     SCENE.get_or_init(common::character_scene)
 }
 
+/// Compares `actual` with `golden/<name>.png` (or writes it under `SINEW_BLESS=1`).
+fn check_golden(name: &str, actual: &RgbaImage) {
+    common::golden::check(name, actual, "golden", premultiplied_tolerance);
+}
+
 fn render_pose(pose: &Pose) -> RgbaImage {
     render_pose_in(scene(), pose)
 }
@@ -58,67 +56,6 @@ fn render_pose_in(scene: &Scene, pose: &Pose) -> RgbaImage {
 fn load_pose(name: &str) -> Pose {
     let path = assets().join("poses").join(format!("{name}.json"));
     serde_json::from_str(&std::fs::read_to_string(&path).expect("a pose file")).expect("a pose")
-}
-
-/// (largest premultiplied channel difference, premultiplied PSNR in dB).
-fn difference(a: &RgbaImage, b: &RgbaImage) -> (u8, f64) {
-    let max = render::max_channel_diff(&render::premultiplied(a), &render::premultiplied(b));
-    (max, render::psnr_premultiplied(a, b))
-}
-
-fn within_tolerance(a: &RgbaImage, b: &RgbaImage) -> bool {
-    let (max, psnr) = difference(a, b);
-    max <= MAX_CHANNEL_DIFF && psnr >= MIN_PSNR_DB
-}
-
-fn diff_image(a: &RgbaImage, b: &RgbaImage) -> RgbaImage {
-    let (pa, pb) = (render::premultiplied(a), render::premultiplied(b));
-    let (pa, pb) = (pa.as_raw(), pb.as_raw());
-    RgbaImage::from_fn(a.width(), a.height(), |x, y| {
-        let i = 4 * (y * a.width() + x) as usize;
-        let d = |k: usize| (u16::from(pa[i + k].abs_diff(pb[i + k])) * DIFF_GAIN).min(255) as u8;
-        let alpha = d(3);
-        Rgba([d(0).max(alpha), d(1).max(alpha), d(2).max(alpha), 255])
-    })
-}
-
-/// Compares `actual` with `golden/<name>.png` (or writes it under `SINEW_BLESS=1`).
-fn check_golden(name: &str, actual: &RgbaImage) {
-    let golden = root().join("golden").join(format!("{name}.png"));
-    if std::env::var("SINEW_BLESS").is_ok_and(|v| v == "1") {
-        save_png(&golden, actual).expect("writes the golden image");
-        eprintln!("blessed {}", golden.display());
-        return;
-    }
-    let expected = load_png(&golden).unwrap_or_else(|e| {
-        panic!("{e}: no golden image for '{name}'; review the render and bless it with SINEW_BLESS=1 cargo test --test golden")
-    });
-    if within_tolerance(actual, &expected) {
-        return;
-    }
-    let (max, psnr) = difference(actual, &expected);
-    let out = failures_dir();
-    let actual_path = out.join(format!("{name}.actual.png"));
-    let diff_path = out.join(format!("{name}.diff.png"));
-    save_png(&actual_path, actual).expect("writes the actual render");
-    if actual.dimensions() == expected.dimensions() {
-        save_png(&diff_path, &diff_image(actual, &expected)).expect("writes the diff");
-    }
-    panic!(
-        "'{name}' differs from {}: max channel difference {max} (allowed {MAX_CHANNEL_DIFF}), PSNR {psnr:.1} dB (required {MIN_PSNR_DB}); actual: {}, diff: {}",
-        golden.display(),
-        actual_path.display(),
-        diff_path.display()
-    );
-}
-
-fn failures_dir() -> PathBuf {
-    let dir = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root().join("target"))
-        .join("golden-failures");
-    std::fs::create_dir_all(&dir).expect("creates the failures folder");
-    dir
 }
 
 #[test]
@@ -167,10 +104,10 @@ fn a_two_degree_turn_fails() {
     forearm.rotate += 2.0;
     let turned = render_pose(&pose);
     let reference = render_pose(&load_pose("reach"));
-    let (max, psnr) = difference(&turned, &reference);
+    let (max, psnr) = premultiplied_difference(&turned, &reference);
     eprintln!("2° forearm turn: max channel difference {max}, PSNR {psnr:.1} dB");
     assert!(
-        !within_tolerance(&turned, &reference),
+        premultiplied_tolerance(&turned, &reference).is_err(),
         "a 2° turn passed the golden tolerance"
     );
 }

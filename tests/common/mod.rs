@@ -3,6 +3,8 @@
 //! image, soft alpha), drawn antialiased with tiny-skia.
 #![allow(dead_code)]
 
+pub mod golden;
+
 use image::RgbaImage;
 use tiny_skia::{
     Color, FillRule, GradientStop, Paint, PathBuilder, Pixmap, Point, RadialGradient, Shader,
