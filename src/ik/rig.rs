@@ -19,6 +19,7 @@ use crate::geom::Point;
 use crate::rig::handles::Handles;
 use crate::rig::pose::{handle_columns, handle_transforms, Affine, IkDrag, Pose};
 use nalgebra::Matrix2;
+use std::collections::BTreeMap;
 
 /// The skinning-IK solver of one rig, with its precomputation and warm start.
 #[derive(Clone, Debug)]
@@ -31,6 +32,10 @@ pub struct RigIk {
     inertia_s: Vec<f64>,
     /// The last two results of [`RigIk::step`], oldest first: the momentum handles' motion.
     history: Vec<Vec<Affine>>,
+    /// Skinning rows of the points drags have gripped, by their rest position's bits: finding
+    /// the triangle under a point scans every triangle, and a dragged point stays the same
+    /// while only its target moves.
+    gripped: BTreeMap<[u64; 2], Vec<f64>>,
 }
 
 impl RigIk {
@@ -60,6 +65,7 @@ impl RigIk {
             solver,
             inertia_s,
             history: Vec::new(),
+            gripped: BTreeMap::new(),
         })
     }
 
@@ -76,7 +82,8 @@ impl RigIk {
         let dynamic = self.inertia_s.iter().any(|&t| t > 0.0)
             && frame_time_s > 0.0
             && frame_time_s.is_finite();
-        let problem = self.problem_with(pose, dynamic.then_some(frame_time_s))?;
+        let drags = self.cached_drag_rows(pose)?;
+        let problem = self.problem_with(pose, dynamic.then_some(frame_time_s), drags)?;
         let solution = if problem.drags.is_empty() && problem.inertia.is_empty() {
             // Not solved: the next solved frame must not start from a stale result.
             self.solver.reset();
@@ -102,7 +109,8 @@ impl RigIk {
     /// The skinning transformations for `pose`: forward kinematics if it has no drags, the
     /// skinning IK otherwise (warm-started from the previous call).
     pub fn transforms(&mut self, pose: &Pose) -> Result<IkSolution, IkError> {
-        let problem = self.problem(pose)?;
+        let drags = self.cached_drag_rows(pose)?;
+        let problem = self.problem_with(pose, None, drags)?;
         if problem.drags.is_empty() {
             return Ok(IkSolution {
                 transforms: problem.anchor,
@@ -116,11 +124,49 @@ impl RigIk {
 
     /// The problem `pose` poses (see the module doc).
     pub fn problem(&self, pose: &Pose) -> Result<Problem, IkError> {
-        self.problem_with(pose, None)
+        let drags = pose
+            .ik
+            .iter()
+            .map(|d| self.drag_row(d))
+            .collect::<Result<Vec<_>, _>>()?;
+        self.problem_with(pose, None, drags)
     }
 
-    /// [`RigIk::problem`]; with a frame time, handles with momentum are free and carry it.
-    fn problem_with(&self, pose: &Pose, frame_time_s: Option<f64>) -> Result<Problem, IkError> {
+    /// The pose's drags as rows, gripping each rest point once per solver (see `gripped`).
+    fn cached_drag_rows(&mut self, pose: &Pose) -> Result<Vec<DragRow>, IkError> {
+        pose.ik
+            .iter()
+            .map(|drag| {
+                let key = drag.at.map(f64::to_bits);
+                match self.gripped.get(&key) {
+                    Some(row)
+                        if drag.to.iter().all(|v| v.is_finite())
+                            && drag.weight.is_none_or(|w| w.is_finite() && w >= 0.0) =>
+                    {
+                        Ok(DragRow {
+                            row: row.clone(),
+                            target: drag.to,
+                            weight: drag.weight,
+                        })
+                    }
+                    _ => {
+                        let row = self.drag_row(drag)?;
+                        self.gripped.insert(key, row.row.clone());
+                        Ok(row)
+                    }
+                }
+            })
+            .collect()
+    }
+
+    /// [`RigIk::problem`] with the drags' rows given; with a frame time, handles with momentum
+    /// are free and carry it.
+    fn problem_with(
+        &self,
+        pose: &Pose,
+        frame_time_s: Option<f64>,
+        drags: Vec<DragRow>,
+    ) -> Result<Problem, IkError> {
         let handles = &self.handles;
         let dragged = !pose.ik.is_empty();
         // A handle the solver may move: unkeyed, and either drags move everything free or it
@@ -208,11 +254,6 @@ impl RigIk {
                 ColumnDofs::Fixed(fk[j])
             });
         }
-        let drags = pose
-            .ik
-            .iter()
-            .map(|d| self.drag_row(d))
-            .collect::<Result<Vec<_>, _>>()?;
         let mut inertia = Vec::new();
         if let (Some(h), Some(now)) = (frame_time_s, self.history.last()) {
             let before = self
