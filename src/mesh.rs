@@ -545,7 +545,12 @@ fn constraint_graph(rings: &[&[Point]]) -> Result<(Vec<Point2<f64>>, Vec<[usize;
     let mut points = Vec::new();
     let mut index_of: HashMap<(u64, u64), usize> = HashMap::new();
     let mut edges = Vec::new();
+    let mut uses: HashMap<(u64, u64), usize> = HashMap::new();
+    for p in rings.iter().flat_map(|r| r.iter()) {
+        *uses.entry((p.x.to_bits(), p.y.to_bits())).or_default() += 1;
+    }
     for ring in rings {
+        let ring = drop_straight_vertices(ring, |p| uses[&(p.x.to_bits(), p.y.to_bits())] > 1);
         let ids: Vec<usize> = ring
             .iter()
             .map(|p| {
@@ -568,6 +573,48 @@ fn constraint_graph(rings: &[&[Point]]) -> Result<(Vec<Point2<f64>>, Vec<[usize;
         }
     }
     Ok((points, edges))
+}
+
+/// A ring vertex whose two edges turn by less than this (the sine of the turn) is dropped.
+///
+/// Tracing can leave a vertex where the outline runs straight on. Refinement then splits the
+/// two collinear constraint edges at midpoints that rounding puts a hair off the line, and the
+/// triangles between those points have areas of 1e-16 px² and cotangents that break the
+/// weight solve.
+pub const STRAIGHT_TURN_SINE: f64 = 1e-9;
+
+/// `ring` without the vertices where it runs straight on (see [`STRAIGHT_TURN_SINE`]), except
+/// vertices that `keep` asks to keep (shared with another ring). Rings that would fall below
+/// three vertices are returned as they are.
+fn drop_straight_vertices(ring: &[Point], keep: impl Fn(Point) -> bool) -> Vec<Point> {
+    let n = ring.len();
+    if n <= 3 {
+        return ring.to_vec();
+    }
+    let straight = |a: Point, b: Point, c: Point| {
+        let (u, v) = (b - a, c - b);
+        let cross = u.x * v.y - u.y * v.x;
+        u.dot(&v) > 0.0 && cross.abs() <= STRAIGHT_TURN_SINE * u.norm() * v.norm()
+    };
+    // Start from a vertex that stays, so the wrap-around needs no special case.
+    let Some(start) = (0..n)
+        .find(|&i| keep(ring[i]) || !straight(ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]))
+    else {
+        return ring.to_vec();
+    };
+    let mut kept = vec![ring[start]];
+    for k in 1..n {
+        let b = ring[(start + k) % n];
+        let c = ring[(start + k + 1) % n];
+        let a = *kept.last().unwrap_or(&ring[start]);
+        if keep(b) || !straight(a, b, c) {
+            kept.push(b);
+        }
+    }
+    if kept.len() < 3 {
+        return ring.to_vec();
+    }
+    kept
 }
 
 #[cfg(test)]
@@ -594,6 +641,34 @@ mod tests {
                 )
             })
             .sum()
+    }
+
+    #[test]
+    fn straight_ring_vertices_are_dropped_unless_shared() {
+        let p = |x: f64, y: f64| Point::new(x, y);
+        // A square with a vertex halfway along two sides, one of them shared with another ring.
+        let ring = [
+            p(0.0, 0.0),
+            p(1.0, 0.0),
+            p(2.0, 0.0),
+            p(2.0 - 1e-12, 1.0),
+            p(2.0, 2.0),
+            p(0.0, 2.0),
+        ];
+        let kept = drop_straight_vertices(&ring, |q| q == p(1.0, 0.0));
+        assert_eq!(
+            kept,
+            vec![
+                p(0.0, 0.0),
+                p(1.0, 0.0),
+                p(2.0, 0.0),
+                p(2.0, 2.0),
+                p(0.0, 2.0)
+            ]
+        );
+        // A turn back (a spike) is not straight, however thin.
+        let spike = [p(0.0, 0.0), p(2.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)];
+        assert_eq!(drop_straight_vertices(&spike, |_| false).len(), 4);
     }
 
     #[test]

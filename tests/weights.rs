@@ -471,3 +471,46 @@ fn a_bound_handle_leaves_other_parts_alone() {
     .expect("an unknown part is an error");
     assert!(err.to_string().contains("'nowhere'"), "{err}");
 }
+
+/// An exact axis-aligned rectangle traces with a vertex where its outline runs straight on;
+/// meshing used to split the collinear edges into slivers of 1e-16 px² whose cotangents made
+/// the biharmonic systems unfactorable.
+#[test]
+fn an_exact_rectangle_gets_weights_with_every_method() {
+    let image = RgbaImage::from_fn(400, 200, |x, y| {
+        if (20..380).contains(&x) && (40..160).contains(&y) {
+            Rgba([200, 120, 60, 255])
+        } else {
+            Rgba([0, 0, 0, 0])
+        }
+    });
+    let layers = [layer("rectangle", image)];
+    let handles = Handles {
+        bones: vec![Bone {
+            name: "arm".into(),
+            parent: None,
+            head: [40.0, 100.0],
+            tail: [110.0, 100.0],
+        }],
+        ..Default::default()
+    };
+    for method in [
+        sinew::weights::WeightMethod::Bbw,
+        sinew::weights::WeightMethod::Biharmonic,
+        sinew::weights::WeightMethod::Harmonic,
+    ] {
+        let mut options = BuildOptions::default();
+        options.weights.method = method;
+        let (doc, _) = pipeline::build_rig(&layers, &std::env::temp_dir(), &options, &handles)
+            .unwrap_or_else(|e| panic!("{method:?}: {e}"));
+        let part = &doc.parts[0];
+        let v = &part.mesh.vertices;
+        for t in &part.mesh.triangles {
+            let p = t.map(|i| Point::new(v[i as usize][0], v[i as usize][1]));
+            assert!(
+                sinew::mesh::triangle_min_angle_deg(p) > 1.0,
+                "{method:?}: sliver {p:?}"
+            );
+        }
+    }
+}
