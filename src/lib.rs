@@ -9,6 +9,7 @@ pub mod anim;
 pub mod autorig;
 pub mod cli;
 pub mod colorize;
+pub mod document;
 pub mod export;
 pub mod geom;
 pub mod ik;

@@ -21,6 +21,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// One input image: a part of the rig.
+#[derive(Clone, Debug)]
 pub struct Layer {
     /// The part's name: the file name without extension.
     pub name: String,
@@ -39,6 +40,8 @@ pub enum PipelineError {
     TooSmall { path: PathBuf, got: [u32; 2] },
     #[error("no input images")]
     NoImages,
+    #[error("cancelled")]
+    Cancelled,
     #[error("{path}: image is {got:?} px but the canvas (from the first image) is {canvas:?} px; all layers must share one canvas")]
     SizeMismatch {
         path: PathBuf,
@@ -166,6 +169,20 @@ pub fn build_rig_with_progress(
     handles: &Handles,
     progress: &mut dyn FnMut(usize, &str),
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
+    let never = std::sync::atomic::AtomicBool::new(false);
+    build_rig_cancellable(layers, doc_dir, options, handles, progress, &never)
+}
+
+/// [`build_rig_with_progress`] that stops with [`PipelineError::Cancelled`] before the next
+/// part once `cancel` is set (the editor builds rigs on a background thread).
+pub fn build_rig_cancellable(
+    layers: &[Layer],
+    doc_dir: &Path,
+    options: &BuildOptions,
+    handles: &Handles,
+    progress: &mut dyn FnMut(usize, &str),
+    cancel: &std::sync::atomic::AtomicBool,
+) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     let first = layers.first().ok_or(PipelineError::NoImages)?;
     let canvas = [first.image.width(), first.image.height()];
     let canvas_area = canvas[0] as f64 * canvas[1] as f64;
@@ -188,6 +205,9 @@ pub fn build_rig_with_progress(
     let mut touched = vec![0usize; columns.len()];
     let mut stats = Vec::with_capacity(layers.len());
     for (done, layer) in layers.iter().enumerate() {
+        if cancel.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(PipelineError::Cancelled);
+        }
         progress(done, &layer.name);
         let outlines =
             trace::trace(&layer.image, &options.trace).map_err(|source| PipelineError::Trace {

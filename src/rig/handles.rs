@@ -103,6 +103,51 @@ impl Handles {
             && self.regions.is_empty()
     }
 
+    /// Renames handle `from` to `to` wherever it is named: the handle itself, bone parents,
+    /// bindings and bone IK constraints. (Call [`Handles::validate`] afterwards: `to` may clash.)
+    pub fn rename(&mut self, from: &str, to: &str) {
+        let fix = |name: &mut String| {
+            if name == from {
+                *name = to.to_string();
+            }
+        };
+        for b in &mut self.bones {
+            fix(&mut b.name);
+            if let Some(parent) = &mut b.parent {
+                fix(parent);
+            }
+        }
+        self.points.iter_mut().for_each(|p| fix(&mut p.name));
+        self.cages.iter_mut().for_each(|c| fix(&mut c.name));
+        self.regions.iter_mut().for_each(|r| fix(&mut r.name));
+        if let Some(parts) = self.bind.remove(from) {
+            self.bind.insert(to.to_string(), parts);
+        }
+        for constraint in &mut self.ik {
+            constraint.bones.iter_mut().for_each(fix);
+            fix(&mut constraint.target);
+        }
+    }
+
+    /// Removes handle `name`. A removed bone's children move up to its parent, and the bone IK
+    /// constraints that name it go with it.
+    pub fn delete(&mut self, name: &str) {
+        if let Some(index) = self.bones.iter().position(|b| b.name == name) {
+            let removed = self.bones.remove(index);
+            for b in &mut self.bones {
+                if b.parent.as_deref() == Some(name) {
+                    b.parent = removed.parent.clone();
+                }
+            }
+        }
+        self.points.retain(|p| p.name != name);
+        self.cages.retain(|c| c.name != name);
+        self.regions.retain(|r| r.name != name);
+        self.bind.remove(name);
+        self.ik
+            .retain(|c| c.target != name && !c.bones.iter().any(|b| b == name));
+    }
+
     /// Every handle's name, in the order weights columns use: bones, points, cages, regions.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         let bones = self.bones.iter().map(|b| b.name.as_str());

@@ -1,0 +1,490 @@
+//! The editable document behind `sinew edit`, with its commands and undo history.
+//!
+//! In: a rig file (or nothing) and [`Command`]s. Out: the current [`State`] — the layers (the
+//! parts' images), the handles, the build options, the animations, the rig built from them
+//! (meshes and weights) when it has been built, and the pose being edited — saved atomically as
+//! a rig document, with an autosave side file.
+//!
+//! Every edit is a [`Command`] given to [`Document::apply`], which checks it against the
+//! current state first: a command that fails leaves the document exactly as it was. The state
+//! before each successful command goes on the undo stack. States share their images and built
+//! rig through `Arc`s, so an undo step costs the handles, options and pose, not the pixels.
+//!
+//! Editing the handles, the layers or the build options makes the built rig *stale*: it is kept
+//! (its meshes are still shown) but cannot be posed until the weights are computed again. The
+//! editor computes them off the UI thread with [`compute_rig`] and hands the result back as
+//! [`Command::SetRig`], which is refused when the inputs changed in the meantime.
+
+use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
+use crate::pipeline::{self, Layer, PipelineError, Scene};
+use crate::rig::{Bone, HandleError, Handles, PointHandle, Pose};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+
+/// Undo steps kept; older ones are forgotten.
+pub const UNDO_LIMIT: usize = 200;
+
+/// What a command or a file operation got wrong. The document is unchanged.
+#[derive(Debug, thiserror::Error)]
+pub enum DocumentError {
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    #[error(transparent)]
+    RigFile(#[from] RigFileError),
+    #[error(transparent)]
+    Handles(#[from] HandleError),
+    #[error("there is no handle named '{0}'")]
+    UnknownHandle(String),
+    #[error("there is no layer named '{0}'")]
+    UnknownLayer(String),
+    #[error("a layer named '{0}' already exists")]
+    DuplicateLayer(String),
+    #[error("layer '{name}' is {got:?} px but the canvas is {canvas:?} px")]
+    LayerSize {
+        name: String,
+        got: [u32; 2],
+        canvas: [u32; 2],
+    },
+    #[error("the weights were computed for handles, layers or options that have changed since")]
+    OutdatedRig,
+    #[error("the rig has no weights for the current handles: compute them first")]
+    NoWeights,
+    #[error("the document has no layers to save")]
+    NothingToSave,
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("computing the weights was cancelled")]
+    Cancelled,
+}
+
+/// Everything an edit can change; one undo step restores one of these.
+#[derive(Clone)]
+pub struct State {
+    /// The parts' images, back to front; all share the canvas size.
+    pub layers: Vec<Arc<Layer>>,
+    pub handles: Handles,
+    pub options: BuildOptions,
+    /// Animations by name, as stored in the rig file.
+    pub animations: BTreeMap<String, serde_json::Value>,
+    /// The rig last built from layers, handles and options (meshes, weights, textures).
+    pub rig: Option<Arc<Scene>>,
+    /// Whether `rig` was built from exactly the current layers, handles and options.
+    pub rig_current: bool,
+    /// The pose shown and edited in pose mode.
+    pub pose: Pose,
+}
+
+/// The inputs a rig is built from, copied out for a background build.
+#[derive(Clone)]
+pub struct RigInputs {
+    pub layers: Vec<Arc<Layer>>,
+    pub handles: Handles,
+    pub options: BuildOptions,
+}
+
+/// One edit of the document.
+#[derive(Clone)]
+pub enum Command {
+    /// Adds a layer in front of the others (its image must have the canvas size).
+    AddLayer(Layer),
+    RemoveLayer { name: String },
+    /// Adds a bone; a bone without a parent starts a new skeleton.
+    AddBone(Bone),
+    /// Moves a bone's head and tail (canvas px).
+    MoveBone {
+        name: String,
+        head: [f64; 2],
+        tail: [f64; 2],
+    },
+    AddPoint(PointHandle),
+    MovePoint { name: String, at: [f64; 2] },
+    /// Renames a handle everywhere it is referred to (parents, bindings, IK constraints, pose).
+    Rename { from: String, to: String },
+    /// Gives a bone another parent (`None`: it becomes a skeleton's root).
+    Reparent {
+        bone: String,
+        parent: Option<String>,
+    },
+    /// Deletes a handle; a deleted bone's children move up to its parent.
+    Delete { name: String },
+    SetOptions(BuildOptions),
+    /// Installs a rig built by [`compute_rig`] from the current inputs.
+    SetRig(Arc<Scene>, RigInputsKey),
+    SetPose(Pose),
+}
+
+/// Identifies the inputs a rig was built from, to refuse a result that arrives after an edit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigInputsKey {
+    layer_names: Vec<String>,
+    handles: Handles,
+    options: BuildOptions,
+}
+
+impl RigInputs {
+    pub fn key(&self) -> RigInputsKey {
+        RigInputsKey {
+            layer_names: self.layers.iter().map(|l| l.name.clone()).collect(),
+            handles: self.handles.clone(),
+            options: self.options.clone(),
+        }
+    }
+}
+
+/// The document: the current state, where it is saved, and its undo history.
+pub struct Document {
+    state: State,
+    /// Where the document is saved; image paths in the file are relative to its folder.
+    pub path: Option<PathBuf>,
+    undo: Vec<State>,
+    redo: Vec<State>,
+    /// Whether there are changes since the last save.
+    pub dirty: bool,
+}
+
+impl Default for Document {
+    fn default() -> Self {
+        Document::new()
+    }
+}
+
+impl Document {
+    /// An empty document: no layers, no handles.
+    pub fn new() -> Self {
+        Document {
+            state: State {
+                layers: Vec::new(),
+                handles: Handles::default(),
+                options: BuildOptions::default(),
+                animations: BTreeMap::new(),
+                rig: None,
+                rig_current: true,
+                pose: Pose::default(),
+            },
+            path: None,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            dirty: false,
+        }
+    }
+
+    /// Opens a rig file and its images. A rig whose parts all have weights for its handles
+    /// opens ready to pose.
+    pub fn open(path: &Path) -> Result<Self, DocumentError> {
+        let doc = RigDocument::load(path)?;
+        let mut layers = Vec::with_capacity(doc.parts.len());
+        for part in &doc.parts {
+            let image_path = RigDocument::image_path(path, part);
+            let image = io::load_png(&image_path).map_err(PipelineError::from)?;
+            layers.push(Arc::new(Layer {
+                name: part.name.clone(),
+                path: image_path,
+                image,
+            }));
+        }
+        let weighted = !doc.handles.is_empty() && doc.parts.iter().all(|p| p.weights.is_some());
+        let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+        let state = State {
+            layers,
+            handles: doc.handles.clone(),
+            options: doc.options.clone(),
+            animations: doc.animations.clone(),
+            rig_current: weighted,
+            rig: Some(Arc::new(Scene::new(doc, &images)?)),
+            pose: Pose::default(),
+        };
+        Ok(Document {
+            state,
+            path: Some(path.to_path_buf()),
+            undo: Vec::new(),
+            redo: Vec::new(),
+            dirty: false,
+        })
+    }
+
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// The rig ready to pose: built from the current inputs, with weights.
+    pub fn posable(&self) -> Option<&Arc<Scene>> {
+        self.state
+            .rig
+            .as_ref()
+            .filter(|_| self.state.rig_current && !self.state.handles.is_empty())
+    }
+
+    /// The inputs to build the rig from, for [`compute_rig`] on another thread.
+    pub fn rig_inputs(&self) -> RigInputs {
+        RigInputs {
+            layers: self.state.layers.clone(),
+            handles: self.state.handles.clone(),
+            options: self.state.options.clone(),
+        }
+    }
+
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    /// Applies `command`; on error nothing changes.
+    pub fn apply(&mut self, command: Command) -> Result<(), DocumentError> {
+        let next = apply_to(&self.state, command)?;
+        let previous = std::mem::replace(&mut self.state, next);
+        self.undo.push(previous);
+        if self.undo.len() > UNDO_LIMIT {
+            self.undo.remove(0);
+        }
+        self.redo.clear();
+        self.dirty = true;
+        Ok(())
+    }
+
+    /// Steps back one command; false when there is nothing to undo.
+    pub fn undo(&mut self) -> bool {
+        match self.undo.pop() {
+            Some(previous) => {
+                let current = std::mem::replace(&mut self.state, previous);
+                self.redo.push(current);
+                self.dirty = true;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Re-applies the last undone command; false when there is nothing to redo.
+    pub fn redo(&mut self) -> bool {
+        match self.redo.pop() {
+            Some(next) => {
+                let current = std::mem::replace(&mut self.state, next);
+                self.undo.push(current);
+                self.dirty = true;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The rig document as it would be saved at `path`. A stale rig is saved with its meshes
+    /// but without weights, so that reopening asks for them again instead of posing with
+    /// weights of other handles.
+    pub fn to_rig_document(&self, path: &Path) -> Result<RigDocument, DocumentError> {
+        let state = &self.state;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let mut doc = match &state.rig {
+            Some(scene) if same_layers(&scene.doc, &state.layers) => scene.doc.clone(),
+            _ => {
+                if state.layers.is_empty() {
+                    return Err(DocumentError::NothingToSave);
+                }
+                let layers: Vec<Layer> = state.layers.iter().map(|l| (**l).clone()).collect();
+                pipeline::build_rig(&layers, dir, &state.options, &Handles::default())?.0
+            }
+        };
+        if !state.rig_current {
+            for part in &mut doc.parts {
+                part.weights = None;
+            }
+        }
+        for (part, layer) in doc.parts.iter_mut().zip(&state.layers) {
+            part.image = pipeline::relative_path(dir, &layer.path);
+        }
+        doc.handles = state.handles.clone();
+        doc.options = state.options.clone();
+        doc.animations = state.animations.clone();
+        Ok(doc)
+    }
+
+    /// Saves to `path` atomically and remembers it as the document's path.
+    pub fn save(&mut self, path: &Path) -> Result<(), DocumentError> {
+        self.to_rig_document(path)?.save(path)?;
+        self.path = Some(path.to_path_buf());
+        self.dirty = false;
+        Ok(())
+    }
+
+    /// Writes the current state to the autosave side file of the document's path (or of
+    /// `fallback` for a document never saved); returns where it went.
+    pub fn autosave(&self, fallback: &Path) -> Result<PathBuf, DocumentError> {
+        let target = autosave_path(self.path.as_deref().unwrap_or(fallback));
+        let doc = self.to_rig_document(&target)?;
+        doc.save(&target)?;
+        Ok(target)
+    }
+}
+
+/// The side file autosaves go to: `NAME.autosave.json` beside `NAME.json`.
+pub fn autosave_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "untitled".into());
+    path.with_file_name(format!("{stem}.autosave.json"))
+}
+
+fn same_layers(doc: &RigDocument, layers: &[Arc<Layer>]) -> bool {
+    doc.parts.len() == layers.len() && doc.parts.iter().zip(layers).all(|(p, l)| p.name == l.name)
+}
+
+/// Builds the rig (trace, mesh, weights) for `inputs`. Meant for a background thread:
+/// `progress(parts_done, parts_total)` reports each part, and setting `cancel` stops the build
+/// before the next part with [`DocumentError::Cancelled`]. `dir` is the folder image paths are
+/// stored relative to.
+pub fn compute_rig(
+    inputs: &RigInputs,
+    dir: &Path,
+    cancel: &AtomicBool,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Scene, DocumentError> {
+    let layers: Vec<Layer> = inputs.layers.iter().map(|l| (**l).clone()).collect();
+    let total = layers.len();
+    let mut report = |done: usize, _: &str| progress(done, total);
+    let built = pipeline::build_rig_cancellable(
+        &layers,
+        dir,
+        &inputs.options,
+        &inputs.handles,
+        &mut report,
+        cancel,
+    );
+    let (doc, _) = match built {
+        Err(PipelineError::Cancelled) => return Err(DocumentError::Cancelled),
+        other => other?,
+    };
+    let images: Vec<_> = layers.into_iter().map(|l| l.image).collect();
+    Ok(Scene::new(doc, &images)?)
+}
+
+/// The state after `command`, or why it cannot apply.
+fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
+    let mut next = state.clone();
+    let mut inputs_changed = true;
+    match command {
+        Command::AddLayer(layer) => {
+            if next.layers.iter().any(|l| l.name == layer.name) {
+                return Err(DocumentError::DuplicateLayer(layer.name));
+            }
+            let got = [layer.image.width(), layer.image.height()];
+            if let Some(first) = next.layers.first() {
+                let canvas = [first.image.width(), first.image.height()];
+                if got != canvas {
+                    return Err(DocumentError::LayerSize {
+                        name: layer.name,
+                        got,
+                        canvas,
+                    });
+                }
+            }
+            next.layers.push(Arc::new(layer));
+        }
+        Command::RemoveLayer { name } => {
+            let index = next
+                .layers
+                .iter()
+                .position(|l| l.name == name)
+                .ok_or_else(|| DocumentError::UnknownLayer(name.clone()))?;
+            next.layers.remove(index);
+            for parts in next.handles.bind.values_mut() {
+                parts.retain(|p| *p != name);
+            }
+        }
+        Command::AddBone(bone) => next.handles.bones.push(bone),
+        Command::MoveBone { name, head, tail } => {
+            let bone = next
+                .handles
+                .bones
+                .iter_mut()
+                .find(|b| b.name == name)
+                .ok_or(DocumentError::UnknownHandle(name))?;
+            bone.head = head;
+            bone.tail = tail;
+        }
+        Command::AddPoint(point) => next.handles.points.push(point),
+        Command::MovePoint { name, at } => {
+            let point = next
+                .handles
+                .points
+                .iter_mut()
+                .find(|p| p.name == name)
+                .ok_or(DocumentError::UnknownHandle(name))?;
+            point.at = at;
+        }
+        Command::Rename { from, to } => {
+            if !next.handles.names().any(|n| n == from) {
+                return Err(DocumentError::UnknownHandle(from));
+            }
+            next.handles.rename(&from, &to);
+            rename_in_pose(&mut next.pose, &from, &to);
+        }
+        Command::Reparent { bone, parent } => {
+            let b = next
+                .handles
+                .bones
+                .iter_mut()
+                .find(|b| b.name == bone)
+                .ok_or(DocumentError::UnknownHandle(bone))?;
+            b.parent = parent;
+        }
+        Command::Delete { name } => {
+            if !next.handles.names().any(|n| n == name) {
+                return Err(DocumentError::UnknownHandle(name));
+            }
+            next.handles.delete(&name);
+            next.pose.bones.remove(&name);
+            next.pose.points.remove(&name);
+            next.pose.cages.remove(&name);
+        }
+        Command::SetOptions(options) => next.options = options,
+        Command::SetRig(scene, key) => {
+            if key != (RigInputs {
+                layers: state.layers.clone(),
+                handles: state.handles.clone(),
+                options: state.options.clone(),
+            })
+            .key()
+            {
+                return Err(DocumentError::OutdatedRig);
+            }
+            next.rig = Some(scene);
+            next.rig_current = true;
+            inputs_changed = false;
+        }
+        Command::SetPose(pose) => {
+            let scene = state
+                .rig
+                .as_ref()
+                .filter(|_| state.rig_current)
+                .ok_or(DocumentError::NoWeights)?;
+            scene.handle_transforms(&pose)?;
+            next.pose = pose;
+            inputs_changed = false;
+        }
+    }
+    if inputs_changed {
+        next.handles.validate()?;
+        next.rig_current = false;
+    }
+    Ok(next)
+}
+
+fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {
+    if let Some(v) = pose.bones.remove(from) {
+        pose.bones.insert(to.to_string(), v);
+    }
+    if let Some(v) = pose.points.remove(from) {
+        pose.points.insert(to.to_string(), v);
+    }
+    if let Some(v) = pose.cages.remove(from) {
+        pose.cages.insert(to.to_string(), v);
+    }
+}

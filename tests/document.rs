@@ -1,0 +1,281 @@
+//! The editor's document model: commands, undo/redo, background rig builds, saving.
+
+mod command;
+mod common;
+
+use image::{Rgba, RgbaImage};
+use sinew::document::{autosave_path, compute_rig, Command, Document, DocumentError};
+use sinew::pipeline::Layer;
+use sinew::rig::pose::IkDrag;
+use sinew::rig::{Bone, PointHandle, Pose};
+use std::sync::atomic::AtomicBool;
+
+/// An opaque 300 × 40 px bar on a 320 × 80 canvas.
+fn bar_layer(name: &str) -> Layer {
+    let image = RgbaImage::from_fn(320, 80, |x, y| {
+        if (10..310).contains(&x) && (20..60).contains(&y) {
+            Rgba([90, 140, 200, 255])
+        } else {
+            Rgba([0, 0, 0, 0])
+        }
+    });
+    Layer {
+        name: name.into(),
+        path: std::env::temp_dir().join(format!("{name}.png")),
+        image,
+    }
+}
+
+fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bone {
+    Bone {
+        name: name.into(),
+        parent: parent.map(Into::into),
+        head,
+        tail,
+    }
+}
+
+/// A document with one bar layer and a two-bone arm along it, weights computed.
+fn arm_document() -> Document {
+    arm_document_with(bar_layer("bar"))
+}
+
+fn arm_document_with(layer: Layer) -> Document {
+    let mut doc = Document::new();
+    doc.apply(Command::AddLayer(layer)).unwrap();
+    doc.apply(Command::AddBone(bone("upper", None, [20.0, 40.0], [160.0, 40.0])))
+        .unwrap();
+    doc.apply(Command::AddBone(bone(
+        "lower",
+        Some("upper"),
+        [160.0, 40.0],
+        [300.0, 40.0],
+    )))
+    .unwrap();
+    compute(&mut doc);
+    doc
+}
+
+fn compute(doc: &mut Document) {
+    let inputs = doc.rig_inputs();
+    let scene = compute_rig(
+        &inputs,
+        &std::env::temp_dir(),
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    doc.apply(Command::SetRig(std::sync::Arc::new(scene), inputs.key()))
+        .unwrap();
+}
+
+#[test]
+fn edits_undo_and_redo_in_order() {
+    let mut doc = arm_document();
+    assert!(doc.posable().is_some());
+    let before = doc.state().handles.clone();
+    doc.apply(Command::AddPoint(PointHandle {
+        name: "tip".into(),
+        at: [290.0, 50.0],
+    }))
+    .unwrap();
+    // Handles changed: the rig is stale until weights are computed again.
+    assert!(doc.posable().is_none());
+    assert_eq!(doc.state().handles.points.len(), 1);
+    assert!(doc.undo());
+    assert_eq!(doc.state().handles, before);
+    assert!(doc.posable().is_some(), "undo restores the weighted rig");
+    assert!(doc.redo());
+    assert_eq!(doc.state().handles.points.len(), 1);
+    assert!(!doc.redo());
+    // A new command clears the redo stack.
+    doc.undo();
+    doc.apply(Command::MoveBone {
+        name: "lower".into(),
+        head: [160.0, 40.0],
+        tail: [280.0, 40.0],
+    })
+    .unwrap();
+    assert!(!doc.can_redo());
+}
+
+#[test]
+fn a_failing_command_changes_nothing() {
+    let mut doc = arm_document();
+    let handles = doc.state().handles.clone();
+    let undo_depth_probe = doc.can_undo();
+    // A cycle, an unknown name, a duplicate name, a clash on rename.
+    let bad = [
+        Command::Reparent {
+            bone: "upper".into(),
+            parent: Some("lower".into()),
+        },
+        Command::Delete {
+            name: "nobody".into(),
+        },
+        Command::AddBone(bone("upper", None, [0.0, 0.0], [5.0, 0.0])),
+        Command::Rename {
+            from: "upper".into(),
+            to: "lower".into(),
+        },
+    ];
+    for command in bad {
+        assert!(doc.apply(command).is_err());
+        assert_eq!(doc.state().handles, handles);
+        assert!(doc.posable().is_some());
+    }
+    assert_eq!(doc.can_undo(), undo_depth_probe);
+    // A layer of another size is refused too.
+    let mut small = bar_layer("small");
+    small.image = RgbaImage::new(10, 10);
+    assert!(matches!(
+        doc.apply(Command::AddLayer(small)),
+        Err(DocumentError::LayerSize { .. })
+    ));
+}
+
+#[test]
+fn rename_and_delete_follow_every_reference() {
+    let mut doc = arm_document();
+    let mut pose = Pose::default();
+    pose.bones.insert(
+        "lower".into(),
+        sinew::rig::pose::BonePose {
+            rotate: 30.0,
+            ..Default::default()
+        },
+    );
+    doc.apply(Command::SetPose(pose)).unwrap();
+    doc.apply(Command::Rename {
+        from: "upper".into(),
+        to: "shoulder".into(),
+    })
+    .unwrap();
+    let h = &doc.state().handles;
+    assert_eq!(h.bones[1].parent.as_deref(), Some("shoulder"));
+    doc.apply(Command::Delete {
+        name: "shoulder".into(),
+    })
+    .unwrap();
+    let h = &doc.state().handles;
+    assert_eq!(h.bones.len(), 1);
+    assert_eq!(h.bones[0].parent, None, "the child moved up to the root");
+    assert!(doc.state().pose.bones.contains_key("lower"));
+}
+
+#[test]
+fn a_rig_built_for_older_inputs_is_refused() {
+    let mut doc = arm_document();
+    doc.apply(Command::MoveBone {
+        name: "lower".into(),
+        head: [160.0, 40.0],
+        tail: [250.0, 40.0],
+    })
+    .unwrap();
+    let stale_inputs = doc.rig_inputs();
+    doc.apply(Command::AddPoint(PointHandle {
+        name: "tip".into(),
+        at: [290.0, 50.0],
+    }))
+    .unwrap();
+    let scene = compute_rig(
+        &stale_inputs,
+        &std::env::temp_dir(),
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    assert!(matches!(
+        doc.apply(Command::SetRig(
+            std::sync::Arc::new(scene),
+            stale_inputs.key()
+        )),
+        Err(DocumentError::OutdatedRig)
+    ));
+    assert!(doc.posable().is_none());
+    // Cancelled before the first part: nothing is built.
+    let cancelled = compute_rig(
+        &doc.rig_inputs(),
+        &std::env::temp_dir(),
+        &AtomicBool::new(true),
+        &mut |_, _| {},
+    );
+    assert!(matches!(cancelled, Err(DocumentError::Cancelled)));
+}
+
+#[test]
+fn posing_needs_current_weights_and_a_valid_pose() {
+    let mut doc = arm_document();
+    let mut drag = Pose::default();
+    drag.ik.push(IkDrag {
+        at: [300.0, 40.0],
+        to: [250.0, 0.0],
+        weight: None,
+    });
+    doc.apply(Command::SetPose(drag.clone())).unwrap();
+    let mut unknown = Pose::default();
+    unknown.bones.insert("ghost".into(), Default::default());
+    assert!(doc.apply(Command::SetPose(unknown)).is_err());
+    doc.apply(Command::AddPoint(PointHandle {
+        name: "tip".into(),
+        at: [290.0, 50.0],
+    }))
+    .unwrap();
+    assert!(matches!(
+        doc.apply(Command::SetPose(drag)),
+        Err(DocumentError::NoWeights)
+    ));
+}
+
+#[test]
+fn saves_atomically_and_reopens_ready_to_pose() {
+    let dir = command::scratch("document-save");
+    // The image must live where the saved file can refer to it.
+    let mut layer = bar_layer("bar");
+    layer.path = dir.join("bar.png");
+    layer.image.save(&layer.path).unwrap();
+    let mut doc = arm_document_with(layer);
+    let path = dir.join("arm.json");
+    doc.save(&path).unwrap();
+    assert!(!doc.dirty);
+    let reopened = Document::open(&path).unwrap();
+    assert!(reopened.posable().is_some());
+    assert_eq!(reopened.state().handles, doc.state().handles);
+    // A stale rig saves without weights, and reopens asking for them.
+    doc.apply(Command::MoveBone {
+        name: "lower".into(),
+        head: [160.0, 40.0],
+        tail: [250.0, 40.0],
+    })
+    .unwrap();
+    let autosaved = doc.autosave(&path).unwrap();
+    assert_eq!(autosaved, autosave_path(&path));
+    let reopened = Document::open(&autosaved).unwrap();
+    assert!(reopened.posable().is_none());
+    assert_eq!(reopened.state().handles.bones[1].tail, [250.0, 40.0]);
+}
+
+#[test]
+fn the_bundled_character_opens_and_poses() {
+    let dir = command::scratch("document-character");
+    let mut scene_doc = common::character_scene().doc;
+    let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    for part in &mut scene_doc.parts {
+        part.image = assets.join(&part.image).to_string_lossy().into_owned();
+    }
+    let grip = scene_doc.parts[0].mesh.vertices[0];
+    let path = dir.join("character.json");
+    scene_doc.save(&path).unwrap();
+    let mut doc = Document::open(&path).unwrap();
+    assert!(doc.posable().is_some());
+    let mut pose = Pose::default();
+    pose.ik.push(IkDrag {
+        at: grip,
+        to: [grip[0] + 20.0, grip[1] - 10.0],
+        weight: None,
+    });
+    doc.apply(Command::SetPose(pose)).unwrap();
+    assert_eq!(doc.state().pose.ik.len(), 1);
+    assert!(doc.undo());
+    assert!(doc.state().pose.ik.is_empty());
+}
