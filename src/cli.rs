@@ -49,6 +49,33 @@ pub enum Command {
     Autorig(AutorigArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
+    /// Open the editor window (rig, weigh and pose by hand).
+    #[cfg(feature = "editor")]
+    Edit(EditArgs),
+}
+
+/// `sinew edit [RIG]`.
+#[cfg(feature = "editor")]
+#[derive(Args, Debug)]
+pub struct EditArgs {
+    /// The rig to open; none starts an empty document (drop PNG layers on the window).
+    pub rig: Option<PathBuf>,
+    /// The mode to start in.
+    #[arg(long, value_enum, default_value = "rig")]
+    pub mode: EditMode,
+    /// A pose to start with (pose mode).
+    #[arg(long)]
+    pub pose: Option<PathBuf>,
+    /// Take a PNG screenshot of the window after its first frames, then quit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+}
+
+#[cfg(feature = "editor")]
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum EditMode {
+    Rig,
+    Pose,
 }
 
 #[derive(Args, Debug)]
@@ -328,7 +355,23 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Colorize(args) => colorize::run(&args),
+        #[cfg(feature = "editor")]
+        Command::Edit(args) => edit(&args),
     }
+}
+
+#[cfg(feature = "editor")]
+fn edit(args: &EditArgs) -> Result<()> {
+    use crate::editor::Mode;
+    let pose = match &args.pose {
+        Some(path) => Some(read_json::<crate::rig::Pose>(path, "pose file")?),
+        None => None,
+    };
+    let mode = match args.mode {
+        EditMode::Rig => Mode::Rig,
+        EditMode::Pose => Mode::Pose,
+    };
+    crate::editor::run(args.rig.as_deref(), mode, pose, args.screenshot.clone())
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {

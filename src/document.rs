@@ -92,7 +92,9 @@ pub struct RigInputs {
 pub enum Command {
     /// Adds a layer in front of the others (its image must have the canvas size).
     AddLayer(Layer),
-    RemoveLayer { name: String },
+    RemoveLayer {
+        name: String,
+    },
     /// Adds a bone; a bone without a parent starts a new skeleton.
     AddBone(Bone),
     /// Moves a bone's head and tail (canvas px).
@@ -102,16 +104,24 @@ pub enum Command {
         tail: [f64; 2],
     },
     AddPoint(PointHandle),
-    MovePoint { name: String, at: [f64; 2] },
+    MovePoint {
+        name: String,
+        at: [f64; 2],
+    },
     /// Renames a handle everywhere it is referred to (parents, bindings, IK constraints, pose).
-    Rename { from: String, to: String },
+    Rename {
+        from: String,
+        to: String,
+    },
     /// Gives a bone another parent (`None`: it becomes a skeleton's root).
     Reparent {
         bone: String,
         parent: Option<String>,
     },
     /// Deletes a handle; a deleted bone's children move up to its parent.
-    Delete { name: String },
+    Delete {
+        name: String,
+    },
     SetOptions(BuildOptions),
     /// Installs a rig built by [`compute_rig`] from the current inputs.
     SetRig(Arc<Scene>, RigInputsKey),
@@ -446,12 +456,13 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::SetOptions(options) => next.options = options,
         Command::SetRig(scene, key) => {
-            if key != (RigInputs {
-                layers: state.layers.clone(),
-                handles: state.handles.clone(),
-                options: state.options.clone(),
-            })
-            .key()
+            if key
+                != (RigInputs {
+                    layers: state.layers.clone(),
+                    handles: state.handles.clone(),
+                    options: state.options.clone(),
+                })
+                .key()
             {
                 return Err(DocumentError::OutdatedRig);
             }

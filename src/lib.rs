@@ -10,6 +10,8 @@ pub mod autorig;
 pub mod cli;
 pub mod colorize;
 pub mod document;
+#[cfg(feature = "editor")]
+pub mod editor;
 pub mod export;
 pub mod geom;
 pub mod ik;

@@ -43,8 +43,13 @@ fn arm_document() -> Document {
 fn arm_document_with(layer: Layer) -> Document {
     let mut doc = Document::new();
     doc.apply(Command::AddLayer(layer)).unwrap();
-    doc.apply(Command::AddBone(bone("upper", None, [20.0, 40.0], [160.0, 40.0])))
-        .unwrap();
+    doc.apply(Command::AddBone(bone(
+        "upper",
+        None,
+        [20.0, 40.0],
+        [160.0, 40.0],
+    )))
+    .unwrap();
     doc.apply(Command::AddBone(bone(
         "lower",
         Some("upper"),

@@ -1,0 +1,1081 @@
+//! The editor (`sinew edit`): an egui/eframe view over [`crate::document::Document`].
+//!
+//! In: a rig file (or nothing), pointer and keyboard input. Out: document commands (every edit
+//! goes through [`Document::apply`], so undo, checking and saving live in the library) and a
+//! picture of the document. Rig builds run on a background thread ([`worker`]); the pose mode
+//! keeps one precomputed skinning-IK solver per built rig and only solves while a point is
+//! dragged.
+//!
+//! Modes: **Rig** (layers, handles, weights: draw bones and points, select, move, rename,
+//! reparent, delete, compute weights with progress and cancel, see a handle's weights as a heat
+//! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
+//! shift-click pins a point; every drag stays as a pin of the pose).
+
+pub mod canvas;
+pub mod worker;
+
+#[cfg(test)]
+mod tests;
+
+use crate::document::{Command, Document, DocumentError};
+use crate::geom::Point;
+use crate::ik::RigIk;
+use crate::pipeline::{Layer, Scene};
+use crate::rig::pose::IkDrag;
+use crate::rig::{Bone, PointHandle, Pose};
+use crate::skin::Blend;
+use canvas::{Placed, View};
+use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+use worker::{Poll, Worker};
+
+/// Seconds between autosaves of a changed document.
+pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
+/// A press and release closer than this (canvas px) is a click, not a drag.
+pub const CLICK_SLOP_PX: f64 = 2.0;
+
+/// What the canvas edits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    Rig,
+    Pose,
+}
+
+/// What a press on the canvas does in rig mode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tool {
+    /// Pick a handle; drag it to move it.
+    Select,
+    /// Press at the head, release at the tail. Starting on a bone's tail makes it the parent.
+    Bone,
+    /// Click to place a point handle.
+    Point,
+}
+
+/// A pointer gesture in progress.
+enum Gesture {
+    NewBone {
+        head: [f64; 2],
+        parent: Option<String>,
+        tail: [f64; 2],
+    },
+    MoveHandle {
+        name: String,
+        from: [f64; 2],
+        to: [f64; 2],
+    },
+    PoseDrag {
+        /// Index of the drag in the live pose's `ik` list.
+        index: usize,
+        pose: Pose,
+    },
+    Pan,
+}
+
+/// Posed vertex positions of a built rig, for one pose.
+struct Posed {
+    scene: *const Scene,
+    pose: Pose,
+    positions: Vec<Vec<Point>>,
+    /// Posed (head, tail) of every bone.
+    bones: Vec<([f64; 2], [f64; 2])>,
+}
+
+/// The editor's state: the document plus what only the view needs.
+pub struct EditorApp {
+    pub doc: Document,
+    pub mode: Mode,
+    pub tool: Tool,
+    pub selected: Option<String>,
+    /// `None` fits the canvas into the window on the next frame.
+    pub view: Option<View>,
+    /// Where the canvas was drawn last frame (tests convert canvas px to screen with it).
+    pub placed: Option<Placed>,
+    /// The last message for the user (errors, saves).
+    pub message: Option<String>,
+    /// Time spent in the editor's own code for the last frame (solve, skin, mesh build), ms.
+    pub last_frame_ms: f64,
+    pub show_help: bool,
+    textures: Vec<(*const Layer, TextureHandle)>,
+    worker: Option<Worker>,
+    gesture: Option<Gesture>,
+    ik: Option<(*const Scene, RigIk)>,
+    posed: Option<Posed>,
+    open_path: String,
+    rename_to: String,
+    last_autosave_s: f64,
+    /// Screenshot to take after a few frames, then quit (for `--screenshot`).
+    screenshot: Option<(PathBuf, u32)>,
+}
+
+impl EditorApp {
+    pub fn new(doc: Document) -> Self {
+        let open_path = doc
+            .path
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default();
+        EditorApp {
+            doc,
+            mode: Mode::Rig,
+            tool: Tool::Select,
+            selected: None,
+            view: None,
+            placed: None,
+            message: None,
+            last_frame_ms: 0.0,
+            show_help: false,
+            textures: Vec::new(),
+            worker: None,
+            gesture: None,
+            ik: None,
+            posed: None,
+            open_path,
+            rename_to: String::new(),
+            last_autosave_s: 0.0,
+            screenshot: None,
+        }
+    }
+
+    /// Takes a screenshot to `path` once the window has drawn a few frames, then closes.
+    pub fn screenshot_then_quit(&mut self, path: PathBuf) {
+        self.screenshot = Some((path, 0));
+    }
+
+    /// Whether a rig build is running.
+    pub fn computing(&self) -> bool {
+        self.worker.is_some()
+    }
+
+    /// Applies a command, reporting a refusal as the message (the document stays as it was).
+    pub fn apply(&mut self, command: Command) -> bool {
+        match self.doc.apply(command) {
+            Ok(()) => true,
+            Err(e) => {
+                self.message = Some(e.to_string());
+                false
+            }
+        }
+    }
+
+    /// Starts computing the weights for the current handles (a no-op while one runs).
+    pub fn compute_weights(&mut self, ctx: &egui::Context) {
+        if self.worker.is_some() {
+            return;
+        }
+        if self.doc.state().layers.is_empty() {
+            self.message = Some("add a layer first (drop a PNG on the window)".into());
+            return;
+        }
+        let dir = self
+            .doc
+            .path
+            .as_deref()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf)
+            .unwrap_or_else(std::env::temp_dir);
+        let ctx = ctx.clone();
+        self.worker = Some(Worker::start(self.doc.rig_inputs(), dir, move || {
+            ctx.request_repaint()
+        }));
+    }
+
+    /// Imports a PNG as a new front layer; a bad file leaves the document as it was.
+    pub fn import_layer(&mut self, path: &Path) {
+        let loaded = crate::io::load_png(path);
+        match loaded {
+            Ok(image) => {
+                let name = path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "layer".into());
+                if self.apply(Command::AddLayer(Layer {
+                    name,
+                    path: path.to_path_buf(),
+                    image,
+                })) {
+                    self.view = None;
+                }
+            }
+            Err(e) => self.message = Some(e.to_string()),
+        }
+    }
+
+    /// Opens a rig file in place of the current document; on failure the current one stays.
+    pub fn open(&mut self, path: &Path) {
+        match Document::open(path) {
+            Ok(doc) => {
+                *self = EditorApp::new(doc);
+            }
+            Err(e) => self.message = Some(format!("cannot open {}: {e}", path.display())),
+        }
+    }
+
+    fn save(&mut self) {
+        let Some(path) = self
+            .doc
+            .path
+            .clone()
+            .or_else(|| (!self.open_path.is_empty()).then(|| PathBuf::from(&self.open_path)))
+        else {
+            self.message = Some("type a file name in the File menu first".into());
+            return;
+        };
+        self.message = Some(match self.doc.save(&path) {
+            Ok(()) => format!("saved {}", path.display()),
+            Err(e) => e.to_string(),
+        });
+    }
+
+    /// One frame of the whole editor.
+    pub fn frame(&mut self, ui: &mut egui::Ui) {
+        let started = Instant::now();
+        let ctx = ui.ctx().clone();
+        self.poll_worker();
+        self.dropped_files(&ctx);
+        self.shortcuts(&ctx);
+        self.autosave(&ctx);
+        egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        egui::Panel::left("side")
+            .default_size(230.0)
+            .show(ui, |ui| self.side_panel(ui));
+        egui::CentralPanel::default().show(ui, |ui| self.canvas(ui));
+        if self.show_help {
+            help_window(&ctx, &mut self.show_help);
+        }
+        self.take_screenshot(&ctx);
+        self.last_frame_ms = started.elapsed().as_secs_f64() * 1e3;
+    }
+
+    fn poll_worker(&mut self) {
+        let Some(worker) = &self.worker else { return };
+        if let Poll::Finished(result) = worker.poll() {
+            let key = worker.key.clone();
+            self.worker = None;
+            match result {
+                Ok(scene) => {
+                    if self.apply(Command::SetRig(Arc::new(scene), key)) {
+                        self.message = Some("weights computed".into());
+                    }
+                }
+                Err(DocumentError::Cancelled) => self.message = Some("cancelled".into()),
+                Err(e) => self.message = Some(e.to_string()),
+            }
+        }
+    }
+
+    fn dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for path in dropped {
+            if path.extension().is_some_and(|e| e == "json") {
+                self.open(&path);
+            } else {
+                self.import_layer(&path);
+            }
+        }
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        let typing = ctx.text_edit_focused();
+        let (undo, redo, delete, rig, pose, help, escape) = ctx.input_mut(|i| {
+            let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+            let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
+            (
+                undo,
+                redo,
+                !typing && i.key_pressed(Key::Delete),
+                !typing && i.key_pressed(Key::Num1),
+                !typing && i.key_pressed(Key::Num2),
+                i.key_pressed(Key::F1) || (!typing && i.key_pressed(Key::Questionmark)),
+                i.key_pressed(Key::Escape),
+            )
+        });
+        if undo && self.gesture.is_none() {
+            self.doc.undo();
+        }
+        if redo && self.gesture.is_none() {
+            self.doc.redo();
+        }
+        if delete {
+            if let Some(name) = self.selected.take() {
+                self.apply(Command::Delete { name });
+            }
+        }
+        if rig {
+            self.mode = Mode::Rig;
+        }
+        if pose {
+            self.mode = Mode::Pose;
+        }
+        if help {
+            self.show_help = !self.show_help;
+        }
+        if escape {
+            self.gesture = None;
+            self.show_help = false;
+        }
+    }
+
+    fn autosave(&mut self, ctx: &egui::Context) {
+        let now = ctx.input(|i| i.time);
+        if !self.doc.dirty || now - self.last_autosave_s < AUTOSAVE_INTERVAL_S {
+            return;
+        }
+        self.last_autosave_s = now;
+        if let Some(path) = self.doc.path.clone() {
+            if let Err(e) = self.doc.autosave(&path) {
+                self.message = Some(format!("autosave failed: {e}"));
+            }
+        }
+    }
+
+    fn menu_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.menu_button("File", |ui| {
+                ui.label("Rig or PNG path:");
+                ui.text_edit_singleline(&mut self.open_path);
+                if ui.button("Open rig").clicked() {
+                    let path = PathBuf::from(&self.open_path);
+                    self.open(&path);
+                }
+                if ui.button("Import layer").clicked() {
+                    let path = PathBuf::from(&self.open_path);
+                    self.import_layer(&path);
+                }
+                if ui.button("Save").clicked() {
+                    self.save();
+                }
+            });
+            if ui
+                .add_enabled(self.doc.can_undo(), egui::Button::new("Undo"))
+                .clicked()
+            {
+                self.doc.undo();
+            }
+            if ui
+                .add_enabled(self.doc.can_redo(), egui::Button::new("Redo"))
+                .clicked()
+            {
+                self.doc.redo();
+            }
+            ui.separator();
+            ui.selectable_value(&mut self.mode, Mode::Rig, "Rig mode");
+            ui.selectable_value(&mut self.mode, Mode::Pose, "Pose mode");
+            ui.separator();
+            if ui.button("Help").clicked() {
+                self.show_help = !self.show_help;
+            }
+        });
+    }
+
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            let state = self.doc.state();
+            ui.label(format!(
+                "{} layers, {} handles{}",
+                state.layers.len(),
+                state.handles.names().count(),
+                if self.doc.dirty { ", modified" } else { "" }
+            ));
+            ui.separator();
+            ui.label(format!("frame {:.1} ms", self.last_frame_ms));
+            if let Some(message) = &self.message {
+                ui.separator();
+                ui.label(message);
+            }
+        });
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        match self.mode {
+            Mode::Rig => self.rig_panel(ui),
+            Mode::Pose => self.pose_panel(ui),
+        }
+    }
+
+    fn rig_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Tools");
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.tool, Tool::Select, "Select");
+            ui.selectable_value(&mut self.tool, Tool::Bone, "Bone");
+            ui.selectable_value(&mut self.tool, Tool::Point, "Point");
+        });
+        ui.separator();
+        ui.heading("Handles");
+        let names: Vec<String> = self.doc.state().handles.names().map(String::from).collect();
+        egui::ScrollArea::vertical()
+            .max_height(180.0)
+            .show(ui, |ui| {
+                for name in names {
+                    let selected = self.selected.as_deref() == Some(name.as_str());
+                    if ui.selectable_label(selected, &name).clicked() {
+                        self.rename_to = name.clone();
+                        self.selected = Some(name);
+                    }
+                }
+            });
+        if let Some(name) = self.selected.clone() {
+            ui.separator();
+            ui.label(format!("Selected: {name}"));
+            ui.horizontal(|ui| {
+                ui.text_edit_singleline(&mut self.rename_to);
+                if ui.button("Rename").clicked() && self.rename_to != name {
+                    let to = self.rename_to.clone();
+                    if self.apply(Command::Rename {
+                        from: name.clone(),
+                        to: to.clone(),
+                    }) {
+                        self.selected = Some(to);
+                    }
+                }
+            });
+            let bones: Vec<String> = self
+                .doc
+                .state()
+                .handles
+                .bones
+                .iter()
+                .map(|b| b.name.clone())
+                .collect();
+            if let Some(bone) = self
+                .doc
+                .state()
+                .handles
+                .bones
+                .iter()
+                .find(|b| b.name == name)
+            {
+                let mut parent = bone.parent.clone();
+                let before = parent.clone();
+                egui::ComboBox::from_label("Parent")
+                    .selected_text(parent.clone().unwrap_or_else(|| "(none)".into()))
+                    .show_ui(ui, |ui| {
+                        ui.selectable_value(&mut parent, None, "(none)");
+                        for b in bones.iter().filter(|b| **b != name) {
+                            ui.selectable_value(&mut parent, Some(b.clone()), b);
+                        }
+                    });
+                if parent != before {
+                    self.apply(Command::Reparent {
+                        bone: name.clone(),
+                        parent,
+                    });
+                }
+            }
+            if ui.button("Delete").clicked() {
+                self.apply(Command::Delete { name });
+                self.selected = None;
+            }
+        }
+        ui.separator();
+        ui.heading("Weights");
+        let mut options = self.doc.state().options.clone();
+        let before = options.clone();
+        use crate::weights::WeightMethod;
+        egui::ComboBox::from_label("Method")
+            .selected_text(format!("{:?}", options.weights.method))
+            .show_ui(ui, |ui| {
+                for m in [
+                    WeightMethod::Bbw,
+                    WeightMethod::Harmonic,
+                    WeightMethod::Biharmonic,
+                    WeightMethod::Rigid,
+                ] {
+                    ui.selectable_value(&mut options.weights.method, m, format!("{m:?}"));
+                }
+            });
+        if options != before {
+            self.apply(Command::SetOptions(options));
+        }
+        match &self.worker {
+            Some(worker) => {
+                let (done, total) = worker.progress();
+                ui.add(
+                    egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                        .text(format!("computing weights: part {done} of {total}")),
+                );
+                if ui.button("Cancel").clicked() {
+                    worker.cancel();
+                }
+            }
+            None => {
+                let current = self.doc.posable().is_some();
+                let label = if current {
+                    "Weights are up to date"
+                } else {
+                    "Weights need computing"
+                };
+                ui.label(label);
+                if ui.button("Compute weights").clicked() {
+                    let ctx = ui.ctx().clone();
+                    self.compute_weights(&ctx);
+                }
+            }
+        }
+    }
+
+    fn pose_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Pose");
+        if self.doc.posable().is_none() {
+            ui.label("Compute the weights in rig mode to pose.");
+            return;
+        }
+        ui.label("Drag any point of the drawing; shift-click pins a point.");
+        let pins = self.doc.state().pose.ik.len();
+        ui.label(format!("{pins} pins and drags"));
+        if ui.button("Clear pins").clicked() {
+            let mut pose = self.doc.state().pose.clone();
+            pose.ik.clear();
+            self.apply(Command::SetPose(pose));
+        }
+        if ui.button("Rest pose").clicked() {
+            self.apply(Command::SetPose(Pose::default()));
+        }
+    }
+
+    /// The texture of each layer, uploaded once per layer image.
+    fn textures(&mut self, ctx: &egui::Context) -> Vec<TextureHandle> {
+        let layers = self.doc.state().layers.clone();
+        let mut out = Vec::with_capacity(layers.len());
+        for layer in &layers {
+            let key = Arc::as_ptr(layer);
+            if let Some((_, t)) = self.textures.iter().find(|(k, _)| *k == key) {
+                out.push(t.clone());
+                continue;
+            }
+            let image = egui::ColorImage::from_rgba_unmultiplied(
+                [layer.image.width() as usize, layer.image.height() as usize],
+                layer.image.as_raw(),
+            );
+            let texture = ctx.load_texture(&layer.name, image, egui::TextureOptions::LINEAR);
+            self.textures.push((key, texture.clone()));
+            out.push(texture);
+        }
+        self.textures
+            .retain(|(k, _)| layers.iter().any(|l| Arc::as_ptr(l) == *k));
+        out
+    }
+
+    /// Posed positions of `scene` for `pose`, solved with the kept IK solver when it has drags.
+    fn posed(&mut self, scene: &Arc<Scene>, pose: &Pose) -> Result<(), String> {
+        let key = Arc::as_ptr(scene);
+        if self
+            .posed
+            .as_ref()
+            .is_some_and(|p| p.scene == key && p.pose == *pose)
+        {
+            return Ok(());
+        }
+        let transforms = if pose.ik.is_empty() {
+            scene.handle_transforms(pose).map_err(|e| e.to_string())?
+        } else {
+            if self.ik.as_ref().is_none_or(|(k, _)| *k != key) {
+                let solver = scene.rig_ik().map_err(|e| e.to_string())?;
+                self.ik = Some((key, solver));
+            }
+            let Some((_, solver)) = self.ik.as_mut() else {
+                return Err("no IK solver".into());
+            };
+            solver
+                .transforms(pose)
+                .map_err(|e| e.to_string())?
+                .transforms
+        };
+        let positions = scene
+            .positions_from_transforms(&transforms, pose, Blend::Linear)
+            .map_err(|e| e.to_string())?;
+        let bones = scene
+            .doc
+            .handles
+            .bones
+            .iter()
+            .zip(&transforms)
+            .map(|(b, t)| {
+                let map = |p: [f64; 2]| {
+                    let q = t.apply(Point::new(p[0], p[1]));
+                    [q.x, q.y]
+                };
+                (map(b.head), map(b.tail))
+            })
+            .collect();
+        self.posed = Some(Posed {
+            scene: key,
+            pose: pose.clone(),
+            positions,
+            bones,
+        });
+        Ok(())
+    }
+
+    fn canvas(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let textures = self.textures(&ctx);
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+        let rect = response.rect;
+        painter.rect_filled(rect, 0.0, Color32::from_gray(40));
+        let canvas_px = self
+            .doc
+            .state()
+            .layers
+            .first()
+            .map(|l| [l.image.width(), l.image.height()])
+            .unwrap_or([512, 512]);
+        let view = *self
+            .view
+            .get_or_insert_with(|| canvas::fit(canvas_px, rect.size()));
+        let placed = Placed {
+            view,
+            origin: rect.min,
+        };
+        self.placed = Some(placed);
+        self.zoom_and_pan(&ctx, &response, placed);
+        let posable = self.doc.posable().cloned();
+        let live_pose = match &self.gesture {
+            Some(Gesture::PoseDrag { pose, .. }) => Some(pose.clone()),
+            _ => None,
+        };
+        let mut shapes = Vec::new();
+        let mut bone_frames = None;
+        match (self.mode, &posable) {
+            (Mode::Pose, Some(scene)) => {
+                let pose = live_pose.unwrap_or_else(|| self.doc.state().pose.clone());
+                if let Err(e) = self.posed(scene, &pose) {
+                    self.message = Some(e);
+                }
+                if let Some(posed) = &self.posed {
+                    for (k, part) in scene.doc.parts.iter().enumerate() {
+                        if let (Some(texture), Some(positions)) =
+                            (textures.get(k), posed.positions.get(k))
+                        {
+                            shapes.push(canvas::textured_mesh(
+                                &placed,
+                                texture,
+                                canvas_px,
+                                &part.mesh.vertices,
+                                positions,
+                                &part.mesh.triangles,
+                            ));
+                        }
+                    }
+                    bone_frames = Some(posed.bones.clone());
+                    for drag in &pose.ik {
+                        let s = placed.screen_from_canvas(drag.to);
+                        shapes.push(egui::Shape::circle_filled(s, 4.0, Color32::RED));
+                    }
+                }
+            }
+            _ => {
+                for texture in &textures {
+                    shapes.push(canvas::image_quad(&placed, texture, canvas_px));
+                }
+                if let (Some(scene), Some(name)) = (&self.doc.state().rig, &self.selected) {
+                    for part in &scene.doc.parts {
+                        let rest: Vec<Point> = part
+                            .mesh
+                            .vertices
+                            .iter()
+                            .map(|p| Point::new(p[0], p[1]))
+                            .collect();
+                        shapes.extend(canvas::wireframe(&placed, &rest, &part.mesh.triangles));
+                        if let (Some(weights), true) = (&part.weights, posable.is_some()) {
+                            shapes.extend(canvas::heat_map(
+                                &placed,
+                                weights,
+                                name,
+                                &rest,
+                                &part.mesh.triangles,
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        let mut handles = self.doc.state().handles.clone();
+        match &self.gesture {
+            Some(Gesture::NewBone { head, parent, tail }) => handles.bones.push(Bone {
+                name: String::new(),
+                parent: parent.clone(),
+                head: *head,
+                tail: *tail,
+            }),
+            Some(Gesture::MoveHandle { name, from, to }) => {
+                move_handle(&mut handles, name, [to[0] - from[0], to[1] - from[1]])
+            }
+            _ => {}
+        }
+        shapes.extend(canvas::handles(
+            &placed,
+            &handles,
+            bone_frames.as_deref(),
+            self.selected.as_deref(),
+        ));
+        painter.extend(shapes);
+        match self.mode {
+            Mode::Rig => self.rig_gestures(&ctx, &response, placed),
+            Mode::Pose => {
+                if let Some(scene) = posable {
+                    self.pose_gestures(&ctx, &response, placed, &scene)
+                }
+            }
+        }
+    }
+
+    fn zoom_and_pan(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
+        if !response.hovered() {
+            return;
+        }
+        let (scroll, pointer) = ctx.input(|i| (i.smooth_scroll_delta().y, i.pointer.hover_pos()));
+        if scroll != 0.0 {
+            if let (Some(view), Some(at)) = (self.view.as_mut(), pointer) {
+                let anchor = placed.canvas_from_screen(at);
+                view.zoom = (view.zoom * (scroll / 200.0).exp()).clamp(0.05, 32.0);
+                // Keep the canvas point under the pointer where it was.
+                let moved = Placed {
+                    view: *view,
+                    origin: placed.origin,
+                }
+                .screen_from_canvas(anchor);
+                view.pan += at - moved;
+            }
+        }
+        if response.dragged_by(egui::PointerButton::Middle) {
+            if let Some(view) = self.view.as_mut() {
+                view.pan += response.drag_delta();
+            }
+        }
+    }
+
+    fn rig_gestures(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
+        let pointer = response.interact_pointer_pos();
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            if let Some(at) = pointer {
+                let c = placed.canvas_from_screen(at);
+                let handles = &self.doc.state().handles;
+                self.gesture = match self.tool {
+                    Tool::Bone => {
+                        // Starting on a bone's tail continues that skeleton.
+                        let parent = handles.bones.iter().find(|b| {
+                            placed.screen_from_canvas(b.tail).distance(at) <= canvas::PICK_RADIUS_PT
+                        });
+                        Some(Gesture::NewBone {
+                            head: parent.map_or(c, |b| b.tail),
+                            parent: parent.map(|b| b.name.clone()),
+                            tail: c,
+                        })
+                    }
+                    Tool::Select => match canvas::pick(&placed, handles, at) {
+                        Some(name) => {
+                            self.rename_to = name.clone();
+                            self.selected = Some(name.clone());
+                            Some(Gesture::MoveHandle {
+                                name,
+                                from: c,
+                                to: c,
+                            })
+                        }
+                        None => Some(Gesture::Pan),
+                    },
+                    Tool::Point => None,
+                };
+            }
+        }
+        if let (Some(at), true) = (pointer, response.dragged()) {
+            let c = placed.canvas_from_screen(at);
+            match &mut self.gesture {
+                Some(Gesture::NewBone { tail, .. }) => *tail = c,
+                Some(Gesture::MoveHandle { to, .. }) => *to = c,
+                Some(Gesture::Pan) => {
+                    if let Some(view) = self.view.as_mut() {
+                        view.pan += response.drag_delta();
+                    }
+                }
+                _ => {}
+            }
+        }
+        if response.drag_stopped() {
+            match self.gesture.take() {
+                Some(Gesture::NewBone { head, parent, tail })
+                    if distance(head, tail) >= CLICK_SLOP_PX =>
+                {
+                    let name = self.unique_name("bone");
+                    if self.apply(Command::AddBone(Bone {
+                        name: name.clone(),
+                        parent,
+                        head,
+                        tail,
+                    })) {
+                        self.selected = Some(name);
+                    }
+                }
+                Some(Gesture::MoveHandle { name, from, to }) if distance(from, to) > 0.0 => {
+                    let mut handles = self.doc.state().handles.clone();
+                    move_handle(&mut handles, &name, [to[0] - from[0], to[1] - from[1]]);
+                    if let Some(b) = handles.bones.iter().find(|b| b.name == name) {
+                        self.apply(Command::MoveBone {
+                            name,
+                            head: b.head,
+                            tail: b.tail,
+                        });
+                    } else if let Some(p) = handles.points.iter().find(|p| p.name == name) {
+                        self.apply(Command::MovePoint { name, at: p.at });
+                    }
+                }
+                _ => {}
+            }
+        }
+        if response.clicked() {
+            if let Some(at) = pointer {
+                let c = placed.canvas_from_screen(at);
+                match self.tool {
+                    Tool::Point => {
+                        let name = self.unique_name("point");
+                        if self.apply(Command::AddPoint(PointHandle {
+                            name: name.clone(),
+                            at: c,
+                        })) {
+                            self.selected = Some(name);
+                        }
+                    }
+                    _ => {
+                        self.selected = canvas::pick(&placed, &self.doc.state().handles, at);
+                        if let Some(name) = &self.selected {
+                            self.rename_to = name.clone();
+                        }
+                    }
+                }
+            }
+        }
+        let _ = ctx;
+    }
+
+    fn pose_gestures(
+        &mut self,
+        ctx: &egui::Context,
+        response: &egui::Response,
+        placed: Placed,
+        scene: &Arc<Scene>,
+    ) {
+        let pointer = response.interact_pointer_pos();
+        let shift = ctx.input(|i| i.modifiers.shift);
+        let grab = |app: &EditorApp, at: Pos2| -> Option<[f64; 2]> {
+            let posed = app.posed.as_ref()?;
+            rest_point_under(scene, &posed.positions, placed.canvas_from_screen(at))
+        };
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            if let Some(at) = pointer {
+                let c = placed.canvas_from_screen(at);
+                let mut pose = self.doc.state().pose.clone();
+                // Grabbing an existing pin moves it; anywhere else on the drawing adds a drag.
+                let existing = pose.ik.iter().position(|d| {
+                    placed.screen_from_canvas(d.to).distance(at) <= canvas::PICK_RADIUS_PT
+                });
+                let index = match existing {
+                    Some(i) => Some(i),
+                    None => grab(self, at).map(|rest| {
+                        pose.ik.push(IkDrag {
+                            at: rest,
+                            to: c,
+                            weight: None,
+                        });
+                        pose.ik.len() - 1
+                    }),
+                };
+                if let Some(index) = index {
+                    self.gesture = Some(Gesture::PoseDrag { index, pose });
+                }
+            }
+        }
+        if let (Some(at), true) = (pointer, response.dragged()) {
+            if let Some(Gesture::PoseDrag { index, pose }) = &mut self.gesture {
+                pose.ik[*index].to = placed.canvas_from_screen(at);
+            }
+        }
+        if response.drag_stopped() {
+            if let Some(Gesture::PoseDrag { pose, .. }) = self.gesture.take() {
+                self.apply(Command::SetPose(pose));
+            }
+        }
+        if response.clicked() && shift {
+            if let Some(at) = pointer {
+                if let Some(rest) = grab(self, at) {
+                    let mut pose = self.doc.state().pose.clone();
+                    pose.ik.push(IkDrag {
+                        at: rest,
+                        to: placed.canvas_from_screen(at),
+                        weight: None,
+                    });
+                    self.apply(Command::SetPose(pose));
+                }
+            }
+        }
+    }
+
+    fn unique_name(&self, stem: &str) -> String {
+        let handles = &self.doc.state().handles;
+        (1..)
+            .map(|k| format!("{stem}{k}"))
+            .find(|n| !handles.names().any(|m| m == n))
+            .unwrap_or_else(|| stem.to_string())
+    }
+
+    fn take_screenshot(&mut self, ctx: &egui::Context) {
+        let Some((path, frames)) = &mut self.screenshot else {
+            return;
+        };
+        *frames += 1;
+        if *frames == SCREENSHOT_AFTER_FRAMES {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(Default::default()));
+        }
+        let shot = ctx.input(|i| {
+            i.raw.events.iter().find_map(|e| match e {
+                egui::Event::Screenshot { image, .. } => Some(image.clone()),
+                _ => None,
+            })
+        });
+        if let Some(image) = shot {
+            let [w, h] = image.size;
+            let bytes: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+            let saved = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
+                .ok_or_else(|| "screenshot size mismatch".to_string())
+                .and_then(|img| {
+                    let mut png = Vec::new();
+                    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+                        .map_err(|e| e.to_string())?;
+                    crate::io::atomic::write_atomic(path, &png).map_err(|e| e.to_string())
+                });
+            if let Err(e) = saved {
+                eprintln!("sinew edit: screenshot: {e}");
+            }
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        } else {
+            ctx.request_repaint();
+        }
+    }
+}
+
+/// Frames drawn before `--screenshot` takes its picture (fonts and textures settle).
+const SCREENSHOT_AFTER_FRAMES: u32 = 5;
+
+impl eframe::App for EditorApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.frame(ui);
+    }
+}
+
+fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Moves handle `name` by `delta_px`.
+fn move_handle(handles: &mut crate::rig::Handles, name: &str, delta_px: [f64; 2]) {
+    let shift = |p: &mut [f64; 2]| {
+        p[0] += delta_px[0];
+        p[1] += delta_px[1];
+    };
+    if let Some(b) = handles.bones.iter_mut().find(|b| b.name == name) {
+        shift(&mut b.head);
+        shift(&mut b.tail);
+    }
+    if let Some(p) = handles.points.iter_mut().find(|p| p.name == name) {
+        shift(&mut p.at);
+    }
+}
+
+/// The rest position of the drawing's point shown at `at_px` (canvas px) in the posed
+/// `positions`: the frontmost part whose posed triangle contains it, barycentrically.
+pub fn rest_point_under(
+    scene: &Scene,
+    positions: &[Vec<Point>],
+    at_px: [f64; 2],
+) -> Option<[f64; 2]> {
+    let p = Point::new(at_px[0], at_px[1]);
+    for (part, posed) in scene.doc.parts.iter().zip(positions).rev() {
+        for t in &part.mesh.triangles {
+            let [a, b, c] = t.map(|i| posed[i as usize]);
+            let area = crate::geom::triangle_area2(a, b, c);
+            if area.abs() < f64::EPSILON {
+                continue;
+            }
+            let wa = crate::geom::triangle_area2(p, b, c) / area;
+            let wb = crate::geom::triangle_area2(a, p, c) / area;
+            let wc = 1.0 - wa - wb;
+            if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
+                let rest = t.map(|i| part.mesh.vertices[i as usize]);
+                return Some([
+                    wa * rest[0][0] + wb * rest[1][0] + wc * rest[2][0],
+                    wa * rest[0][1] + wb * rest[1][1] + wc * rest[2][1],
+                ]);
+            }
+        }
+    }
+    None
+}
+
+fn help_window(ctx: &egui::Context, open: &mut bool) {
+    egui::Window::new("Keyboard shortcuts")
+        .open(open)
+        .collapsible(false)
+        .show(ctx, |ui| {
+            egui::Grid::new("shortcuts").show(ui, |ui| {
+                for (keys, what) in SHORTCUTS {
+                    ui.label(*keys);
+                    ui.label(*what);
+                    ui.end_row();
+                }
+            });
+        });
+}
+
+/// The shortcuts the help overlay lists (every one of them works).
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("1 / 2", "rig mode / pose mode"),
+    ("Ctrl+Z", "undo"),
+    ("Ctrl+Shift+Z", "redo"),
+    ("Delete", "delete the selected handle"),
+    ("Shift+click", "pin a point (pose mode)"),
+    ("Mouse wheel", "zoom about the pointer"),
+    ("Middle drag", "pan"),
+    ("Esc", "cancel the gesture, close this help"),
+    ("F1 or ?", "this help"),
+];
+
+/// Opens the editor window on `path` (or an empty document); `screenshot` takes a picture of
+/// the first frames and quits; `mode` and `pose` set what it shows first.
+pub fn run(
+    path: Option<&Path>,
+    mode: Mode,
+    pose: Option<Pose>,
+    screenshot: Option<PathBuf>,
+) -> anyhow::Result<()> {
+    let doc = match path {
+        Some(p) => Document::open(p)?,
+        None => Document::new(),
+    };
+    let mut app = EditorApp::new(doc);
+    app.mode = mode;
+    if let Some(pose) = pose {
+        app.doc.apply(Command::SetPose(pose))?;
+    }
+    if let Some(shot) = screenshot {
+        app.screenshot_then_quit(shot);
+    }
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1280.0, 800.0])
+            .with_title("sinew")
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native("sinew", options, Box::new(|_| Ok(Box::new(app))))
+        .map_err(|e| anyhow::anyhow!("the editor window failed: {e}"))
+}

@@ -1,0 +1,222 @@
+//! The editor driven through egui_kittest: real frames, simulated pointer and keys, checked
+//! against the document.
+
+use super::*;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::Harness;
+
+/// Frames a background weight build may take before a test gives up (50 ms apart).
+const BUILD_FRAMES: usize = 1200;
+
+fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1200.0, 800.0))
+        .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
+}
+
+/// The bundled character rigged with default options, saved (with absolute image paths) in a
+/// fresh folder.
+fn character_rig(name: &str) -> PathBuf {
+    let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    let list: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
+    )
+    .expect("layers.json parses");
+    let paths: Vec<PathBuf> = list["layers"]
+        .as_array()
+        .expect("a layer list")
+        .iter()
+        .map(|n| assets.join(format!("{}.png", n.as_str().expect("a name"))))
+        .collect();
+    let layers = crate::pipeline::load_layers(&paths).expect("layers");
+    let handles: crate::rig::Handles = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("handles.json")).expect("handles.json"),
+    )
+    .expect("handles parse");
+    let dir = std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let (mut doc, _) = crate::pipeline::build_rig(&layers, &assets, &Default::default(), &handles)
+        .expect("the character rigs");
+    for part in &mut doc.parts {
+        part.image = assets.join(&part.image).to_string_lossy().into_owned();
+    }
+    let path = dir.join("character.json");
+    doc.save(&path).expect("saved");
+    path
+}
+
+fn screen(h: &Harness<'_, EditorApp>, canvas_px: [f64; 2]) -> Pos2 {
+    h.state()
+        .placed
+        .expect("the canvas was drawn")
+        .screen_from_canvas(canvas_px)
+}
+
+/// Press at `from`, move in steps, release at `to` (canvas px).
+fn drag(h: &mut Harness<'_, EditorApp>, from: [f64; 2], to: [f64; 2]) {
+    h.drag_at(screen(h, from));
+    h.step();
+    for k in 1..=4 {
+        let t = k as f64 / 4.0;
+        let p = [
+            from[0] + t * (to[0] - from[0]),
+            from[1] + t * (to[1] - from[1]),
+        ];
+        h.hover_at(screen(h, p));
+        h.step();
+    }
+    h.drop_at(screen(h, to));
+    h.step();
+    h.run();
+}
+
+fn wait_for_weights(h: &mut Harness<'_, EditorApp>) {
+    for _ in 0..BUILD_FRAMES {
+        h.step();
+        if !h.state().computing() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    h.run();
+    assert!(!h.state().computing(), "weights took too long");
+}
+
+/// A point well inside the torso at rest, canvas px.
+fn torso_point(h: &Harness<'_, EditorApp>) -> [f64; 2] {
+    let scene = h.state().doc.posable().expect("posable").clone();
+    let part = scene
+        .doc
+        .parts
+        .iter()
+        .find(|p| p.name == "torso")
+        .expect("a torso");
+    let v = &part.mesh.vertices;
+    let n = v.len() as f64;
+    let c = v
+        .iter()
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    // The nearest vertex to the centroid lies on the drawing.
+    *v.iter()
+        .min_by(|a, b| distance(**a, c).total_cmp(&distance(**b, c)))
+        .expect("vertices")
+}
+
+#[test]
+fn rig_weigh_pose_undo_through_the_ui() {
+    let path = character_rig("flow");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.get_by_label("Weights are up to date");
+    let bones_before = h.state().doc.state().handles.bones.len();
+
+    // Rig mode: draw a bone with the bone tool.
+    h.get_by_label("Bone").click();
+    h.run();
+    drag(&mut h, [200.0, 60.0], [240.0, 40.0]);
+    let handles = &h.state().doc.state().handles;
+    assert_eq!(
+        handles.bones.len(),
+        bones_before + 1,
+        "{:?}",
+        h.state().message
+    );
+    let added = handles.bones.last().expect("a bone");
+    assert!(
+        distance(added.tail, [240.0, 40.0]) < 1.0,
+        "tail {:?}",
+        added.tail
+    );
+    assert!(
+        h.state().doc.posable().is_none(),
+        "new handle: weights stale"
+    );
+    h.get_by_label("Weights need computing");
+
+    // Computing runs in the background; the UI keeps drawing frames meanwhile.
+    h.get_by_label("Compute weights").click();
+    h.step();
+    assert!(h.state().computing());
+    h.get_by_label("Cancel");
+    wait_for_weights(&mut h);
+    assert!(h.state().doc.posable().is_some(), "{:?}", h.state().message);
+
+    // Pose mode: drag a point of the torso; the pose gets a drag and the shape moves.
+    h.key_press(Key::Num2);
+    h.run();
+    assert_eq!(h.state().mode, Mode::Pose);
+    let grip = torso_point(&h);
+    drag(&mut h, grip, [grip[0] + 25.0, grip[1] - 15.0]);
+    let pose = &h.state().doc.state().pose;
+    assert_eq!(pose.ik.len(), 1, "{:?}", h.state().message);
+    assert!(distance(pose.ik[0].at, grip) < 1.0);
+    assert!(distance(pose.ik[0].to, [grip[0] + 25.0, grip[1] - 15.0]) < 1.0);
+    let posed = h.state().posed.as_ref().expect("posed");
+    let moved = posed
+        .positions
+        .iter()
+        .flatten()
+        .zip(
+            h.state()
+                .doc
+                .posable()
+                .expect("rig")
+                .rest_positions()
+                .iter()
+                .flatten(),
+        )
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(moved > 10.0, "the shape moved only {moved} px");
+
+    // Undo the drag with the keyboard, then redo it.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(h.state().doc.state().pose.ik.is_empty());
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    assert_eq!(h.state().doc.state().pose.ik.len(), 1);
+}
+
+#[test]
+fn bad_files_show_a_message_and_keep_the_document() {
+    let path = character_rig("bad");
+    let dir = path.parent().expect("a folder").to_path_buf();
+    let mut app = EditorApp::new(Document::open(&path).expect("opens"));
+    let layers = app.doc.state().layers.len();
+
+    let corrupt = dir.join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").expect("written");
+    app.import_layer(&corrupt);
+    assert!(app.message.is_some());
+    assert_eq!(app.doc.state().layers.len(), layers);
+
+    let mut newer: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("json");
+    newer["version"] = serde_json::json!(99);
+    let newer_path = dir.join("newer.json");
+    std::fs::write(&newer_path, newer.to_string()).expect("written");
+    app.message = None;
+    app.open(&newer_path);
+    let message = app.message.clone().expect("a message");
+    assert!(message.contains("newer.json"), "{message}");
+    assert_eq!(app.doc.path.as_deref(), Some(path.as_path()));
+    assert_eq!(app.doc.state().layers.len(), layers);
+
+    // The message reaches the window's status bar.
+    let mut h = harness(app);
+    h.run();
+    h.get_by_label(&message);
+}
+
+#[test]
+fn the_help_overlay_lists_the_shortcuts() {
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+    h.key_press(Key::F1);
+    h.run();
+    for (keys, _) in SHORTCUTS {
+        h.get_by_label(keys);
+    }
+}

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Screenshots of the editor, one per mode, for docs/ (a person runs this on purpose and looks at
+# the PNGs before committing them).
+#
+#   tools/editor-screenshots/run.sh [OUT_DIR]      (default: docs/)
+#
+# Runs the editor under Xvfb with Mesa's software OpenGL (no GPU needed). Installs what it needs
+# on first use from Debian's packages (needs root or sudo): xvfb, xauth and the X libraries winit
+# loads at run time. Exit status: 0 done, 3 on a setup error.
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+out="${1:-$root/docs}"
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"
+  elif command -v sudo >/dev/null; then sudo "$@"
+  else echo "editor-screenshots: need root (or sudo) to install $*" >&2; exit 3
+  fi
+}
+if ! command -v xvfb-run >/dev/null; then
+  as_root apt-get update -qq >&2
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+    xvfb xauth libgl1-mesa-dri libegl1 libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6 >&2
+fi
+
+cd "$root"
+cargo build --release --locked
+sinew="$root/target/release/sinew"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+# The bundled character, rigged; the demo's rig refers to the assets by relative paths.
+"$sinew" demo -o "$work/demo" >/dev/null
+rig="$work/demo/rig.json"
+mkdir -p "$out"
+shoot() { # MODE OUT.png [extra args]
+  local mode="$1" png="$2"; shift 2
+  LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 1280x800x24" \
+    "$sinew" edit "$rig" --mode "$mode" --screenshot "$png" "$@"
+}
+shoot rig "$out/editor-rig.png"
+shoot pose "$out/editor-pose.png" --pose "$root/assets/character/poses/lift.json"
+echo "wrote $out/editor-rig.png $out/editor-pose.png"
