@@ -460,15 +460,9 @@ fn non_uniform(
         }
     }
     if dd <= (min_dist + max_dist) * 0.5 {
-        (
-            ta - (min_y * bend_dir).atan2(min_x),
-            min_angle * bend_dir,
-        )
+        (ta - (min_y * bend_dir).atan2(min_x), min_angle * bend_dir)
     } else {
-        (
-            ta - (max_y * bend_dir).atan2(max_x),
-            max_angle * bend_dir,
-        )
+        (ta - (max_y * bend_dir).atan2(max_x), max_angle * bend_dir)
     }
 }
 
@@ -596,7 +590,11 @@ mod tests {
             assert_eq!(side > 0.0, bend, "bend_positive {bend}: elbow at {elbow:?}");
             // Spine's bendPositive: the child's local rotation comes out positive.
             let child = pose.bones["lower"].rotate;
-            assert_eq!(child > 0.0, bend, "bend_positive {bend}: child turned {child}°");
+            assert_eq!(
+                child > 0.0,
+                bend,
+                "bend_positive {bend}: child turned {child}°"
+            );
         }
     }
 
@@ -667,7 +665,10 @@ mod tests {
         let pose = constrained_pose(&handles, &keyed).unwrap();
         // Straight up on screen from the head at (100, 0); the shear is part of the x axis.
         let end = end_of(&handles, &pose, 1);
-        assert!((end - Point::new(100.0, -80.0)).norm() < 1e-9, "end {end:?}");
+        assert!(
+            (end - Point::new(100.0, -80.0)).norm() < 1e-9,
+            "end {end:?}"
+        );
         assert!((pose.bones["lower"].rotate - 80.0).abs() < 1e-9);
     }
 

@@ -81,6 +81,15 @@ function lint(json, atlas) {
     if (boneIndex.has(b.name)) out.push(`bone ${b.name}: listed twice`);
     boneIndex.set(b.name, i);
   });
+  const constraints = new Set();
+  (json.ik || []).forEach((k, i) => {
+    only(`ik ${k.name}`, k, ["name", "order", "skin", "bones", "target", "mix", "softness", "bendPositive", "compress", "stretch", "uniform"]);
+    if (constraints.has(k.name)) out.push(`ik ${k.name}: listed twice`);
+    constraints.add(k.name);
+    if (!(k.bones.length === 1 || k.bones.length === 2)) out.push(`ik ${k.name}: ${k.bones.length} bones (the runtime solves 1 or 2)`);
+    if (k.order !== i) out.push(`ik ${k.name}: order ${k.order} at position ${i}`);
+    for (const b of [...k.bones, k.target]) if (!boneIndex.has(b)) out.push(`ik ${k.name}: unknown bone ${b}`);
+  });
   const slots = new Map();
   for (const s of json.slots || []) {
     only(`slot ${s.name}`, s, ["name", "bone", "color", "dark", "attachment", "blend", "visible"]);
@@ -158,6 +167,10 @@ function lint(json, atlas) {
         else if (kind === "attachment") keysOk(where, keys, ["name"], 0);
         else out.push(`${where}: timeline sinew does not write`);
       }
+    }
+    for (const [constraint, keys] of Object.entries(a.ik || {})) {
+      if (!constraints.has(constraint)) out.push(`animation ${name}: unknown IK constraint ${constraint}`);
+      keysOk(`animation ${name}, ik ${constraint}`, keys, ["mix", "softness", "bendPositive", "compress", "stretch"], 2);
     }
     for (const [i, k] of (a.drawOrder || []).entries()) {
       only(`animation ${name}, drawOrder key ${i}`, k, ["time", "offsets"]);
