@@ -110,7 +110,7 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
 
     // Flags.
     for (flags, message) in [
-        (vec!["--spine-version", "4.3"], "not supported"),
+        (vec!["--spine-version", "4.4"], "not supported"),
         (vec!["--fps", "0"], "bake rate"),
         (vec!["--max-influences", "0"], "at least 1"),
         (vec!["--max-vertices", "2"], "at least 3"),

@@ -18,7 +18,7 @@ use command::{s, scratch};
 use serde::Deserialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::export::spine::bake::bake_times;
-use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions};
+use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
 use sinew::geom::Point;
 use sinew::io::{self, RigDocument};
 use sinew::pipeline::Scene;
@@ -545,6 +545,18 @@ fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
         &coarse,
         Compare::RuntimeMode,
     );
+    // The same rig for the 4.3 runtime, which refuses timelines it does not know.
+    let v43 = SpineOptions {
+        version: SpineVersion::V4_3,
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("v43"),
+        &["--spine-version", "4.3"],
+        &v43,
+        Compare::RuntimeMode,
+    );
     // Fewer influences: loads, setup pose exact; the deviation is printed.
     let few = SpineOptions {
         max_influences: Some(2),
@@ -680,6 +692,22 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
     for bone in ["t1", "t2", "t3"] {
         assert!(curl[bone]["rotate"].is_array(), "{bone} is baked in 'curl'");
     }
+    // The 4.3 layout (constraints in one typed array) in the 4.3 runtime.
+    let v43 = SpineOptions {
+        version: SpineVersion::V4_3,
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("v43"),
+        &["--spine-version", "4.3"],
+        &v43,
+        Compare::RuntimeMode,
+    );
+    let json43: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("v43/rig.json")).unwrap()).unwrap();
+    assert_eq!(json43["constraints"][0]["type"], "ik");
+    assert!(json43.get("ik").is_none());
     // Everything baked: the constraints are keyed off, so the runtime does not solve them a
     // second time on top of the baked keys.
     let baked = SpineOptions {

@@ -3,8 +3,10 @@
 //! In: the rig's [`Handles`] (their `ik` constraints, see [`crate::rig::bone_ik`]) and the
 //! export's [`Skeleton`]. Out: which constraints Spine solves itself — every one- and two-bone
 //! constraint, written as a Spine 4.2 `ik` entry (`bones`, `target`, `mix`, `softness`,
-//! `bendPositive`, `order`; spine-format.md §8) — and, per animation, which of them must be
-//! switched off (an IK timeline keying `mix` to 0) because their chain is baked.
+//! `bendPositive`, `order`; spine-format.md §8), or for 4.3 as an entry of the typed
+//! `constraints` array (`"type": "ik"`, the same fields, update order = array order; §11) — and,
+//! per animation, which of them must be switched off (an IK timeline keying `mix` to 0, which
+//! 4.2 and 4.3 read alike) because their chain is baked.
 //!
 //! sinew's one- and two-bone solver is spine-core's own (`bone_ik` ports `apply1`/`apply2`), so
 //! the fields carry over unchanged: `bend_positive` is `bendPositive`, `softness_px` is
@@ -20,6 +22,7 @@
 
 use super::skeleton::Skeleton;
 use super::timelines::num;
+use super::SpineVersion;
 use crate::rig::Handles;
 use serde_json::{json, Value};
 use std::collections::BTreeSet;
@@ -76,18 +79,31 @@ pub fn switch_off_baked(
     }
 }
 
-/// The 4.2 `ik` entry of constraint `c`, updated `order`-th among the skeleton's constraints.
-pub fn ik_entry(handles: &Handles, c: usize, order: usize) -> Value {
+/// The top-level key of the constraint entries: `ik` up to 4.2, `constraints` in 4.3.
+pub fn block_key(version: SpineVersion) -> &'static str {
+    match version {
+        SpineVersion::V4_1 | SpineVersion::V4_2 => "ik",
+        SpineVersion::V4_3 => "constraints",
+    }
+}
+
+/// The entry of constraint `c`, updated `order`-th among the skeleton's constraints (4.3 has no
+/// `order`: the entries must be written in that order).
+pub fn ik_entry(handles: &Handles, c: usize, order: usize, version: SpineVersion) -> Value {
     let k = &handles.ik[c];
-    json!({
+    let mut entry = json!({
         "name": k.name,
-        "order": order,
         "bones": k.bones,
         "target": k.target,
         "mix": num(k.applied_mix()),
         "softness": num(k.softness_px),
         "bendPositive": k.bend_positive,
-    })
+    });
+    match version {
+        SpineVersion::V4_1 | SpineVersion::V4_2 => entry["order"] = json!(order),
+        SpineVersion::V4_3 => entry["type"] = json!("ik"),
+    }
+    entry
 }
 
 /// An animation's IK timeline that switches a constraint off for its whole length.
@@ -135,7 +151,12 @@ mod tests {
     fn one_and_two_bone_chains_export_with_spine_fields() {
         let h = rig();
         assert_eq!(exported(&h), vec![1]);
-        let e = ik_entry(&h, 1, 0);
+        let e = ik_entry(&h, 1, 0, SpineVersion::V4_2);
+        assert_eq!(e["order"], json!(0));
+        assert!(e.get("type").is_none());
+        let e43 = ik_entry(&h, 1, 0, SpineVersion::V4_3);
+        assert_eq!(e43["type"], json!("ik"));
+        assert!(e43.get("order").is_none());
         assert_eq!(e["bones"], json!(["b", "c"]));
         assert_eq!(e["bendPositive"], json!(false));
         assert_eq!(e["mix"], json!(1.0), "mix is written as applied");
