@@ -8,7 +8,8 @@
 //! Rigs: the bundled character as `sinew demo` writes it (bones, a point; Bézier keys), a
 //! generated rig with two skeletons, a point, a cage, a region, colour, visibility and
 //! draw-order keys, stepped keys and timelines that start after 0 s, and a generated rig with
-//! bone IK constraints: a two-bone arm (bend negative, mix < 1, softness) and a one-bone pole
+//! bone IK constraints: a two-bone arm (bend negative, mix < 1, softness, its root keyed to a
+//! non-uniform scale) and a one-bone pole
 //! that the runtime solves itself from their moving target's keys, and a three-bone tail
 //! (FABRIK, baked into keys).
 
@@ -639,7 +640,8 @@ fn ik_rig(dir: &Path) -> PathBuf {
                     {"time": 0, "value": [0, 0], "curve": [0.2, -10, 0.35, -40, 0.1, 5, 0.3, 20]},
                     {"time": 0.5, "value": [-45, 25], "curve": [0.6, -45, 0.8, 10, 0.6, 25, 0.9, -20]},
                     {"time": 1.0, "value": [15, -30]}]},
-                "upper": {"rotate": [{"time": 0, "value": 0}, {"time": 1.0, "value": 40}]},
+                "upper": {"rotate": [{"time": 0, "value": 0}, {"time": 1.0, "value": 40}],
+                          "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.15, 0.85]}]},
                 "lower": {"rotate": [{"time": 0.2, "value": 0, "curve": [0.3, 10, 0.5, -30]},
                                      {"time": 0.7, "value": -25}]}
             }
@@ -684,6 +686,8 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
     assert_eq!(json["ik"][0]["bendPositive"], false);
     let reach = &json["animations"]["reach"];
     assert!(reach["bones"]["reach"]["translate"].is_array() && reach.get("ik").is_none());
+    // A non-uniform scale of the chain's root: spine-core's other two-bone solver.
+    assert!(reach["bones"]["upper"]["scale"].is_array());
     assert!(
         reach["bones"]["t1"].is_null(),
         "nothing of the tail moves in 'reach'"
