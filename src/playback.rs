@@ -248,7 +248,7 @@ pub fn bake(
                         .map(move |&p| (a.apply(p) - b.apply(p)).norm())
                 })
                 .fold(0.0, f64::max);
-            if !(apart <= BAKE_REPLAY_TOLERANCE_PX) {
+            if apart.is_nan() || apart > BAKE_REPLAY_TOLERANCE_PX {
                 let names: Vec<&str> = handles.ik.iter().map(|c| c.name.as_str()).collect();
                 return Err(PipelineError::BakeBoneIk(names.join(", ")));
             }

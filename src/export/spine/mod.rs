@@ -1,5 +1,5 @@
-//! Spine export: a rig as Spine 4.2 skeleton JSON, a `.atlas` and its page PNGs, which the
-//! official runtimes play where sinew draws the rig.
+//! Spine export: a rig as Spine 4.2 (or 4.1, 4.3) skeleton JSON, a `.atlas` and its page PNGs,
+//! which the official runtimes play where sinew draws the rig.
 //!
 //! In: a loaded [`Scene`] (the rig document, every part with weights), the parts' images
 //! (straight-alpha RGBA8 on the canvas), a base name and [`SpineOptions`]. Out: a
