@@ -97,7 +97,7 @@ pub struct SpineArgs {
     /// The folder to write into (created if missing).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Spine editor line to write for: 4.2 (or 4.1).
+    /// Spine editor line to write for: 4.2 (or 4.1, or 4.3).
     #[arg(long, default_value = "4.2")]
     pub spine_version: String,
     /// Keys per second for motion Spine cannot express natively (baked).

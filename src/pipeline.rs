@@ -82,7 +82,7 @@ pub enum PipelineError {
     Pose(#[from] PoseError),
     #[error(transparent)]
     Ik(#[from] crate::ik::IkError),
-    #[error("baking a rig with bone IK constraints ({0}) is not supported: played back, the keys would be constrained a second time")]
+    #[error("cannot bake: played back, the rig's bone IK constraints ({0}) would solve again and not reproduce the baked motion (skinning IK moved a constrained chain)")]
     BakeBoneIk(String),
     #[error("part '{part}' has weights for handle '{handle}', which the rig does not have")]
     UnknownWeightHandle { part: String, handle: String },

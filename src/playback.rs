@@ -195,11 +195,22 @@ pub fn render_poses(
         .collect()
 }
 
+/// How far (px, at the corners of the rig's rest bounding box) playing a baked frame on the rig
+/// may move a handle away from the transformation that was baked.
+pub const BAKE_REPLAY_TOLERANCE_PX: f64 = 1e-3;
+
 /// Bakes `animation` at `times_s` (ascending; the caller includes the end time if the loop
 /// must close) into an animation with linear keys for every bone, point and cage, computed from
-/// the skinning transformations playback solves — skinning IK and bone IK included — and no
-/// `ik` timelines. Part looks and draw order are kept as authored. Rotations are unwrapped
-/// (each key within 180° of the previous), since runtimes interpolate plain numbers.
+/// the skinning transformations playback solves — skinning IK included — and no `ik`
+/// timelines. Part looks and draw order are kept as authored. Rotations are unwrapped (each key
+/// within 180° of the previous), since runtimes interpolate plain numbers.
+///
+/// Bone IK constraints stay in the rig and solve again when the baked keys play, so the bones of
+/// their chains are baked with the keys the constraints solve from (the animation's own), not
+/// with the solved rotations, which a constraint with mix < 1 would blend a second time. Every
+/// baked frame is played back on the rig and compared with what was baked; when a constraint
+/// would not reproduce it (skinning IK moved a chain, which then follows its ancestor without
+/// solving again), the bake is refused.
 pub fn bake(
     scene: &Scene,
     animation: &Animation,
@@ -207,19 +218,42 @@ pub fn bake(
 ) -> Result<Animation, PipelineError> {
     use crate::anim::timeline::{BoneTimelines, Key, PointTimelines};
     let handles = &scene.doc.handles;
-    if !handles.ik.is_empty() {
-        let names: Vec<&str> = handles.ik.iter().map(|c| c.name.as_str()).collect();
-        return Err(PipelineError::BakeBoneIk(names.join(", ")));
-    }
     let poses: Vec<Pose> = times_s
         .iter()
         .map(|&t| animation.sample(t, false))
         .collect();
     let transforms = scene.sequence_transforms(&poses, times_s)?;
-    let baked: Vec<Pose> = transforms
+    let mut baked: Vec<Pose> = transforms
         .iter()
         .map(|t| crate::rig::pose::pose_from_transforms(handles, t))
         .collect::<Result<_, _>>()?;
+    if !handles.ik.is_empty() {
+        let constrained: std::collections::BTreeSet<&String> =
+            handles.ik.iter().flat_map(|c| &c.bones).collect();
+        let corners = rest_corners(scene);
+        for ((frame, keyed), solved) in baked.iter_mut().zip(&poses).zip(&transforms) {
+            for &bone in &constrained {
+                let input = keyed.bones.get(bone).cloned().unwrap_or_default();
+                frame.bones.insert(bone.clone(), input);
+            }
+            // Bones only: constraints move nothing else.
+            let replayed = crate::rig::handle_transforms(handles, frame)?;
+            let apart = replayed
+                .iter()
+                .zip(solved)
+                .take(handles.bones.len())
+                .flat_map(|(a, b)| {
+                    corners
+                        .iter()
+                        .map(move |&p| (a.apply(p) - b.apply(p)).norm())
+                })
+                .fold(0.0, f64::max);
+            if apart.is_nan() || apart > BAKE_REPLAY_TOLERANCE_PX {
+                let names: Vec<&str> = handles.ik.iter().map(|c| c.name.as_str()).collect();
+                return Err(PipelineError::BakeBoneIk(names.join(", ")));
+            }
+        }
+    }
     // One linear key per frame time.
     let keys = |values: &mut dyn Iterator<Item = [f64; 2]>| -> Option<Vec<Key<[f64; 2]>>> {
         Some(
@@ -290,6 +324,25 @@ pub fn bake(
         );
     }
     Ok(out)
+}
+
+/// The corners of the box around every part's rest mesh (canvas px).
+fn rest_corners(scene: &Scene) -> Vec<crate::geom::Point> {
+    use crate::geom::Point;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in scene.doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
+        lo = [lo[0].min(v[0]), lo[1].min(v[1])];
+        hi = [hi[0].max(v[0]), hi[1].max(v[1])];
+    }
+    if !lo[0].is_finite() {
+        return vec![Point::origin()];
+    }
+    vec![
+        Point::new(lo[0], lo[1]),
+        Point::new(hi[0], lo[1]),
+        Point::new(hi[0], hi[1]),
+        Point::new(lo[0], hi[1]),
+    ]
 }
 
 fn linear_key<V>(time: f64, value: V) -> crate::anim::timeline::Key<V> {

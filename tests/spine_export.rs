@@ -110,7 +110,7 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
 
     // Flags.
     for (flags, message) in [
-        (vec!["--spine-version", "4.3"], "not supported"),
+        (vec!["--spine-version", "4.4"], "not supported"),
         (vec!["--fps", "0"], "bake rate"),
         (vec!["--max-influences", "0"], "at least 1"),
         (vec!["--max-vertices", "2"], "at least 3"),
@@ -133,20 +133,21 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
         "does not grip the drawing",
     );
 
-    // Bone IK constraints do not export yet: refused rather than played unconstrained.
+    // Bone IK constraints export as Spine IK constraints, under names Spine can use.
     let mut doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&rig_good).unwrap()).unwrap();
     doc["handles"]["bones"]
         .as_array_mut()
         .unwrap()
         .push(serde_json::json!({"name": "goal", "head": [40, 20], "tail": [44, 20]}));
-    doc["handles"]["ik"] = serde_json::json!([{"name": "aim", "bones": ["b"], "target": "goal"}]);
+    doc["handles"]["ik"] =
+        serde_json::json!([{"name": "aim\nleft", "bones": ["b"], "target": "goal"}]);
     let rig_constrained = good.join("constrained.json");
     std::fs::write(&rig_constrained, doc.to_string()).unwrap();
     assert_refused(
         &["export", "spine", s(&rig_constrained), "-o", s(&out)],
         &out,
-        "bone IK constraints (aim)",
+        "IK constraint name \"aim\\nleft\" cannot be used in Spine",
     );
 
     // An output path that is a file.

@@ -5,9 +5,13 @@
 //! its draw order, attachments and slot colours must be sinew's, and the loader must find
 //! nothing it would ignore. The deviation from sinew's exact playback is printed.
 //!
-//! Rigs: the bundled character as `sinew demo` writes it (bones, a point; Bézier keys), and a
+//! Rigs: the bundled character as `sinew demo` writes it (bones, a point; Bézier keys), a
 //! generated rig with two skeletons, a point, a cage, a region, colour, visibility and
-//! draw-order keys, stepped keys and timelines that start after 0 s.
+//! draw-order keys, stepped keys and timelines that start after 0 s, and a generated rig with
+//! bone IK constraints: a two-bone arm (bend negative, mix < 1, softness, its root keyed to a
+//! non-uniform scale) and a one-bone pole
+//! that the runtime solves itself from their moving target's keys, and a three-bone tail
+//! (FABRIK, baked into keys).
 
 mod command;
 
@@ -15,7 +19,7 @@ use command::{s, scratch};
 use serde::Deserialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::export::spine::bake::bake_times;
-use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions};
+use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
 use sinew::geom::Point;
 use sinew::io::{self, RigDocument};
 use sinew::pipeline::Scene;
@@ -161,16 +165,18 @@ enum Compare {
     ReportOnly,
 }
 
-/// How one animation is compared: skinning-IK drags are baked into keys at the export's rate
-/// (Spine has no such constraint), so between keys the runtime interpolates the baked keys
-/// linearly while sinew solves exactly; such an animation is compared at its bake times.
+/// How one animation is compared: skinning-IK drags and bone IK chains longer than two bones
+/// are baked into keys at the export's rate (Spine has no such constraints), so between keys the
+/// runtime interpolates the baked keys linearly while sinew solves exactly; such an animation
+/// is compared at its bake times.
 fn compare_for(
     compare: Compare,
     animation: &sinew::anim::Animation,
+    baked: &[String],
     options: &SpineOptions,
 ) -> Compare {
     match compare {
-        Compare::RuntimeMode if !animation.ik.is_empty() => {
+        Compare::RuntimeMode if !animation.ik.is_empty() || !baked.is_empty() => {
             Compare::ExactAtBakeTimes(options.bake_fps)
         }
         other => other,
@@ -215,10 +221,23 @@ fn check_rig(
         }
     }
     let animations = anim::load_animations(&doc).unwrap();
+    let baked: BTreeMap<&str, &[String]> = export
+        .baked
+        .iter()
+        .map(|(name, bones)| (name.as_str(), bones.as_slice()))
+        .collect();
+    let compare_of = |name: &str, a: &sinew::anim::Animation| {
+        compare_for(
+            compare,
+            a,
+            baked.get(name).copied().unwrap_or_default(),
+            options,
+        )
+    };
     let times: BTreeMap<String, Vec<f64>> = animations
         .iter()
         .map(|(name, a)| {
-            let times = match compare_for(compare, a, &options) {
+            let times = match compare_of(name, a) {
                 Compare::ExactAtBakeTimes(fps) => {
                     let mut t = bake_times(a.duration_s(), fps);
                     t.retain(|&t| t < a.duration_s());
@@ -246,8 +265,14 @@ fn check_rig(
     }
     assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
 
-    // Setup pose = rest meshes.
-    let setup = deviation(&export, &doc, &oracle.setup, &scene.rest_positions());
+    // Setup pose = rest meshes, or with bone IK constraints (which Spine applies in the setup
+    // pose too) sinew's pose with nothing keyed.
+    let rest = if doc.handles.ik.is_empty() {
+        scene.rest_positions()
+    } else {
+        scene.pose_positions(&Default::default()).unwrap()
+    };
+    let setup = deviation(&export, &doc, &oracle.setup, &rest);
     println!("{}: setup pose deviation {setup:.2e} px", rig.display());
     assert!(setup <= SETUP_TOLERANCE_PX, "setup pose off by {setup} px");
 
@@ -273,7 +298,7 @@ fn check_rig(
             let exact = scene.pose_positions(&animation.sample(t, true)).unwrap();
             let d_exact = deviation(&export, &doc, &frame.slots, &exact);
             worst_exact = worst_exact.max(d_exact);
-            match compare_for(compare, animation, &options) {
+            match compare_of(name, animation) {
                 Compare::RuntimeMode => {
                     assert!(d <= ANIMATION_TOLERANCE_PX, "{name} at {t} s: {d} px")
                 }
@@ -307,9 +332,7 @@ fn check_rig(
                 }
             }
             // Some times through the command line, as a user previews them.
-            if compare_for(compare, animation, &options) == Compare::RuntimeMode
-                && i % cli_every == 0
-            {
+            if compare_of(name, animation) == Compare::RuntimeMode && i % cli_every == 0 {
                 let v = dir.join("v.json");
                 let time = format!("{t}");
                 sinew(&[
@@ -348,6 +371,7 @@ fn check_rig(
         }
     }
     let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
+    println!("{flags:?}: baked {:?}", export.baked);
     println!(
         "{} {flags:?} ({vertices} vertices): runtime vs sinew --match-runtime spine: max \
          {worst_runtime:.2e} px; vs exact playback: max {worst_exact:.3} px",
@@ -522,6 +546,18 @@ fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
         &coarse,
         Compare::RuntimeMode,
     );
+    // The same rig for the 4.3 runtime, which refuses timelines it does not know.
+    let v43 = SpineOptions {
+        version: SpineVersion::V4_3,
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("v43"),
+        &["--spine-version", "4.3"],
+        &v43,
+        Compare::RuntimeMode,
+    );
     // Fewer influences: loads, setup pose exact; the deviation is printed.
     let few = SpineOptions {
         max_influences: Some(2),
@@ -534,5 +570,180 @@ fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
         &few,
         Compare::ReportOnly,
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Three layers: an arm with a two-bone constraint, a flag on a pole that a one-bone constraint
+/// aims, both at the target `reach`; a tail of three bones reaching for `tail_goal` (FABRIK).
+/// `reach` moves on Bézier keys while the arm's own bones are keyed too (the constraint's mix
+/// blends from those keys); `tail_goal` moves on linear keys.
+fn ik_rig(dir: &Path) -> PathBuf {
+    let rect = |x: f32, y: f32, w: f32, h: f32| {
+        move |pb: &mut tiny_skia::PathBuilder| {
+            pb.push_rect(tiny_skia::Rect::from_xywh(x, y, w, h).unwrap())
+        }
+    };
+    layer(
+        &dir.join("arm.png"),
+        rect(15.0, 20.0, 135.0, 12.0),
+        [60, 120, 220],
+    );
+    layer(
+        &dir.join("flag.png"),
+        rect(84.0, 40.0, 46.0, 40.0),
+        [230, 120, 40],
+    );
+    // An oval: on this rectangle's mesh the weight solve finds vertices no handle reaches.
+    layer(
+        &dir.join("tail.png"),
+        |pb| pb.push_oval(tiny_skia::Rect::from_xywh(12.0, 84.0, 142.0, 22.0).unwrap()),
+        [90, 200, 90],
+    );
+    let handles = serde_json::json!({
+        "bones": [
+            {"name": "upper", "head": [20, 26], "tail": [80, 26]},
+            {"name": "lower", "parent": "upper", "head": [80, 26], "tail": [140, 26]},
+            {"name": "pole", "head": [90, 78], "tail": [90, 50]},
+            {"name": "reach", "head": [120, 45], "tail": [128, 45]},
+            {"name": "t1", "head": [20, 95], "tail": [60, 95]},
+            {"name": "t2", "parent": "t1", "head": [60, 95], "tail": [100, 95]},
+            {"name": "t3", "parent": "t2", "head": [100, 95], "tail": [145, 95]},
+            {"name": "tail_goal", "head": [145, 95], "tail": [150, 95]}
+        ],
+        "bind": {
+            "upper": ["arm"], "lower": ["arm"], "pole": ["flag"], "reach": ["flag"],
+            "t1": ["tail"], "t2": ["tail"], "t3": ["tail"], "tail_goal": ["tail"]
+        },
+        "ik": [
+            {"name": "arm_ik", "bones": ["upper", "lower"], "target": "reach",
+             "bend_positive": false, "mix": 0.85, "softness_px": 8},
+            {"name": "look", "bones": ["pole"], "target": "reach"},
+            {"name": "tail_ik", "bones": ["t1", "t2", "t3"], "target": "tail_goal"}
+        ]
+    });
+    std::fs::write(dir.join("handles.json"), handles.to_string()).unwrap();
+    let rig = dir.join("rig.json");
+    sinew(&[
+        "rig",
+        s(&dir.join("arm.png")),
+        s(&dir.join("flag.png")),
+        s(&dir.join("tail.png")),
+        "--handles",
+        s(&dir.join("handles.json")),
+        "-o",
+        s(&rig),
+    ]);
+    let animations = serde_json::json!({
+        "reach": {
+            "bones": {
+                "reach": {"translate": [
+                    {"time": 0, "value": [0, 0], "curve": [0.2, -10, 0.35, -40, 0.1, 5, 0.3, 20]},
+                    {"time": 0.5, "value": [-45, 25], "curve": [0.6, -45, 0.8, 10, 0.6, 25, 0.9, -20]},
+                    {"time": 1.0, "value": [15, -30]}]},
+                "upper": {"rotate": [{"time": 0, "value": 0}, {"time": 1.0, "value": 40}],
+                          "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.15, 0.85]}]},
+                "lower": {"rotate": [{"time": 0.2, "value": 0, "curve": [0.3, 10, 0.5, -30]},
+                                     {"time": 0.7, "value": -25}]}
+            }
+        },
+        "curl": {
+            "bones": {
+                "tail_goal": {"translate": [{"time": 0, "value": [0, 0]},
+                                            {"time": 1.0, "value": [-25, -40]}]}
+            }
+        }
+    });
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = animations;
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    rig
+}
+
+#[test]
+fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
+    let dir = scratch("ik");
+    let rig = ik_rig(&dir);
+    let defaults = SpineOptions::default();
+    check_rig(
+        &rig,
+        &dir.join("export"),
+        &[],
+        &defaults,
+        Compare::RuntimeMode,
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("export/rig.json")).unwrap())
+            .unwrap();
+    // The two Spine can solve are constraints; the FABRIK tail is not, and only it is baked.
+    let names: Vec<&str> = json["ik"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["arm_ik", "look"]);
+    assert_eq!(json["ik"][0]["bendPositive"], false);
+    let reach = &json["animations"]["reach"];
+    assert!(reach["bones"]["reach"]["translate"].is_array() && reach.get("ik").is_none());
+    // A non-uniform scale of the chain's root: spine-core's other two-bone solver.
+    assert!(reach["bones"]["upper"]["scale"].is_array());
+    assert!(
+        reach["bones"]["t1"].is_null(),
+        "nothing of the tail moves in 'reach'"
+    );
+    let curl = &json["animations"]["curl"]["bones"];
+    for bone in ["t1", "t2", "t3"] {
+        assert!(curl[bone]["rotate"].is_array(), "{bone} is baked in 'curl'");
+    }
+    // The 4.3 layout (constraints in one typed array) in the 4.3 runtime.
+    let v43 = SpineOptions {
+        version: SpineVersion::V4_3,
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("v43"),
+        &["--spine-version", "4.3"],
+        &v43,
+        Compare::RuntimeMode,
+    );
+    let json43: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("v43/rig.json")).unwrap()).unwrap();
+    assert_eq!(json43["constraints"][0]["type"], "ik");
+    assert!(json43.get("ik").is_none());
+    // Everything baked: the constraints are keyed off, so the runtime does not solve them a
+    // second time on top of the baked keys.
+    let baked = SpineOptions {
+        bake: BakeMode::All,
+        bake_fps: 20.0,
+        ..SpineOptions::default()
+    };
+    check_rig(
+        &rig,
+        &dir.join("baked"),
+        &["--bake", "all", "--fps", "20"],
+        &baked,
+        Compare::ExactAtBakeTimes(20.0),
+    );
+    // sinew's own bake (`playback::bake`) leaves the constraints in the rig: played there, the
+    // baked animation shows what the original does at the bake times (mix < 1 is not blended a
+    // second time; the FABRIK tail solves again from the same keys).
+    let scene = Scene::load(&rig).unwrap();
+    for (name, animation) in anim::load_animations(&scene.doc).unwrap() {
+        let times = bake_times(animation.duration_s(), 10.0);
+        let baked = sinew::playback::bake(&scene, &animation, &times).unwrap();
+        for &t in &times {
+            let original = scene.pose_positions(&animation.sample(t, false)).unwrap();
+            let replayed = scene.pose_positions(&baked.sample(t, false)).unwrap();
+            let apart = original
+                .iter()
+                .flatten()
+                .zip(replayed.iter().flatten())
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            assert!(apart <= 1e-3, "sinew bake of {name} at {t} s: {apart} px");
+        }
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,8 +1,9 @@
 // Loads a Spine export in the official runtime (@esotericsoftware/spine-core, pinned in
-// package.json) and reports what it draws: per slot in draw order, its attachment, colour and
+// package.json: 4.2.119, and 4.3.13 as `spine-core-43` for files whose `skeleton.spine` says
+// 4.3) and reports what it draws: per slot in draw order, its attachment, colour and
 // world vertices, in the setup pose and at requested times of animations. Also lints the JSON
-// against what the 4.2 loader reads, so content the runtime would silently ignore or misread
-// shows up as a warning.
+// against what the loader of the file's line reads, so content the runtime would silently
+// ignore or misread shows up as a warning.
 //
 //   node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json
 //
@@ -11,7 +12,6 @@
 // "warnings": [...]}; Snapshot = [{"name", "attachment", "color": [r, g, b, a],
 // "vertices": [x0, y0, ...]}] in draw order (vertices only for meshes).
 // Exit status: 0 when loaded (warnings are reported, not fatal), 2 when the runtime refuses it.
-import * as spine from "@esotericsoftware/spine-core";
 import fs from "node:fs";
 
 const [skeletonPath, atlasPath, requestPath, outPath] = process.argv.slice(2);
@@ -21,6 +21,10 @@ if (!outPath) {
 }
 
 const raw = JSON.parse(fs.readFileSync(skeletonPath, "utf8"));
+// 4.3 moved pose data into pose objects and constraints into one typed array (spine-format.md
+// §10, §11); everything this script touches differs only in the calls below.
+const v43 = String((raw.skeleton || {}).spine || "").startsWith("4.3.");
+const spine = await import(v43 ? "spine-core-43" : "@esotericsoftware/spine-core");
 const atlas = new spine.TextureAtlas(fs.readFileSync(atlasPath, "utf8"));
 const request = JSON.parse(fs.readFileSync(requestPath, "utf8"));
 const warnings = lint(raw, atlas);
@@ -36,20 +40,23 @@ const skeleton = new spine.Skeleton(data);
 
 function snapshot() {
   skeleton.updateWorldTransform(spine.Physics.none);
-  return skeleton.drawOrder.map((slot) => {
-    const a = slot.getAttachment();
-    const c = slot.color;
+  const order = v43 ? skeleton.drawOrder.appliedPose : skeleton.drawOrder;
+  return order.map((slot) => {
+    const a = v43 ? slot.appliedPose.getAttachment() : slot.getAttachment();
+    const c = v43 ? slot.appliedPose.color : slot.color;
     const entry = { name: slot.data.name, attachment: a ? a.name : null, color: [c.r, c.g, c.b, c.a] };
     if (a instanceof spine.MeshAttachment) {
       const out = new Array(a.worldVerticesLength);
-      a.computeWorldVertices(slot, 0, a.worldVerticesLength, out, 0, 2);
+      if (v43) a.computeWorldVertices(skeleton, slot, 0, a.worldVerticesLength, out, 0, 2);
+      else a.computeWorldVertices(slot, 0, a.worldVerticesLength, out, 0, 2);
       entry.vertices = out;
     }
     return entry;
   });
 }
 
-skeleton.setToSetupPose();
+const setupPose = () => (v43 ? skeleton.setupPose() : skeleton.setToSetupPose());
+setupPose();
 const result = { setup: snapshot(), animations: {}, warnings };
 for (const [name, times] of Object.entries(request.times || {})) {
   const animation = data.findAnimation(name);
@@ -58,21 +65,25 @@ for (const [name, times] of Object.entries(request.times || {})) {
     process.exit(2);
   }
   const frames = times.map((time) => {
-    skeleton.setToSetupPose();
-    animation.apply(skeleton, time, time, false, [], 1, spine.MixBlend.setup, spine.MixDirection.mixIn);
+    setupPose();
+    if (v43) animation.apply(skeleton, time, time, false, [], 1, spine.MixFrom.setup, false, false, false);
+    else animation.apply(skeleton, time, time, false, [], 1, spine.MixBlend.setup, spine.MixDirection.mixIn);
     return { time, slots: snapshot() };
   });
   result.animations[name] = { duration: animation.duration, frames };
 }
 fs.writeFileSync(outPath, JSON.stringify(result));
 
-// What SkeletonJson.js (4.2) reads; anything else it ignores without a word.
+// What SkeletonJson.js (4.2, or 4.3 where it differs) reads; anything else it ignores without a
+// word.
 function lint(json, atlas) {
   const out = [];
+  const line = v43 ? "4.3" : "4.2";
   const only = (where, obj, keys) => {
-    for (const k of Object.keys(obj || {})) if (!keys.includes(k)) out.push(`${where}: key '${k}' is not read by the 4.2 runtime`);
+    for (const k of Object.keys(obj || {})) if (!keys.includes(k)) out.push(`${where}: key '${k}' is not read by the ${line} runtime`);
   };
-  only("top level", json, ["skeleton", "bones", "slots", "ik", "transform", "path", "physics", "skins", "events", "animations"]);
+  const constraintBlocks = v43 ? ["constraints"] : ["ik", "transform", "path", "physics"];
+  only("top level", json, ["skeleton", "bones", "slots", ...constraintBlocks, "skins", "events", "animations"]);
   only("skeleton", json.skeleton, ["hash", "spine", "x", "y", "width", "height", "referenceScale", "fps", "images", "audio"]);
   const boneIndex = new Map();
   (json.bones || []).forEach((b, i) => {
@@ -80,6 +91,19 @@ function lint(json, atlas) {
     if (b.parent !== undefined && !boneIndex.has(b.parent)) out.push(`bone ${b.name}: parent '${b.parent}' is not listed before it`);
     if (boneIndex.has(b.name)) out.push(`bone ${b.name}: listed twice`);
     boneIndex.set(b.name, i);
+  });
+  const constraints = new Set();
+  const iks = v43 ? (json.constraints || []).filter((k) => k.type === "ik") : json.ik || [];
+  if (v43 && iks.length !== (json.constraints || []).length) out.push("constraints: a type other than 'ik' (sinew writes IK only)");
+  iks.forEach((k, i) => {
+    const fields = v43 ? ["type", "name", "skin", "bones", "target", "mix", "softness", "bendPositive", "compress", "stretch", "scaleY"]
+      : ["name", "order", "skin", "bones", "target", "mix", "softness", "bendPositive", "compress", "stretch", "uniform"];
+    only(`ik ${k.name}`, k, fields);
+    if (constraints.has(k.name)) out.push(`ik ${k.name}: listed twice`);
+    constraints.add(k.name);
+    if (!(k.bones.length === 1 || k.bones.length === 2)) out.push(`ik ${k.name}: ${k.bones.length} bones (the runtime solves 1 or 2)`);
+    if (!v43 && k.order !== i) out.push(`ik ${k.name}: order ${k.order} at position ${i}`);
+    for (const b of [...k.bones, k.target]) if (!boneIndex.has(b)) out.push(`ik ${k.name}: unknown bone ${b}`);
   });
   const slots = new Map();
   for (const s of json.slots || []) {
@@ -158,6 +182,10 @@ function lint(json, atlas) {
         else if (kind === "attachment") keysOk(where, keys, ["name"], 0);
         else out.push(`${where}: timeline sinew does not write`);
       }
+    }
+    for (const [constraint, keys] of Object.entries(a.ik || {})) {
+      if (!constraints.has(constraint)) out.push(`animation ${name}: unknown IK constraint ${constraint}`);
+      keysOk(`animation ${name}, ik ${constraint}`, keys, ["mix", "softness", "bendPositive", "compress", "stretch"], 2);
     }
     for (const [i, k] of (a.drawOrder || []).entries()) {
       only(`animation ${name}, drawOrder key ${i}`, k, ["time", "offsets"]);

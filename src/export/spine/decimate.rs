@@ -14,11 +14,16 @@
 //! changes when it is interpolated from v's weights), plus a small multiple of the edge length so
 //! that ties favour short edges. A collapse is refused if it would flip or flatten a triangle or
 //! break the mesh's topology (the link condition), so holes and separate pieces survive.
+//!
+//! Speed: each vertex's one-ring (neighbours, outline edges) is cached and recomputed only for
+//! the vertices a collapse touches, triangle lists are small vectors, weight rows are sorted
+//! once and merged, and each edge around a collapse is re-costed once, not once per endpoint.
+//! None of this changes which collapses happen (`benches/spine.rs` measures it).
 
 use crate::geom::Point;
 use crate::mesh::Mesh;
 use std::cmp::Ordering;
-use std::collections::{BTreeMap, BTreeSet, BinaryHeap};
+use std::collections::BinaryHeap;
 
 /// Edge length (px) weight that breaks ties towards short edges.
 pub const SHORT_EDGE_PREFERENCE: f64 = 0.01;
@@ -30,17 +35,38 @@ fn double_area(a: Point, b: Point, c: Point) -> f64 {
     (b - a).perp(&(c - a))
 }
 
-/// Distance between two sparse weight rows (Euclidean over columns), summed in column order so
+/// A weight row sorted by column (stably: repeated columns keep their order).
+fn sorted_row(row: &[(usize, f64)]) -> Vec<(usize, f64)> {
+    let mut sorted = row.to_vec();
+    sorted.sort_by_key(|&(j, _)| j);
+    sorted
+}
+
+/// Distance between two sparse weight rows sorted by column (Euclidean over columns): per
+/// column, `a`'s weights added and `b`'s subtracted, the squares summed in column order, so
 /// that it is the same number on every run.
 fn weight_distance(a: &[(usize, f64)], b: &[(usize, f64)]) -> f64 {
-    let mut d: BTreeMap<usize, f64> = BTreeMap::new();
-    for &(j, w) in a {
-        *d.entry(j).or_default() += w;
+    let (mut i, mut k) = (0, 0);
+    let mut sum = 0.0;
+    while i < a.len() || k < b.len() {
+        let j = match (a.get(i), b.get(k)) {
+            (Some(&(ja, _)), Some(&(jb, _))) => ja.min(jb),
+            (Some(&(ja, _)), None) => ja,
+            (None, Some(&(jb, _))) => jb,
+            (None, None) => break,
+        };
+        let mut d = 0.0;
+        while let Some(&(_, w)) = a.get(i).filter(|e| e.0 == j) {
+            d += w;
+            i += 1;
+        }
+        while let Some(&(_, w)) = b.get(k).filter(|e| e.0 == j) {
+            d -= w;
+            k += 1;
+        }
+        sum += d * d;
     }
-    for &(j, w) in b {
-        *d.entry(j).or_default() -= w;
-    }
-    d.values().map(|x| x * x).sum::<f64>().sqrt()
+    sum.sqrt()
 }
 
 #[derive(PartialEq)]
@@ -70,42 +96,78 @@ impl PartialOrd for Candidate {
     }
 }
 
+/// A vertex's one-ring: its neighbours in ascending order, each with whether the edge to it is
+/// on the outline (used by one triangle only).
+struct Ring {
+    neighbours: Vec<usize>,
+    boundary: Vec<bool>,
+}
+
+impl Ring {
+    fn boundary_neighbours(&self) -> impl Iterator<Item = usize> + '_ {
+        self.neighbours
+            .iter()
+            .zip(&self.boundary)
+            .filter(|(_, &b)| b)
+            .map(|(&w, _)| w)
+    }
+
+    fn on_outline(&self) -> bool {
+        self.boundary.iter().any(|&b| b)
+    }
+}
+
 struct State<'a> {
     points: &'a [Point],
-    rows: &'a [Vec<(usize, f64)>],
+    /// Weight rows sorted by column.
+    rows: Vec<Vec<(usize, f64)>>,
     triangles: Vec<[usize; 3]>,
     alive: Vec<bool>,
-    /// Per vertex, the triangles using it.
-    around: Vec<BTreeSet<usize>>,
+    /// Per vertex, the triangles using it (a handful: plain vectors beat sets here).
+    around: Vec<Vec<usize>>,
+    /// Per vertex, its [`Ring`], kept up to date as triangles change.
+    rings: Vec<Ring>,
     stamp: Vec<u64>,
 }
 
 impl State<'_> {
-    fn neighbours(&self, u: usize) -> BTreeSet<usize> {
-        self.around[u]
+    /// u's neighbours and outline edges, from the two other corners of each of its triangles:
+    /// an edge seen in exactly one triangle is on the outline.
+    fn ring(&self, u: usize) -> Ring {
+        let mut corners: Vec<usize> = self.around[u]
             .iter()
             .flat_map(|&t| self.triangles[t])
             .filter(|&w| w != u)
-            .collect()
+            .collect();
+        corners.sort_unstable();
+        let mut ring = Ring {
+            neighbours: Vec::with_capacity(corners.len() / 2 + 1),
+            boundary: Vec::with_capacity(corners.len() / 2 + 1),
+        };
+        let mut k = 0;
+        while k < corners.len() {
+            let w = corners[k];
+            let mut count = 0;
+            while k < corners.len() && corners[k] == w {
+                count += 1;
+                k += 1;
+            }
+            ring.neighbours.push(w);
+            ring.boundary.push(count == 1);
+        }
+        ring
+    }
+
+    fn neighbours(&self, u: usize) -> &[usize] {
+        &self.rings[u].neighbours
     }
 
     /// Triangles using both u and v.
     fn shared(&self, u: usize, v: usize) -> Vec<usize> {
         self.around[u]
-            .intersection(&self.around[v])
+            .iter()
             .copied()
-            .collect()
-    }
-
-    fn is_boundary_edge(&self, u: usize, v: usize) -> bool {
-        self.shared(u, v).len() == 1
-    }
-
-    /// The outline neighbours of u (empty for an interior vertex).
-    fn boundary_neighbours(&self, u: usize) -> Vec<usize> {
-        self.neighbours(u)
-            .into_iter()
-            .filter(|&w| self.is_boundary_edge(u, w))
+            .filter(|&t| self.triangles[t].contains(&v))
             .collect()
     }
 
@@ -115,11 +177,12 @@ impl State<'_> {
         if shared.is_empty() {
             return None;
         }
-        let boundary_u = self.boundary_neighbours(u);
+        let (ring_u, ring_v) = (&self.rings[u], &self.rings[v]);
         let mut shape_px = 0.0;
-        if !boundary_u.is_empty() {
+        if ring_u.on_outline() {
             // An outline vertex slides along the outline only, and only where the outline is a
             // simple curve through it.
+            let boundary_u: Vec<usize> = ring_u.boundary_neighbours().collect();
             if boundary_u.len() != 2 || !boundary_u.contains(&v) || shared.len() != 1 {
                 return None;
             }
@@ -136,21 +199,22 @@ impl State<'_> {
             } else {
                 (pu - pv).norm()
             };
-        } else if !self.boundary_neighbours(v).is_empty() && shared.len() != 2 {
+        } else if ring_v.on_outline() && shared.len() != 2 {
             return None;
         }
         // Link condition: u and v share exactly the neighbours across their shared triangles.
-        let opposite: BTreeSet<usize> = shared
+        let mut opposite: Vec<usize> = shared
             .iter()
             .flat_map(|&t| self.triangles[t])
             .filter(|&w| w != u && w != v)
             .collect();
-        let common: BTreeSet<usize> = self
-            .neighbours(u)
-            .intersection(&self.neighbours(v))
-            .copied()
-            .collect();
-        if common != opposite {
+        opposite.sort_unstable();
+        opposite.dedup();
+        let common = ring_u
+            .neighbours
+            .iter()
+            .filter(|w| ring_v.neighbours.binary_search(w).is_ok());
+        if !common.eq(opposite.iter()) {
             return None;
         }
         // No flipped or flattened triangle.
@@ -182,17 +246,16 @@ impl State<'_> {
         )
     }
 
-    fn push_candidates(&self, u: usize, heap: &mut BinaryHeap<Candidate>) {
-        for v in self.neighbours(u) {
-            for (a, b) in [(u, v), (v, u)] {
-                if let Some(cost) = self.cost(a, b) {
-                    heap.push(Candidate {
-                        cost,
-                        u: a,
-                        v: b,
-                        stamp: (self.stamp[a], self.stamp[b]),
-                    });
-                }
+    /// Both directions of the edge u–v, at the current stamps, when allowed.
+    fn push_edge(&self, u: usize, v: usize, heap: &mut BinaryHeap<Candidate>) {
+        for (a, b) in [(u, v), (v, u)] {
+            if let Some(cost) = self.cost(a, b) {
+                heap.push(Candidate {
+                    cost,
+                    u: a,
+                    v: b,
+                    stamp: (self.stamp[a], self.stamp[b]),
+                });
             }
         }
     }
@@ -211,23 +274,27 @@ pub fn decimate(
         .iter()
         .map(|t| t.map(|v| v as usize))
         .collect();
-    let mut around = vec![BTreeSet::new(); n];
+    let mut around = vec![Vec::new(); n];
     for (i, t) in triangles.iter().enumerate() {
         for &v in t {
-            around[v].insert(i);
+            if !around[v].contains(&i) {
+                around[v].push(i);
+            }
         }
     }
     let mut state = State {
         points: &mesh.vertices,
-        rows,
+        rows: rows.iter().map(|r| sorted_row(r)).collect(),
         alive: vec![true; triangles.len()],
         triangles,
         around,
+        rings: Vec::new(),
         stamp: vec![0; n],
     };
+    state.rings = (0..n).map(|u| state.ring(u)).collect();
     let mut heap = BinaryHeap::new();
     for u in 0..n {
-        for v in state.neighbours(u) {
+        for &v in state.neighbours(u) {
             if let Some(cost) = state.cost(u, v) {
                 heap.push(Candidate {
                     cost,
@@ -240,6 +307,7 @@ pub fn decimate(
     }
     let mut removed = vec![false; n];
     let mut remaining = (0..n).filter(|&v| !state.around[v].is_empty()).count();
+    let mut edges: Vec<(usize, usize)> = Vec::new();
     while remaining > max_vertices {
         let Some(c) = heap.pop() else { break };
         if removed[c.u] || removed[c.v] || c.stamp != (state.stamp[c.u], state.stamp[c.v]) {
@@ -250,27 +318,41 @@ pub fn decimate(
             continue;
         }
         let (u, v) = (c.u, c.v);
-        let touched = state.neighbours(u);
-        for t in state.around[u].clone() {
+        let touched = state.neighbours(u).to_vec();
+        for t in std::mem::take(&mut state.around[u]) {
             let tri = state.triangles[t];
             if tri.contains(&v) {
                 state.alive[t] = false;
                 for w in tri {
-                    state.around[w].remove(&t);
+                    state.around[w].retain(|&x| x != t);
                 }
             } else {
                 state.triangles[t] = tri.map(|w| if w == u { v } else { w });
-                state.around[v].insert(t);
+                state.around[v].push(t);
             }
         }
-        state.around[u].clear();
         removed[u] = true;
         remaining -= 1;
+        // Only the triangles around u changed: their corners are u's neighbours and v.
+        state.rings[u] = state.ring(u);
+        for &w in touched.iter().chain([&v]) {
+            state.rings[w] = state.ring(w);
+        }
         for &w in touched.iter().chain([&v]) {
             state.stamp[w] += 1;
         }
+        // Every edge at a touched vertex, once: a candidate pushed twice at the same stamps
+        // is the same candidate, and popping its copy would change nothing.
+        edges.clear();
         for &w in touched.iter().chain([&v]) {
-            state.push_candidates(w, &mut heap);
+            for &x in state.neighbours(w) {
+                edges.push((w.min(x), w.max(x)));
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        for &(a, b) in &edges {
+            state.push_edge(a, b, &mut heap);
         }
     }
     let kept: Vec<usize> = (0..n)

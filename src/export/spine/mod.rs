@@ -1,5 +1,5 @@
-//! Spine export: a rig as Spine 4.2 skeleton JSON, a `.atlas` and its page PNGs, which the
-//! official runtimes play where sinew draws the rig.
+//! Spine export: a rig as Spine 4.2 (or 4.1, 4.3) skeleton JSON, a `.atlas` and its page PNGs,
+//! which the official runtimes play where sinew draws the rig.
 //!
 //! In: a loaded [`Scene`] (the rig document, every part with weights), the parts' images
 //! (straight-alpha RGBA8 on the canvas), a base name and [`SpineOptions`]. Out: a
@@ -13,6 +13,7 @@
 //! - [`decimate`]: coarser runtime meshes carrying the fine mesh's weights;
 //! - [`atlas`]: trimmed regions packed into pages, premultiplied, and the atlas text;
 //! - [`timelines`]: sinew timelines as native Spine timelines with their curves;
+//! - [`constraints`]: one- and two-bone IK constraints as Spine IK constraints;
 //! - [`bake`]: what Spine cannot express, sampled at `bake_fps` through the one pose path.
 //!
 //! Spine facts relied on are in `/work/shared/spine-format.md` (section numbers cited there);
@@ -20,6 +21,7 @@
 
 pub mod atlas;
 pub mod bake;
+pub mod constraints;
 pub mod decimate;
 pub mod frame;
 pub mod mesh;
@@ -53,14 +55,19 @@ pub enum SpineVersion {
     #[default]
     #[serde(rename = "4.2")]
     V4_2,
+    /// 4.3: IK constraints in the one typed `constraints` array (update order = array order);
+    /// the rest of what sinew writes reads the same (spine-format.md §11).
+    #[serde(rename = "4.3")]
+    V4_3,
 }
 
 impl SpineVersion {
-    /// Parses `4.1` or `4.2` (what `--spine-version` takes).
+    /// Parses `4.1`, `4.2` or `4.3` (what `--spine-version` takes).
     pub fn parse(text: &str) -> Result<Self, SpineError> {
         match text.trim() {
             "4.1" => Ok(SpineVersion::V4_1),
             "4.2" => Ok(SpineVersion::V4_2),
+            "4.3" => Ok(SpineVersion::V4_3),
             other => Err(SpineError::UnsupportedVersion(other.to_string())),
         }
     }
@@ -70,6 +77,7 @@ impl SpineVersion {
         match self {
             SpineVersion::V4_1 => "4.1.0",
             SpineVersion::V4_2 => "4.2.0",
+            SpineVersion::V4_3 => "4.3.0",
         }
     }
 }
@@ -134,7 +142,7 @@ pub enum SpineError {
     },
     #[error("two Spine bones would be named '{name}' (the root bone, or a cage vertex 'cage.k')")]
     NameTaken { name: String },
-    #[error("Spine version '{0}' is not supported (4.1 or 4.2; 4.3 moved constraints into one typed array and is not written yet)")]
+    #[error("Spine version '{0}' is not supported (4.1, 4.2 or 4.3)")]
     UnsupportedVersion(String),
     #[error("the bake rate must be a number in (0, {MAX_BAKE_FPS}] keys per second, not {0}")]
     Fps(f64),
@@ -156,8 +164,8 @@ pub enum SpineError {
     },
     #[error("the transformation of '{0}' is singular")]
     Singular(String),
-    #[error("the rig has bone IK constraints ({0}); exporting them as Spine IK constraints is not supported yet")]
-    BoneIkConstraints(String),
+    #[error("two IK constraints are named '{0}'; Spine needs unique constraint names")]
+    DuplicateConstraint(String),
     #[error(transparent)]
     Anim(#[from] AnimError),
     #[error("baking: {0}")]
@@ -239,12 +247,6 @@ pub fn export_spine(
     if let Some(n) = options.max_vertices.filter(|&n| n < 3) {
         return Err(SpineError::MaxVertices(n));
     }
-    // Forward kinematics applies the constraints on both sides of the bake's comparison, so
-    // their motion would neither bake nor export: refuse rather than play differently.
-    if !doc.handles.ik.is_empty() {
-        let names: Vec<&str> = doc.handles.ik.iter().map(|c| c.name.as_str()).collect();
-        return Err(SpineError::BoneIkConstraints(names.join(", ")));
-    }
     check_name("file", name, true)?;
     check_name("root bone", &options.root_bone, false)?;
     for part in &doc.parts {
@@ -259,6 +261,18 @@ pub fn export_spine(
     for animation in doc.animations.keys() {
         check_name("animation", animation, false)?;
     }
+    for (c, constraint) in doc.handles.ik.iter().enumerate() {
+        check_name("IK constraint", &constraint.name, false)?;
+        if doc.handles.ik[..c]
+            .iter()
+            .any(|k| k.name == constraint.name)
+        {
+            return Err(SpineError::DuplicateConstraint(constraint.name.clone()));
+        }
+    }
+    // Spine solves one- and two-bone constraints itself; longer chains are baked.
+    let exported_ik = constraints::exported(&doc.handles);
+    let spine_handles = constraints::with_constraints(&doc.handles, &exported_ik);
     let frame = SpineFrame::for_canvas(doc.canvas);
     let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
     let columns = handle_columns(&doc.handles);
@@ -340,14 +354,16 @@ pub fn export_spine(
     for (anim_name, animation) in &animations {
         let times = bake::bake_times(animation.duration_s(), options.bake_fps);
         let samples = bake::sample_path(animation, &times, &path).map_err(SpineError::Pose)?;
-        let baked = bake::bones_to_bake(
+        let mut baked = bake::bones_to_bake(
             options.bake,
-            &doc.handles,
+            &spine_handles,
             &skeleton,
             &samples,
             &corners,
             options.bake_tolerance_px,
         )?;
+        let switched_off =
+            constraints::switch_off_baked(&doc.handles, &skeleton, &exported_ik, &mut baked);
         let timelines::NativeTimelines {
             mut bones,
             slots,
@@ -378,6 +394,17 @@ pub fn export_spine(
         if !slots.is_empty() {
             a.insert("slots".into(), Value::Object(slots));
         }
+        if !switched_off.is_empty() {
+            a.insert(
+                "ik".into(),
+                Value::Object(
+                    switched_off
+                        .iter()
+                        .map(|&c| (doc.handles.ik[c].name.clone(), constraints::off_timeline()))
+                        .collect(),
+                ),
+            );
+        }
         if let Some(d) = draw_order {
             a.insert("drawOrder".into(), d);
         }
@@ -399,6 +426,7 @@ pub fn export_spine(
         &skeleton,
         &parts,
         &atlas,
+        &exported_ik,
         animations_json,
     );
     let mut pages = Vec::with_capacity(atlas.pages.len());
@@ -457,6 +485,7 @@ fn skeleton_json(
     skeleton: &Skeleton,
     parts: &[ExportedPart],
     atlas: &atlas::Atlas,
+    exported_ik: &[usize],
     animations: Map<String, Value>,
 ) -> String {
     // Bounds of the setup pose: the rest meshes in Spine's world.
@@ -524,7 +553,13 @@ fn skeleton_json(
         });
         attachments.insert(part.name.clone(), json!({ part.name.clone(): mesh }));
     }
-    let out = json!({
+    // Update order = file order, as sinew applies them.
+    let ik: Vec<Value> = exported_ik
+        .iter()
+        .enumerate()
+        .map(|(order, &c)| constraints::ik_entry(&doc.handles, c, order, options.version))
+        .collect();
+    let mut out = json!({
         "skeleton": {
             "spine": options.version.version_string(),
             "x": num(lo[0]),
@@ -533,13 +568,16 @@ fn skeleton_json(
             "height": num(hi[1] - lo[1]),
             "images": "./",
             "fps": num(options.bake_fps),
-            "hash": content_hash(name, &bones, &attachments, &animations),
+            "hash": content_hash(name, &bones, &ik, &attachments, &animations),
         },
         "bones": bones,
         "slots": slots,
         "skins": [{"name": "default", "attachments": attachments}],
         "animations": animations,
     });
+    if !ik.is_empty() {
+        out[constraints::block_key(options.version)] = Value::from(ik);
+    }
     // serde_json writes f64 as the shortest text that reads back exactly: lossless, and the
     // same bytes for the same rig. Compact: the weighted vertex arrays are long.
     serde_json::to_string(&out).unwrap_or_default() + "\n"
@@ -549,12 +587,14 @@ fn skeleton_json(
 fn content_hash(
     name: &str,
     bones: &[Value],
+    ik: &[Value],
     attachments: &Map<String, Value>,
     animations: &Map<String, Value>,
 ) -> String {
     let text = format!(
-        "{name}{}{}{}",
+        "{name}{}{}{}{}",
         Value::from(bones.to_vec()),
+        Value::from(ik.to_vec()),
         Value::Object(attachments.clone()),
         Value::Object(animations.clone())
     );
