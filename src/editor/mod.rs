@@ -758,7 +758,9 @@ impl EditorApp {
     fn rig_gestures(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
         let pointer = response.interact_pointer_pos();
         if response.drag_started_by(egui::PointerButton::Primary) {
-            if let Some(at) = pointer {
+            // Where the button went down, not where the drag was recognized.
+            let origin = ctx.input(|i| i.pointer.press_origin()).or(pointer);
+            if let Some(at) = origin {
                 let c = placed.canvas_from_screen(at);
                 let handles = &self.doc.state().handles;
                 self.gesture = match self.tool {
@@ -855,7 +857,6 @@ impl EditorApp {
                 }
             }
         }
-        let _ = ctx;
     }
 
     fn pose_gestures(
@@ -872,7 +873,9 @@ impl EditorApp {
             rest_point_under(scene, &posed.positions, placed.canvas_from_screen(at))
         };
         if response.drag_started_by(egui::PointerButton::Primary) {
-            if let Some(at) = pointer {
+            // Where the button went down, not where the drag was recognized.
+            let origin = ctx.input(|i| i.pointer.press_origin()).or(pointer);
+            if let Some(at) = origin {
                 let c = placed.canvas_from_screen(at);
                 let mut pose = self.doc.state().pose.clone();
                 // Grabbing an existing pin moves it; anywhere else on the drawing adds a drag.
