@@ -15,6 +15,7 @@
 //! editor computes them off the UI thread with [`compute_rig`] and hands the result back as
 //! [`Command::SetRig`], which is refused when the inputs changed in the meantime.
 
+use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
 use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, HandleError, Handles, PointHandle, Pose};
@@ -60,6 +61,10 @@ pub enum DocumentError {
     },
     #[error("computing the weights was cancelled")]
     Cancelled,
+    #[error(transparent)]
+    Animation(#[from] crate::anim::AnimError),
+    #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
+    KeyTime(f64),
 }
 
 /// Everything an edit can change; one undo step restores one of these.
@@ -126,7 +131,20 @@ pub enum Command {
     /// Installs a rig built by [`compute_rig`] from the current inputs.
     SetRig(Arc<Scene>, RigInputsKey),
     SetPose(Pose),
+    /// Keys `pose` into `animation` at `time_s` (creating the animation): every bone and point
+    /// the pose names gets rotate, translate, scale and shear keys, every IK drag a key of the
+    /// drag timeline with the same rest point. A key already at that time is replaced.
+    SetKey {
+        animation: String,
+        time_s: f64,
+        pose: Pose,
+    },
+    /// Removes every key of `animation` at `time_s`.
+    DeleteKeys { animation: String, time_s: f64 },
 }
+
+/// Keys closer in time than this (s) are the same key.
+pub const KEY_TIME_TOLERANCE_S: f64 = 1e-6;
 
 /// Identifies the inputs a rig was built from, to refuse a result that arrives after an edit.
 #[derive(Clone, Debug, PartialEq)]
@@ -470,6 +488,24 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             next.rig_current = true;
             inputs_changed = false;
         }
+        Command::SetKey {
+            animation,
+            time_s,
+            pose,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation)?;
+            key_pose(&mut anim, time_s, &pose);
+            store_animation(&mut next, &animation, &anim)?;
+            inputs_changed = false;
+        }
+        Command::DeleteKeys { animation, time_s } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation)?;
+            delete_keys(&mut anim, time_s);
+            store_animation(&mut next, &animation, &anim)?;
+            inputs_changed = false;
+        }
         Command::SetPose(pose) => {
             let scene = state
                 .rig
@@ -498,4 +534,145 @@ fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {
     if let Some(v) = pose.cages.remove(from) {
         pose.cages.insert(to.to_string(), v);
     }
+}
+
+fn check_key_time(time_s: f64) -> Result<(), DocumentError> {
+    if time_s.is_finite() && time_s >= 0.0 {
+        Ok(())
+    } else {
+        Err(DocumentError::KeyTime(time_s))
+    }
+}
+
+/// The animation stored under `name`, or a new empty one.
+pub fn animation_named(state: &State, name: &str) -> Result<Animation, DocumentError> {
+    match state.animations.get(name) {
+        Some(value) => Ok(Animation::from_json(name, value)?),
+        None => Ok(Animation::default()),
+    }
+}
+
+fn store_animation(next: &mut State, name: &str, anim: &Animation) -> Result<(), DocumentError> {
+    anim.validate(name)?;
+    let value = serde_json::to_value(anim).map_err(|e| {
+        DocumentError::Animation(crate::anim::AnimError::Malformed {
+            animation: name.to_string(),
+            reason: e.to_string(),
+        })
+    })?;
+    next.animations.insert(name.to_string(), value);
+    Ok(())
+}
+
+/// Puts a linear key at `time_s` into `keys` (kept sorted), replacing one at the same time.
+fn put_key<V>(keys: &mut Vec<Key<V>>, time_s: f64, value: V) {
+    match keys
+        .iter()
+        .position(|k| k.time > time_s - KEY_TIME_TOLERANCE_S)
+    {
+        Some(i) if (keys[i].time - time_s).abs() <= KEY_TIME_TOLERANCE_S => {
+            keys[i].value = value;
+        }
+        Some(i) => keys.insert(
+            i,
+            Key {
+                time: time_s,
+                value,
+                curve: Curve::Linear,
+            },
+        ),
+        None => keys.push(Key {
+            time: time_s,
+            value,
+            curve: Curve::Linear,
+        }),
+    }
+}
+
+fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
+    for (name, b) in &pose.bones {
+        let t = anim.bones.entry(name.clone()).or_default();
+        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate);
+        put_key(t.translate.get_or_insert_with(Vec::new), time_s, b.translate);
+        put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale);
+        put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear);
+    }
+    for (name, p) in &pose.points {
+        let t = anim.points.entry(name.clone()).or_default();
+        put_key(t.translate.get_or_insert_with(Vec::new), time_s, p.translate);
+        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate);
+        put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale);
+        put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear);
+    }
+    for drag in &pose.ik {
+        match anim
+            .ik
+            .iter_mut()
+            .find(|t| t.at == drag.at && t.weight == drag.weight)
+        {
+            Some(t) => put_key(&mut t.to, time_s, drag.to),
+            None => anim.ik.push(IkTimeline {
+                at: drag.at,
+                to: vec![Key {
+                    time: time_s,
+                    value: drag.to,
+                    curve: Curve::Linear,
+                }],
+                weight: drag.weight,
+            }),
+        }
+    }
+}
+
+fn delete_keys(anim: &mut Animation, time_s: f64) {
+    fn drop_at<V>(keys: &mut Option<Vec<Key<V>>>, time_s: f64) {
+        if let Some(k) = keys {
+            k.retain(|k| (k.time - time_s).abs() > KEY_TIME_TOLERANCE_S);
+            if k.is_empty() {
+                *keys = None;
+            }
+        }
+    }
+    for t in anim.bones.values_mut() {
+        drop_at(&mut t.rotate, time_s);
+        drop_at(&mut t.translate, time_s);
+        drop_at(&mut t.scale, time_s);
+        drop_at(&mut t.shear, time_s);
+    }
+    anim.bones.retain(|_, t| *t != BoneTimelines::default());
+    for t in anim.points.values_mut() {
+        drop_at(&mut t.translate, time_s);
+        drop_at(&mut t.rotate, time_s);
+        drop_at(&mut t.scale, time_s);
+        drop_at(&mut t.shear, time_s);
+    }
+    anim.points.retain(|_, t| *t != PointTimelines::default());
+    for t in &mut anim.ik {
+        t.to.retain(|k| (k.time - time_s).abs() > KEY_TIME_TOLERANCE_S);
+    }
+    anim.ik.retain(|t| !t.to.is_empty());
+}
+
+/// Every key time of `anim`, sorted, duplicates (within [`KEY_TIME_TOLERANCE_S`]) merged.
+pub fn key_times(anim: &Animation) -> Vec<f64> {
+    let mut times: Vec<f64> = Vec::new();
+    let mut add = |t: f64| times.push(t);
+    for b in anim.bones.values() {
+        b.rotate.iter().flatten().for_each(|k| add(k.time));
+        b.translate.iter().flatten().for_each(|k| add(k.time));
+        b.scale.iter().flatten().for_each(|k| add(k.time));
+        b.shear.iter().flatten().for_each(|k| add(k.time));
+    }
+    for p in anim.points.values() {
+        p.translate.iter().flatten().for_each(|k| add(k.time));
+        p.rotate.iter().flatten().for_each(|k| add(k.time));
+        p.scale.iter().flatten().for_each(|k| add(k.time));
+        p.shear.iter().flatten().for_each(|k| add(k.time));
+    }
+    for t in &anim.ik {
+        t.to.iter().for_each(|k| add(k.time));
+    }
+    times.sort_by(f64::total_cmp);
+    times.dedup_by(|a, b| (*a - *b).abs() <= KEY_TIME_TOLERANCE_S);
+    times
 }

@@ -284,3 +284,55 @@ fn the_bundled_character_opens_and_poses() {
     assert!(doc.undo());
     assert!(doc.state().pose.ik.is_empty());
 }
+
+#[test]
+fn keys_set_replace_sample_and_delete() {
+    use sinew::document::{animation_named, key_times};
+    let mut doc = arm_document();
+    let drag = |to: [f64; 2]| {
+        let mut pose = Pose::default();
+        pose.ik.push(IkDrag {
+            at: [300.0, 40.0],
+            to,
+            weight: None,
+        });
+        pose.bones.insert(
+            "upper".into(),
+            sinew::rig::pose::BonePose {
+                rotate: to[1] / 10.0,
+                ..Default::default()
+            },
+        );
+        pose
+    };
+    let key = |time_s: f64, pose: Pose| Command::SetKey {
+        animation: "wave".into(),
+        time_s,
+        pose,
+    };
+    doc.apply(key(0.0, drag([300.0, 40.0]))).unwrap();
+    doc.apply(key(1.0, drag([260.0, 0.0]))).unwrap();
+    // The same time again replaces the key instead of adding one.
+    doc.apply(key(1.0, drag([280.0, 10.0]))).unwrap();
+    let anim = animation_named(doc.state(), "wave").unwrap();
+    assert_eq!(key_times(&anim), vec![0.0, 1.0]);
+    assert_eq!(anim.ik.len(), 1, "one timeline per rest point");
+    let half = anim.sample(0.5, false);
+    assert_eq!(half.ik[0].to, [290.0, 25.0]);
+    assert_eq!(half.bones["upper"].rotate, 2.5);
+    // Keys are undoable edits; weights stay current.
+    assert!(doc.posable().is_some());
+    doc.undo();
+    let anim = animation_named(doc.state(), "wave").unwrap();
+    assert_eq!(anim.sample(1.0, false).ik[0].to, [260.0, 0.0]);
+    doc.apply(Command::DeleteKeys {
+        animation: "wave".into(),
+        time_s: 0.0,
+    })
+    .unwrap();
+    let anim = animation_named(doc.state(), "wave").unwrap();
+    assert_eq!(key_times(&anim), vec![1.0]);
+    assert!(doc
+        .apply(key(f64::NAN, Pose::default()))
+        .is_err_and(|e| matches!(e, DocumentError::KeyTime(_))));
+}
