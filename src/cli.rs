@@ -76,6 +76,7 @@ pub struct EditArgs {
 pub enum EditMode {
     Rig,
     Pose,
+    Animate,
 }
 
 #[derive(Args, Debug)]
@@ -370,6 +371,7 @@ fn edit(args: &EditArgs) -> Result<()> {
     let mode = match args.mode {
         EditMode::Rig => Mode::Rig,
         EditMode::Pose => Mode::Pose,
+        EditMode::Animate => Mode::Animate,
     };
     crate::editor::run(args.rig.as_deref(), mode, pose, args.screenshot.clone())
 }

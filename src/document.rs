@@ -140,7 +140,10 @@ pub enum Command {
         pose: Pose,
     },
     /// Removes every key of `animation` at `time_s`.
-    DeleteKeys { animation: String, time_s: f64 },
+    DeleteKeys {
+        animation: String,
+        time_s: f64,
+    },
 }
 
 /// Keys closer in time than this (s) are the same key.
@@ -593,13 +596,21 @@ fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
     for (name, b) in &pose.bones {
         let t = anim.bones.entry(name.clone()).or_default();
         put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate);
-        put_key(t.translate.get_or_insert_with(Vec::new), time_s, b.translate);
+        put_key(
+            t.translate.get_or_insert_with(Vec::new),
+            time_s,
+            b.translate,
+        );
         put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale);
         put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear);
     }
     for (name, p) in &pose.points {
         let t = anim.points.entry(name.clone()).or_default();
-        put_key(t.translate.get_or_insert_with(Vec::new), time_s, p.translate);
+        put_key(
+            t.translate.get_or_insert_with(Vec::new),
+            time_s,
+            p.translate,
+        );
         put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate);
         put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale);
         put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear);

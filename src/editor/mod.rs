@@ -33,6 +33,10 @@ use worker::{Poll, Worker};
 
 /// Seconds between autosaves of a changed document.
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
+/// Frames per second of the animate mode's frame steps.
+pub const DEFAULT_FPS: f64 = 24.0;
+/// The timeline shows at least this many seconds.
+pub const MIN_TIMELINE_S: f64 = 2.0;
 /// A press and release closer than this (canvas px) is a click, not a drag.
 pub const CLICK_SLOP_PX: f64 = 2.0;
 
@@ -41,6 +45,7 @@ pub const CLICK_SLOP_PX: f64 = 2.0;
 pub enum Mode {
     Rig,
     Pose,
+    Animate,
 }
 
 /// What a press on the canvas does in rig mode.
@@ -108,10 +113,25 @@ pub struct EditorApp {
     last_autosave_s: f64,
     /// Screenshot to take after a few frames, then quit (for `--screenshot`).
     screenshot: Option<(PathBuf, u32)>,
+    /// Animate mode: the animation edited, the playhead, playback.
+    pub animation: String,
+    pub time_s: f64,
+    pub playing: bool,
+    /// Frames per second of the frame-step buttons.
+    pub fps: f64,
+    /// Animate mode: the pose edited since the playhead last moved (not yet keyed).
+    shown: Option<Pose>,
 }
 
 impl EditorApp {
     pub fn new(doc: Document) -> Self {
+        let first_animation = doc
+            .state()
+            .animations
+            .keys()
+            .next()
+            .cloned()
+            .unwrap_or_else(|| "animation".into());
         let open_path = doc
             .path
             .as_ref()
@@ -136,6 +156,11 @@ impl EditorApp {
             rename_to: String::new(),
             last_autosave_s: 0.0,
             screenshot: None,
+            animation: first_animation,
+            time_s: 0.0,
+            playing: false,
+            fps: DEFAULT_FPS,
+            shown: None,
         }
     }
 
@@ -238,7 +263,11 @@ impl EditorApp {
         self.shortcuts(&ctx);
         self.autosave(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
+        self.advance_playback(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
+        if self.mode == Mode::Animate {
+            egui::Panel::bottom("timeline").show(ui, |ui| self.animate_panel(ui));
+        }
         egui::Panel::left("side")
             .default_size(230.0)
             .show(ui, |ui| self.side_panel(ui));
@@ -287,6 +316,18 @@ impl EditorApp {
 
     fn shortcuts(&mut self, ctx: &egui::Context) {
         let typing = ctx.text_edit_focused();
+        let (animate, space) = ctx.input(|i| {
+            (
+                !typing && i.key_pressed(Key::Num3),
+                !typing && i.key_pressed(Key::Space),
+            )
+        });
+        if animate {
+            self.mode = Mode::Animate;
+        }
+        if space && self.mode == Mode::Animate {
+            self.playing = !self.playing;
+        }
         let (undo, redo, delete, rig, pose, help, escape) = ctx.input_mut(|i| {
             let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
             let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
@@ -371,6 +412,7 @@ impl EditorApp {
             ui.separator();
             ui.selectable_value(&mut self.mode, Mode::Rig, "Rig mode");
             ui.selectable_value(&mut self.mode, Mode::Pose, "Pose mode");
+            ui.selectable_value(&mut self.mode, Mode::Animate, "Animate mode");
             ui.separator();
             if ui.button("Help").clicked() {
                 self.show_help = !self.show_help;
@@ -399,7 +441,7 @@ impl EditorApp {
     fn side_panel(&mut self, ui: &mut egui::Ui) {
         match self.mode {
             Mode::Rig => self.rig_panel(ui),
-            Mode::Pose => self.pose_panel(ui),
+            Mode::Pose | Mode::Animate => self.pose_panel(ui),
         }
     }
 
@@ -647,8 +689,8 @@ impl EditorApp {
         let mut shapes = Vec::new();
         let mut bone_frames = None;
         match (self.mode, &posable) {
-            (Mode::Pose, Some(scene)) => {
-                let pose = live_pose.unwrap_or_else(|| self.doc.state().pose.clone());
+            (Mode::Pose | Mode::Animate, Some(scene)) => {
+                let pose = live_pose.unwrap_or_else(|| self.edited_pose());
                 if let Err(e) = self.posed(scene, &pose) {
                     self.message = Some(e);
                 }
@@ -722,7 +764,7 @@ impl EditorApp {
         painter.extend(shapes);
         match self.mode {
             Mode::Rig => self.rig_gestures(&ctx, &response, placed),
-            Mode::Pose => {
+            Mode::Pose | Mode::Animate => {
                 if let Some(scene) = posable {
                     self.pose_gestures(&ctx, &response, placed, &scene)
                 }
@@ -877,7 +919,7 @@ impl EditorApp {
             let origin = ctx.input(|i| i.pointer.press_origin()).or(pointer);
             if let Some(at) = origin {
                 let c = placed.canvas_from_screen(at);
-                let mut pose = self.doc.state().pose.clone();
+                let mut pose = self.edited_pose();
                 // Grabbing an existing pin moves it; anywhere else on the drawing adds a drag.
                 let existing = pose.ik.iter().position(|d| {
                     placed.screen_from_canvas(d.to).distance(at) <= canvas::PICK_RADIUS_PT
@@ -905,22 +947,159 @@ impl EditorApp {
         }
         if response.drag_stopped() {
             if let Some(Gesture::PoseDrag { pose, .. }) = self.gesture.take() {
-                self.apply(Command::SetPose(pose));
+                self.commit_pose(pose);
             }
         }
         if response.clicked() && shift {
             if let Some(at) = pointer {
                 if let Some(rest) = grab(self, at) {
-                    let mut pose = self.doc.state().pose.clone();
+                    let mut pose = self.edited_pose();
                     pose.ik.push(IkDrag {
                         at: rest,
                         to: placed.canvas_from_screen(at),
                         weight: None,
                     });
-                    self.apply(Command::SetPose(pose));
+                    self.commit_pose(pose);
                 }
             }
         }
+    }
+
+    /// The pose the canvas edits: the document's in pose mode; in animate mode the pose being
+    /// prepared for a key (the animation sampled at the current time until it is edited).
+    pub fn edited_pose(&self) -> Pose {
+        match self.mode {
+            Mode::Animate => self.shown.clone().unwrap_or_else(|| self.sampled_pose()),
+            _ => self.doc.state().pose.clone(),
+        }
+    }
+
+    /// The current animation at the current time (clamped to its keys).
+    pub fn sampled_pose(&self) -> Pose {
+        crate::document::animation_named(self.doc.state(), &self.animation)
+            .map(|a| a.sample(self.time_s, false))
+            .unwrap_or_default()
+    }
+
+    fn commit_pose(&mut self, pose: Pose) {
+        match self.mode {
+            Mode::Animate => self.shown = Some(pose),
+            _ => {
+                self.apply(Command::SetPose(pose));
+            }
+        }
+    }
+
+    /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
+    pub fn set_time(&mut self, time_s: f64) {
+        self.time_s = time_s.max(0.0);
+        self.shown = None;
+    }
+
+    /// The current animation's length: its last key, at least [`MIN_TIMELINE_S`].
+    pub fn timeline_length_s(&self) -> f64 {
+        crate::document::animation_named(self.doc.state(), &self.animation)
+            .map(|a| a.duration_s())
+            .unwrap_or(0.0)
+            .max(MIN_TIMELINE_S)
+    }
+
+    fn animate_panel(&mut self, ui: &mut egui::Ui) {
+        let frame_s = 1.0 / self.fps;
+        ui.horizontal(|ui| {
+            ui.label("Animation");
+            ui.add(egui::TextEdit::singleline(&mut self.animation).desired_width(120.0));
+            let play = if self.playing { "Pause" } else { "Play" };
+            if ui.button(play).clicked() {
+                self.playing = !self.playing;
+            }
+            if ui.button("Previous frame").clicked() {
+                let t = ((self.time_s / frame_s).round() - 1.0).max(0.0) * frame_s;
+                self.set_time(t);
+            }
+            if ui.button("Next frame").clicked() {
+                let t = ((self.time_s / frame_s).round() + 1.0) * frame_s;
+                self.set_time(t);
+            }
+            let mut t = self.time_s;
+            let length = self.timeline_length_s();
+            if ui
+                .add(egui::Slider::new(&mut t, 0.0..=length).text("s"))
+                .changed()
+            {
+                self.set_time(t);
+            }
+            if ui.button("Set key").clicked() {
+                let pose = self.edited_pose();
+                let animation = self.animation.clone();
+                if self.apply(Command::SetKey {
+                    animation,
+                    time_s: self.time_s,
+                    pose,
+                }) {
+                    self.shown = None;
+                }
+            }
+            if ui.button("Delete key").clicked() {
+                let animation = self.animation.clone();
+                self.apply(Command::DeleteKeys {
+                    animation,
+                    time_s: self.time_s,
+                });
+            }
+        });
+        // The dopesheet: one diamond per key time; clicking one moves the playhead there.
+        let anim =
+            crate::document::animation_named(self.doc.state(), &self.animation).unwrap_or_default();
+        let times = crate::document::key_times(&anim);
+        let (response, painter) =
+            ui.allocate_painter(egui::vec2(ui.available_width(), 28.0), Sense::click());
+        let rect = response.rect;
+        painter.rect_filled(rect, 2.0, Color32::from_gray(30));
+        let length = self.timeline_length_s();
+        let x_of = |t: f64| rect.left() + 8.0 + (rect.width() - 16.0) * (t / length) as f32;
+        for &t in &times {
+            let c = egui::pos2(x_of(t), rect.center().y);
+            let d = 6.0;
+            painter.add(egui::Shape::convex_polygon(
+                vec![
+                    c + egui::vec2(0.0, -d),
+                    c + egui::vec2(d, 0.0),
+                    c + egui::vec2(0.0, d),
+                    c + egui::vec2(-d, 0.0),
+                ],
+                Color32::from_rgb(255, 200, 40),
+                egui::Stroke::NONE,
+            ));
+        }
+        let x = x_of(self.time_s);
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+            egui::Stroke::new(2.0, Color32::RED),
+        );
+        if let (true, Some(at)) = (response.clicked(), response.interact_pointer_pos()) {
+            let nearest = times
+                .iter()
+                .copied()
+                .min_by(|a, b| (x_of(*a) - at.x).abs().total_cmp(&(x_of(*b) - at.x).abs()));
+            let t = match nearest {
+                Some(k) if (x_of(k) - at.x).abs() <= canvas::PICK_RADIUS_PT => k,
+                _ => (((at.x - rect.left() - 8.0) / (rect.width() - 16.0)) as f64 * length)
+                    .clamp(0.0, length),
+            };
+            self.set_time(t);
+        }
+    }
+
+    fn advance_playback(&mut self, ctx: &egui::Context) {
+        if !self.playing || self.mode != Mode::Animate {
+            return;
+        }
+        let dt = f64::from(ctx.input(|i| i.stable_dt));
+        let length = self.timeline_length_s();
+        let t = self.time_s + dt;
+        self.set_time(if t > length { t % length } else { t });
+        ctx.request_repaint();
     }
 
     fn unique_name(&self, stem: &str) -> String {
@@ -1041,7 +1220,8 @@ fn help_window(ctx: &egui::Context, open: &mut bool) {
 
 /// The shortcuts the help overlay lists (every one of them works).
 pub const SHORTCUTS: &[(&str, &str)] = &[
-    ("1 / 2", "rig mode / pose mode"),
+    ("1 / 2 / 3", "rig mode / pose mode / animate mode"),
+    ("Space", "play or pause (animate mode)"),
     ("Ctrl+Z", "undo"),
     ("Ctrl+Shift+Z", "redo"),
     ("Delete", "delete the selected handle"),

@@ -222,3 +222,58 @@ fn the_help_overlay_lists_the_shortcuts() {
         h.get_by_label(keys);
     }
 }
+
+#[test]
+fn set_two_keys_and_scrub_the_timeline() {
+    let path = character_rig("animate");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    assert_eq!(h.state().mode, Mode::Animate);
+    let grip = torso_point(&h);
+    let first = [grip[0] + 20.0, grip[1] - 10.0];
+    drag(&mut h, grip, first);
+    assert_eq!(
+        h.state().edited_pose().ik.len(),
+        1,
+        "{:?}",
+        h.state().message
+    );
+    h.get_by_label("Set key").click();
+    h.run();
+    for _ in 0..24 {
+        h.get_by_label("Next frame").click();
+        h.run();
+    }
+    assert!(
+        (h.state().time_s - 1.0).abs() < 1e-9,
+        "{}",
+        h.state().time_s
+    );
+    // Grab the pin where the first key left it and move it to the other side.
+    let second = [grip[0] - 20.0, grip[1] - 10.0];
+    drag(&mut h, first, second);
+    h.get_by_label("Set key").click();
+    h.run();
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation").expect("keys");
+    assert_eq!(crate::document::key_times(&anim), vec![0.0, 1.0]);
+    for _ in 0..12 {
+        h.get_by_label("Previous frame").click();
+        h.run();
+    }
+    let halfway = h.state().edited_pose();
+    assert_eq!(halfway.ik.len(), 1);
+    assert!(
+        distance(halfway.ik[0].to, [grip[0], grip[1] - 10.0]) < 1.0,
+        "{:?}",
+        halfway.ik[0].to
+    );
+    // The canvas shows that pose: the posed mesh was solved for it.
+    assert_eq!(h.state().posed.as_ref().expect("posed").pose, halfway);
+    // Setting keys is undoable like any edit.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation").expect("keys");
+    assert_eq!(crate::document::key_times(&anim), vec![0.0]);
+}
