@@ -69,6 +69,9 @@ pub struct EditArgs {
     /// Take a PNG screenshot of the window after its first frames, then quit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// A handle to select first (rig mode shows its weights).
+    #[arg(long)]
+    pub select: Option<String>,
 }
 
 #[cfg(feature = "editor")]
@@ -373,7 +376,13 @@ fn edit(args: &EditArgs) -> Result<()> {
         EditMode::Pose => Mode::Pose,
         EditMode::Animate => Mode::Animate,
     };
-    crate::editor::run(args.rig.as_deref(), mode, pose, args.screenshot.clone())
+    crate::editor::run(crate::editor::Start {
+        rig: args.rig.clone(),
+        mode,
+        pose,
+        select: args.select.clone(),
+        screenshot: args.screenshot.clone(),
+    })
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {

@@ -1232,24 +1232,38 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("F1 or ?", "this help"),
 ];
 
-/// Opens the editor window on `path` (or an empty document); `screenshot` takes a picture of
-/// the first frames and quits; `mode` and `pose` set what it shows first.
-pub fn run(
-    path: Option<&Path>,
-    mode: Mode,
-    pose: Option<Pose>,
-    screenshot: Option<PathBuf>,
-) -> anyhow::Result<()> {
-    let doc = match path {
+/// What `sinew edit` starts with.
+#[derive(Clone, Debug)]
+pub struct Start {
+    /// The rig to open; none: an empty document.
+    pub rig: Option<PathBuf>,
+    pub mode: Mode,
+    /// A pose to start with.
+    pub pose: Option<Pose>,
+    /// A handle to select (rig mode shows its weights).
+    pub select: Option<String>,
+    /// Take a picture of the first frames to this PNG, then quit.
+    pub screenshot: Option<PathBuf>,
+}
+
+/// Opens the editor window.
+pub fn run(start: Start) -> anyhow::Result<()> {
+    let doc = match &start.rig {
         Some(p) => Document::open(p)?,
         None => Document::new(),
     };
     let mut app = EditorApp::new(doc);
-    app.mode = mode;
-    if let Some(pose) = pose {
+    app.mode = start.mode;
+    if let Some(pose) = start.pose {
         app.doc.apply(Command::SetPose(pose))?;
     }
-    if let Some(shot) = screenshot {
+    if let Some(name) = start.select {
+        if !app.doc.state().handles.names().any(|n| n == name) {
+            anyhow::bail!("the rig has no handle named '{name}'");
+        }
+        app.selected = Some(name);
+    }
+    if let Some(shot) = start.screenshot {
         app.screenshot_then_quit(shot);
     }
     let options = eframe::NativeOptions {

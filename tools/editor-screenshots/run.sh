@@ -31,13 +31,14 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # The bundled character, rigged; the demo's rig refers to the assets by relative paths.
 "$sinew" demo -o "$work/demo" >/dev/null
-rig="$work/demo/rig.json"
+rig="$work/demo/character.json"
 mkdir -p "$out"
 shoot() { # MODE OUT.png [extra args]
   local mode="$1" png="$2"; shift 2
   LIBGL_ALWAYS_SOFTWARE=1 xvfb-run -a -s "-screen 0 1280x800x24" \
     "$sinew" edit "$rig" --mode "$mode" --screenshot "$png" "$@"
 }
-shoot rig "$out/editor-rig.png"
+shoot rig "$out/editor-rig.png" --select arm_upper_l
 shoot pose "$out/editor-pose.png" --pose "$root/assets/character/poses/lift.json"
-echo "wrote $out/editor-rig.png $out/editor-pose.png"
+shoot animate "$out/editor-animate.png" --pose "$root/assets/character/poses/lift.json"
+echo "wrote $out/editor-{rig,pose,animate}.png"
