@@ -37,9 +37,18 @@ fn main() {
         .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app);
     h.run();
     // Grip the torso's vertex nearest its centroid.
-    let torso = &scene.doc.parts.iter().find(|p| p.name == "torso").expect("torso").mesh;
+    let torso = &scene
+        .doc
+        .parts
+        .iter()
+        .find(|p| p.name == "torso")
+        .expect("torso")
+        .mesh;
     let n = torso.vertices.len() as f64;
-    let c = torso.vertices.iter().fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    let c = torso
+        .vertices
+        .iter()
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
     let grip = *torso
         .vertices
         .iter()

@@ -144,16 +144,18 @@ pub fn heat_color(w: f64) -> Color32 {
     } else {
         (2.0 * w - 1.0, 2.0 - 2.0 * w, 0.0)
     };
-    Color32::from_rgba_unmultiplied((r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8, 170)
+    // Cold areas stay see-through so the drawing shows under them.
+    let alpha = 70.0 + 130.0 * w;
+    Color32::from_rgba_unmultiplied(
+        (r * 255.0) as u8,
+        (g * 255.0) as u8,
+        (b * 255.0) as u8,
+        alpha as u8,
+    )
 }
 
 /// Bones as tapered outlines from head to tail, points as rings; `selected` highlighted.
-pub fn handles(
-    placed: &Placed,
-    handles: &Handles,
-    bone_frames: Option<&[([f64; 2], [f64; 2])]>,
-    selected: Option<&str>,
-) -> Vec<Shape> {
+pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Vec<Shape> {
     let mut shapes = Vec::new();
     let color = |name: &str| {
         if selected == Some(name) {
@@ -162,13 +164,10 @@ pub fn handles(
             Color32::from_rgb(80, 220, 255)
         }
     };
-    for (k, bone) in handles.bones.iter().enumerate() {
-        let (head, tail) = bone_frames
-            .and_then(|f| f.get(k).copied())
-            .unwrap_or((bone.head, bone.tail));
+    for bone in &handles.bones {
         let (h, t) = (
-            placed.screen_from_canvas(head),
-            placed.screen_from_canvas(tail),
+            placed.screen_from_canvas(bone.head),
+            placed.screen_from_canvas(bone.tail),
         );
         let along = t - h;
         let width = (along.length() * 0.12).clamp(3.0, 10.0);
@@ -272,7 +271,7 @@ mod tests {
     #[test]
     fn heat_colors_run_blue_to_red() {
         let (cold, hot) = (heat_color(0.0), heat_color(1.0));
-        assert!(cold.b() > 100 && cold.r() == 0);
+        assert!(cold.b() > 50 && cold.r() == 0 && cold.a() < hot.a());
         assert!(hot.r() > 100 && hot.b() == 0);
     }
 }

@@ -84,8 +84,8 @@ struct Posed {
     scene: *const Scene,
     pose: Pose,
     positions: Vec<Vec<Point>>,
-    /// Posed (head, tail) of every bone.
-    bones: Vec<([f64; 2], [f64; 2])>,
+    /// The handles where the pose puts them (bones' heads and tails, points), for drawing.
+    handles: crate::rig::Handles,
 }
 
 /// The editor's state: the document plus what only the view needs.
@@ -636,25 +636,34 @@ impl EditorApp {
         let positions = scene
             .positions_from_transforms(&transforms, pose, Blend::Linear)
             .map_err(|e| e.to_string())?;
-        let bones = scene
-            .doc
-            .handles
-            .bones
-            .iter()
-            .zip(&transforms)
-            .map(|(b, t)| {
-                let map = |p: [f64; 2]| {
-                    let q = t.apply(Point::new(p[0], p[1]));
-                    [q.x, q.y]
-                };
-                (map(b.head), map(b.tail))
-            })
-            .collect();
+        let map = |t: &crate::rig::pose::Affine, p: [f64; 2]| {
+            let q = t.apply(Point::new(p[0], p[1]));
+            [q.x, q.y]
+        };
+        let mut handles = scene.doc.handles.clone();
+        let bone_count = handles.bones.len();
+        for (b, t) in handles.bones.iter_mut().zip(&transforms) {
+            (b.head, b.tail) = (map(t, b.head), map(t, b.tail));
+        }
+        for (p, t) in handles
+            .points
+            .iter_mut()
+            .zip(transforms.iter().skip(bone_count))
+        {
+            p.at = map(t, p.at);
+        }
+        // Cage vertices follow the points in column order, one column each.
+        let mut cage_columns = transforms.iter().skip(bone_count + handles.points.len());
+        for cage in &mut handles.cages {
+            for (v, t) in cage.polygon.iter_mut().zip(cage_columns.by_ref()) {
+                *v = map(t, *v);
+            }
+        }
         self.posed = Some(Posed {
             scene: key,
             pose: pose.clone(),
             positions,
-            bones,
+            handles,
         });
         Ok(())
     }
@@ -687,7 +696,7 @@ impl EditorApp {
             _ => None,
         };
         let mut shapes = Vec::new();
-        let mut bone_frames = None;
+        let mut posed_handles = None;
         match (self.mode, &posable) {
             (Mode::Pose | Mode::Animate, Some(scene)) => {
                 let pose = live_pose.unwrap_or_else(|| self.edited_pose());
@@ -709,7 +718,7 @@ impl EditorApp {
                             ));
                         }
                     }
-                    bone_frames = Some(posed.bones.clone());
+                    posed_handles = Some(posed.handles.clone());
                     for drag in &pose.ik {
                         let s = placed.screen_from_canvas(drag.to);
                         shapes.push(egui::Shape::circle_filled(s, 4.0, Color32::RED));
@@ -742,7 +751,7 @@ impl EditorApp {
                 }
             }
         }
-        let mut handles = self.doc.state().handles.clone();
+        let mut handles = posed_handles.unwrap_or_else(|| self.doc.state().handles.clone());
         match &self.gesture {
             Some(Gesture::NewBone { head, parent, tail }) => handles.bones.push(Bone {
                 name: String::new(),
@@ -755,12 +764,7 @@ impl EditorApp {
             }
             _ => {}
         }
-        shapes.extend(canvas::handles(
-            &placed,
-            &handles,
-            bone_frames.as_deref(),
-            self.selected.as_deref(),
-        ));
+        shapes.extend(canvas::handles(&placed, &handles, self.selected.as_deref()));
         painter.extend(shapes);
         match self.mode {
             Mode::Rig => self.rig_gestures(&ctx, &response, placed),
@@ -1261,6 +1265,7 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         if !app.doc.state().handles.names().any(|n| n == name) {
             anyhow::bail!("the rig has no handle named '{name}'");
         }
+        app.rename_to = name.clone();
         app.selected = Some(name);
     }
     if let Some(shot) = start.screenshot {
