@@ -60,9 +60,9 @@ pub enum Command {
 pub struct EditArgs {
     /// The rig to open; none starts an empty document (drop PNG layers on the window).
     pub rig: Option<PathBuf>,
-    /// The mode to start in.
-    #[arg(long, value_enum, default_value = "rig")]
-    pub mode: EditMode,
+    /// The mode to start in (default: the one the rig's saved view was left in, else rig).
+    #[arg(long, value_enum)]
+    pub mode: Option<EditMode>,
     /// A pose to start with (pose mode).
     #[arg(long)]
     pub pose: Option<PathBuf>,
@@ -371,11 +371,11 @@ fn edit(args: &EditArgs) -> Result<()> {
         Some(path) => Some(read_json::<crate::rig::Pose>(path, "pose file")?),
         None => None,
     };
-    let mode = match args.mode {
+    let mode = args.mode.map(|m| match m {
         EditMode::Rig => Mode::Rig,
         EditMode::Pose => Mode::Pose,
         EditMode::Animate => Mode::Animate,
-    };
+    });
     crate::editor::run(crate::editor::Start {
         rig: args.rig.clone(),
         mode,

@@ -40,8 +40,37 @@ pub const MIN_TIMELINE_S: f64 = 2.0;
 /// A press and release closer than this (canvas px) is a click, not a drag.
 pub const CLICK_SLOP_PX: f64 = 2.0;
 
+/// The view saved beside a document (`NAME.view.json`), so reopening shows it as it was left.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ViewState {
+    pub zoom: f32,
+    /// Canvas origin offset, points.
+    pub pan: [f32; 2],
+    pub mode: Mode,
+    pub selected: Option<String>,
+    pub animation: String,
+    pub time_s: f64,
+}
+
+/// The view side file of the document at `path`.
+pub fn view_path(path: &Path) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "untitled".into());
+    path.with_file_name(format!("{stem}.view.json"))
+}
+
+/// The view saved beside `path`, if there is a readable one (a bad one is ignored: the view is
+/// a convenience, the document is what matters).
+pub fn load_view(path: &Path) -> Option<ViewState> {
+    serde_json::from_slice(&std::fs::read(view_path(path)).ok()?).ok()
+}
+
 /// What the canvas edits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Mode {
     Rig,
     Pose,
@@ -233,8 +262,55 @@ impl EditorApp {
         match Document::open(path) {
             Ok(doc) => {
                 *self = EditorApp::new(doc);
+                if let Some(view) = load_view(path) {
+                    self.restore_view(view);
+                }
             }
             Err(e) => self.message = Some(format!("cannot open {}: {e}", path.display())),
+        }
+    }
+
+    /// What the view looks like now, for [`ViewState`]'s side file.
+    pub fn view_state(&self) -> ViewState {
+        let view = self.view.unwrap_or_default();
+        ViewState {
+            zoom: view.zoom,
+            pan: [view.pan.x, view.pan.y],
+            mode: self.mode,
+            selected: self.selected.clone(),
+            animation: self.animation.clone(),
+            time_s: self.time_s,
+        }
+    }
+
+    /// Puts the view back as `state` describes it (a handle that no longer exists is dropped).
+    pub fn restore_view(&mut self, state: ViewState) {
+        self.view = Some(View {
+            zoom: state.zoom.clamp(0.05, 32.0),
+            pan: egui::vec2(state.pan[0], state.pan[1]),
+        });
+        self.mode = state.mode;
+        self.selected = state
+            .selected
+            .filter(|n| self.doc.state().handles.names().any(|m| m == n));
+        self.rename_to = self.selected.clone().unwrap_or_default();
+        self.animation = state.animation;
+        self.time_s = if state.time_s.is_finite() {
+            state.time_s.max(0.0)
+        } else {
+            0.0
+        };
+    }
+
+    /// Saves the document and, beside it, the view; returns the message for the status bar.
+    pub fn save_to(&mut self, path: &Path) -> String {
+        if let Err(e) = self.doc.save(path) {
+            return e.to_string();
+        }
+        let view = serde_json::to_vec_pretty(&self.view_state()).unwrap_or_default();
+        match crate::io::atomic::write_atomic(&view_path(path), &view) {
+            Ok(()) => format!("saved {}", path.display()),
+            Err(e) => format!("saved {}, but not the view: {e}", path.display()),
         }
     }
 
@@ -248,10 +324,7 @@ impl EditorApp {
             self.message = Some("type a file name in the File menu first".into());
             return;
         };
-        self.message = Some(match self.doc.save(&path) {
-            Ok(()) => format!("saved {}", path.display()),
-            Err(e) => e.to_string(),
-        });
+        self.message = Some(self.save_to(&path));
     }
 
     /// One frame of the whole editor.
@@ -1241,7 +1314,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
 pub struct Start {
     /// The rig to open; none: an empty document.
     pub rig: Option<PathBuf>,
-    pub mode: Mode,
+    /// The mode to start in; none: the saved view's (or rig mode).
+    pub mode: Option<Mode>,
     /// A pose to start with.
     pub pose: Option<Pose>,
     /// A handle to select (rig mode shows its weights).
@@ -1257,7 +1331,12 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         None => Document::new(),
     };
     let mut app = EditorApp::new(doc);
-    app.mode = start.mode;
+    if let Some(view) = start.rig.as_deref().and_then(load_view) {
+        app.restore_view(view);
+    }
+    if let Some(mode) = start.mode {
+        app.mode = mode;
+    }
     if let Some(pose) = start.pose {
         app.doc.apply(Command::SetPose(pose))?;
     }

@@ -277,3 +277,22 @@ fn set_two_keys_and_scrub_the_timeline() {
     let anim = crate::document::animation_named(h.state().doc.state(), "animation").expect("keys");
     assert_eq!(crate::document::key_times(&anim), vec![0.0]);
 }
+
+#[test]
+fn reopening_restores_the_view() {
+    let path = character_rig("view");
+    let mut app = EditorApp::new(Document::open(&path).expect("opens"));
+    app.mode = Mode::Animate;
+    app.view = Some(View {
+        zoom: 2.5,
+        pan: egui::vec2(-40.0, 12.0),
+    });
+    app.selected = Some("head".into());
+    app.time_s = 0.75;
+    let message = app.save_to(&path);
+    assert!(message.starts_with("saved"), "{message}");
+    let mut reopened = EditorApp::new(Document::new());
+    reopened.open(&path);
+    assert_eq!(reopened.view_state(), app.view_state());
+    assert!(reopened.message.is_none());
+}
