@@ -282,28 +282,16 @@ impl Document {
 
     /// Steps back one command; false when there is nothing to undo.
     pub fn undo(&mut self) -> bool {
-        match self.undo.pop() {
-            Some(previous) => {
-                let current = std::mem::replace(&mut self.state, previous);
-                self.redo.push(current);
-                self.dirty = true;
-                true
-            }
-            None => false,
-        }
+        let stepped = swap_in(&mut self.state, &mut self.undo, &mut self.redo);
+        self.dirty |= stepped;
+        stepped
     }
 
     /// Re-applies the last undone command; false when there is nothing to redo.
     pub fn redo(&mut self) -> bool {
-        match self.redo.pop() {
-            Some(next) => {
-                let current = std::mem::replace(&mut self.state, next);
-                self.undo.push(current);
-                self.dirty = true;
-                true
-            }
-            None => false,
-        }
+        let stepped = swap_in(&mut self.state, &mut self.redo, &mut self.undo);
+        self.dirty |= stepped;
+        stepped
     }
 
     /// The rig document as it would be saved at `path`. A stale rig is saved with its meshes
@@ -354,13 +342,29 @@ impl Document {
     }
 }
 
+/// Makes the last state of `from` current, pushing the current one onto `to`.
+fn swap_in(state: &mut State, from: &mut Vec<State>, to: &mut Vec<State>) -> bool {
+    match from.pop() {
+        Some(other) => {
+            to.push(std::mem::replace(state, other));
+            true
+        }
+        None => false,
+    }
+}
+
 /// The side file autosaves go to: `NAME.autosave.json` beside `NAME.json`.
 pub fn autosave_path(path: &Path) -> PathBuf {
+    side_file(path, "autosave")
+}
+
+/// `NAME.KIND.json` beside the document `NAME.json` (autosaves, the editor's view).
+pub fn side_file(path: &Path, kind: &str) -> PathBuf {
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "untitled".into());
-    path.with_file_name(format!("{stem}.autosave.json"))
+    path.with_file_name(format!("{stem}.{kind}.json"))
 }
 
 fn same_layers(doc: &RigDocument, layers: &[Arc<Layer>]) -> bool {

@@ -55,11 +55,7 @@ pub struct ViewState {
 
 /// The view side file of the document at `path`.
 pub fn view_path(path: &Path) -> PathBuf {
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "untitled".into());
-    path.with_file_name(format!("{stem}.view.json"))
+    crate::document::side_file(path, "view")
 }
 
 /// The view saved beside `path`, if there is a readable one (a bad one is ignored: the view is
