@@ -132,6 +132,8 @@ pub struct EditorApp {
     worker: Option<Worker>,
     gesture: Option<Gesture>,
     ik: Option<(*const Scene, RigIk)>,
+    /// The rig whose skinning-IK precomputation was started in the background.
+    ik_warmed: *const Scene,
     posed: Option<Posed>,
     open_path: String,
     rename_to: String,
@@ -176,6 +178,7 @@ impl EditorApp {
             worker: None,
             gesture: None,
             ik: None,
+            ik_warmed: std::ptr::null(),
             posed: None,
             open_path,
             rename_to: String::new(),
@@ -328,6 +331,7 @@ impl EditorApp {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_worker();
+        self.warm_ik();
         self.dropped_files(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
@@ -346,6 +350,23 @@ impl EditorApp {
         }
         self.take_screenshot(&ctx);
         self.last_frame_ms = started.elapsed().as_secs_f64() * 1e3;
+    }
+
+    /// Starts the skinning-IK precomputation of a newly posable rig on another thread, so the
+    /// first drag in pose mode does not wait for it (the scene caches the result).
+    fn warm_ik(&mut self) {
+        let Some(scene) = self.doc.posable() else {
+            return;
+        };
+        if Arc::as_ptr(scene) == self.ik_warmed {
+            return;
+        }
+        self.ik_warmed = Arc::as_ptr(scene);
+        let scene = scene.clone();
+        std::thread::spawn(move || {
+            // Errors show up again, with a message, when the editor asks for the solver.
+            let _ = scene.rig_ik();
+        });
     }
 
     fn poll_worker(&mut self) {
