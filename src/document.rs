@@ -63,6 +63,8 @@ pub enum DocumentError {
     Cancelled,
     #[error(transparent)]
     Animation(#[from] crate::anim::AnimError),
+    #[error(transparent)]
+    Spine(#[from] crate::export::spine::SpineError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
 }
@@ -330,6 +332,25 @@ impl Document {
         self.path = Some(path.to_path_buf());
         self.dirty = false;
         Ok(())
+    }
+
+    /// Exports the current state for Spine's runtimes into `dir` (see [`crate::export::spine`]):
+    /// `NAME.json`, `NAME.atlas` and the atlas pages, with the document's current animations.
+    /// Needs current weights.
+    pub fn export_spine(
+        &self,
+        dir: &Path,
+        name: &str,
+        options: &crate::export::spine::SpineOptions,
+    ) -> Result<Vec<PathBuf>, DocumentError> {
+        if self.posable().is_none() {
+            return Err(DocumentError::NoWeights);
+        }
+        let doc = self.to_rig_document(&dir.join(format!("{name}.sinew.json")))?;
+        let images: Vec<_> = self.state.layers.iter().map(|l| l.image.clone()).collect();
+        let scene = Scene::new(doc, &images)?;
+        let export = crate::export::spine::export_spine(&scene, &images, name, options)?;
+        Ok(export.write(dir)?)
     }
 
     /// Writes the current state to the autosave side file of the document's path (or of

@@ -148,6 +148,8 @@ pub struct EditorApp {
     pub fps: f64,
     /// Animate mode: the pose edited since the playhead last moved (not yet keyed).
     shown: Option<Pose>,
+    /// Where File → Export writes.
+    pub export_dir: String,
 }
 
 impl EditorApp {
@@ -189,6 +191,7 @@ impl EditorApp {
             playing: false,
             fps: DEFAULT_FPS,
             shown: None,
+            export_dir: "export".into(),
         }
     }
 
@@ -310,6 +313,29 @@ impl EditorApp {
         match crate::io::atomic::write_atomic(&view_path(path), &view) {
             Ok(()) => format!("saved {}", path.display()),
             Err(e) => format!("saved {}, but not the view: {e}", path.display()),
+        }
+    }
+
+    /// Exports the document for Spine's runtimes (default options, as `sinew export spine`)
+    /// into `dir`; returns the message for the status bar.
+    pub fn export_spine(&mut self, dir: &Path) -> String {
+        let name = self
+            .doc
+            .path
+            .as_deref()
+            .and_then(Path::file_stem)
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "skeleton".into());
+        let options = crate::export::spine::SpineOptions::default();
+        match std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))
+            .and_then(|()| {
+                self.doc
+                    .export_spine(dir, &name, &options)
+                    .map_err(|e| e.to_string())
+            }) {
+            Ok(written) => format!("exported {} files to {}", written.len(), dir.display()),
+            Err(e) => e,
         }
     }
 
@@ -485,6 +511,13 @@ impl EditorApp {
                 }
                 if ui.button("Save").clicked() {
                     self.save();
+                }
+                ui.separator();
+                ui.label("Export folder:");
+                ui.text_edit_singleline(&mut self.export_dir);
+                if ui.button("Export Spine").clicked() {
+                    let dir = PathBuf::from(&self.export_dir);
+                    self.message = Some(self.export_spine(&dir));
                 }
             });
             if ui

@@ -296,3 +296,24 @@ fn reopening_restores_the_view() {
     assert_eq!(reopened.view_state(), app.view_state());
     assert!(reopened.message.is_none());
 }
+
+#[test]
+fn exports_for_spine_from_the_file_menu_function() {
+    let path = character_rig("export");
+    let mut app = EditorApp::new(Document::open(&path).expect("opens"));
+    let dir = path.parent().expect("a folder").join("spine");
+    let message = app.export_spine(&dir);
+    assert!(message.starts_with("exported"), "{message}");
+    for file in ["character.json", "character.atlas"] {
+        assert!(dir.join(file).is_file(), "{file} missing: {message}");
+    }
+    // Without current weights there is nothing to export, and nothing is written.
+    app.apply(Command::AddPoint(PointHandle {
+        name: "extra".into(),
+        at: [10.0, 10.0],
+    }));
+    let empty = path.parent().expect("a folder").join("none");
+    let message = app.export_spine(&empty);
+    assert!(message.contains("compute"), "{message}");
+    assert_eq!(std::fs::read_dir(&empty).map(|d| d.count()).unwrap_or(0), 0);
+}
