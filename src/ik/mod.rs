@@ -9,6 +9,7 @@
 //! - [`arap`]: the per-vertex ARAP energy (Sorkine & Alexa 2007), the yardstick.
 //! - [`cluster`]: rotation clusters by k-means in weight space.
 //! - [`subspace`]: the energy reduced to the handles' affine parameters (precomputed per rig).
+//! - [`fold`]: the orientation guard: triangles about to fold over are held near rigid.
 //! - [`fast`]: the local/global solver over the reduced energy (factorized per constraint set,
 //!   solved per frame).
 //! - [`rig`]: a rig and a pose → which handles are free, fixed or following, joints, drags,
@@ -18,6 +19,7 @@
 pub mod arap;
 pub mod cluster;
 pub mod fast;
+pub mod fold;
 pub mod reference;
 pub mod rig;
 pub mod subspace;
@@ -95,7 +97,19 @@ pub struct IkOptions {
     pub momentum_iterations: usize,
     /// How far outside every part an ik drag's `at` may lie and still grip the nearest
     /// triangle, px. Default 2.
-    pub grip_tolerance_px: f64,
+    pub grip_tolerance_px: f64,    /// Fold guard ([`fold`]): how many blended triangles (besides one per handle) are checked
+    /// for orientation after each solve, those where the weights change fastest first; 0 turns
+    /// the guard off. Default 4096.
+    pub fold_check_triangles: usize,
+    /// A checked triangle whose posed area falls below this share of its rest area (negative:
+    /// folded over) is guarded: held near its cluster's rotation. Default 0.1.
+    pub fold_area_ratio: f64,
+    /// A guarded triangle's weight, per px² of its rest area, relative to the ARAP energy; it
+    /// grows tenfold in each round that finds the triangle still below `fold_area_ratio`.
+    /// Default 100.
+    pub fold_stiffness: f64,
+    /// Rounds of checking, guarding and iterating again per solve. Default 6.
+    pub fold_rounds: usize,
 }
 
 impl Default for IkOptions {
@@ -114,6 +128,10 @@ impl Default for IkOptions {
             connect_joints: true,
             anchor: 1e-6,
             grip_tolerance_px: 2.0,
+            fold_check_triangles: 4096,
+            fold_area_ratio: 0.1,
+            fold_stiffness: 100.0,
+            fold_rounds: 6,
             momentum: BTreeMap::new(),
             momentum_damping: 0.1,
             momentum_iterations: 32,
