@@ -154,18 +154,24 @@ fn naive(meshes: &[SkinnedMesh], drags: &[IkDrag], columns: usize) -> Vec<Affine
 #[test]
 fn drags_are_met_and_nothing_folds() {
     let meshes = scene().skinned_meshes().unwrap();
-    // A third of the character's height is about 120 px. Pressing the head straight down onto
-    // the pinned feet by that much folds the legs (they cannot get shorter), so the squat
-    // stops at half of it; the hand travels the full third.
+    // A third of the character's height is about 120 px: the head pressed that far straight
+    // down onto the pinned feet (the reduced ARAP optimum folds the waist or the legs there; the
+    // fold guard keeps them turned the right way), pushed sideways and diagonally, and the hand
+    // carried as far in every direction.
     let head = [256.0, 150.0];
     let hand = [160.0, 330.0];
     for (at, dx, dy) in [
         (head, 0.0, -40.0),
         (head, -60.0, 30.0),
         (head, 120.0, 0.0),
-        (head, 0.0, 60.0),
+        (head, -120.0, 0.0),
+        (head, 0.0, 120.0),
+        (head, 85.0, 85.0),
         (head, -85.0, -85.0),
         (hand, -40.0, -112.0),
+        (hand, 120.0, 0.0),
+        (hand, -120.0, 0.0),
+        (hand, 0.0, 120.0),
     ] {
         let mut drags = pins();
         drags.push(drag(at, [at[0] + dx, at[1] + dy]));
@@ -193,11 +199,28 @@ fn drags_are_met_and_nothing_folds() {
             pixmap.save_png(format!("target/ik_{dx}_{dy}.png")).unwrap();
         }
         println!(
-            "drag ({dx:>5}, {dy:>5}): {} iterations, drag error {:.2e} px, {folded} inverted triangles",
-            solution.iterations, solution.drag_error_px
+            "drag ({dx:>5}, {dy:>5}): {} iterations, drag error {:.2e} px, {folded} inverted triangles, {} guarded",
+            solution.iterations, solution.drag_error_px, ik.solver.guarded_triangles()
         );
         assert_eq!(folded, 0, "drag ({dx}, {dy}) folds {folded} triangles");
     }
+}
+
+#[test]
+fn without_the_fold_guard_the_deep_squat_folds() {
+    // The guard is what keeps the 120 px squat above unfolded: the energy alone folds it.
+    let meshes = scene().skinned_meshes().unwrap();
+    let options = IkOptions {
+        fold_check_triangles: 0,
+        ..IkOptions::default()
+    };
+    let mut drags = pins();
+    drags.push(drag([256.0, 150.0], [256.0, 270.0]));
+    let mut ik = RigIk::precompute(&scene().doc.handles, meshes.clone(), options).unwrap();
+    let solution = ik.transforms(&pose_with(drags)).unwrap();
+    let folded = inverted(&meshes, &skinned(&meshes, &solution.transforms));
+    println!("squat without the guard: {folded} inverted triangles");
+    assert!(folded > 0);
 }
 
 #[test]
@@ -454,10 +477,60 @@ fn momentum_handles_lag_swing_and_settle() {
     );
 }
 
-/// The tail tip's offset from where a rigid tail would carry it, frame by frame, as the hip
-/// jumps 60 px left over a quarter second and then stands still: (largest lag, farthest swing
-/// past, final offset), px.
+/// At 30 fps for 2.5 s (see [`tail_offsets`]): (largest lag, farthest swing past, final
+/// offset), px.
 fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
+    let offsets: Vec<f64> = tail_offsets(inertia_s, 30.0, 2.5)
+        .into_iter()
+        .map(|(_, x)| x)
+        .collect();
+    let lag = offsets[..10].iter().cloned().fold(0.0, f64::max);
+    let swing = offsets[8..].iter().cloned().fold(0.0, f64::min);
+    (lag, swing, offsets.last().unwrap().abs())
+}
+
+#[test]
+fn momentum_does_not_depend_on_the_frame_rate() {
+    // The same hip jump sampled at 24 and at 48 frames per second: the tail tip's path, compared
+    // at the 24 fps frames, agrees within 30% of the largest lag, the swing past within 40%,
+    // and both settle (within 0.5 px). What differs is implicit Euler's numerical damping, which
+    // grows with the step (first order: swings of 16, 18, 22 and 26 px at 24, 30, 48 and 96 fps
+    // for this tail); the velocity and its decay are per second, so they do not.
+    let slow = tail_offsets(0.01, 24.0, 2.5);
+    let fast = tail_offsets(0.01, 48.0, 2.5);
+    let lag = slow
+        .iter()
+        .chain(&fast)
+        .map(|p| p.1.abs())
+        .fold(0.0, f64::max);
+    let mut worst: f64 = 0.0;
+    for (k, &(t, x)) in slow.iter().enumerate() {
+        let (t2, x2) = fast[2 * k];
+        assert!((t - t2).abs() < 1e-9);
+        worst = worst.max((x - x2).abs());
+    }
+    let swing = |path: &[(f64, f64)]| path.iter().map(|p| p.1).fold(0.0, f64::min);
+    println!(
+        "24 vs 48 fps: largest lag {lag:.1} px, paths differ by {worst:.2} px at most; swing {:.1} vs {:.1} px; end {:.2} vs {:.2} px",
+        swing(&slow),
+        swing(&fast),
+        slow.last().unwrap().1,
+        fast.last().unwrap().1
+    );
+    assert!(worst <= 0.3 * lag, "paths differ by {worst} px (lag {lag})");
+    assert!(
+        (swing(&slow) - swing(&fast)).abs() <= 0.4 * swing(&fast).abs(),
+        "swings differ"
+    );
+    for path in [&slow, &fast] {
+        assert!(path.last().unwrap().1.abs() < 0.5, "settles");
+    }
+}
+
+/// The tail tip's offset from where a rigid tail would carry it, at `fps` frames per second for
+/// `duration_s`, as the hip jumps 60 px left over a quarter second and then stands still:
+/// (time s, offset px) per frame.
+fn tail_offsets(inertia_s: f64, fps: f64, duration_s: f64) -> Vec<(f64, f64)> {
     let meshes = scene().skinned_meshes().unwrap();
     let handles = &scene().doc.handles;
     let mut options = IkOptions::default();
@@ -468,9 +541,8 @@ fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
     let columns = handle_columns(handles);
     let tip_bone = columns.iter().position(|c| c == "tail_6").unwrap();
     let tail_tip = Point::new(452.0, 214.0);
-    let fps = 30.0;
     let mut offsets = Vec::new();
-    for k in 0..=75 {
+    for k in 0..=(duration_s * fps).round() as usize {
         let t = k as f64 / fps;
         let x = -60.0 * (t / 0.25).min(1.0);
         let mut pose = Pose::default();
@@ -482,9 +554,100 @@ fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
             },
         );
         let solution = ik.step(&pose, 1.0 / fps).unwrap();
-        offsets.push(solution.transforms[tip_bone].apply(tail_tip).x - (tail_tip.x + x));
+        offsets.push((
+            t,
+            solution.transforms[tip_bone].apply(tail_tip).x - (tail_tip.x + x),
+        ));
     }
-    let lag = offsets[..10].iter().cloned().fold(0.0, f64::max);
-    let swing = offsets[8..].iter().cloned().fold(0.0, f64::min);
-    (lag, swing, offsets.last().unwrap().abs())
+    offsets
+}
+
+#[test]
+fn stretchable_bones_stretch_under_ik() {
+    // The left forearm scaled 1.5× along its length while the head is dragged sideways: with
+    // stretchable blending the hand past the forearm's tail is carried, keeping its size along
+    // the forearm; linear blending scales it with the bone.
+    let handles = &scene().doc.handles;
+    let bone = handles
+        .bones
+        .iter()
+        .position(|b| b.name == "arm_lower_l")
+        .unwrap();
+    let (head, tail) = (
+        Point::new(handles.bones[bone].head[0], handles.bones[bone].head[1]),
+        Point::new(handles.bones[bone].tail[0], handles.bones[bone].tail[1]),
+    );
+    let mut drags = pins();
+    drags.push(drag([256.0, 150.0], [216.0, 160.0]));
+    let mut pose = pose_with(drags);
+    pose.bones.insert(
+        "arm_lower_l".into(),
+        sinew::rig::pose::BonePose {
+            scale: [1.5, 1.0],
+            ..Default::default()
+        },
+    );
+    let solution = scene().rig_ik().unwrap().transforms(&pose).unwrap();
+    assert!(solution.drag_error_px <= 0.05);
+    let part = scene()
+        .doc
+        .parts
+        .iter()
+        .position(|p| p.name == "arm_lower_l")
+        .unwrap();
+    let rest = &scene().rest_positions()[part];
+    let axis = tail - head;
+    // The hand: rest vertices more than 5 px past the forearm's tail.
+    let hand: Vec<usize> = (0..rest.len())
+        .filter(|&i| (rest[i] - tail).dot(&axis) / axis.norm() > 5.0)
+        .collect();
+    assert!(hand.len() > 10, "{} hand vertices", hand.len());
+    let posed_axis = {
+        let a = solution.transforms[bone].linear * axis;
+        a / a.norm()
+    };
+    // The hand's extent along the (posed) forearm, relative to its rest extent.
+    let extent = |points: &[Point], along: nalgebra::Vector2<f64>| {
+        let s: Vec<f64> = hand.iter().map(|&i| points[i].coords.dot(&along)).collect();
+        s.iter().cloned().fold(f64::MIN, f64::max) - s.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    let rest_extent = extent(rest, axis / axis.norm());
+    let ratio = |blend| {
+        let positions = scene()
+            .positions_from_transforms(&solution.transforms, &pose, blend)
+            .unwrap();
+        extent(&positions[part], posed_axis) / rest_extent
+    };
+    let (stretch, linear) = (
+        ratio(sinew::skin::Blend::Stretch),
+        ratio(sinew::skin::Blend::Linear),
+    );
+    // Control: forward kinematics alone (no drags), where stretches always came from the pose.
+    let mut fk_pose = pose.clone();
+    fk_pose.ik.clear();
+    let fk = scene().handle_transforms(&fk_pose).unwrap();
+    let fk_positions = scene()
+        .positions_from_transforms(&fk, &fk_pose, sinew::skin::Blend::Stretch)
+        .unwrap();
+    let fk_axis = {
+        let a = fk[bone].linear * axis;
+        a / a.norm()
+    };
+    let fk_stretch = extent(&fk_positions[part], fk_axis) / rest_extent;
+    println!(
+        "hand along the forearm: stretch blending {stretch:.3}×, linear {linear:.3}× its rest \
+         extent (forward kinematics, stretch blending: {fk_stretch:.3}×)"
+    );
+    // Under IK the free upper arm is an affine map and shortens (the solver measures the
+    // linearly blended shape, so it offsets part of the forearm's scale), so the hand is not
+    // its rest size either way; but stretchable blending removes exactly the forearm's own
+    // 1.5× from it, which linear blending keeps.
+    assert!(
+        (fk_stretch - 1.0).abs() < 0.05,
+        "forward kinematics {fk_stretch}"
+    );
+    assert!(
+        (linear / stretch - 1.5).abs() < 0.1,
+        "linear {linear} vs stretch blending {stretch}"
+    );
 }

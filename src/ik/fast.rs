@@ -165,6 +165,10 @@ pub const COLUMN_HOLD: f64 = 1e-9;
 /// How much a guarded triangle's weight grows in each round that finds it still folded.
 pub const FOLD_ESCALATION: f64 = 10.0;
 
+/// A folded triangle whose Jacobian the free parameters move by less than this share of its
+/// whole dependence on T is left unguarded (the fixed handles fold it).
+pub const FOLD_FREE_SHARE: f64 = 1e-9;
+
 /// The skinning-IK solver of one rig: precompute once, then solve per frame or per drag.
 #[derive(Clone, Debug)]
 pub struct FastIk {
@@ -444,28 +448,25 @@ impl FastIk {
             let current = matches!(&self.system,
                 Some(s) if s.guard == self.guard && s.problem.same_structure(problem));
             if !current {
-                self.system = Some(self.factor(problem, &self.guard)?);
+                match self.factor(problem, &self.guard) {
+                    Ok(system) => self.system = Some(system),
+                    // Guard weights so large that the system no longer factors: keep the last
+                    // factorization's guard and its result.
+                    Err(IkError::Singular) if round > 0 => {
+                        if let Some(s) = &self.system {
+                            self.guard = s.guard.clone();
+                        }
+                        break;
+                    }
+                    Err(e) => return Err(e),
+                }
             }
             iterations += self.iterate(problem, &mut t, iteration_limit)?;
             if round == self.options.fold_rounds || self.folds.is_empty() {
                 break;
             }
-            let folds = self.folds.folds(&t, self.options.fold_area_ratio);
-            if folds.is_empty() {
+            if !self.guard_folds(&t) {
                 break;
-            }
-            for fold in folds {
-                match self.guard.iter_mut().find(|g| g.triangle == fold.triangle) {
-                    Some(g) => g.lambda *= FOLD_ESCALATION,
-                    None => {
-                        let (_, area, cluster) = self.folds.jacobian_map(fold.triangle);
-                        self.guard.push(Guard {
-                            triangle: fold.triangle,
-                            lambda: self.options.fold_stiffness * area,
-                            cluster,
-                        });
-                    }
-                }
             }
         }
         let drag_error_px = problem
@@ -486,6 +487,36 @@ impl FastIk {
             drag_error_px,
             energy,
         })
+    }
+
+    /// Guards the checked triangles that `t` folds (nearly) over and that the free parameters can
+    /// turn back; returns whether the guard changed.
+    fn guard_folds(&mut self, t: &DMatrix<f64>) -> bool {
+        let Some(system) = &self.system else {
+            return false;
+        };
+        let mut changed = false;
+        for fold in self.folds.folds(t, self.options.fold_area_ratio) {
+            if let Some(g) = self.guard.iter_mut().find(|g| g.triangle == fold.triangle) {
+                g.lambda *= FOLD_ESCALATION;
+                changed = true;
+                continue;
+            }
+            let (u, area, cluster) = self.folds.jacobian_map(fold.triangle);
+            // A triangle folded by handles the pose fixes is the pose's doing: no free
+            // parameter moves it, and a guard would only weigh on the factorization.
+            let free_part = (&u * &system.p).norm();
+            if free_part <= FOLD_FREE_SHARE * u.norm() {
+                continue;
+            }
+            self.guard.push(Guard {
+                triangle: fold.triangle,
+                lambda: self.options.fold_stiffness * area,
+                cluster,
+            });
+            changed = true;
+        }
+        changed
     }
 
     /// Local/global iterations on `t` with the current system, at most `limit`; returns how
