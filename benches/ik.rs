@@ -6,10 +6,11 @@
 //! the distance to each handle (σ = 60 px), built outside the timing. What is timed:
 //!
 //! - `ik/precompute/10kx20/{1thread,2threads}`: `FastIk::precompute` (weight-space k-means,
-//!   the reduced matrices A, B and G). Target < 100 ms.
+//!   the reduced matrices A, B and G, the fold guard's choice of triangles). Target < 100 ms.
 //! - `ik/factor/10kx20`: the first solve of a new constraint structure (two pins and one drag):
 //!   the KKT null-space factorization plus one warm solve.
-//! - `ik/solve/10kx20`: one warm-started solve (8 local/global iterations at most) while the
+//! - `ik/solve/10kx20`: one warm-started solve (8 local/global iterations at most, then the
+//!   fold guard's orientation check of 4096 blended triangles and one per handle) while the
 //!   drag target moves, as in the editor. Target < 0.3 ms on one core.
 //!
 //! The solves run on one thread; the precomputation once in a one-thread rayon pool and once in

@@ -11,7 +11,7 @@ use crate::ik::{RigIk, SkinnedMesh};
 use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
 use crate::render::{self, MeshRenderer, PartDraw, RenderError, RenderPart, Texture};
-use crate::rig::pose::{bone_stretches, Affine};
+use crate::rig::pose::{bone_stretches_under, Affine};
 use crate::rig::{handle_columns, handle_transforms, HandleError, Handles, Pose, PoseError};
 use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
@@ -558,21 +558,17 @@ impl Scene {
     }
 
     /// Every part's vertex positions under per-column skinning `transforms` (from
-    /// [`handle_transforms`] or the skinning IK). Stretchable bones need forward-kinematics
-    /// bone frames: a pose with IK drags blends linearly instead.
+    /// [`handle_transforms`] or the skinning IK). With [`Blend::Stretch`], a bone the pose
+    /// scales along its length stretches from its transform in `transforms`, solved or not.
     pub fn positions_from_transforms(
         &self,
         transforms: &[Affine],
         pose: &Pose,
         blend: Blend,
     ) -> Result<Vec<Vec<Point>>, PipelineError> {
-        let blend = match blend {
-            Blend::Stretch if !pose.ik.is_empty() => Blend::Linear,
-            other => other,
-        };
         // Bones come first among the columns, so bone i's stretch is column i's.
         let stretches = match blend {
-            Blend::Stretch => bone_stretches(&self.doc.handles, pose)?,
+            Blend::Stretch => bone_stretches_under(&self.doc.handles, pose, transforms)?,
             Blend::Linear | Blend::Dqs => Vec::new(),
         };
         let columns = handle_columns(&self.doc.handles);

@@ -154,18 +154,24 @@ fn naive(meshes: &[SkinnedMesh], drags: &[IkDrag], columns: usize) -> Vec<Affine
 #[test]
 fn drags_are_met_and_nothing_folds() {
     let meshes = scene().skinned_meshes().unwrap();
-    // A third of the character's height is about 120 px. Pressing the head straight down onto
-    // the pinned feet by that much folds the legs (they cannot get shorter), so the squat
-    // stops at half of it; the hand travels the full third.
+    // A third of the character's height is about 120 px: the head pressed that far straight
+    // down onto the pinned feet (the reduced ARAP optimum folds the waist or the legs there; the
+    // fold guard keeps them turned the right way), pushed sideways and diagonally, and the hand
+    // carried as far in every direction.
     let head = [256.0, 150.0];
     let hand = [160.0, 330.0];
     for (at, dx, dy) in [
         (head, 0.0, -40.0),
         (head, -60.0, 30.0),
         (head, 120.0, 0.0),
-        (head, 0.0, 60.0),
+        (head, -120.0, 0.0),
+        (head, 0.0, 120.0),
+        (head, 85.0, 85.0),
         (head, -85.0, -85.0),
         (hand, -40.0, -112.0),
+        (hand, 120.0, 0.0),
+        (hand, -120.0, 0.0),
+        (hand, 0.0, 120.0),
     ] {
         let mut drags = pins();
         drags.push(drag(at, [at[0] + dx, at[1] + dy]));
@@ -193,11 +199,28 @@ fn drags_are_met_and_nothing_folds() {
             pixmap.save_png(format!("target/ik_{dx}_{dy}.png")).unwrap();
         }
         println!(
-            "drag ({dx:>5}, {dy:>5}): {} iterations, drag error {:.2e} px, {folded} inverted triangles",
-            solution.iterations, solution.drag_error_px
+            "drag ({dx:>5}, {dy:>5}): {} iterations, drag error {:.2e} px, {folded} inverted triangles, {} guarded",
+            solution.iterations, solution.drag_error_px, ik.solver.guarded_triangles()
         );
         assert_eq!(folded, 0, "drag ({dx}, {dy}) folds {folded} triangles");
     }
+}
+
+#[test]
+fn without_the_fold_guard_the_deep_squat_folds() {
+    // The guard is what keeps the 120 px squat above unfolded: the energy alone folds it.
+    let meshes = scene().skinned_meshes().unwrap();
+    let options = IkOptions {
+        fold_check_triangles: 0,
+        ..IkOptions::default()
+    };
+    let mut drags = pins();
+    drags.push(drag([256.0, 150.0], [256.0, 270.0]));
+    let mut ik = RigIk::precompute(&scene().doc.handles, meshes.clone(), options).unwrap();
+    let solution = ik.transforms(&pose_with(drags)).unwrap();
+    let folded = inverted(&meshes, &skinned(&meshes, &solution.transforms));
+    println!("squat without the guard: {folded} inverted triangles");
+    assert!(folded > 0);
 }
 
 #[test]
@@ -454,10 +477,70 @@ fn momentum_handles_lag_swing_and_settle() {
     );
 }
 
-/// The tail tip's offset from where a rigid tail would carry it, frame by frame, as the hip
-/// jumps 60 px left over a quarter second and then stands still: (largest lag, farthest swing
-/// past, final offset), px.
+#[test]
+fn momentum_does_not_depend_on_the_frame_rate() {
+    // The same hip jump sampled at 24 and at 48 frames per second, and at 48 fps with every
+    // other frame dropped in turn (steps of 1/48 and 1/24 s alternating): the tail tip's path,
+    // compared at the frames they share, agrees within 10% of its largest lag, and all settle.
+    // Inertia 0.03 s keeps ω·h small enough that implicit Euler's own step dependence
+    // (numerical damping, first order) stays within that; a velocity extrapolated per frame
+    // instead of per second, or a damping counted per frame, is off by 25–35% on these paths.
+    let inertia_s = 0.03;
+    let at =
+        |fps: f64| -> Vec<f64> { (0..=(2.5 * fps) as usize).map(|k| k as f64 / fps).collect() };
+    let fine = tail_offsets_at(inertia_s, &at(48.0));
+    let coarse = tail_offsets_at(inertia_s, &at(24.0));
+    let mut kept = vec![0usize];
+    while let Some(&last) = kept.last() {
+        let next = last + if kept.len() % 2 == 1 { 1 } else { 2 };
+        if next >= fine.len() {
+            break;
+        }
+        kept.push(next);
+    }
+    let irregular = tail_offsets_at(
+        inertia_s,
+        &kept.iter().map(|&k| k as f64 / 48.0).collect::<Vec<_>>(),
+    );
+    let lag = fine.iter().map(|x| x.abs()).fold(0.0, f64::max);
+    let differ = |path: &[f64], frames: &mut dyn Iterator<Item = usize>| {
+        path.iter()
+            .zip(frames)
+            .map(|(x, k)| (x - fine[k]).abs())
+            .fold(0.0, f64::max)
+    };
+    let coarse_off = differ(&coarse, &mut (0..).map(|k| 2 * k));
+    let irregular_off = differ(&irregular, &mut kept.iter().copied());
+    println!(
+        "48 fps: largest lag {lag:.1} px; 24 fps differs by {coarse_off:.2} px at most, irregular frames by {irregular_off:.2} px; ends {:.2}, {:.2}, {:.2} px",
+        fine.last().unwrap(),
+        coarse.last().unwrap(),
+        irregular.last().unwrap()
+    );
+    assert!(coarse_off <= 0.1 * lag, "24 fps differs by {coarse_off} px");
+    assert!(
+        irregular_off <= 0.1 * lag,
+        "irregular frames differ by {irregular_off} px"
+    );
+    for path in [&fine, &coarse, &irregular] {
+        assert!(path.last().unwrap().abs() < 1.0, "settles");
+    }
+}
+
+/// At 30 fps for 2.5 s (see [`tail_offsets_at`]): (largest lag, farthest swing past, final
+/// offset), px.
 fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
+    let times: Vec<f64> = (0..=75).map(|k| k as f64 / 30.0).collect();
+    let offsets = tail_offsets_at(inertia_s, &times);
+    let lag = offsets[..10].iter().cloned().fold(0.0, f64::max);
+    let swing = offsets[8..].iter().cloned().fold(0.0, f64::min);
+    (lag, swing, offsets.last().unwrap().abs())
+}
+
+/// The tail tip's offset from where a rigid tail would carry it (px), at each of `times_s`, as
+/// the hip jumps 60 px left over a quarter second and then stands still. The first frame is
+/// stepped as long as the second.
+fn tail_offsets_at(inertia_s: f64, times_s: &[f64]) -> Vec<f64> {
     let meshes = scene().skinned_meshes().unwrap();
     let handles = &scene().doc.handles;
     let mut options = IkOptions::default();
@@ -468,10 +551,13 @@ fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
     let columns = handle_columns(handles);
     let tip_bone = columns.iter().position(|c| c == "tail_6").unwrap();
     let tail_tip = Point::new(452.0, 214.0);
-    let fps = 30.0;
     let mut offsets = Vec::new();
-    for k in 0..=75 {
-        let t = k as f64 / fps;
+    for (k, &t) in times_s.iter().enumerate() {
+        let frame_time_s = if k == 0 {
+            times_s[1] - times_s[0]
+        } else {
+            t - times_s[k - 1]
+        };
         let x = -60.0 * (t / 0.25).min(1.0);
         let mut pose = Pose::default();
         pose.bones.insert(
@@ -481,10 +567,98 @@ fn tail_after_hip_jump(inertia_s: f64) -> (f64, f64, f64) {
                 ..Default::default()
             },
         );
-        let solution = ik.step(&pose, 1.0 / fps).unwrap();
+        let solution = ik.step(&pose, frame_time_s).unwrap();
         offsets.push(solution.transforms[tip_bone].apply(tail_tip).x - (tail_tip.x + x));
     }
-    let lag = offsets[..10].iter().cloned().fold(0.0, f64::max);
-    let swing = offsets[8..].iter().cloned().fold(0.0, f64::min);
-    (lag, swing, offsets.last().unwrap().abs())
+    offsets
+}
+
+#[test]
+fn stretchable_bones_stretch_under_ik() {
+    // The left forearm scaled 1.5× along its length while the head is dragged sideways: with
+    // stretchable blending the hand past the forearm's tail is carried, keeping its size along
+    // the forearm; linear blending scales it with the bone.
+    let handles = &scene().doc.handles;
+    let bone = handles
+        .bones
+        .iter()
+        .position(|b| b.name == "arm_lower_l")
+        .unwrap();
+    let (head, tail) = (
+        Point::new(handles.bones[bone].head[0], handles.bones[bone].head[1]),
+        Point::new(handles.bones[bone].tail[0], handles.bones[bone].tail[1]),
+    );
+    let mut drags = pins();
+    drags.push(drag([256.0, 150.0], [216.0, 160.0]));
+    let mut pose = pose_with(drags);
+    pose.bones.insert(
+        "arm_lower_l".into(),
+        sinew::rig::pose::BonePose {
+            scale: [1.5, 1.0],
+            ..Default::default()
+        },
+    );
+    let solution = scene().rig_ik().unwrap().transforms(&pose).unwrap();
+    assert!(solution.drag_error_px <= 0.05);
+    let part = scene()
+        .doc
+        .parts
+        .iter()
+        .position(|p| p.name == "arm_lower_l")
+        .unwrap();
+    let rest = &scene().rest_positions()[part];
+    let axis = tail - head;
+    // The hand: rest vertices more than 5 px past the forearm's tail.
+    let hand: Vec<usize> = (0..rest.len())
+        .filter(|&i| (rest[i] - tail).dot(&axis) / axis.norm() > 5.0)
+        .collect();
+    assert!(hand.len() > 10, "{} hand vertices", hand.len());
+    let posed_axis = {
+        let a = solution.transforms[bone].linear * axis;
+        a / a.norm()
+    };
+    // The hand's extent along the (posed) forearm, relative to its rest extent.
+    let extent = |points: &[Point], along: nalgebra::Vector2<f64>| {
+        let s: Vec<f64> = hand.iter().map(|&i| points[i].coords.dot(&along)).collect();
+        s.iter().cloned().fold(f64::MIN, f64::max) - s.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    let rest_extent = extent(rest, axis / axis.norm());
+    let ratio = |blend| {
+        let positions = scene()
+            .positions_from_transforms(&solution.transforms, &pose, blend)
+            .unwrap();
+        extent(&positions[part], posed_axis) / rest_extent
+    };
+    let (stretch, linear) = (
+        ratio(sinew::skin::Blend::Stretch),
+        ratio(sinew::skin::Blend::Linear),
+    );
+    // Control: forward kinematics alone (no drags), where stretches always came from the pose.
+    let mut fk_pose = pose.clone();
+    fk_pose.ik.clear();
+    let fk = scene().handle_transforms(&fk_pose).unwrap();
+    let fk_positions = scene()
+        .positions_from_transforms(&fk, &fk_pose, sinew::skin::Blend::Stretch)
+        .unwrap();
+    let fk_axis = {
+        let a = fk[bone].linear * axis;
+        a / a.norm()
+    };
+    let fk_stretch = extent(&fk_positions[part], fk_axis) / rest_extent;
+    println!(
+        "hand along the forearm: stretch blending {stretch:.3}×, linear {linear:.3}× its rest \
+         extent (forward kinematics, stretch blending: {fk_stretch:.3}×)"
+    );
+    // Under IK the free upper arm is an affine map and shortens (the solver measures the
+    // linearly blended shape, so it offsets part of the forearm's scale), so the hand is not
+    // its rest size either way; but stretchable blending removes exactly the forearm's own
+    // 1.5× from it, which linear blending keeps.
+    assert!(
+        (fk_stretch - 1.0).abs() < 0.05,
+        "forward kinematics {fk_stretch}"
+    );
+    assert!(
+        (linear / stretch - 1.5).abs() < 0.1,
+        "linear {linear} vs stretch blending {stretch}"
+    );
 }

@@ -36,7 +36,7 @@ pub fn cotangent_edges(rest: &[Point], triangles: &[[u32; 3]]) -> Vec<WeightedEd
             half.push((a.min(b), a.max(b), 0.5 * cot));
         }
     }
-    half.sort_by(|x, y| (x.0, x.1).cmp(&(y.0, y.1)));
+    half.sort_by_key(|x| (x.0, x.1));
     let mut edges: Vec<WeightedEdge> = Vec::with_capacity(half.len() / 2 + 1);
     for (i, j, w) in half {
         match edges.last_mut() {

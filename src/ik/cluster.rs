@@ -19,7 +19,7 @@ pub fn weight_space_clusters(
     count: usize,
     iterations: usize,
 ) -> (Vec<u32>, usize) {
-    let n = if dim == 0 { 0 } else { points.len() / dim };
+    let n = points.len().checked_div(dim).unwrap_or(0);
     if n == 0 {
         return (Vec::new(), 0);
     }

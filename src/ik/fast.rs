@@ -19,10 +19,16 @@
 //!
 //! Rigid handles (regions always, bones when [`IkOptions::rigidity`] asks) are held near
 //! rotations by a penalty λ‖L − R‖² (R the nearest rotation, refreshed in every local step); λ is
-//! the column's rigidity times its own stiffness in A, so the term is unit-free. Hard constraints are met exactly whenever they are
-//! feasible; infeasible ones are met in the least-squares sense.
+//! the column's rigidity times its own stiffness in A, so the term is unit-free. Hard constraints
+//! are met exactly whenever they are feasible; infeasible ones are met in the least-squares sense.
+//!
+//! After the iterations, the [`super::fold`] guard checks the skinned triangles' orientation; a
+//! triangle (nearly) folded over gets a rigidity term of its own, the system is factored again
+//! and the iterations resume, up to [`IkOptions::fold_rounds`] times per solve. The guarded
+//! triangles are kept for the following warm-started solves of the same structure.
 
 use super::arap::{best_rotation, nearest_rotation};
+use super::fold::FoldCheck;
 use super::subspace::Subspace;
 use super::{IkError, IkOptions};
 use crate::rig::pose::Affine;
@@ -135,11 +141,33 @@ struct System {
     energy_per_gram: f64,
     /// The per-entry pull toward the anchor ([`COLUMN_HOLD`] × mean diagonal of A).
     column_hold: f64,
+    /// The guarded triangles it was factored with (see [`FastIk::guard`]).
+    guard: Vec<Guard>,
+    /// Per guarded triangle: X Pᵀ λ Uᵀ (nz × 2), times its cluster's Rᵀ gives its share of z.
+    x_pt_guard: Vec<DMatrix<f64>>,
+}
+
+/// A triangle held near its cluster's rotation: λ‖J − R‖²_F (see [`super::fold`]).
+#[derive(Clone, Debug, PartialEq)]
+struct Guard {
+    /// Index among the fold check's triangles.
+    triangle: usize,
+    /// px².
+    lambda: f64,
+    /// The cluster whose rotation R is.
+    cluster: usize,
 }
 
 /// Pull of every handle parameter toward its anchor, relative to A's mean diagonal: negligible
 /// for any column that moves vertices, decisive for one that moves none.
 pub const COLUMN_HOLD: f64 = 1e-9;
+
+/// How much a guarded triangle's weight grows in each round that finds it still folded.
+pub const FOLD_ESCALATION: f64 = 10.0;
+
+/// A folded triangle whose Jacobian the free parameters move by less than this share of its
+/// whole dependence on T is left unguarded (the fixed handles fold it).
+pub const FOLD_FREE_SHARE: f64 = 1e-9;
 
 /// The skinning-IK solver of one rig: precompute once, then solve per frame or per drag.
 #[derive(Clone, Debug)]
@@ -149,6 +177,11 @@ pub struct FastIk {
     /// A bound on |v| over the rig's rest vertices, px: converts a change of a linear part
     /// into a bound on how far a vertex moves.
     extent_px: f64,
+    /// The triangles whose orientation is checked after each solve.
+    folds: FoldCheck,
+    /// Triangles found folding in earlier rounds or solves of the current structure, with their
+    /// rigidity weights.
+    guard: Vec<Guard>,
     system: Option<System>,
     previous: Option<DMatrix<f64>>,
 }
@@ -194,14 +227,30 @@ impl FastIk {
             options,
             subspace,
             extent_px,
+            folds: FoldCheck::default(),
+            guard: Vec::new(),
             system: None,
             previous: None,
         }
     }
 
-    /// Forgets the warm start (e.g. when the animation jumps).
+    /// Sets the triangles whose orientation the solver guards (none by default).
+    pub fn with_fold_check(mut self, folds: FoldCheck) -> Self {
+        self.folds = folds;
+        self.guard.clear();
+        self.system = None;
+        self
+    }
+
+    /// How many triangles the fold guard currently holds near rigid.
+    pub fn guarded_triangles(&self) -> usize {
+        self.guard.len()
+    }
+
+    /// Forgets the warm start (e.g. when the animation jumps) and the guarded triangles.
     pub fn reset(&mut self) {
         self.previous = None;
+        self.guard.clear();
     }
 
     /// Mean diagonal of A over the translation entries: the energy stiffness of moving one
@@ -214,7 +263,7 @@ impl FastIk {
         (s / m as f64).max(f64::MIN_POSITIVE)
     }
 
-    fn factor(&self, problem: &Problem) -> Result<System, IkError> {
+    fn factor(&self, problem: &Problem, guard: &[Guard]) -> Result<System, IkError> {
         let m = self.subspace.column_count;
         if problem.columns.len() != m || problem.anchor.len() != m {
             return Err(IkError::ColumnCount {
@@ -324,6 +373,12 @@ impl FastIk {
                 }
             }
         }
+        let mut guard_rhs = Vec::with_capacity(guard.len());
+        for g in guard {
+            let (u, _, _) = self.folds.jacobian_map(g.triangle);
+            q_t += u.tr_mul(&u) * g.lambda;
+            guard_rhs.push(u.transpose() * g.lambda);
+        }
         let e_t = DMatrix::from_fn(hard.len(), dim, |r, c| hard[r][c]);
         let h = p.tr_mul(&(&q_t * &p));
         let e = &e_t * &p;
@@ -345,6 +400,7 @@ impl FastIk {
         };
         let y = (DMatrix::identity(nz, nz) - &x * &h) * &e_pinv;
         let x_pt_b = &x * p.tr_mul(&self.subspace.b);
+        let x_pt_guard = guard_rhs.iter().map(|g| &x * p.tr_mul(g)).collect();
         Ok(System {
             problem: problem.clone(),
             p,
@@ -357,6 +413,8 @@ impl FastIk {
             anchor_weight,
             energy_per_gram,
             column_hold,
+            guard: guard.to_vec(),
+            x_pt_guard,
         })
     }
 
@@ -372,10 +430,103 @@ impl FastIk {
         problem: &Problem,
         warm_iterations: Option<usize>,
     ) -> Result<IkSolution, IkError> {
-        let reuse = matches!(&self.system, Some(s) if s.problem.same_structure(problem));
-        if !reuse {
-            self.system = Some(self.factor(problem)?);
+        let same_structure = matches!(&self.system, Some(s) if s.problem.same_structure(problem));
+        if !same_structure {
+            // Triangles guarded for another set of constraints need not fold under this one.
+            self.guard.clear();
         }
+        let dim = 3 * self.subspace.column_count;
+        let (mut t, iteration_limit) = match &self.previous {
+            Some(prev) if prev.nrows() == dim => (
+                prev.clone(),
+                warm_iterations.unwrap_or(self.options.iterations),
+            ),
+            _ => (stack(&problem.anchor), self.options.cold_iterations),
+        };
+        let mut iterations = 0;
+        for round in 0..=self.options.fold_rounds {
+            let current = matches!(&self.system,
+                Some(s) if s.guard == self.guard && s.problem.same_structure(problem));
+            if !current {
+                match self.factor(problem, &self.guard) {
+                    Ok(system) => self.system = Some(system),
+                    // Guard weights so large that the system no longer factors: keep the last
+                    // factorization's guard and its result.
+                    Err(IkError::Singular) if round > 0 => {
+                        if let Some(s) = &self.system {
+                            self.guard = s.guard.clone();
+                        }
+                        break;
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+            iterations += self.iterate(problem, &mut t, iteration_limit)?;
+            if round == self.options.fold_rounds || self.folds.is_empty() {
+                break;
+            }
+            if !self.guard_folds(&t) {
+                break;
+            }
+        }
+        let drag_error_px = problem
+            .drags
+            .iter()
+            .filter(|d| d.weight.is_none())
+            .map(|d| {
+                let row = DVector::from_column_slice(&d.row);
+                let pos = t.tr_mul(&row);
+                (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
+            })
+            .fold(0.0, f64::max);
+        let energy = self.reduced_energy(&t);
+        self.previous = Some(t.clone());
+        Ok(IkSolution {
+            transforms: unstack(&t),
+            iterations,
+            drag_error_px,
+            energy,
+        })
+    }
+
+    /// Guards the checked triangles that `t` folds (nearly) over and that the free parameters can
+    /// turn back; returns whether the guard changed.
+    fn guard_folds(&mut self, t: &DMatrix<f64>) -> bool {
+        let Some(system) = &self.system else {
+            return false;
+        };
+        let mut changed = false;
+        for fold in self.folds.folds(t, self.options.fold_area_ratio) {
+            if let Some(g) = self.guard.iter_mut().find(|g| g.triangle == fold.triangle) {
+                g.lambda *= FOLD_ESCALATION;
+                changed = true;
+                continue;
+            }
+            let (u, area, cluster) = self.folds.jacobian_map(fold.triangle);
+            // A triangle folded by handles the pose fixes is the pose's doing: no free
+            // parameter moves it, and a guard would only weigh on the factorization.
+            let free_part = (&u * &system.p).norm();
+            if free_part <= FOLD_FREE_SHARE * u.norm() {
+                continue;
+            }
+            self.guard.push(Guard {
+                triangle: fold.triangle,
+                lambda: self.options.fold_stiffness * area,
+                cluster,
+            });
+            changed = true;
+        }
+        changed
+    }
+
+    /// Local/global iterations on `t` with the current system, at most `limit`; returns how
+    /// many ran.
+    fn iterate(
+        &self,
+        problem: &Problem,
+        t: &mut DMatrix<f64>,
+        limit: usize,
+    ) -> Result<usize, IkError> {
         let Some(system) = &self.system else {
             return Err(IkError::Singular);
         };
@@ -431,22 +582,15 @@ impl FastIk {
         let e = DMatrix::from_fn(targets.len(), 2, |r, c| targets[r][c] - e_q[(r, c)]);
         let z_const = &system.x * system.p.tr_mul(&f_const) + &system.y * &e;
 
-        let (mut t, iteration_limit) = match &self.previous {
-            Some(prev) if prev.nrows() == dim => (
-                prev.clone(),
-                warm_iterations.unwrap_or(self.options.iterations),
-            ),
-            _ => (anchor.clone(), self.options.cold_iterations),
-        };
         let r_count = self.subspace.cluster_count;
         let nz = system.p.ncols();
         let mut r_flat = DMatrix::<f64>::zeros(2 * r_count, 2);
         let mut rigid_rhs = DMatrix::<f64>::zeros(nz, 2);
         let mut iterations = 0;
-        for _ in 0..iteration_limit.max(1) {
+        for _ in 0..limit.max(1) {
             iterations += 1;
             // Local step: cluster rotations from C = Bᵀ T, rigid targets from T.
-            let c = self.subspace.b.tr_mul(&t);
+            let c = self.subspace.b.tr_mul(t);
             for k in 0..r_count {
                 let ck = Matrix2::new(
                     c[(2 * k, 0)],
@@ -463,7 +607,7 @@ impl FastIk {
             }
             rigid_rhs.fill(0.0);
             for &(j, o, lambda) in &system.rigid {
-                let l = rows_to_affine(&t, j).linear;
+                let l = rows_to_affine(t, j).linear;
                 let mut target = nearest_rotation(&l);
                 if self.options.allow_uniform_scale {
                     let s = (target.transpose() * l).trace() * 0.5;
@@ -479,38 +623,24 @@ impl FastIk {
             if !system.rigid.is_empty() {
                 z += &system.x * &rigid_rhs;
             }
+            for (g, x_pt_u) in system.guard.iter().zip(&system.x_pt_guard) {
+                z += x_pt_u * r_flat.view((2 * g.cluster, 0), (2, 2));
+            }
             let next = &system.p * &z + &q;
             let change = (0..m)
                 .map(|j| {
                     let d = rows_to_affine(&next, j);
-                    let o = rows_to_affine(&t, j);
+                    let o = rows_to_affine(t, j);
                     (d.linear - o.linear).norm() * self.extent_px
                         + (d.translation - o.translation).norm()
                 })
                 .fold(0.0, f64::max);
-            t = next;
+            *t = next;
             if change <= self.options.tolerance_px {
                 break;
             }
         }
-        let drag_error_px = problem
-            .drags
-            .iter()
-            .filter(|d| d.weight.is_none())
-            .map(|d| {
-                let row = DVector::from_column_slice(&d.row);
-                let pos = t.tr_mul(&row);
-                (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
-            })
-            .fold(0.0, f64::max);
-        let energy = self.reduced_energy(&t);
-        self.previous = Some(t.clone());
-        Ok(IkSolution {
-            transforms: unstack(&t),
-            iterations,
-            drag_error_px,
-            energy,
-        })
+        Ok(iterations)
     }
 
     /// The clustered ARAP energy of `t` with its best cluster rotations, px².
@@ -613,6 +743,12 @@ impl FastIk {
             )
         };
         let subspace = super::subspace::reduce(meshes, column_count, &clusters, count);
-        Ok(FastIk::new(subspace, extent_px, options))
+        let folds = FoldCheck::new(
+            meshes,
+            column_count,
+            &clusters,
+            options.fold_check_triangles,
+        );
+        Ok(FastIk::new(subspace, extent_px, options).with_fold_check(folds))
     }
 }

@@ -32,6 +32,9 @@ pub struct RigIk {
     inertia_s: Vec<f64>,
     /// The last two results of [`RigIk::step`], oldest first: the momentum handles' motion.
     history: Vec<Vec<Affine>>,
+    /// The time between the two results in `history`, s: their difference over it is the
+    /// momentum handles' velocity.
+    history_step_s: f64,
     /// Skinning rows of the points drags have gripped, by their rest position's bits: finding
     /// the triangle under a point scans every triangle, and a dragged point stays the same
     /// while only its target moves.
@@ -65,6 +68,7 @@ impl RigIk {
             solver,
             inertia_s,
             history: Vec::new(),
+            history_step_s: 0.0,
             gripped: BTreeMap::new(),
         })
     }
@@ -103,6 +107,7 @@ impl RigIk {
         if self.history.len() > 2 {
             self.history.remove(0);
         }
+        self.history_step_s = frame_time_s;
         Ok(solution)
     }
 
@@ -261,7 +266,19 @@ impl RigIk {
                 .first()
                 .filter(|_| self.history.len() == 2)
                 .unwrap_or(now);
-            let keep = 1.0 - options.momentum_damping.clamp(0.0, 1.0);
+            // Velocity per second (the last step over its own duration), carried over this
+            // frame's h and decayed by exp(−rate · h): the motion does not depend on the frame
+            // rate, only the time stepping's accuracy does.
+            let velocity_per_s = if self.history.len() == 2
+                && self.history_step_s > 0.0
+                && self.history_step_s.is_finite()
+            {
+                1.0 / self.history_step_s
+            } else {
+                0.0
+            };
+            let rate = options.momentum_damping_per_s.max(0.0);
+            let carry = h * velocity_per_s * (-rate * h).exp();
             for (j, c) in columns.iter().enumerate() {
                 let tau = self.inertia_s[j];
                 if tau <= 0.0
@@ -273,9 +290,9 @@ impl RigIk {
                     continue;
                 }
                 let predicted = Affine {
-                    linear: now[j].linear + (now[j].linear - before[j].linear) * keep,
+                    linear: now[j].linear + (now[j].linear - before[j].linear) * carry,
                     translation: now[j].translation
-                        + (now[j].translation - before[j].translation) * keep,
+                        + (now[j].translation - before[j].translation) * carry,
                 };
                 inertia.push((j, (tau / h).powi(2), predicted));
             }

@@ -374,9 +374,18 @@ pub fn bone_stretches(
     handles: &Handles,
     pose: &Pose,
 ) -> Result<Vec<Option<BoneStretch>>, PoseError> {
-    let transforms = bone_transforms(handles, pose)?;
+    bone_stretches_under(handles, pose, &bone_transforms(handles, pose)?)
+}
+
+/// [`bone_stretches`] for given skinning `transforms` (bones first, e.g. solved by the skinning
+/// IK): the along-bone scale comes from the pose, everything else from the transforms.
+pub fn bone_stretches_under(
+    handles: &Handles,
+    pose: &Pose,
+    transforms: &[Affine],
+) -> Result<Vec<Option<BoneStretch>>, PoseError> {
     let mut out = Vec::with_capacity(handles.bones.len());
-    for (bone, t) in handles.bones.iter().zip(&transforms) {
+    for (bone, t) in handles.bones.iter().zip(transforms) {
         let scale_along = pose.bones.get(&bone.name).map_or(1.0, |p| p.scale[0]);
         if scale_along == 1.0 || scale_along == 0.0 {
             out.push(None);
