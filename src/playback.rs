@@ -230,7 +230,7 @@ pub fn bake(
     if !handles.ik.is_empty() {
         let constrained: std::collections::BTreeSet<&String> =
             handles.ik.iter().flat_map(|c| &c.bones).collect();
-        let corners = rest_corners(scene);
+        let corners = rest_corners(&scene.doc);
         for ((frame, keyed), solved) in baked.iter_mut().zip(&poses).zip(&transforms) {
             for &bone in &constrained {
                 let input = keyed.bones.get(bone).cloned().unwrap_or_default();
@@ -326,11 +326,12 @@ pub fn bake(
     Ok(out)
 }
 
-/// The corners of the box around every part's rest mesh (canvas px).
-fn rest_corners(scene: &Scene) -> Vec<crate::geom::Point> {
+/// The corners of the box around every part's rest mesh (canvas px); the origin alone for a
+/// document without vertices.
+pub fn rest_corners(doc: &crate::io::RigDocument) -> Vec<crate::geom::Point> {
     use crate::geom::Point;
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for v in scene.doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
+    for v in doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
         lo = [lo[0].min(v[0]), lo[1].min(v[1])];
         hi = [hi[0].max(v[0]), hi[1].max(v[1])];
     }

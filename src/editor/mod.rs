@@ -29,7 +29,7 @@ use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
-use worker::{Poll, Worker};
+use worker::Worker;
 
 /// Seconds between autosaves of a changed document.
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
@@ -397,7 +397,7 @@ impl EditorApp {
 
     fn poll_worker(&mut self) {
         let Some(worker) = &self.worker else { return };
-        if let Poll::Finished(result) = worker.poll() {
+        if let Some(result) = worker.poll() {
             let key = worker.key.clone();
             self.worker = None;
             match result {

@@ -21,12 +21,6 @@ pub struct Worker {
     pub key: RigInputsKey,
 }
 
-/// What polling a worker found.
-pub enum Poll {
-    Running { done: usize, total: usize },
-    Finished(Result<Scene, DocumentError>),
-}
-
 impl Worker {
     /// Starts building; `wake` is called from the worker thread after each part and at the end
     /// (the editor asks egui for a repaint there).
@@ -65,15 +59,13 @@ impl Worker {
         (self.done.load(Ordering::Relaxed), self.total)
     }
 
-    /// Takes the result when the build has finished.
-    pub fn poll(&self) -> Poll {
+    /// Takes the result once the build has finished; `None` while it runs.
+    pub fn poll(&self) -> Option<Result<Scene, DocumentError>> {
         match self.result.try_recv() {
-            Ok(result) => Poll::Finished(result),
-            Err(TryRecvError::Empty) => Poll::Running {
-                done: self.done.load(Ordering::Relaxed),
-                total: self.total,
-            },
-            Err(TryRecvError::Disconnected) => Poll::Finished(Err(DocumentError::Cancelled)),
+            Ok(result) => Some(result),
+            Err(TryRecvError::Empty) => None,
+            // The thread ended without a word: it can only have been torn down.
+            Err(TryRecvError::Disconnected) => Some(Err(DocumentError::Cancelled)),
         }
     }
 }

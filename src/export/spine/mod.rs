@@ -347,7 +347,8 @@ pub fn export_spine(
     // Animations: native timelines, and baked keys for what they cannot express.
     let animations = anim::load_animations(doc)?;
     let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
-    let corners = rig_corners(doc);
+    // Where a handle's transformation is compared when deciding what to bake.
+    let corners = crate::playback::rest_corners(doc);
     let path = |pose: &Pose| scene.handle_transforms(pose);
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
@@ -446,25 +447,6 @@ pub fn export_spine(
         atlas: atlas.text(),
         pages,
     })
-}
-
-/// The corners of the box around every part's rest mesh (canvas px): where a handle's
-/// transformation is compared when deciding what to bake.
-fn rig_corners(doc: &RigDocument) -> Vec<Point> {
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for v in doc.parts.iter().flat_map(|p| &p.mesh.vertices) {
-        lo = [lo[0].min(v[0]), lo[1].min(v[1])];
-        hi = [hi[0].max(v[0]), hi[1].max(v[1])];
-    }
-    if !lo[0].is_finite() {
-        return vec![Point::origin()];
-    }
-    vec![
-        Point::new(lo[0], lo[1]),
-        Point::new(hi[0], lo[1]),
-        Point::new(hi[0], hi[1]),
-        Point::new(lo[0], hi[1]),
-    ]
 }
 
 fn png_bytes(image: &RgbaImage, file: &str) -> Result<Vec<u8>, SpineError> {
