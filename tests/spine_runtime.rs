@@ -422,6 +422,15 @@ fn layer(path: &Path, fill: impl Fn(&mut tiny_skia::PathBuilder), rgb: [u8; 3]) 
     sinew::io::save_png(path, &sinew::render::rgba_from_pixmap(&pixmap)).unwrap();
 }
 
+/// Writes `animations` into the rig file at `rig`; returns its path.
+fn with_animations(rig: PathBuf, animations: serde_json::Value) -> PathBuf {
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = animations;
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    rig
+}
+
 /// A layer shape: the rectangle at (x, y) of size w × h, px.
 fn rect(x: f32, y: f32, w: f32, h: f32) -> impl Fn(&mut tiny_skia::PathBuilder) {
     move |pb: &mut tiny_skia::PathBuilder| {
@@ -503,11 +512,7 @@ fn generated_rig(dir: &Path) -> PathBuf {
         },
         "idle": {"bones": {"spine_b": {"rotate": [{"time": 0.5, "value": 12}]}}}
     });
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
-    doc["animations"] = animations;
-    std::fs::write(&rig, doc.to_string()).unwrap();
-    rig
+    with_animations(rig, animations)
 }
 
 #[test]
@@ -650,11 +655,7 @@ fn ik_rig(dir: &Path) -> PathBuf {
             }
         }
     });
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
-    doc["animations"] = animations;
-    std::fs::write(&rig, doc.to_string()).unwrap();
-    rig
+    with_animations(rig, animations)
 }
 
 #[test]
