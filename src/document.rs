@@ -65,6 +65,8 @@ pub enum DocumentError {
     Animation(#[from] crate::anim::AnimError),
     #[error(transparent)]
     Spine(#[from] crate::export::spine::SpineError),
+    #[error("render: {0}")]
+    Render(String),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
 }
@@ -353,6 +355,22 @@ impl Document {
         Ok(export.write(dir)?)
     }
 
+    /// What [`render_animation`] needs, copied out of the current state (for another thread).
+    pub fn render_job(&self) -> Result<(RigDocument, Vec<image::RgbaImage>), DocumentError> {
+        if self.posable().is_none() {
+            return Err(DocumentError::NoWeights);
+        }
+        let dir = self
+            .path
+            .as_deref()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf)
+            .unwrap_or_else(std::env::temp_dir);
+        let doc = self.to_rig_document(&dir.join("render.sinew.json"))?;
+        let images = self.state.layers.iter().map(|l| l.image.clone()).collect();
+        Ok((doc, images))
+    }
+
     /// Writes the current state to the autosave side file of the document's path (or of
     /// `fallback` for a document never saved); returns where it went.
     pub fn autosave(&self, fallback: &Path) -> Result<PathBuf, DocumentError> {
@@ -361,6 +379,44 @@ impl Document {
         doc.save(&target)?;
         Ok(target)
     }
+}
+
+/// Renders animation `name` of `doc` at `fps` at canvas size to `output`, which is a folder of
+/// numbered PNGs, a `.gif` or a `.png` sprite sheet, as `sinew render` does.
+pub fn render_animation(
+    doc: RigDocument,
+    images: &[image::RgbaImage],
+    name: &str,
+    fps: f64,
+    output: &Path,
+) -> Result<crate::io::sequence::SequenceReport, DocumentError> {
+    use crate::playback::{self, FrameView};
+    let animation = crate::anim::load_animations(&doc)?
+        .remove(name)
+        .ok_or_else(|| {
+            DocumentError::Animation(crate::anim::AnimError::Malformed {
+                animation: name.to_string(),
+                reason: "the document has no animation of that name".into(),
+            })
+        })?;
+    let render_error = |e: String| DocumentError::Render(e);
+    crate::io::sequence::format_for_path(output).map_err(|e| render_error(e.to_string()))?;
+    let view =
+        FrameView::new(doc.canvas, 1.0, None, None).map_err(|e| render_error(e.to_string()))?;
+    let times = playback::frame_times(animation.duration_s(), fps)
+        .map_err(|e| render_error(e.to_string()))?;
+    let scene = Scene::new(doc, images)?;
+    let poses = playback::poses_at_with(&animation, &times, &Default::default());
+    let frames = playback::render_poses(
+        &scene,
+        &poses,
+        &times,
+        crate::skin::Blend::Linear,
+        &view,
+        &|| {},
+    )?;
+    crate::io::sequence::write_sequence(&frames, fps, output, &Default::default())
+        .map_err(|e| render_error(e.to_string()))
 }
 
 /// Makes the last state of `from` current, pushing the current one onto `to`.

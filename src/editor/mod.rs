@@ -150,6 +150,10 @@ pub struct EditorApp {
     shown: Option<Pose>,
     /// Where File → Export writes.
     pub export_dir: String,
+    /// Where File → Render writes.
+    pub render_path: String,
+    /// A render under way on another thread: its message when done.
+    render: Option<std::sync::mpsc::Receiver<String>>,
 }
 
 impl EditorApp {
@@ -192,6 +196,8 @@ impl EditorApp {
             fps: DEFAULT_FPS,
             shown: None,
             export_dir: "export".into(),
+            render_path: "render.gif".into(),
+            render: None,
         }
     }
 
@@ -339,6 +345,54 @@ impl EditorApp {
         }
     }
 
+    /// Renders the current animation to [`EditorApp::render_path`] on another thread; the
+    /// status bar says when it is written.
+    pub fn start_render(&mut self, ctx: &egui::Context) {
+        let job = match self.doc.render_job() {
+            Ok(job) => job,
+            Err(e) => {
+                self.message = Some(e.to_string());
+                return;
+            }
+        };
+        let (send, receive) = std::sync::mpsc::channel();
+        let (name, fps, output) = (
+            self.animation.clone(),
+            self.fps,
+            PathBuf::from(&self.render_path),
+        );
+        let ctx = ctx.clone();
+        std::thread::spawn(move || {
+            let (doc, images) = job;
+            let message = match crate::document::render_animation(doc, &images, &name, fps, &output)
+            {
+                Ok(report) => format!(
+                    "rendered {} frames to {}",
+                    report.frame_count,
+                    output.display()
+                ),
+                Err(e) => e.to_string(),
+            };
+            // The editor may have closed meanwhile.
+            let _ = send.send(message);
+            ctx.request_repaint();
+        });
+        self.message = Some("rendering…".into());
+        self.render = Some(receive);
+    }
+
+    /// Whether a render is running.
+    pub fn rendering(&self) -> bool {
+        self.render.is_some()
+    }
+
+    fn poll_render(&mut self) {
+        if let Some(message) = self.render.as_ref().and_then(|r| r.try_recv().ok()) {
+            self.message = Some(message);
+            self.render = None;
+        }
+    }
+
     fn save(&mut self) {
         let Some(path) = self
             .doc
@@ -357,6 +411,7 @@ impl EditorApp {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
         self.poll_worker();
+        self.poll_render();
         self.warm_ik();
         self.dropped_files(&ctx);
         self.shortcuts(&ctx);
@@ -518,6 +573,15 @@ impl EditorApp {
                 if ui.button("Export Spine").clicked() {
                     let dir = PathBuf::from(&self.export_dir);
                     self.message = Some(self.export_spine(&dir));
+                }
+                ui.label("Render the current animation to (.gif, .png sheet or a folder):");
+                ui.text_edit_singleline(&mut self.render_path);
+                if ui
+                    .add_enabled(self.render.is_none(), egui::Button::new("Render"))
+                    .clicked()
+                {
+                    let ctx = ui.ctx().clone();
+                    self.start_render(&ctx);
                 }
             });
             if ui

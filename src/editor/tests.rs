@@ -317,3 +317,59 @@ fn exports_for_spine_from_the_file_menu_function() {
     assert!(message.contains("compute"), "{message}");
     assert_eq!(std::fs::read_dir(&empty).map(|d| d.count()).unwrap_or(0), 0);
 }
+
+#[test]
+fn renders_the_current_animation_in_the_background() {
+    let path = character_rig("render");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let gif = path.parent().expect("a folder").join("nod.gif");
+    {
+        let app = h.state_mut();
+        for (time_s, degrees) in [(0.0, 0.0), (0.5, 20.0)] {
+            let mut pose = Pose::default();
+            pose.bones.insert(
+                "head".into(),
+                crate::rig::pose::BonePose {
+                    rotate: degrees,
+                    ..Default::default()
+                },
+            );
+            assert!(app.apply(Command::SetKey {
+                animation: "nod".into(),
+                time_s,
+                pose,
+            }));
+        }
+        app.animation = "nod".into();
+        app.fps = 8.0;
+        app.render_path = gif.display().to_string();
+    }
+    h.run();
+    let ctx = h.ctx.clone();
+    h.state_mut().start_render(&ctx);
+    for _ in 0..BUILD_FRAMES {
+        h.step();
+        if !h.state().rendering() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("rendered"), "{message}");
+    let bytes = std::fs::read(&gif).expect("the GIF was written");
+    assert!(bytes.starts_with(b"GIF89a"));
+    // An animation the document does not have: a message, no file.
+    h.state_mut().animation = "nope".into();
+    h.state_mut().render_path = path.with_file_name("nope.gif").display().to_string();
+    h.state_mut().start_render(&ctx);
+    for _ in 0..BUILD_FRAMES {
+        h.step();
+        if !h.state().rendering() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("nope"), "{message}");
+    assert!(!path.with_file_name("nope.gif").exists());
+}
