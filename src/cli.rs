@@ -781,11 +781,7 @@ fn demo(args: &DemoArgs) -> Result<()> {
 /// Loads a rig document and its parts' images.
 fn load_rig_with_images(path: &Path) -> Result<(RigDocument, Vec<image::RgbaImage>)> {
     let doc = RigDocument::load(path)?;
-    let images = doc
-        .parts
-        .iter()
-        .map(|part| io::load_png(&RigDocument::image_path(path, part)))
-        .collect::<Result<Vec<_>, _>>()?;
+    let images = pipeline::load_part_images(path, &doc)?;
     Ok((doc, images))
 }
 

@@ -16,7 +16,7 @@
 //! [`Command::SetRig`], which is refused when the inputs changed in the meantime.
 
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
-use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
+use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, HandleError, Handles, PointHandle, Pose};
 use std::collections::BTreeMap;
@@ -65,8 +65,10 @@ pub enum DocumentError {
     Animation(#[from] crate::anim::AnimError),
     #[error(transparent)]
     Spine(#[from] crate::export::spine::SpineError),
-    #[error("render: {0}")]
-    Render(String),
+    #[error(transparent)]
+    Playback(#[from] crate::playback::PlaybackError),
+    #[error(transparent)]
+    Sequence(#[from] crate::io::sequence::SequenceError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
 }
@@ -212,16 +214,18 @@ impl Document {
     /// opens ready to pose.
     pub fn open(path: &Path) -> Result<Self, DocumentError> {
         let doc = RigDocument::load(path)?;
-        let mut layers = Vec::with_capacity(doc.parts.len());
-        for part in &doc.parts {
-            let image_path = RigDocument::image_path(path, part);
-            let image = io::load_png(&image_path).map_err(PipelineError::from)?;
-            layers.push(Arc::new(Layer {
-                name: part.name.clone(),
-                path: image_path,
-                image,
-            }));
-        }
+        let layers: Vec<Arc<Layer>> = doc
+            .parts
+            .iter()
+            .zip(pipeline::load_part_images(path, &doc)?)
+            .map(|(part, image)| {
+                Arc::new(Layer {
+                    name: part.name.clone(),
+                    path: RigDocument::image_path(path, part),
+                    image,
+                })
+            })
+            .collect();
         let weighted = !doc.handles.is_empty() && doc.parts.iter().all(|p| p.weights.is_some());
         let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
         let state = State {
@@ -399,12 +403,9 @@ pub fn render_animation(
                 reason: "the document has no animation of that name".into(),
             })
         })?;
-    let render_error = |e: String| DocumentError::Render(e);
-    crate::io::sequence::format_for_path(output).map_err(|e| render_error(e.to_string()))?;
-    let view =
-        FrameView::new(doc.canvas, 1.0, None, None).map_err(|e| render_error(e.to_string()))?;
-    let times = playback::frame_times(animation.duration_s(), fps)
-        .map_err(|e| render_error(e.to_string()))?;
+    crate::io::sequence::format_for_path(output)?;
+    let view = FrameView::new(doc.canvas, 1.0, None, None)?;
+    let times = playback::frame_times(animation.duration_s(), fps)?;
     let scene = Scene::new(doc, images)?;
     let poses = playback::poses_at_with(&animation, &times, &Default::default());
     let frames = playback::render_poses(
@@ -416,7 +417,7 @@ pub fn render_animation(
         &|| {},
     )?;
     crate::io::sequence::write_sequence(&frames, fps, output, &Default::default())
-        .map_err(|e| render_error(e.to_string()))
+        .map_err(DocumentError::from)
 }
 
 /// Makes the last state of `from` current, pushing the current one onto `to`.

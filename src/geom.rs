@@ -44,6 +44,22 @@ pub fn point_in_ring(p: Point, ring: &[Point]) -> bool {
     inside
 }
 
+/// Barycentric coordinates of `p` in triangle abc (weights of a, b, c), or `None` for a
+/// degenerate triangle (|det| below [`DEGENERATE_DET`]).
+pub fn barycentric(p: Point, a: Point, b: Point, c: Point) -> Option<[f64; 3]> {
+    let (v0, v1, v2) = (b - a, c - a, p - a);
+    let det = v0.x * v1.y - v0.y * v1.x;
+    if det.abs() < DEGENERATE_DET {
+        return None;
+    }
+    let u = (v2.x * v1.y - v2.y * v1.x) / det;
+    let v = (v0.x * v2.y - v0.y * v2.x) / det;
+    Some([1.0 - u - v, u, v])
+}
+
+/// Twice a triangle's area (px²) below which [`barycentric`] calls it degenerate.
+pub const DEGENERATE_DET: f64 = 1e-12;
+
 /// Twice the signed area of triangle (a, b, c), in px²; positive when a → b → c turns clockwise
 /// on screen (y down).
 pub fn triangle_area2(a: Point, b: Point, c: Point) -> f64 {

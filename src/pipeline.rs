@@ -359,6 +359,15 @@ fn texture_border_px(doc: &RigDocument) -> u32 {
     padding.ceil() as u32 + TEXTURE_BORDER_MARGIN_PX
 }
 
+/// Every part's image of the document saved at `path` (image paths are relative to its folder),
+/// in part order.
+pub fn load_part_images(path: &Path, doc: &RigDocument) -> Result<Vec<RgbaImage>, PipelineError> {
+    doc.parts
+        .iter()
+        .map(|part| Ok(io::load_png(&RigDocument::image_path(path, part))?))
+        .collect()
+}
+
 /// A document with its textures and per-part render state, ready to draw.
 pub struct Scene {
     pub doc: RigDocument,
@@ -371,11 +380,7 @@ impl Scene {
     /// Loads the document at `path` and every part's image.
     pub fn load(path: &Path) -> Result<Self, PipelineError> {
         let doc = RigDocument::load(path)?;
-        let images = doc
-            .parts
-            .iter()
-            .map(|part| io::load_png(&RigDocument::image_path(path, part)))
-            .collect::<Result<Vec<_>, _>>()?;
+        let images = load_part_images(path, &doc)?;
         Scene::new(doc, &images)
     }
 

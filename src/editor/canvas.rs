@@ -212,35 +212,25 @@ pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Ve
 
 /// The handle nearest to `at` (screen points) within [`PICK_RADIUS_PT`], by name.
 pub fn pick(placed: &Placed, handles: &Handles, at: Pos2) -> Option<String> {
-    let mut best: Option<(f32, &str)> = None;
-    for bone in &handles.bones {
-        let (h, t) = (
-            placed.screen_from_canvas(bone.head),
-            placed.screen_from_canvas(bone.tail),
-        );
-        let d = segment_distance(at, h, t);
-        if d <= PICK_RADIUS_PT && best.is_none_or(|(b, _)| d < b) {
-            best = Some((d, &bone.name));
-        }
-    }
-    for point in &handles.points {
-        let d = placed.screen_from_canvas(point.at).distance(at);
-        if d <= PICK_RADIUS_PT && best.is_none_or(|(b, _)| d < b) {
-            best = Some((d, &point.name));
-        }
-    }
-    best.map(|(_, name)| name.to_string())
-}
-
-/// Distance from `p` to the segment a–b, points.
-pub fn segment_distance(p: Pos2, a: Pos2, b: Pos2) -> f32 {
-    let ab = b - a;
-    let t = if ab.length_sq() > 0.0 {
-        ((p - a).dot(ab) / ab.length_sq()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
+    use crate::weights::boundary::segment_distance;
+    // Measured in canvas px, then compared in screen points: the view only scales.
+    let c = placed.canvas_from_screen(at);
+    let c = Point::new(c[0], c[1]);
+    let pt = |p: [f64; 2]| Point::new(p[0], p[1]);
+    let bones = handles
+        .bones
+        .iter()
+        .map(|b| (segment_distance(c, pt(b.head), pt(b.tail)).0, &b.name));
+    let points = handles
+        .points
+        .iter()
+        .map(|p| ((c - pt(p.at)).norm(), &p.name));
+    bones
+        .chain(points)
+        .map(|(d_px, name)| (d_px as f32 * placed.view.zoom, name))
+        .filter(|(d_pt, _)| *d_pt <= PICK_RADIUS_PT)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, name)| name.clone())
 }
 
 #[cfg(test)]

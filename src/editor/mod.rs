@@ -1375,13 +1375,9 @@ pub fn rest_point_under(
     for (part, posed) in scene.doc.parts.iter().zip(positions).rev() {
         for t in &part.mesh.triangles {
             let [a, b, c] = t.map(|i| posed[i as usize]);
-            let area = crate::geom::triangle_area2(a, b, c);
-            if area.abs() < f64::EPSILON {
+            let Some([wa, wb, wc]) = crate::geom::barycentric(p, a, b, c) else {
                 continue;
-            }
-            let wa = crate::geom::triangle_area2(p, b, c) / area;
-            let wb = crate::geom::triangle_area2(a, p, c) / area;
-            let wc = 1.0 - wa - wb;
+            };
             if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
                 let rest = t.map(|i| part.mesh.vertices[i as usize]);
                 return Some([

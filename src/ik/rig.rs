@@ -351,7 +351,7 @@ pub fn grip(
     for (m, mesh) in meshes.iter().enumerate().rev() {
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let [a, b, c] = tri.map(|v| mesh.rest[v as usize]);
-            let Some(bary) = barycentric(p, a, b, c) else {
+            let Some(bary) = crate::geom::barycentric(p, a, b, c) else {
                 continue;
             };
             if bary.iter().all(|&x| x >= -1e-12) {
@@ -373,18 +373,6 @@ pub fn grip(
         }
     }
     nearest.map(|(_, m, t, w)| (m, t, w))
-}
-
-/// Barycentric coordinates of `p` in triangle abc, or `None` for a degenerate triangle.
-fn barycentric(p: Point, a: Point, b: Point, c: Point) -> Option<[f64; 3]> {
-    let (v0, v1, v2) = (b - a, c - a, p - a);
-    let det = v0.x * v1.y - v0.y * v1.x;
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let u = (v2.x * v1.y - v2.y * v1.x) / det;
-    let v = (v0.x * v2.y - v0.y * v2.x) / det;
-    Some([1.0 - u - v, u, v])
 }
 
 /// Applies per-column transforms to a rest point through its skinning row (for checks).
