@@ -422,6 +422,23 @@ fn layer(path: &Path, fill: impl Fn(&mut tiny_skia::PathBuilder), rgb: [u8; 3]) 
     sinew::io::save_png(path, &sinew::render::rgba_from_pixmap(&pixmap)).unwrap();
 }
 
+/// `sinew rig` of the layers `DIR/NAME.png` with `handles`, into `DIR/rig.json`.
+fn rig_of(dir: &Path, layers: &[&str], handles: &serde_json::Value) -> PathBuf {
+    std::fs::write(dir.join("handles.json"), handles.to_string()).unwrap();
+    let rig = dir.join("rig.json");
+    let images: Vec<String> = layers
+        .iter()
+        .map(|n| s(&dir.join(format!("{n}.png"))).to_string())
+        .collect();
+    let mut args: Vec<&str> = vec!["rig"];
+    args.extend(images.iter().map(String::as_str));
+    let handles_path = s(&dir.join("handles.json")).to_string();
+    let rig_path = s(&rig).to_string();
+    args.extend(["--handles", handles_path.as_str(), "-o", rig_path.as_str()]);
+    sinew(&args);
+    rig
+}
+
 /// Writes `animations` into the rig file at `rig`; returns its path.
 fn with_animations(rig: PathBuf, animations: serde_json::Value) -> PathBuf {
     let mut doc: serde_json::Value =
@@ -467,18 +484,7 @@ fn generated_rig(dir: &Path) -> PathBuf {
         "regions": [{"name": "patch", "polygon": [[82, 30], [94, 30], [94, 42], [82, 42]]}],
         "bind": {"blob_b": ["blob"], "arm_b": ["arm", "body"]}
     });
-    std::fs::write(dir.join("handles.json"), handles.to_string()).unwrap();
-    let rig = dir.join("rig.json");
-    sinew(&[
-        "rig",
-        s(&dir.join("body.png")),
-        s(&dir.join("arm.png")),
-        s(&dir.join("blob.png")),
-        "--handles",
-        s(&dir.join("handles.json")),
-        "-o",
-        s(&rig),
-    ]);
+    let rig = rig_of(dir, &["body", "arm", "blob"], &handles);
     let animations = serde_json::json!({
         "move": {
             "bones": {
@@ -623,18 +629,7 @@ fn ik_rig(dir: &Path) -> PathBuf {
             {"name": "tail_ik", "bones": ["t1", "t2", "t3"], "target": "tail_goal"}
         ]
     });
-    std::fs::write(dir.join("handles.json"), handles.to_string()).unwrap();
-    let rig = dir.join("rig.json");
-    sinew(&[
-        "rig",
-        s(&dir.join("arm.png")),
-        s(&dir.join("flag.png")),
-        s(&dir.join("tail.png")),
-        "--handles",
-        s(&dir.join("handles.json")),
-        "-o",
-        s(&rig),
-    ]);
+    let rig = rig_of(dir, &["arm", "flag", "tail"], &handles);
     let animations = serde_json::json!({
         "reach": {
             "bones": {
