@@ -653,10 +653,11 @@ impl EditorApp {
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
-        match self.mode {
+        // Rig mode's tools outgrow a short window: the panel scrolls.
+        egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),
             Mode::Pose | Mode::Animate => self.pose_panel(ui),
-        }
+        });
     }
 
     fn rig_panel(&mut self, ui: &mut egui::Ui) {

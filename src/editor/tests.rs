@@ -521,6 +521,8 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     assert!(distance(moved[0], [160.0, 140.0]) < 0.5, "{moved:?}");
 
     // The traced mesh, rebuilt live when a meshing option changes.
+    h.get_by_label("Show the traced mesh").scroll_to_me();
+    h.run();
     h.get_by_label("Show the traced mesh").click();
     wait_until(&mut h, "the mesh preview", |app| {
         !app.previewing() && app.preview_vertex_count().is_some()
@@ -540,6 +542,8 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
 
     // The automatic rig replaces the handles; undo brings the hand-made ones back.
     let hand_made = h.state().doc.state().handles.clone();
+    h.get_by_label("Propose handles").scroll_to_me();
+    h.run();
     h.get_by_label("Propose handles").click();
     wait_until(&mut h, "the automatic rig", |app| {
         !app.rig_tools.proposing()
