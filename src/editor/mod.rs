@@ -9,9 +9,11 @@
 //! Modes: **Rig** (layers, handles, weights: draw bones and points, select, move, rename,
 //! reparent, delete, compute weights with progress and cancel, see a handle's weights as a heat
 //! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
-//! shift-click pins a point; every drag stays as a pin of the pose).
+//! shift-click pins a point; every drag stays as a pin of the pose). **Colorize** ([`colorize`])
+//! scribbles colors on a line-art PNG and shows the colored result as it is solved.
 
 pub mod canvas;
+pub mod colorize;
 pub mod gizmo;
 pub mod worker;
 
@@ -72,6 +74,7 @@ pub enum Mode {
     Rig,
     Pose,
     Animate,
+    Colorize,
 }
 
 /// What a press on the canvas does in rig mode.
@@ -161,6 +164,8 @@ pub struct EditorApp {
     pub render_settings: crate::playback::RenderSettings,
     /// A render under way on another thread: its message when done.
     render: Option<std::sync::mpsc::Receiver<String>>,
+    /// Colorize mode: line art, scribbles, the background solve.
+    pub colorize: colorize::ColorizeEditor,
 }
 
 impl EditorApp {
@@ -206,6 +211,7 @@ impl EditorApp {
             render_path: "render.gif".into(),
             render_settings: Default::default(),
             render: None,
+            colorize: Default::default(),
         }
     }
 
@@ -421,6 +427,7 @@ impl EditorApp {
         self.poll_worker();
         self.poll_render();
         self.warm_ik();
+        self.colorize_frame_start(&ctx);
         self.dropped_files(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
@@ -593,23 +600,25 @@ impl EditorApp {
                     let ctx = ui.ctx().clone();
                     self.start_render(&ctx);
                 }
+                self.colorize_file_menu(ui);
             });
             if ui
-                .add_enabled(self.doc.can_undo(), egui::Button::new("Undo"))
+                .add_enabled(self.can_undo_in_mode(), egui::Button::new("Undo"))
                 .clicked()
             {
-                self.doc.undo();
+                self.undo_in_mode();
             }
             if ui
-                .add_enabled(self.doc.can_redo(), egui::Button::new("Redo"))
+                .add_enabled(self.can_redo_in_mode(), egui::Button::new("Redo"))
                 .clicked()
             {
-                self.doc.redo();
+                self.redo_in_mode();
             }
             ui.separator();
             ui.selectable_value(&mut self.mode, Mode::Rig, "Rig mode");
             ui.selectable_value(&mut self.mode, Mode::Pose, "Pose mode");
             ui.selectable_value(&mut self.mode, Mode::Animate, "Animate mode");
+            ui.selectable_value(&mut self.mode, Mode::Colorize, "Colorize mode");
             ui.separator();
             if ui.button("Help").clicked() {
                 self.show_help = !self.show_help;
@@ -639,6 +648,7 @@ impl EditorApp {
         match self.mode {
             Mode::Rig => self.rig_panel(ui),
             Mode::Pose | Mode::Animate => self.pose_panel(ui),
+            Mode::Colorize => self.colorize_panel(ui),
         }
     }
 
@@ -867,6 +877,9 @@ impl EditorApp {
     }
 
     fn canvas(&mut self, ui: &mut egui::Ui) {
+        if self.mode == Mode::Colorize {
+            return self.colorize_canvas(ui);
+        }
         let ctx = ui.ctx().clone();
         let textures = self.textures(&ctx);
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
@@ -981,6 +994,7 @@ impl EditorApp {
                     self.pose_gestures(&ctx, &response, placed, &scene)
                 }
             }
+            Mode::Colorize => {}
         }
     }
 
@@ -1580,7 +1594,10 @@ fn help_window(ctx: &egui::Context, open: &mut bool) {
 
 /// The shortcuts the help overlay lists (every one of them works).
 pub const SHORTCUTS: &[(&str, &str)] = &[
-    ("1 / 2 / 3", "rig mode / pose mode / animate mode"),
+    (
+        "1 / 2 / 3 / 4",
+        "rig mode / pose mode / animate mode / colorize mode",
+    ),
     ("Space", "play or pause (animate mode)"),
     ("Ctrl+Z", "undo"),
     ("Ctrl+Shift+Z", "redo"),
@@ -1596,6 +1613,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Middle drag", "pan"),
     ("Esc", "cancel the gesture, close this help"),
     ("F1 or ?", "this help"),
+    (
+        "B / E / V",
+        "colorize mode: brush / eraser / result or scribbles only",
+    ),
 ];
 
 /// What `sinew edit` starts with.
