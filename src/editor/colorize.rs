@@ -717,12 +717,18 @@ fn stroke_shapes(placed: &Placed, stroke: &ScribbleStroke) -> Vec<egui::Shape> {
         .iter()
         .map(|p| placed.screen_from_canvas(*p))
         .collect();
-    let mut shapes: Vec<egui::Shape> = points
-        .iter()
-        .map(|p| egui::Shape::circle_filled(*p, width / 2.0, color))
-        .collect();
-    if points.len() > 1 {
-        shapes.push(egui::Shape::line(points, egui::Stroke::new(width, color)));
+    // A dark rim first: a scribble stays visible over the region it colored.
+    let rim = Color32::from_black_alpha(150);
+    let mut shapes = Vec::new();
+    for (w, c) in [(width + 2.0, rim), (width, color)] {
+        shapes.extend(
+            points
+                .iter()
+                .map(|p| egui::Shape::circle_filled(*p, w / 2.0, c)),
+        );
+        if points.len() > 1 {
+            shapes.push(egui::Shape::line(points.clone(), egui::Stroke::new(w, c)));
+        }
     }
     shapes
 }

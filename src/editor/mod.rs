@@ -283,7 +283,10 @@ impl EditorApp {
     pub fn open(&mut self, path: &Path) {
         match Document::open(path) {
             Ok(doc) => {
+                // Colorize mode's line art and strokes are not part of the rig document.
+                let colorize = std::mem::take(&mut self.colorize);
                 *self = EditorApp::new(doc);
+                self.colorize = colorize;
                 if let Some(view) = load_view(path) {
                     self.restore_view(view);
                 }

@@ -589,5 +589,26 @@ fn colorize_two_scribbles_then_undo_one() {
     let message = h.state_mut().save_colorized(&out);
     assert!(message.starts_with("saved"), "{message}");
     assert_eq!(crate::io::load_png(&out).expect("a PNG"), one.image);
+
+    // The eraser (key E) takes the stroke it is clicked on; undo brings back the stroke and
+    // its result, without solving again.
+    h.key_press(Key::E);
+    h.run();
+    let middle = [
+        (background[0][0] + background[1][0]) / 2.0,
+        background[0][1],
+    ];
+    h.drag_at(screen(&h, middle));
+    h.step();
+    h.drop_at(screen(&h, middle));
+    h.step();
+    h.run();
+    let c = &h.state().colorize;
+    assert_eq!(c.session.as_ref().map(|s| s.strokes().len()), Some(0));
+    assert!(c.shown_result().is_none());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    let result = h.state().colorize.shown_result().cloned().expect("shown");
+    assert!(Arc::ptr_eq(&result, &one));
     let _ = std::fs::remove_dir_all(&dir);
 }
