@@ -9,9 +9,11 @@
 //! Modes: **Rig** (layers, handles, weights: draw bones and points, select, move, rename,
 //! reparent, delete, compute weights with progress and cancel, see a handle's weights as a heat
 //! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
-//! shift-click pins a point; every drag stays as a pin of the pose).
+//! shift-click pins a point; every drag stays as a pin of the pose). Rig mode's Paint tool,
+//! the handle locks and the per-vertex weights readout live in [`paint`].
 
 pub mod canvas;
+pub mod paint;
 pub mod worker;
 
 #[cfg(test)]
@@ -82,6 +84,8 @@ pub enum Tool {
     Bone,
     /// Click to place a point handle.
     Point,
+    /// Paint the selected handle's weights (see [`paint`]).
+    Paint,
 }
 
 /// A pointer gesture in progress.
@@ -102,6 +106,7 @@ enum Gesture {
         pose: Pose,
     },
     Pan,
+    Paint(paint::PaintStroke),
 }
 
 /// Posed vertex positions of a built rig, for one pose.
@@ -154,6 +159,8 @@ pub struct EditorApp {
     pub render_path: String,
     /// A render under way on another thread: its message when done.
     render: Option<std::sync::mpsc::Receiver<String>>,
+    /// Rig mode's brush settings.
+    pub paint: paint::PaintSettings,
 }
 
 impl EditorApp {
@@ -198,6 +205,7 @@ impl EditorApp {
             export_dir: "export".into(),
             render_path: "render.gif".into(),
             render: None,
+            paint: paint::PaintSettings::default(),
         }
     }
 
@@ -638,7 +646,11 @@ impl EditorApp {
             ui.selectable_value(&mut self.tool, Tool::Select, "Select");
             ui.selectable_value(&mut self.tool, Tool::Bone, "Bone");
             ui.selectable_value(&mut self.tool, Tool::Point, "Point");
+            ui.selectable_value(&mut self.tool, Tool::Paint, "Paint");
         });
+        if self.tool == Tool::Paint {
+            self.paint_panel(ui);
+        }
         ui.separator();
         ui.heading("Handles");
         let names: Vec<String> = self.doc.state().handles.names().map(String::from).collect();
@@ -647,10 +659,13 @@ impl EditorApp {
             .show(ui, |ui| {
                 for name in names {
                     let selected = self.selected.as_deref() == Some(name.as_str());
-                    if ui.selectable_label(selected, &name).clicked() {
-                        self.rename_to = name.clone();
-                        self.selected = Some(name);
-                    }
+                    ui.horizontal(|ui| {
+                        self.lock_box(ui, &name);
+                        if ui.selectable_label(selected, &name).clicked() {
+                            self.rename_to = name.clone();
+                            self.selected = Some(name);
+                        }
+                    });
                 }
             });
         if let Some(name) = self.selected.clone() {
@@ -751,6 +766,7 @@ impl EditorApp {
                 }
             }
         }
+        self.vertex_weights_panel(ui);
     }
 
     fn pose_panel(&mut self, ui: &mut egui::Ui) {
@@ -917,7 +933,7 @@ impl EditorApp {
                     shapes.push(canvas::image_quad(&placed, texture, canvas_px));
                 }
                 if let (Some(scene), Some(name)) = (&self.doc.state().rig, &self.selected) {
-                    for part in &scene.doc.parts {
+                    for (k, part) in scene.doc.parts.iter().enumerate() {
                         let rest: Vec<Point> = part
                             .mesh
                             .vertices
@@ -926,13 +942,23 @@ impl EditorApp {
                             .collect();
                         shapes.extend(canvas::wireframe(&placed, &rest, &part.mesh.triangles));
                         if let (Some(weights), true) = (&part.weights, posable.is_some()) {
-                            shapes.extend(canvas::heat_map(
-                                &placed,
-                                weights,
-                                name,
-                                &rest,
-                                &part.mesh.triangles,
-                            ));
+                            shapes.extend(match self.shown_rows(k) {
+                                Some(rows) => paint::heat_map_rows(
+                                    &placed,
+                                    weights,
+                                    rows,
+                                    name,
+                                    &rest,
+                                    &part.mesh.triangles,
+                                ),
+                                None => canvas::heat_map(
+                                    &placed,
+                                    weights,
+                                    name,
+                                    &rest,
+                                    &part.mesh.triangles,
+                                ),
+                            });
                         }
                     }
                 }
@@ -952,6 +978,10 @@ impl EditorApp {
             _ => {}
         }
         shapes.extend(canvas::handles(&placed, &handles, self.selected.as_deref()));
+        self.track_hover(&response, &placed);
+        if self.mode == Mode::Rig && self.tool == Tool::Paint {
+            shapes.extend(self.brush_shape(&placed));
+        }
         painter.extend(shapes);
         match self.mode {
             Mode::Rig => self.rig_gestures(&ctx, &response, placed),
@@ -989,6 +1019,10 @@ impl EditorApp {
     }
 
     fn rig_gestures(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
+        if self.tool == Tool::Paint {
+            self.paint_gestures(ctx, response, placed);
+            return;
+        }
         let pointer = response.interact_pointer_pos();
         if response.drag_started_by(egui::PointerButton::Primary) {
             // Where the button went down, not where the drag was recognized.
@@ -1020,7 +1054,7 @@ impl EditorApp {
                         }
                         None => Some(Gesture::Pan),
                     },
-                    Tool::Point => None,
+                    Tool::Point | Tool::Paint => None,
                 };
             }
         }
