@@ -418,10 +418,28 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     h.state_mut().paint.options.radius_px = 24.0;
     h.state_mut().paint.options.strength = 0.5;
 
-    // One stroke across the hip–chest joint.
-    drag(&mut h, [240.0, 262.0], [272.0, 262.0]);
+    // One stroke across the hip–chest joint. While it runs, the canvas shows a preview; the
+    // document changes once, at release, to exactly that preview.
+    let (from, to) = ([240.0, 262.0], [272.0, 262.0]);
+    h.drag_at(screen(&h, from));
+    h.step();
+    for k in 1..=4 {
+        let t = k as f64 / 4.0;
+        h.hover_at(screen(&h, [from[0] + t * (to[0] - from[0]), from[1]]));
+        h.step();
+    }
+    let preview = h.state().shown_rows(index).expect("a preview").to_vec();
+    assert_eq!(
+        torso(h.state()).0.doc.parts[index].weights.as_ref(),
+        Some(&before),
+        "the document waits for the release"
+    );
+    h.drop_at(screen(&h, to));
+    h.step();
+    h.run();
     let (scene, index) = torso(h.state());
     let after = scene.doc.parts[index].weights.clone().expect("weights");
+    assert_eq!(after.rows, preview);
     let (chest0, chest1) = (column(&before, "chest"), column(&after, "chest"));
     let v = &scene.doc.parts[index].mesh.vertices;
     let raised = (0..v.len())
@@ -433,7 +451,9 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
         "chest rose by {raised}: {:?}",
         h.state().message
     );
-    for (a, b) in column(&before, "head").iter().zip(column(&after, "head")) {
+    let head = column(&before, "head");
+    assert!(head.iter().any(|&w| w > 0.01), "the head weighs the torso");
+    for (a, b) in head.iter().zip(column(&after, "head")) {
         assert_eq!(a.to_bits(), b.to_bits(), "the locked head column changed");
     }
     for row in &after.rows {
