@@ -52,7 +52,8 @@ impl Falloff {
     /// The factor in [0, 1] at distance `d_px` from the centre of a brush of radius `r_px`
     /// (zero outside).
     pub fn factor(self, d_px: f64, r_px: f64) -> f64 {
-        if !(d_px < r_px) {
+        // NaN distances paint nothing.
+        if d_px.is_nan() || d_px >= r_px {
             return 0.0;
         }
         let x = d_px / r_px;
@@ -400,7 +401,7 @@ pub fn set_weight(
             .filter(|&k| free(k))
             .map(|k| spread.get(k).copied().unwrap_or(0.0).max(0.0))
             .sum();
-        if !(spread_sum > 0.0) {
+        if spread_sum.is_nan() || spread_sum <= 0.0 {
             return false;
         }
         for k in (0..columns).filter(|&k| free(k)) {
