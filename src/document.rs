@@ -576,6 +576,16 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             rename_in_pose(&mut next.pose, &from, &to);
             if next.locked.remove(&from) {
                 next.locked.insert(to);
+                // The previous weights follow, so a recompute still finds the locked column.
+                let columns = crate::rig::handle_columns(&state.handles)
+                    .into_iter()
+                    .zip(crate::rig::handle_columns(&next.handles))
+                    .filter(|(a, b)| a != b)
+                    .collect();
+                next.rig = state
+                    .rig
+                    .as_ref()
+                    .map(|scene| Arc::new(scene.with_columns_renamed(&columns)));
             }
         }
         Command::Reparent { bone, parent } => {

@@ -456,6 +456,29 @@ impl Scene {
         })
     }
 
+    /// This scene with the weight columns named in `renamed` (old name → new name) renamed in
+    /// every part, textures shared: after a handle is renamed, the weights computed before
+    /// still name its column, so a recompute can keep them if it is locked. Only the weights'
+    /// column names change (not `doc.handles`): such a scene is stale until recomputed.
+    pub fn with_columns_renamed(
+        &self,
+        renamed: &std::collections::HashMap<String, String>,
+    ) -> Scene {
+        let mut doc = self.doc.clone();
+        for weights in doc.parts.iter_mut().filter_map(|p| p.weights.as_mut()) {
+            for name in &mut weights.handles {
+                if let Some(to) = renamed.get(name) {
+                    name.clone_from(to);
+                }
+            }
+        }
+        Scene {
+            doc,
+            parts: self.parts.clone(),
+            ik: std::sync::OnceLock::new(),
+        }
+    }
+
     /// Every part's rest vertex positions.
     pub fn rest_positions(&self) -> Vec<Vec<Point>> {
         self.doc

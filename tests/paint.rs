@@ -337,6 +337,21 @@ fn locks_are_saved_and_reopened() {
     doc.save(&path).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(!text.contains("\"locked\""), "no locks, no field");
+    // Paint b where c rules, lock it, rename it: the recompute keeps its weights.
+    doc.apply(Command::PaintWeights {
+        part: "bar".into(),
+        handle: "b".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[250.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 20.0,
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            spacing: 0.25,
+        },
+    })
+    .unwrap();
+    let painted = column(&rows(&doc), 1);
     doc.apply(Command::SetLocked {
         handle: "b".into(),
         locked: true,
@@ -348,6 +363,25 @@ fn locks_are_saved_and_reopened() {
     })
     .unwrap();
     compute(&mut doc);
+    let kept = rows(&doc);
+    let scene = doc.posable().unwrap();
+    assert_eq!(
+        scene.doc.parts[0].weights.as_ref().unwrap().handles,
+        vec!["a", "mid", "c"]
+    );
+    check_rows(&kept);
+    let v = vertices(&doc);
+    let near = (0..v.len())
+        .filter(|&i| (v[i][0] - 250.0).hypot(v[i][1] - 40.0) < 18.0)
+        .collect::<Vec<_>>();
+    assert!(!near.is_empty());
+    for i in near {
+        assert!(
+            painted[i] == 1.0 && column(&kept, 1)[i] == 1.0,
+            "mid at {:?}",
+            v[i]
+        );
+    }
     doc.save(&path).unwrap();
     let reopened = Document::open(&path).unwrap();
     assert_eq!(
