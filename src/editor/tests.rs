@@ -469,4 +469,20 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     let (scene, index) = torso(h.state());
     assert_eq!(scene.doc.parts[index].weights.as_ref(), Some(&before));
     assert!(h.state().doc.state().locked.contains("head"));
+
+    // Redo the stroke, lock the chest too and recompute: the painted chest stays.
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    h.get_by_label("lock chest").click();
+    h.run();
+    h.get_by_label("Compute weights").click();
+    wait_for_weights(&mut h);
+    let (scene, index) = torso(h.state());
+    let recomputed = scene.doc.parts[index].weights.clone().expect("weights");
+    assert_eq!(h.state().message.as_deref(), Some("weights computed"));
+    assert_eq!(column(&recomputed, "chest"), chest1);
+    for row in &recomputed.rows {
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
+    }
 }
