@@ -14,12 +14,17 @@
 //! (its meshes are still shown) but cannot be posed until the weights are computed again. The
 //! editor computes them off the UI thread with [`compute_rig`] and hands the result back as
 //! [`Command::SetRig`], which is refused when the inputs changed in the meantime.
+//!
+//! Weights can be painted ([`Command::PaintWeights`], one stroke per command) and handles
+//! locked ([`Command::SetLocked`]): painting leaves locked handles' weights alone, and
+//! [`compute_rig`] keeps them from the previous rig while it recomputes the others.
 
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
 use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle, Pose, Region};
-use std::collections::BTreeMap;
+use crate::weights::{BrushMode, BrushOptions, PaintMesh};
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -81,6 +86,10 @@ pub enum DocumentError {
     },
     #[error(transparent)]
     Autorig(#[from] crate::autorig::AutorigError),
+    #[error("handle '{0}' is locked: unlock it to paint its weights")]
+    LockedHandle(String),
+    #[error("painting weights: {0}")]
+    Paint(#[from] crate::weights::PaintError),
 }
 
 /// Everything an edit can change; one undo step restores one of these.
@@ -98,6 +107,8 @@ pub struct State {
     pub rig_current: bool,
     /// The pose shown and edited in pose mode.
     pub pose: Pose,
+    /// Handles whose weights painting and recomputing keep (see [`Command::SetLocked`]).
+    pub locked: BTreeSet<String>,
 }
 
 /// The inputs a rig is built from, copied out for a background build.
@@ -106,6 +117,10 @@ pub struct RigInputs {
     pub layers: Vec<Arc<Layer>>,
     pub handles: Handles,
     pub options: BuildOptions,
+    /// Handles whose weights the build keeps from `previous`.
+    pub locked: BTreeSet<String>,
+    /// The rig built before (current or stale): where locked weights come from.
+    pub previous: Option<Arc<Scene>>,
 }
 
 /// One edit of the document.
@@ -172,6 +187,22 @@ pub enum Command {
         name: String,
         polygon: Vec<[f64; 2]>,
     },
+    /// Paints one brush stroke (press to release) on `handle`'s weights over `part` (see
+    /// [`crate::weights::paint`]): one undo step. Needs current weights; locked handles keep
+    /// theirs, and a locked `handle` is refused.
+    PaintWeights {
+        part: String,
+        handle: String,
+        mode: BrushMode,
+        /// The pointer's path, canvas px.
+        samples_px: Vec<[f64; 2]>,
+        options: BrushOptions,
+    },
+    /// Locks or unlocks a handle's weights. The built rig stays current.
+    SetLocked {
+        handle: String,
+        locked: bool,
+    },
 }
 
 /// Keys closer in time than this (s) are the same key.
@@ -183,6 +214,7 @@ pub struct RigInputsKey {
     layer_names: Vec<String>,
     handles: Handles,
     options: BuildOptions,
+    locked: BTreeSet<String>,
 }
 
 impl RigInputs {
@@ -191,6 +223,7 @@ impl RigInputs {
             layer_names: self.layers.iter().map(|l| l.name.clone()).collect(),
             handles: self.handles.clone(),
             options: self.options.clone(),
+            locked: self.locked.clone(),
         }
     }
 }
@@ -224,6 +257,7 @@ impl Document {
                 rig: None,
                 rig_current: true,
                 pose: Pose::default(),
+                locked: BTreeSet::new(),
             },
             path: None,
             undo: Vec::new(),
@@ -256,6 +290,7 @@ impl Document {
             options: doc.options.clone(),
             animations: doc.animations.clone(),
             rig_current: weighted,
+            locked: doc.locked.iter().cloned().collect(),
             rig: Some(Arc::new(Scene::new(doc, &images)?)),
             pose: Pose::default(),
         };
@@ -282,11 +317,7 @@ impl Document {
 
     /// The inputs to build the rig from, for [`compute_rig`] on another thread.
     pub fn rig_inputs(&self) -> RigInputs {
-        RigInputs {
-            layers: self.state.layers.clone(),
-            handles: self.state.handles.clone(),
-            options: self.state.options.clone(),
-        }
+        rig_inputs_of(&self.state)
     }
 
     pub fn can_undo(&self) -> bool {
@@ -351,6 +382,7 @@ impl Document {
         doc.handles = state.handles.clone();
         doc.options = state.options.clone();
         doc.animations = state.animations.clone();
+        doc.locked = state.locked.iter().cloned().collect();
         Ok(doc)
     }
 
@@ -481,7 +513,8 @@ fn same_layers(doc: &RigDocument, layers: &[Arc<Layer>]) -> bool {
 /// Builds the rig (trace, mesh, weights) for `inputs`. Meant for a background thread:
 /// `progress(parts_done, parts_total)` reports each part, and setting `cancel` stops the build
 /// before the next part with [`DocumentError::Cancelled`]. `dir` is the folder image paths are
-/// stored relative to.
+/// stored relative to. Locked handles keep their weights from `inputs.previous`
+/// ([`pipeline::keep_locked_weights`]); painted weights of the others are recomputed.
 pub fn compute_rig(
     inputs: &RigInputs,
     dir: &Path,
@@ -499,10 +532,13 @@ pub fn compute_rig(
         &mut report,
         cancel,
     );
-    let (doc, _) = match built {
+    let (mut doc, _) = match built {
         Err(PipelineError::Cancelled) => return Err(DocumentError::Cancelled),
         other => other?,
     };
+    if let Some(previous) = &inputs.previous {
+        pipeline::keep_locked_weights(&mut doc, &previous.doc, &inputs.locked)?;
+    }
     let images: Vec<_> = layers.into_iter().map(|l| l.image).collect();
     Ok(Scene::new(doc, &images)?)
 }
@@ -567,6 +603,19 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             }
             next.handles.rename(&from, &to);
             rename_in_pose(&mut next.pose, &from, &to);
+            if next.locked.remove(&from) {
+                next.locked.insert(to);
+                // The previous weights follow, so a recompute still finds the locked column.
+                let columns = crate::rig::handle_columns(&state.handles)
+                    .into_iter()
+                    .zip(crate::rig::handle_columns(&next.handles))
+                    .filter(|(a, b)| a != b)
+                    .collect();
+                next.rig = state
+                    .rig
+                    .as_ref()
+                    .map(|scene| Arc::new(scene.with_columns_renamed(&columns)));
+            }
         }
         Command::Reparent { bone, parent } => {
             let b = next
@@ -582,20 +631,14 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
                 return Err(DocumentError::UnknownHandle(name));
             }
             next.handles.delete(&name);
+            next.locked.remove(&name);
             next.pose.bones.remove(&name);
             next.pose.points.remove(&name);
             next.pose.cages.remove(&name);
         }
         Command::SetOptions(options) => next.options = options,
         Command::SetRig(scene, key) => {
-            if key
-                != (RigInputs {
-                    layers: state.layers.clone(),
-                    handles: state.handles.clone(),
-                    options: state.options.clone(),
-                })
-                .key()
-            {
+            if key != rig_inputs_of(state).key() {
                 return Err(DocumentError::OutdatedRig);
             }
             next.rig = Some(scene);
@@ -632,10 +675,11 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::SetHandles(handles) => {
             next.handles = handles;
-            let names: std::collections::BTreeSet<&str> = next.handles.names().collect();
+            let names: BTreeSet<&str> = next.handles.names().collect();
             next.pose.bones.retain(|n, _| names.contains(n.as_str()));
             next.pose.points.retain(|n, _| names.contains(n.as_str()));
             next.pose.cages.retain(|n, _| names.contains(n.as_str()));
+            next.locked.retain(|n| names.contains(n.as_str()));
         }
         Command::AddCage(cage) => next.handles.cages.push(cage),
         Command::AddRegion(region) => next.handles.regions.push(region),
@@ -664,12 +708,106 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             *target = polygon;
             // A posed cage keeps its pose; the rest polygon moved under it.
         }
+        Command::PaintWeights {
+            part,
+            handle,
+            mode,
+            samples_px,
+            options,
+        } => {
+            next.rig = Some(Arc::new(paint_weights(
+                state,
+                &part,
+                &handle,
+                mode,
+                &samples_px,
+                &options,
+            )?));
+            inputs_changed = false;
+        }
+        Command::SetLocked { handle, locked } => {
+            if !state.handles.names().any(|n| n == handle) {
+                return Err(DocumentError::UnknownHandle(handle));
+            }
+            if locked {
+                next.locked.insert(handle);
+            } else {
+                next.locked.remove(&handle);
+            }
+            inputs_changed = false;
+        }
     }
     if inputs_changed {
         next.handles.validate()?;
         next.rig_current = false;
     }
     Ok(next)
+}
+
+fn rig_inputs_of(state: &State) -> RigInputs {
+    RigInputs {
+        layers: state.layers.clone(),
+        handles: state.handles.clone(),
+        options: state.options.clone(),
+        locked: state.locked.clone(),
+        previous: state.rig.clone(),
+    }
+}
+
+/// The weight columns of `part` in the current rig with their locked flags, and the rig.
+pub fn part_weights_for_painting<'a>(
+    state: &'a State,
+    part: &str,
+) -> Result<(&'a Arc<Scene>, usize, Vec<bool>), DocumentError> {
+    let scene = state
+        .rig
+        .as_ref()
+        .filter(|_| state.rig_current && !state.handles.is_empty())
+        .ok_or(DocumentError::NoWeights)?;
+    let index = scene
+        .doc
+        .parts
+        .iter()
+        .position(|p| p.name == part)
+        .ok_or_else(|| DocumentError::UnknownLayer(part.to_string()))?;
+    let weights = scene.doc.parts[index]
+        .weights
+        .as_ref()
+        .ok_or(DocumentError::NoWeights)?;
+    let locked = pipeline::locked_columns(&state.handles, &state.locked, &weights.handles);
+    Ok((scene, index, locked))
+}
+
+/// The rig after one stroke of [`Command::PaintWeights`].
+fn paint_weights(
+    state: &State,
+    part: &str,
+    handle: &str,
+    mode: BrushMode,
+    samples_px: &[[f64; 2]],
+    options: &BrushOptions,
+) -> Result<Scene, DocumentError> {
+    let (scene, index, locked) = part_weights_for_painting(state, part)?;
+    let part_doc = &scene.doc.parts[index];
+    let Some(weights) = &part_doc.weights else {
+        return Err(DocumentError::NoWeights);
+    };
+    let column = weights
+        .handles
+        .iter()
+        .position(|h| h == handle)
+        .ok_or_else(|| DocumentError::UnknownHandle(handle.to_string()))?;
+    if locked[column] {
+        return Err(DocumentError::LockedHandle(handle.to_string()));
+    }
+    let mesh = PaintMesh::new(&part_doc.mesh.vertices, &part_doc.mesh.triangles)?;
+    let mut rows = weights.rows.clone();
+    crate::weights::paint_stroke(&mesh, &mut rows, &locked, column, mode, samples_px, options)?;
+    let painted = crate::io::WeightsDoc {
+        handles: weights.handles.clone(),
+        rows,
+    };
+    Ok(scene.with_part_weights(index, painted)?)
 }
 
 fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {

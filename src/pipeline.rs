@@ -5,6 +5,7 @@
 //!   with the handles' geometry embedded, weights, per part).
 //! - [`Scene`]: a loaded document with its textures: poses it (forward kinematics + skinning)
 //!   and draws any vertex positions.
+//! - [`keep_locked_weights`]: a rebuilt document keeps the locked handles' previous weights.
 
 use crate::geom::Point;
 use crate::ik::{RigIk, SkinnedMesh};
@@ -17,7 +18,7 @@ use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
 use crate::weights::{self, WeightError};
 use image::RgbaImage;
-use std::collections::HashSet;
+use std::collections::{BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
 
 /// One input image: a part of the rig.
@@ -88,6 +89,13 @@ pub enum PipelineError {
     UnknownWeightHandle { part: String, handle: String },
     #[error("canvas {0:?} px is too large to draw")]
     Canvas([u32; 2]),
+    #[error("part '{part}': keeping locked weights: {source}")]
+    Locked {
+        part: String,
+        source: weights::LockError,
+    },
+    #[error("there is no part {0}")]
+    UnknownPart(usize),
 }
 
 /// What building one part found, for the report a person reads.
@@ -371,7 +379,8 @@ pub fn load_part_images(path: &Path, doc: &RigDocument) -> Result<Vec<RgbaImage>
 /// A document with its textures and per-part render state, ready to draw.
 pub struct Scene {
     pub doc: RigDocument,
-    parts: Vec<RenderPart>,
+    /// Shared by the scenes that differ only in weights ([`Scene::with_part_weights`]).
+    parts: std::sync::Arc<Vec<RenderPart>>,
     /// The skinning-IK precomputation, made the first time a pose has drags.
     ik: std::sync::OnceLock<Result<RigIk, crate::ik::IkError>>,
 }
@@ -416,9 +425,58 @@ impl Scene {
         }
         Ok(Scene {
             doc,
-            parts,
+            parts: std::sync::Arc::new(parts),
             ik: std::sync::OnceLock::new(),
         })
+    }
+
+    /// This scene with part `part`'s weights replaced (meshes, handles and textures kept and
+    /// shared, so painting weights does not copy pixels); the skinning-IK precomputation
+    /// starts afresh. The weights must fit the part's mesh and the handles.
+    pub fn with_part_weights(
+        &self,
+        part: usize,
+        weights: WeightsDoc,
+    ) -> Result<Scene, PipelineError> {
+        let mut doc = self.doc.clone();
+        doc.parts
+            .get_mut(part)
+            .ok_or(PipelineError::UnknownPart(part))?
+            .weights = Some(weights);
+        doc.validate().map_err(|reason| {
+            PipelineError::Document(io::DocumentError::Invalid {
+                path: PathBuf::from(&doc.parts[part].name),
+                reason,
+            })
+        })?;
+        Ok(Scene {
+            doc,
+            parts: self.parts.clone(),
+            ik: std::sync::OnceLock::new(),
+        })
+    }
+
+    /// This scene with the weight columns named in `renamed` (old name → new name) renamed in
+    /// every part, textures shared: after a handle is renamed, the weights computed before
+    /// still name its column, so a recompute can keep them if it is locked. Only the weights'
+    /// column names change (not `doc.handles`): such a scene is stale until recomputed.
+    pub fn with_columns_renamed(
+        &self,
+        renamed: &std::collections::HashMap<String, String>,
+    ) -> Scene {
+        let mut doc = self.doc.clone();
+        for weights in doc.parts.iter_mut().filter_map(|p| p.weights.as_mut()) {
+            for name in &mut weights.handles {
+                if let Some(to) = renamed.get(name) {
+                    name.clone_from(to);
+                }
+            }
+        }
+        Scene {
+            doc,
+            parts: self.parts.clone(),
+            ik: std::sync::OnceLock::new(),
+        }
     }
 
     /// Every part's rest vertex positions.
@@ -665,6 +723,132 @@ impl Scene {
             PipelineError::Render { part, source }
         })
     }
+}
+
+/// For each weight column named in `columns`, whether its handle is in `locked` (a cage's
+/// columns `CAGE.k` follow the cage). Columns no handle has are not locked.
+pub fn locked_columns(
+    handles: &Handles,
+    locked: &BTreeSet<String>,
+    columns: &[String],
+) -> Vec<bool> {
+    let owners = column_owners(handles);
+    columns
+        .iter()
+        .map(|c| {
+            owners
+                .iter()
+                .find(|(column, _)| column == c)
+                .is_some_and(|(_, owner)| locked.contains(owner))
+        })
+        .collect()
+}
+
+/// Every weight column of `handles` (in [`handle_columns`] order) with the handle it belongs to.
+fn column_owners(handles: &Handles) -> Vec<(String, String)> {
+    let owners = handles
+        .bones
+        .iter()
+        .map(|b| &b.name)
+        .chain(handles.points.iter().map(|p| &p.name))
+        .chain(
+            handles
+                .cages
+                .iter()
+                .flat_map(|c| std::iter::repeat_n(&c.name, c.polygon.len())),
+        )
+        .chain(handles.regions.iter().map(|r| &r.name));
+    handle_columns(handles)
+        .into_iter()
+        .zip(owners.cloned())
+        .collect()
+}
+
+/// Gives the freshly built `fresh` the weights of the `locked` handles that `previous` had,
+/// part by part (matched by name): per vertex, locked columns keep their previous values and
+/// the fresh unlocked columns are rescaled to fill the rest (see [`weights::keep_locked`]).
+/// A part whose mesh changed (a re-trace) gets the previous rows carried over by locating its
+/// vertices in the previous mesh ([`weights::transfer_rows`]). A locked handle the previous
+/// part had no weights for, or that may no longer weigh the part (`bind`), is recomputed.
+pub fn keep_locked_weights(
+    fresh: &mut RigDocument,
+    previous: &RigDocument,
+    locked: &BTreeSet<String>,
+) -> Result<(), PipelineError> {
+    if locked.is_empty() {
+        return Ok(());
+    }
+    let owners = column_owners(&fresh.handles);
+    for part in &mut fresh.parts {
+        let Some(weights) = part.weights.as_mut() else {
+            continue;
+        };
+        let Some((old, old_weights)) = previous
+            .parts
+            .iter()
+            .find(|p| p.name == part.name)
+            .and_then(|p| Some((p, p.weights.as_ref()?)))
+        else {
+            continue;
+        };
+        // The previous columns' places among the fresh ones.
+        let place: Vec<Option<u32>> = old_weights
+            .handles
+            .iter()
+            .map(|h| {
+                weights
+                    .handles
+                    .iter()
+                    .position(|c| c == h)
+                    .map(|i| i as u32)
+            })
+            .collect();
+        let mask: Vec<bool> = weights
+            .handles
+            .iter()
+            .map(|c| {
+                owners
+                    .iter()
+                    .find(|(column, _)| column == c)
+                    .is_some_and(|(_, owner)| {
+                        locked.contains(owner) && fresh.handles.binds(owner, &part.name)
+                    })
+                    && old_weights.handles.contains(c)
+            })
+            .collect();
+        if !mask.iter().any(|&m| m) {
+            continue;
+        }
+        let mapped: Vec<Vec<(u32, f64)>> = old_weights
+            .rows
+            .iter()
+            .map(|row| {
+                let mut r: Vec<(u32, f64)> = row
+                    .iter()
+                    .filter_map(|&(c, w)| Some((place.get(c as usize).copied().flatten()?, w)))
+                    .collect();
+                r.sort_by_key(|e| e.0);
+                r
+            })
+            .collect();
+        let error = |source| PipelineError::Locked {
+            part: part.name.clone(),
+            source,
+        };
+        let before = if old.mesh == part.mesh {
+            mapped
+        } else {
+            weights::transfer_rows(
+                &old.mesh.vertices,
+                &old.mesh.triangles,
+                &mapped,
+                &part.mesh.vertices,
+            )
+            .map_err(error)?
+        };
+        weights::keep_locked(&mut weights.rows, &before, &mask).map_err(error)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -10,11 +10,13 @@
 //! reparent, delete, compute weights with progress and cancel, see a handle's weights as a heat
 //! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
 //! shift-click pins a point; every drag stays as a pin of the pose). **Colorize** ([`colorize`])
-//! scribbles colors on a line-art PNG and shows the colored result as it is solved.
+//! scribbles colors on a line-art PNG and shows the colored result as it is solved. Rig mode's
+//! Paint tool, the handle locks and the per-vertex weights readout live in [`paint`].
 
 pub mod canvas;
 pub mod colorize;
 pub mod gizmo;
+pub mod paint;
 pub mod rig_tools;
 pub mod worker;
 
@@ -91,6 +93,8 @@ pub enum Tool {
     Cage,
     /// Click vertices of a region (its inside moves rigidly); close as a cage.
     Region,
+    /// Paint the selected handle's weights (see [`paint`]).
+    Paint,
 }
 
 /// A pointer gesture in progress.
@@ -118,6 +122,7 @@ enum Gesture {
         points: Vec<[f64; 2]>,
     },
     Pan,
+    Paint(paint::PaintStroke),
 }
 
 /// Posed vertex positions of a built rig, for one pose.
@@ -178,6 +183,8 @@ pub struct EditorApp {
     pub rig_tools: rig_tools::RigTools,
     /// Colorize mode: line art, scribbles, the background solve.
     pub colorize: colorize::ColorizeEditor,
+    /// Rig mode's brush settings.
+    pub paint: paint::PaintSettings,
 }
 
 impl EditorApp {
@@ -225,6 +232,7 @@ impl EditorApp {
             rig_tools: Default::default(),
             render: None,
             colorize: Default::default(),
+            paint: paint::PaintSettings::default(),
         }
     }
 
@@ -681,7 +689,11 @@ impl EditorApp {
             ui.selectable_value(&mut self.tool, Tool::Point, "Point");
             ui.selectable_value(&mut self.tool, Tool::Cage, "Cage");
             ui.selectable_value(&mut self.tool, Tool::Region, "Region");
+            ui.selectable_value(&mut self.tool, Tool::Paint, "Paint");
         });
+        if self.tool == Tool::Paint {
+            self.paint_panel(ui);
+        }
         ui.separator();
         ui.heading("Handles");
         let names: Vec<String> = self.doc.state().handles.names().map(String::from).collect();
@@ -690,10 +702,13 @@ impl EditorApp {
             .show(ui, |ui| {
                 for name in names {
                     let selected = self.selected.as_deref() == Some(name.as_str());
-                    if ui.selectable_label(selected, &name).clicked() {
-                        self.rename_to = name.clone();
-                        self.selected = Some(name);
-                    }
+                    ui.horizontal(|ui| {
+                        self.lock_box(ui, &name);
+                        if ui.selectable_label(selected, &name).clicked() {
+                            self.rename_to = name.clone();
+                            self.selected = Some(name);
+                        }
+                    });
                 }
             });
         if let Some(name) = self.selected.clone() {
@@ -794,6 +809,7 @@ impl EditorApp {
                 }
             }
         }
+        self.vertex_weights_panel(ui);
         self.rig_tools_panel(ui);
     }
 
@@ -966,7 +982,7 @@ impl EditorApp {
                     shapes.push(canvas::image_quad(&placed, texture, canvas_px));
                 }
                 if let (Some(scene), Some(name)) = (&self.doc.state().rig, &self.selected) {
-                    for part in &scene.doc.parts {
+                    for (k, part) in scene.doc.parts.iter().enumerate() {
                         let rest: Vec<Point> = part
                             .mesh
                             .vertices
@@ -975,13 +991,23 @@ impl EditorApp {
                             .collect();
                         shapes.extend(canvas::wireframe(&placed, &rest, &part.mesh.triangles));
                         if let (Some(weights), true) = (&part.weights, posable.is_some()) {
-                            shapes.extend(canvas::heat_map(
-                                &placed,
-                                weights,
-                                name,
-                                &rest,
-                                &part.mesh.triangles,
-                            ));
+                            shapes.extend(match self.shown_rows(k) {
+                                Some(rows) => paint::heat_map_rows(
+                                    &placed,
+                                    weights,
+                                    rows,
+                                    name,
+                                    &rest,
+                                    &part.mesh.triangles,
+                                ),
+                                None => canvas::heat_map(
+                                    &placed,
+                                    weights,
+                                    name,
+                                    &rest,
+                                    &part.mesh.triangles,
+                                ),
+                            });
                         }
                     }
                 }
@@ -1011,6 +1037,10 @@ impl EditorApp {
                 };
                 shapes.extend(gizmo::shapes(&placed, &target, active));
             }
+        }
+        self.track_hover(&response, &placed);
+        if self.mode == Mode::Rig && self.tool == Tool::Paint {
+            shapes.extend(self.brush_shape(&placed));
         }
         painter.extend(shapes);
         match self.mode {
@@ -1050,6 +1080,10 @@ impl EditorApp {
     }
 
     fn rig_gestures(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
+        if self.tool == Tool::Paint {
+            self.paint_gestures(ctx, response, placed);
+            return;
+        }
         let pointer = response.interact_pointer_pos();
         if response.drag_started_by(egui::PointerButton::Primary) {
             // Where the button went down, not where the drag was recognized.
@@ -1081,7 +1115,7 @@ impl EditorApp {
                         }
                         None => Some(Gesture::Pan),
                     },
-                    Tool::Point | Tool::Cage | Tool::Region => None,
+                    Tool::Point | Tool::Cage | Tool::Region | Tool::Paint => None,
                 };
             }
         }

@@ -708,3 +708,116 @@ fn colorize_two_scribbles_then_undo_one() {
     assert!(Arc::ptr_eq(&result, &one));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn paint_weights_with_a_locked_handle_through_the_ui() {
+    let path = character_rig("paint");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.get_by_label("Weights are up to date");
+    let torso = |app: &EditorApp| {
+        let scene = app.doc.posable().expect("posable").clone();
+        let index = scene
+            .doc
+            .parts
+            .iter()
+            .position(|p| p.name == "torso")
+            .expect("a torso");
+        (scene, index)
+    };
+    let (scene, index) = torso(h.state());
+    let before = scene.doc.parts[index].weights.clone().expect("weights");
+    let column = |w: &crate::io::WeightsDoc, name: &str| -> Vec<f64> {
+        let c = w.handles.iter().position(|h| h == name).expect("a column") as u32;
+        w.rows
+            .iter()
+            .map(|r| r.iter().find(|e| e.0 == c).map_or(0.0, |e| e.1))
+            .collect()
+    };
+
+    // Lock the head from its box in the handle list, select the chest, take the brush.
+    h.get_by_label("lock head").click();
+    h.run();
+    assert!(
+        h.state().doc.state().locked.contains("head"),
+        "{:?}",
+        h.state().message
+    );
+    h.get_by_label("chest").click();
+    h.run();
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    h.get_by_label("Paint").click();
+    h.run();
+    h.get_by_label("Subtract");
+    assert_eq!(h.state().paint.mode, crate::weights::BrushMode::Add);
+    h.state_mut().paint.options.radius_px = 24.0;
+    h.state_mut().paint.options.strength = 0.5;
+
+    // One stroke across the hip–chest joint. While it runs, the canvas shows a preview; the
+    // document changes once, at release, to exactly that preview.
+    let (from, to) = ([240.0, 262.0], [272.0, 262.0]);
+    h.drag_at(screen(&h, from));
+    h.step();
+    for k in 1..=4 {
+        let t = k as f64 / 4.0;
+        h.hover_at(screen(&h, [from[0] + t * (to[0] - from[0]), from[1]]));
+        h.step();
+    }
+    let preview = h.state().shown_rows(index).expect("a preview").to_vec();
+    assert_eq!(
+        torso(h.state()).0.doc.parts[index].weights.as_ref(),
+        Some(&before),
+        "the document waits for the release"
+    );
+    h.drop_at(screen(&h, to));
+    h.step();
+    h.run();
+    let (scene, index) = torso(h.state());
+    let after = scene.doc.parts[index].weights.clone().expect("weights");
+    assert_eq!(after.rows, preview);
+    let (chest0, chest1) = (column(&before, "chest"), column(&after, "chest"));
+    let v = &scene.doc.parts[index].mesh.vertices;
+    let raised = (0..v.len())
+        .filter(|&i| distance(v[i], [256.0, 262.0]) < 12.0)
+        .map(|i| chest1[i] - chest0[i])
+        .fold(0.0, f64::max);
+    assert!(
+        raised > 0.1,
+        "chest rose by {raised}: {:?}",
+        h.state().message
+    );
+    let head = column(&before, "head");
+    assert!(head.iter().any(|&w| w > 0.01), "the head weighs the torso");
+    for (a, b) in head.iter().zip(column(&after, "head")) {
+        assert_eq!(a.to_bits(), b.to_bits(), "the locked head column changed");
+    }
+    for row in &after.rows {
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
+    }
+    // The side panel reads out the weights under the pointer.
+    h.get_by_label_contains("torso vertex");
+
+    // The stroke is one undo step.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    let (scene, index) = torso(h.state());
+    assert_eq!(scene.doc.parts[index].weights.as_ref(), Some(&before));
+    assert!(h.state().doc.state().locked.contains("head"));
+
+    // Redo the stroke, lock the chest too and recompute: the painted chest stays.
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.run();
+    h.get_by_label("lock chest").click();
+    h.run();
+    h.get_by_label("Compute weights").click();
+    wait_for_weights(&mut h);
+    let (scene, index) = torso(h.state());
+    let recomputed = scene.doc.parts[index].weights.clone().expect("weights");
+    assert_eq!(h.state().message.as_deref(), Some("weights computed"));
+    assert_eq!(column(&recomputed, "chest"), chest1);
+    for row in &recomputed.rows {
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
+    }
+}

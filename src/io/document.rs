@@ -38,6 +38,10 @@ pub struct RigDocument {
     /// The options the meshes were built with, so a re-trace reproduces them.
     #[serde(default)]
     pub options: BuildOptions,
+    /// Handles whose weights are locked: painting leaves them alone and recomputing the weights
+    /// keeps them (a cage locks all its columns). Absent when none is locked.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub locked: Vec<String>,
 }
 
 /// How the document's meshes were built.
@@ -136,6 +140,7 @@ impl RigDocument {
             handles: Handles::default(),
             animations: BTreeMap::new(),
             options: BuildOptions::default(),
+            locked: Vec::new(),
         }
     }
 
@@ -211,6 +216,13 @@ impl RigDocument {
         self.handles
             .validate()
             .map_err(|e: HandleError| format!("handles: {e}"))?;
+        if let Some(name) = self
+            .locked
+            .iter()
+            .find(|n| !self.handles.names().any(|h| h == n.as_str()))
+        {
+            return Err(format!("locked handle '{name}' is not a handle"));
+        }
         let mut names = HashSet::new();
         for part in &self.parts {
             if !names.insert(part.name.as_str()) {
@@ -286,6 +298,33 @@ mod tests {
             RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
             doc
         );
+    }
+
+    #[test]
+    fn locks_are_optional_and_checked() {
+        // A document without locks writes no `locked` field, so older readers load it.
+        let doc = sample();
+        let value = serde_json::to_value(&doc).unwrap();
+        assert!(value.get("locked").is_none());
+        let mut locked = doc.clone();
+        locked.handles.points.push(crate::rig::PointHandle {
+            name: "nose".into(),
+            at: [1.0, 1.0],
+        });
+        locked.locked = vec!["nose".into()];
+        let text = serde_json::to_string(&locked).unwrap();
+        assert_eq!(
+            RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
+            locked
+        );
+        locked.locked = vec!["ear".into()];
+        let e = RigDocument::from_json(
+            &serde_json::to_string(&locked).unwrap(),
+            Path::new("r.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(e, "r.json: locked handle 'ear' is not a handle");
     }
 
     #[test]

@@ -9,19 +9,27 @@
 //! - [`boundary`]: handles → fixed weights on the mesh vertices that carry their geometry.
 //! - [`rigid`]: rigid cutout weights (nearest handle inside the shape, blend band at joints).
 //! - [`part`]: one part end to end: boundary conditions, solve, normalize, sparsify.
+//! - [`paint`]: brush dabs (add, subtract, smooth) on a part's weights, locked columns kept.
+//! - [`locked`]: locked columns kept through a recompute, rows carried over to a new mesh.
 
 pub mod boundary;
 pub mod laplacian;
 pub mod lift;
+pub mod locked;
 pub mod monotone;
+pub mod paint;
 pub mod part;
 pub mod reference;
 pub mod rigid;
 pub mod solve;
 pub mod sparse;
 
+pub use locked::{keep_locked, transfer_rows, LockError};
 pub use monotone::{
     count_spurious_extrema, monotone_bounded_biharmonic_weights, MonotoneOptions, MonotoneReport,
+};
+pub use paint::{
+    dab_centres, paint_dab, paint_stroke, BrushMode, BrushOptions, Falloff, PaintError, PaintMesh,
 };
 pub use part::{part_weights, PartWeights, WeightError, WeightMethod, WeightOptions};
 pub use solve::{

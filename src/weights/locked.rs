@@ -1,0 +1,327 @@
+//! Locked weight columns kept through a recompute.
+//!
+//! In: a part's freshly computed rows, its previous rows on the same vertices with the same
+//! columns ([`transfer_rows`] carries rows over from the mesh the part had before a re-trace),
+//! and one locked flag per column. Out ([`keep_locked`]): rows whose locked columns hold their
+//! previous values bit for bit and whose unlocked columns are the fresh ones rescaled to fill
+//! 1 − Σ locked, so the rows still sum to one. This is how an animator keeps painted weights
+//! of some handles while the others are recomputed after an edit.
+//!
+//! Rows are sparse: per vertex its non-zero `(column, weight)` pairs, sorted by column.
+
+use crate::geom::{barycentric, Point};
+
+/// What does not fit. Nothing was changed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum LockError {
+    #[error("{fresh} fresh weight rows but {previous} previous ones")]
+    RowCount { fresh: usize, previous: usize },
+    #[error("{rows} weight rows for {vertices} mesh vertices")]
+    MeshRows { rows: usize, vertices: usize },
+    #[error("vertex {vertex} has a weight in column {column} of {columns}")]
+    Column {
+        vertex: usize,
+        column: u32,
+        columns: usize,
+    },
+    #[error("triangle {triangle} uses vertex {vertex} of {vertices}")]
+    Triangle {
+        triangle: usize,
+        vertex: u32,
+        vertices: usize,
+    },
+    #[error("the previous mesh has no vertices to carry weights from")]
+    EmptyMesh,
+}
+
+fn check_columns(rows: &[Vec<(u32, f64)>], columns: usize) -> Result<(), LockError> {
+    for (vertex, row) in rows.iter().enumerate() {
+        if let Some(&(c, _)) = row.iter().find(|(c, _)| *c as usize >= columns) {
+            return Err(LockError::Column {
+                vertex,
+                column: c,
+                columns,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Replaces the locked columns of `fresh` by those of `previous`, vertex by vertex, and
+/// rescales the fresh unlocked columns to fill the rest of one. Where the fresh unlocked
+/// columns are all zero, the previous unlocked ones are rescaled instead; where those are zero
+/// too, the vertex keeps its previous row. `locked` has one flag per column.
+pub fn keep_locked(
+    fresh: &mut [Vec<(u32, f64)>],
+    previous: &[Vec<(u32, f64)>],
+    locked: &[bool],
+) -> Result<(), LockError> {
+    if fresh.len() != previous.len() {
+        return Err(LockError::RowCount {
+            fresh: fresh.len(),
+            previous: previous.len(),
+        });
+    }
+    let columns = locked.len();
+    check_columns(fresh, columns)?;
+    check_columns(previous, columns)?;
+    if !locked.iter().any(|&l| l) {
+        return Ok(());
+    }
+    for (row, before) in fresh.iter_mut().zip(previous) {
+        let locked_sum: f64 = before
+            .iter()
+            .filter(|(c, _)| locked[*c as usize])
+            .map(|e| e.1)
+            .sum();
+        let room = (1.0 - locked_sum).max(0.0);
+        let unlocked = |r: &[(u32, f64)]| -> Vec<(u32, f64)> {
+            r.iter()
+                .filter(|(c, _)| !locked[*c as usize])
+                .copied()
+                .collect()
+        };
+        let sum = |r: &[(u32, f64)]| -> f64 { r.iter().map(|e| e.1).sum() };
+        let (fresh_free, old_free) = (unlocked(row), unlocked(before));
+        let source = if sum(&fresh_free) > 0.0 {
+            fresh_free
+        } else if sum(&old_free) > 0.0 {
+            old_free
+        } else {
+            *row = before.clone();
+            continue;
+        };
+        let scale = room / sum(&source);
+        let mut merged: Vec<(u32, f64)> = before
+            .iter()
+            .filter(|(c, _)| locked[*c as usize])
+            .copied()
+            .chain(
+                source
+                    .iter()
+                    .map(|&(c, w)| (c, (w * scale).clamp(0.0, 1.0)))
+                    .filter(|e| e.1 > 0.0),
+            )
+            .collect();
+        merged.sort_by_key(|e| e.0);
+        *row = merged;
+    }
+    Ok(())
+}
+
+/// The rows of a mesh's vertices `to_px` carried over from another mesh of the same part
+/// (`from_vertices`, `from_triangles`, `from_rows`): a vertex inside a triangle of the old mesh
+/// gets the barycentric blend of its corners' rows; a vertex outside every old triangle (the
+/// outline grew) gets the row of the nearest old vertex. Rows that sum to one blend to rows
+/// that sum to one.
+pub fn transfer_rows(
+    from_vertices: &[[f64; 2]],
+    from_triangles: &[[u32; 3]],
+    from_rows: &[Vec<(u32, f64)>],
+    to_px: &[[f64; 2]],
+) -> Result<Vec<Vec<(u32, f64)>>, LockError> {
+    let n = from_vertices.len();
+    if from_rows.len() != n {
+        return Err(LockError::MeshRows {
+            rows: from_rows.len(),
+            vertices: n,
+        });
+    }
+    if n == 0 {
+        return Err(LockError::EmptyMesh);
+    }
+    for (triangle, t) in from_triangles.iter().enumerate() {
+        if let Some(&vertex) = t.iter().find(|&&v| v as usize >= n) {
+            return Err(LockError::Triangle {
+                triangle,
+                vertex,
+                vertices: n,
+            });
+        }
+    }
+    let grid = TriangleGrid::new(from_vertices, from_triangles);
+    let pt = |p: [f64; 2]| Point::new(p[0], p[1]);
+    Ok(to_px
+        .iter()
+        .map(|&p| {
+            let inside = grid.candidates(p).find_map(|t| {
+                let [a, b, c] = from_triangles[t].map(|v| pt(from_vertices[v as usize]));
+                let w = barycentric(pt(p), a, b, c)?;
+                // A hair of slack so points on shared edges are not lost between triangles.
+                w.iter()
+                    .all(|&x| x >= -1e-9)
+                    .then(|| (from_triangles[t], w.map(|x| x.max(0.0))))
+            });
+            match inside {
+                Some((t, w)) => {
+                    let total: f64 = w.iter().sum();
+                    let mut dense: Vec<(u32, f64)> = Vec::new();
+                    for (k, &v) in t.iter().enumerate() {
+                        for &(c, x) in &from_rows[v as usize] {
+                            match dense.iter_mut().find(|e| e.0 == c) {
+                                Some(e) => e.1 += x * w[k] / total,
+                                None => dense.push((c, x * w[k] / total)),
+                            }
+                        }
+                    }
+                    // Rounding can lift a blend of ones a hair above one.
+                    dense.iter_mut().for_each(|e| e.1 = e.1.min(1.0));
+                    dense.retain(|e| e.1 > 0.0);
+                    dense.sort_by_key(|e| e.0);
+                    dense
+                }
+                None => {
+                    let nearest = (0..n)
+                        .min_by(|&i, &j| {
+                            let d = |k: usize| {
+                                let q = from_vertices[k];
+                                (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)
+                            };
+                            d(i).total_cmp(&d(j))
+                        })
+                        .unwrap_or(0);
+                    from_rows[nearest].clone()
+                }
+            }
+        })
+        .collect())
+}
+
+/// Triangles bucketed by the grid cells their bounding boxes overlap, for point location.
+struct TriangleGrid {
+    origin: [f64; 2],
+    cell_px: f64,
+    size: [usize; 2],
+    cells: Vec<Vec<usize>>,
+}
+
+impl TriangleGrid {
+    fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Self {
+        let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+        for v in vertices {
+            for k in 0..2 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        let extent = [(hi[0] - lo[0]).max(1e-9), (hi[1] - lo[1]).max(1e-9)];
+        // About one triangle per cell.
+        let cells_wanted = triangles.len().clamp(1, 1 << 20) as f64;
+        let cell_px = ((extent[0] * extent[1]) / cells_wanted).sqrt().max(1e-6);
+        let size = [
+            ((extent[0] / cell_px).ceil() as usize).clamp(1, 1024),
+            ((extent[1] / cell_px).ceil() as usize).clamp(1, 1024),
+        ];
+        let cell_px = (extent[0] / size[0] as f64).max(extent[1] / size[1] as f64);
+        let mut grid = TriangleGrid {
+            origin: lo,
+            cell_px,
+            size,
+            cells: vec![Vec::new(); size[0] * size[1]],
+        };
+        for (t, tri) in triangles.iter().enumerate() {
+            let ps = tri.map(|v| vertices[v as usize]);
+            let min = [0, 1].map(|k| ps.iter().map(|p| p[k]).fold(f64::MAX, f64::min));
+            let max = [0, 1].map(|k| ps.iter().map(|p| p[k]).fold(f64::MIN, f64::max));
+            let (c0, c1) = (grid.cell(min), grid.cell(max));
+            for y in c0[1]..=c1[1] {
+                for x in c0[0]..=c1[0] {
+                    grid.cells[y * size[0] + x].push(t);
+                }
+            }
+        }
+        grid
+    }
+
+    /// The cell holding `p`, clamped to the grid.
+    fn cell(&self, p: [f64; 2]) -> [usize; 2] {
+        [0, 1].map(|k| {
+            let i = ((p[k] - self.origin[k]) / self.cell_px).floor();
+            if i.is_nan() {
+                0
+            } else {
+                (i.max(0.0) as usize).min(self.size[k] - 1)
+            }
+        })
+    }
+
+    /// Triangles whose bounding box may contain `p`.
+    fn candidates(&self, p: [f64; 2]) -> impl Iterator<Item = usize> + '_ {
+        let c = self.cell(p);
+        self.cells[c[1] * self.size[0] + c[0]].iter().copied()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sums_to_one(rows: &[Vec<(u32, f64)>]) {
+        for row in rows {
+            let s: f64 = row.iter().map(|e| e.1).sum();
+            assert!((s - 1.0).abs() < 1e-9, "{row:?}");
+            assert!(row.iter().all(|e| (0.0..=1.0).contains(&e.1)));
+        }
+    }
+
+    #[test]
+    fn locked_columns_keep_their_values_and_the_rest_is_rescaled() {
+        let previous = vec![
+            vec![(0, 0.2), (1, 0.3), (2, 0.5)],
+            vec![(1, 1.0)],
+            vec![(0, 0.6), (2, 0.4)],
+        ];
+        let mut fresh = vec![
+            vec![(0, 0.5), (1, 0.5)],
+            vec![(0, 0.25), (2, 0.75)],
+            vec![(1, 1.0)],
+        ];
+        keep_locked(&mut fresh, &previous, &[false, true, false]).unwrap();
+        sums_to_one(&fresh);
+        // Vertex 0: column 1 stays 0.3, the fresh column 0 fills 0.7 (the fresh 1 was locked).
+        assert_eq!(fresh[0], vec![(0, 0.7), (1, 0.3)]);
+        // Vertex 1: column 1 was everything, so the fresh others vanish.
+        assert_eq!(fresh[1], vec![(1, 1.0)]);
+        // Vertex 2: the locked column was zero; only it was fresh, so the previous unlocked
+        // columns come back.
+        assert_eq!(fresh[2], vec![(0, 0.6), (2, 0.4)]);
+        // Bit-identical locked values.
+        assert_eq!(fresh[0][1].1.to_bits(), 0.3f64.to_bits());
+        // Nothing locked: nothing changes.
+        let mut untouched = vec![vec![(0, 1.0)]; 3];
+        keep_locked(&mut untouched, &previous, &[false; 3]).unwrap();
+        assert_eq!(untouched, vec![vec![(0, 1.0)]; 3]);
+        assert!(keep_locked(&mut untouched, &previous[..2], &[true; 3]).is_err());
+        assert!(keep_locked(&mut untouched, &previous, &[true; 2]).is_err());
+    }
+
+    #[test]
+    fn rows_carry_over_to_a_new_mesh() {
+        // Old mesh: the unit square (10 px) as two triangles, column 0 at x = 0, 1 at x = 10.
+        let from = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let tris = [[0, 1, 2], [0, 2, 3]];
+        let rows = vec![
+            vec![(0, 1.0)],
+            vec![(1, 1.0)],
+            vec![(1, 1.0)],
+            vec![(0, 1.0)],
+        ];
+        let to = [[2.5, 5.0], [10.0, 10.0], [5.0, 5.0], [14.0, 3.0]];
+        let carried = transfer_rows(&from, &tris, &rows, &to).unwrap();
+        sums_to_one(&carried);
+        let w1 = |r: &Vec<(u32, f64)>| r.iter().find(|e| e.0 == 1).map_or(0.0, |e| e.1);
+        assert!((w1(&carried[0]) - 0.25).abs() < 1e-12, "{:?}", carried[0]);
+        assert!((w1(&carried[1]) - 1.0).abs() < 1e-12);
+        assert!((w1(&carried[2]) - 0.5).abs() < 1e-12);
+        // Outside: the nearest old vertex, (10, 0).
+        assert_eq!(carried[3], vec![(1, 1.0)]);
+        assert_eq!(
+            transfer_rows(&from, &[[0, 1, 9]], &rows, &to),
+            Err(LockError::Triangle {
+                triangle: 0,
+                vertex: 9,
+                vertices: 4
+            })
+        );
+    }
+}

@@ -1,0 +1,807 @@
+//! Weight painting: brush dabs on one part's skinning weights, with locked columns.
+//!
+//! In: a part's rest mesh ([`PaintMesh`]: vertices in canvas px and their mesh neighbours), its
+//! sparse weight rows (per vertex its non-zero `(column, weight)` pairs, summing to one), one
+//! locked flag per weight column, the column painted, a [`BrushMode`], the stroke's samples in
+//! canvas px and [`BrushOptions`]. Out: the rows changed in place, still summing to one (to
+//! 1e-9), every weight in [0, 1], locked columns bit-identical.
+//!
+//! A dab sets the painted column `j` of each vertex within the radius to a target (add,
+//! subtract, or move toward the neighbours' average), and then rescales the *unlocked other*
+//! columns so that the row sums to one again. Locked columns never change, so the painted
+//! column can take at most 1 − Σ locked. Where every other column is locked, the vertex cannot
+//! change. Where the unlocked others all weigh zero at a vertex (say, in the middle of a bone's
+//! rigid zone), the weight taken from `j` goes to the unlocked columns the vertex's mesh
+//! neighbours use, in their proportions; with none there either, the vertex stays as it is.
+//!
+//! A stroke is resampled into dabs at a fixed spacing along its polyline, starting at its first
+//! sample, so the dabs of a stroke's prefix are a prefix of its dabs: an editor can preview a
+//! stroke dab by dab and commit the whole stroke once, getting the same weights.
+
+use serde::{Deserialize, Serialize};
+
+/// What a dab does to the painted column.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BrushMode {
+    /// Raises the weight by strength × falloff.
+    #[default]
+    Add,
+    /// Lowers the weight by strength × falloff.
+    Subtract,
+    /// Moves the weight toward the average of its mesh neighbours' weights by strength × falloff
+    /// of the difference (a Jacobi step: every vertex reads the weights from before the dab).
+    Smooth,
+}
+
+/// How a dab's effect fades from its centre (distance d) to its rim (radius r).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Falloff {
+    /// Full effect everywhere inside the radius.
+    Constant,
+    /// 1 − d/r.
+    Linear,
+    /// (1 − (d/r)²)²: full at the centre, fading with zero slope at the rim, so strokes leave
+    /// no visible edge.
+    #[default]
+    Smooth,
+}
+
+impl Falloff {
+    /// The factor in [0, 1] at distance `d_px` from the centre of a brush of radius `r_px`
+    /// (zero outside).
+    pub fn factor(self, d_px: f64, r_px: f64) -> f64 {
+        // NaN distances paint nothing.
+        if d_px.is_nan() || d_px >= r_px {
+            return 0.0;
+        }
+        let x = d_px / r_px;
+        match self {
+            Falloff::Constant => 1.0,
+            Falloff::Linear => 1.0 - x,
+            Falloff::Smooth => (1.0 - x * x).powi(2),
+        }
+    }
+}
+
+/// How a brush paints. Shared by the editor and the document's paint command.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BrushOptions {
+    /// Brush radius, canvas px. Default 24.
+    pub radius_px: f64,
+    /// Effect of one dab at the centre, in [0, 1]: the weight added or subtracted, or the
+    /// fraction of the way to the neighbours' average. Default 0.1.
+    pub strength: f64,
+    /// Default [`Falloff::Smooth`].
+    pub falloff: Falloff,
+    /// Dabs along a stroke lie this fraction of the radius apart, in (0, 1]. Default 0.25
+    /// (a point crossed by a stroke's middle gets about eight dabs).
+    pub spacing: f64,
+}
+
+impl Default for BrushOptions {
+    fn default() -> Self {
+        BrushOptions {
+            radius_px: 24.0,
+            strength: 0.1,
+            falloff: Falloff::Smooth,
+            spacing: 0.25,
+        }
+    }
+}
+
+/// What is wrong with a paint request. Nothing was changed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum PaintError {
+    #[error("invalid brush option: {0}")]
+    InvalidOptions(String),
+    #[error("a brush position is not finite: {0:?}")]
+    NotFinite([f64; 2]),
+    #[error("column {column} is painted, but the weights have {columns} columns")]
+    UnknownColumn { column: usize, columns: usize },
+    #[error("column {0} is locked")]
+    LockedColumn(usize),
+    #[error("{rows} weight rows for {vertices} mesh vertices")]
+    RowCount { rows: usize, vertices: usize },
+    #[error("vertex {vertex} has a weight in column {column} of {columns}")]
+    RowColumn {
+        vertex: usize,
+        column: u32,
+        columns: usize,
+    },
+    #[error("triangle {triangle} uses vertex {vertex} of {vertices}")]
+    Triangle {
+        triangle: usize,
+        vertex: u32,
+        vertices: usize,
+    },
+}
+
+/// A part's rest mesh prepared for painting: positions and, per vertex, its mesh neighbours.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaintMesh {
+    /// Rest positions, canvas px.
+    pub vertices: Vec<[f64; 2]>,
+    /// Per vertex, the vertices sharing an edge with it, sorted.
+    pub neighbours: Vec<Vec<u32>>,
+}
+
+impl PaintMesh {
+    pub fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Result<Self, PaintError> {
+        let n = vertices.len();
+        let mut neighbours = vec![Vec::new(); n];
+        for (t, tri) in triangles.iter().enumerate() {
+            if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
+                return Err(PaintError::Triangle {
+                    triangle: t,
+                    vertex: v,
+                    vertices: n,
+                });
+            }
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                neighbours[a as usize].push(b);
+                neighbours[b as usize].push(a);
+            }
+        }
+        for list in &mut neighbours {
+            list.sort_unstable();
+            list.dedup();
+        }
+        Ok(PaintMesh {
+            vertices: vertices.to_vec(),
+            neighbours,
+        })
+    }
+}
+
+/// What a stroke did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StrokeReport {
+    pub dabs: usize,
+    /// Vertex changes summed over the dabs (a vertex changed by two dabs counts twice).
+    pub vertex_changes: usize,
+}
+
+/// Checks `options` (radius, strength and spacing in range, finite).
+pub fn check_options(options: &BrushOptions) -> Result<(), PaintError> {
+    if !(options.radius_px.is_finite() && options.radius_px > 0.0) {
+        return Err(PaintError::InvalidOptions(format!(
+            "the radius must be a positive number of px, not {}",
+            options.radius_px
+        )));
+    }
+    if !(0.0..=1.0).contains(&options.strength) {
+        return Err(PaintError::InvalidOptions(format!(
+            "the strength must lie in [0, 1], not {}",
+            options.strength
+        )));
+    }
+    if !(options.spacing > 0.0 && options.spacing <= 1.0) {
+        return Err(PaintError::InvalidOptions(format!(
+            "the spacing must lie in (0, 1], not {}",
+            options.spacing
+        )));
+    }
+    Ok(())
+}
+
+/// The dab centres of a stroke through `samples_px`: its first sample, then every
+/// `spacing × radius` px of arc length along the polyline (the last partial step gets no dab,
+/// so a longer stroke only appends dabs). No samples: no dabs.
+pub fn dab_centres(
+    samples_px: &[[f64; 2]],
+    options: &BrushOptions,
+) -> Result<Vec<[f64; 2]>, PaintError> {
+    check_options(options)?;
+    if let Some(bad) = samples_px
+        .iter()
+        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
+        return Err(PaintError::NotFinite(*bad));
+    }
+    let step_px = options.spacing * options.radius_px;
+    let Some(&first) = samples_px.first() else {
+        return Ok(Vec::new());
+    };
+    let mut dabs = vec![first];
+    // Arc length still to go from the current position to the next dab.
+    let mut to_next = step_px;
+    for pair in samples_px.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let mut at = 0.0;
+        while length - at >= to_next {
+            at += to_next;
+            let t = at / length;
+            dabs.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            to_next = step_px;
+        }
+        to_next -= length - at;
+    }
+    Ok(dabs)
+}
+
+/// Checks that `rows` and `locked` fit `mesh` and that `column` can be painted; returns the
+/// number of columns.
+fn check_target(
+    mesh: &PaintMesh,
+    rows: &[Vec<(u32, f64)>],
+    locked: &[bool],
+    column: usize,
+) -> Result<usize, PaintError> {
+    let columns = locked.len();
+    if column >= columns {
+        return Err(PaintError::UnknownColumn { column, columns });
+    }
+    if locked[column] {
+        return Err(PaintError::LockedColumn(column));
+    }
+    if rows.len() != mesh.vertices.len() {
+        return Err(PaintError::RowCount {
+            rows: rows.len(),
+            vertices: mesh.vertices.len(),
+        });
+    }
+    for (vertex, row) in rows.iter().enumerate() {
+        if let Some(&(c, _)) = row.iter().find(|(c, _)| *c as usize >= columns) {
+            return Err(PaintError::RowColumn {
+                vertex,
+                column: c,
+                columns,
+            });
+        }
+    }
+    Ok(columns)
+}
+
+/// Paints one stroke: every dab of [`dab_centres`] in order. `locked` has one flag per weight
+/// column; `column` must not be locked. On error nothing is changed.
+#[allow(clippy::too_many_arguments)]
+pub fn paint_stroke(
+    mesh: &PaintMesh,
+    rows: &mut [Vec<(u32, f64)>],
+    locked: &[bool],
+    column: usize,
+    mode: BrushMode,
+    samples_px: &[[f64; 2]],
+    options: &BrushOptions,
+) -> Result<StrokeReport, PaintError> {
+    check_target(mesh, rows, locked, column)?;
+    let dabs = dab_centres(samples_px, options)?;
+    let mut report = StrokeReport {
+        dabs: dabs.len(),
+        vertex_changes: 0,
+    };
+    for centre in dabs {
+        report.vertex_changes += apply_dab(mesh, rows, locked, column, mode, centre, options);
+    }
+    Ok(report)
+}
+
+/// Paints one dab at `centre_px`; returns how many vertices changed. On error nothing is
+/// changed.
+pub fn paint_dab(
+    mesh: &PaintMesh,
+    rows: &mut [Vec<(u32, f64)>],
+    locked: &[bool],
+    column: usize,
+    mode: BrushMode,
+    centre_px: [f64; 2],
+    options: &BrushOptions,
+) -> Result<usize, PaintError> {
+    check_target(mesh, rows, locked, column)?;
+    check_options(options)?;
+    if !(centre_px[0].is_finite() && centre_px[1].is_finite()) {
+        return Err(PaintError::NotFinite(centre_px));
+    }
+    Ok(apply_dab(
+        mesh, rows, locked, column, mode, centre_px, options,
+    ))
+}
+
+/// The weight of `column` in a sparse row.
+pub fn weight_in(row: &[(u32, f64)], column: usize) -> f64 {
+    row.iter()
+        .find(|(c, _)| *c as usize == column)
+        .map_or(0.0, |(_, w)| *w)
+}
+
+/// One dab, inputs checked.
+fn apply_dab(
+    mesh: &PaintMesh,
+    rows: &mut [Vec<(u32, f64)>],
+    locked: &[bool],
+    column: usize,
+    mode: BrushMode,
+    centre: [f64; 2],
+    options: &BrushOptions,
+) -> usize {
+    let r = options.radius_px;
+    // Targets first, all read from the rows before the dab, then the writes: smoothing must
+    // not see half a dab, and the fallback spread reads the neighbours as they were.
+    let mut changes: Vec<(usize, f64, Vec<f64>)> = Vec::new();
+    for (i, p) in mesh.vertices.iter().enumerate() {
+        let d = (p[0] - centre[0]).hypot(p[1] - centre[1]);
+        let a = options.strength * options.falloff.factor(d, r);
+        if a <= 0.0 {
+            continue;
+        }
+        let w = weight_in(&rows[i], column);
+        let target = match mode {
+            BrushMode::Add => w + a,
+            BrushMode::Subtract => w - a,
+            BrushMode::Smooth => {
+                let around = &mesh.neighbours[i];
+                if around.is_empty() {
+                    continue;
+                }
+                let mean = around
+                    .iter()
+                    .map(|&k| weight_in(&rows[k as usize], column))
+                    .sum::<f64>()
+                    / around.len() as f64;
+                w + a * (mean - w)
+            }
+        };
+        // Where the weight goes when the vertex's own free columns are all zero.
+        let mut spread = vec![0.0; locked.len()];
+        for &k in &mesh.neighbours[i] {
+            for &(c, x) in &rows[k as usize] {
+                spread[c as usize] += x;
+            }
+        }
+        changes.push((i, target, spread));
+    }
+    let mut changed = 0;
+    for (i, target, spread) in changes {
+        if set_weight(&mut rows[i], column, target, locked, &spread) {
+            changed += 1;
+        }
+    }
+    changed
+}
+
+/// Sets `column` of `row` to `target` (clamped to what the locked columns leave) and rescales
+/// the unlocked other columns so the row sums to one; locked columns are copied bit for bit.
+/// When the unlocked others all weigh zero, weight taken from `column` goes to them in the
+/// proportions of `spread` (one value per column; the neighbours' weights). Returns whether
+/// the row changed; it does not when every other column is locked, or when the weight would
+/// have nowhere to go.
+pub fn set_weight(
+    row: &mut Vec<(u32, f64)>,
+    column: usize,
+    target: f64,
+    locked: &[bool],
+    spread: &[f64],
+) -> bool {
+    let columns = locked.len();
+    let free = |k: usize| k != column && !locked[k];
+    if !(0..columns).any(free) || !target.is_finite() {
+        return false;
+    }
+    let mut dense = vec![0.0; columns];
+    for &(c, w) in row.iter() {
+        dense[c as usize] = w;
+    }
+    let locked_sum: f64 = (0..columns).filter(|&k| locked[k]).map(|k| dense[k]).sum();
+    let room = (1.0 - locked_sum).clamp(0.0, 1.0);
+    let t = target.clamp(0.0, room);
+    let rest = room - t;
+    let free_sum: f64 = (0..columns).filter(|&k| free(k)).map(|k| dense[k]).sum();
+    if free_sum > 0.0 {
+        let scale = rest / free_sum;
+        for k in (0..columns).filter(|&k| free(k)) {
+            dense[k] = (dense[k] * scale).clamp(0.0, 1.0);
+        }
+    } else if rest > 0.0 {
+        let spread_sum: f64 = (0..columns)
+            .filter(|&k| free(k))
+            .map(|k| spread.get(k).copied().unwrap_or(0.0).max(0.0))
+            .sum();
+        if spread_sum.is_nan() || spread_sum <= 0.0 {
+            return false;
+        }
+        for k in (0..columns).filter(|&k| free(k)) {
+            let share = spread.get(k).copied().unwrap_or(0.0).max(0.0) / spread_sum;
+            dense[k] = (rest * share).clamp(0.0, 1.0);
+        }
+    }
+    dense[column] = t;
+    // Locked entries go back exactly as they were (a locked zero stays absent).
+    let next: Vec<(u32, f64)> = dense
+        .iter()
+        .enumerate()
+        .filter(|&(k, &w)| if locked[k] { w != 0.0 } else { w > 0.0 })
+        .map(|(k, &w)| (k as u32, w))
+        .collect();
+    if next == *row {
+        return false;
+    }
+    *row = next;
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of `n × n` vertices, `step` px apart, two triangles per cell.
+    fn grid(n: usize, step: f64) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+        let mut vertices = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                vertices.push([x as f64 * step, y as f64 * step]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for y in 0..n - 1 {
+            for x in 0..n - 1 {
+                let i = (y * n + x) as u32;
+                let n = n as u32;
+                triangles.push([i, i + 1, i + n]);
+                triangles.push([i + 1, i + n + 1, i + n]);
+            }
+        }
+        (vertices, triangles)
+    }
+
+    /// Three columns varying smoothly over the grid: left, right, and a bump in the middle.
+    fn rows_for(vertices: &[[f64; 2]], width: f64) -> Vec<Vec<(u32, f64)>> {
+        vertices
+            .iter()
+            .map(|p| {
+                let u = p[0] / width;
+                let bump = 0.3 * (-((p[1] / width - 0.5).powi(2)) * 8.0).exp();
+                let raw = [(1.0 - u) * (1.0 - bump), u * (1.0 - bump), bump];
+                raw.iter()
+                    .enumerate()
+                    .filter(|(_, &w)| w > 0.0)
+                    .map(|(k, &w)| (k as u32, w))
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn check_rows(rows: &[Vec<(u32, f64)>]) {
+        for (i, row) in rows.iter().enumerate() {
+            let sum: f64 = row.iter().map(|e| e.1).sum();
+            assert!(
+                (sum - 1.0).abs() < 1e-9,
+                "vertex {i} sums to {sum}: {row:?}"
+            );
+            for &(_, w) in row {
+                assert!((0.0..=1.0).contains(&w), "vertex {i}: {row:?}");
+            }
+            assert!(row.windows(2).all(|p| p[0].0 < p[1].0), "sorted {row:?}");
+        }
+    }
+
+    fn column(rows: &[Vec<(u32, f64)>], c: usize) -> Vec<f64> {
+        rows.iter().map(|r| weight_in(r, c)).collect()
+    }
+
+    #[test]
+    fn add_and_subtract_keep_rows_summing_to_one_and_locked_columns_exact() {
+        let (v, t) = grid(21, 5.0);
+        let mesh = PaintMesh::new(&v, &t).unwrap();
+        let before = rows_for(&v, 100.0);
+        let locked = [false, false, true];
+        let options = BrushOptions {
+            radius_px: 30.0,
+            strength: 0.4,
+            ..Default::default()
+        };
+        let stroke = [[20.0, 50.0], [80.0, 50.0]];
+        let mut rows = before.clone();
+        let report = paint_stroke(
+            &mesh,
+            &mut rows,
+            &locked,
+            1,
+            BrushMode::Add,
+            &stroke,
+            &options,
+        )
+        .unwrap();
+        assert!(report.dabs > 5 && report.vertex_changes > 0, "{report:?}");
+        check_rows(&rows);
+        // The locked column is bit-identical everywhere.
+        let (old, new) = (column(&before, 2), column(&rows, 2));
+        assert!(old
+            .iter()
+            .zip(&new)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+        // Column 1 rose under the stroke, never fell, and did not move far away from it.
+        let (b1, a1) = (column(&before, 1), column(&rows, 1));
+        let centre = 10 * 21 + 3; // (15, 50)-ish: under the stroke's start
+        assert!(
+            a1[centre] > b1[centre] + 0.1,
+            "{} → {}",
+            b1[centre],
+            a1[centre]
+        );
+        for (i, p) in v.iter().enumerate() {
+            assert!(a1[i] >= b1[i] - 1e-12);
+            if (p[1] - 50.0).abs() > 31.0 {
+                assert_eq!(a1[i].to_bits(), b1[i].to_bits(), "outside the brush");
+            }
+        }
+        // Saturates at what the lock leaves: 1 − locked.
+        let mut full = before.clone();
+        let strong = BrushOptions {
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            ..options
+        };
+        paint_stroke(
+            &mesh,
+            &mut full,
+            &locked,
+            1,
+            BrushMode::Add,
+            &stroke,
+            &strong,
+        )
+        .unwrap();
+        check_rows(&full);
+        let i = 10 * 21 + 10;
+        assert!((weight_in(&full[i], 1) + weight_in(&full[i], 2) - 1.0).abs() < 1e-12);
+        assert_eq!(weight_in(&full[i], 0), 0.0);
+
+        // Subtracting gives the weight to the unlocked other column only.
+        let mut less = before.clone();
+        paint_stroke(
+            &mesh,
+            &mut less,
+            &locked,
+            0,
+            BrushMode::Subtract,
+            &stroke,
+            &strong,
+        )
+        .unwrap();
+        check_rows(&less);
+        let i = 10 * 21 + 6;
+        assert_eq!(weight_in(&less[i], 0), 0.0);
+        assert_eq!(
+            weight_in(&less[i], 2).to_bits(),
+            weight_in(&before[i], 2).to_bits()
+        );
+        assert!((weight_in(&less[i], 1) - (1.0 - weight_in(&before[i], 2))).abs() < 1e-12);
+    }
+
+    #[test]
+    fn smoothing_reduces_variation() {
+        let (v, t) = grid(21, 5.0);
+        let mesh = PaintMesh::new(&v, &t).unwrap();
+        // A sharp step in column 0 down the middle.
+        let before: Vec<Vec<(u32, f64)>> = v
+            .iter()
+            .map(|p| {
+                if p[0] < 50.0 {
+                    vec![(0, 1.0)]
+                } else {
+                    vec![(1, 1.0)]
+                }
+            })
+            .collect();
+        let mut rows = before.clone();
+        let options = BrushOptions {
+            radius_px: 40.0,
+            strength: 0.8,
+            ..Default::default()
+        };
+        let stroke = [[50.0, 20.0], [50.0, 80.0]];
+        paint_stroke(
+            &mesh,
+            &mut rows,
+            &[false, false],
+            0,
+            BrushMode::Smooth,
+            &stroke,
+            &options,
+        )
+        .unwrap();
+        check_rows(&rows);
+        // Total variation of column 0 over the mesh's edges.
+        let variation = |rows: &[Vec<(u32, f64)>]| -> f64 {
+            let c = column(rows, 0);
+            mesh.neighbours
+                .iter()
+                .enumerate()
+                .flat_map(|(i, n)| n.iter().map(move |&k| (i, k as usize)))
+                .map(|(i, k)| (c[i] - c[k]).powi(2))
+                .sum()
+        };
+        let (b, a) = (variation(&before), variation(&rows));
+        assert!(a < 0.8 * b, "variation {b} → {a}");
+        // Near the step, weights are now strictly between 0 and 1.
+        let i = 10 * 21 + 9;
+        let w = weight_in(&rows[i], 0);
+        assert!(w > 0.05 && w < 0.95, "{w}");
+    }
+
+    #[test]
+    fn fully_locked_vertices_and_locked_columns_are_refused_or_kept() {
+        let (v, t) = grid(5, 10.0);
+        let mesh = PaintMesh::new(&v, &t).unwrap();
+        let rows: Vec<Vec<(u32, f64)>> = vec![vec![(0, 0.25), (1, 0.5), (2, 0.25)]; v.len()];
+        let options = BrushOptions {
+            radius_px: 100.0,
+            strength: 0.5,
+            ..Default::default()
+        };
+        // Every other column locked: nothing can change.
+        let mut same = rows.clone();
+        let report = paint_stroke(
+            &mesh,
+            &mut same,
+            &[false, true, true],
+            0,
+            BrushMode::Add,
+            &[[20.0, 20.0]],
+            &options,
+        )
+        .unwrap();
+        assert_eq!(report.vertex_changes, 0);
+        assert_eq!(same, rows);
+        // Painting a locked column is refused, as are bad options and rows.
+        let mut copy = rows.clone();
+        assert_eq!(
+            paint_stroke(
+                &mesh,
+                &mut copy,
+                &[true, false, false],
+                0,
+                BrushMode::Add,
+                &[[0.0, 0.0]],
+                &options
+            ),
+            Err(PaintError::LockedColumn(0))
+        );
+        let bad = BrushOptions {
+            strength: 1.5,
+            ..options
+        };
+        assert!(matches!(
+            paint_stroke(
+                &mesh,
+                &mut copy,
+                &[false; 3],
+                0,
+                BrushMode::Add,
+                &[[0.0, 0.0]],
+                &bad
+            ),
+            Err(PaintError::InvalidOptions(_))
+        ));
+        assert!(matches!(
+            paint_stroke(
+                &mesh,
+                &mut copy,
+                &[false; 3],
+                3,
+                BrushMode::Add,
+                &[[0.0, 0.0]],
+                &options
+            ),
+            Err(PaintError::UnknownColumn { .. })
+        ));
+        assert!(matches!(
+            paint_stroke(
+                &mesh,
+                &mut copy,
+                &[false; 2],
+                0,
+                BrushMode::Add,
+                &[[0.0, 0.0]],
+                &options
+            ),
+            Err(PaintError::RowColumn { .. })
+        ));
+        assert!(matches!(
+            paint_stroke(
+                &mesh,
+                &mut copy,
+                &[false; 3],
+                0,
+                BrushMode::Add,
+                &[[f64::NAN, 0.0]],
+                &options
+            ),
+            Err(PaintError::NotFinite(_))
+        ));
+        assert_eq!(copy, rows);
+    }
+
+    #[test]
+    fn subtracting_a_sole_influence_spreads_to_the_neighbours_columns() {
+        // A strip: vertices 0..3 weigh column 0 only, the last column 1 only.
+        let v = [
+            [0.0, 0.0],
+            [10.0, 0.0],
+            [20.0, 0.0],
+            [0.0, 10.0],
+            [10.0, 10.0],
+            [20.0, 10.0],
+        ];
+        let t = [[0, 1, 3], [1, 4, 3], [1, 2, 4], [2, 5, 4]];
+        let mesh = PaintMesh::new(&v, &t).unwrap();
+        let mut rows = vec![
+            vec![(0, 1.0)],
+            vec![(0, 1.0)],
+            vec![(1, 1.0)],
+            vec![(0, 1.0)],
+            vec![(0, 1.0)],
+            vec![(1, 1.0)],
+        ];
+        let options = BrushOptions {
+            radius_px: 3.0,
+            strength: 0.5,
+            falloff: Falloff::Constant,
+            ..Default::default()
+        };
+        // Vertex 3's neighbours weigh only column 0: nowhere to go, it stays.
+        paint_dab(
+            &mesh,
+            &mut rows,
+            &[false; 3],
+            0,
+            BrushMode::Subtract,
+            [0.0, 10.0],
+            &options,
+        )
+        .unwrap();
+        assert_eq!(rows[3], vec![(0, 1.0)]);
+        // Vertex 1 has a neighbour weighing column 1: it gets the weight.
+        paint_dab(
+            &mesh,
+            &mut rows,
+            &[false; 3],
+            0,
+            BrushMode::Subtract,
+            [10.0, 0.0],
+            &options,
+        )
+        .unwrap();
+        assert_eq!(rows[1], vec![(0, 0.5), (1, 0.5)]);
+    }
+
+    #[test]
+    fn dabs_are_evenly_spaced_and_prefix_stable() {
+        let options = BrushOptions {
+            radius_px: 8.0,
+            spacing: 0.5,
+            ..Default::default()
+        };
+        let stroke = [[0.0, 0.0], [3.0, 0.0], [10.0, 0.0], [10.0, 9.0]];
+        let dabs = dab_centres(&stroke, &options).unwrap();
+        // Length 19, a dab every 4 px from 0: 0, 4, 8, 12, 16.
+        assert_eq!(dabs.len(), 5, "{dabs:?}");
+        assert_eq!(dabs[2], [8.0, 0.0]);
+        assert!((dabs[3][0] - 10.0).abs() < 1e-12 && (dabs[3][1] - 2.0).abs() < 1e-12);
+        for k in 1..stroke.len() {
+            let prefix = dab_centres(&stroke[..k], &options).unwrap();
+            assert_eq!(prefix[..], dabs[..prefix.len()]);
+        }
+        assert!(dab_centres(&[], &options).unwrap().is_empty());
+        assert_eq!(
+            dab_centres(&[[1.0, 2.0]], &options).unwrap(),
+            vec![[1.0, 2.0]]
+        );
+    }
+
+    #[test]
+    fn falloffs_fade_to_zero_at_the_rim() {
+        for f in [Falloff::Constant, Falloff::Linear, Falloff::Smooth] {
+            assert_eq!(f.factor(0.0, 10.0), 1.0);
+            assert_eq!(f.factor(10.0, 10.0), 0.0);
+            assert_eq!(f.factor(f64::NAN, 10.0), 0.0);
+        }
+        assert!((Falloff::Smooth.factor(5.0, 10.0) - 0.5625).abs() < 1e-15);
+        assert!((Falloff::Linear.factor(5.0, 10.0) - 0.5).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,394 @@
+//! Weight painting and locked handles through the document: commands, undo, recomputes that
+//! keep locked weights (same mesh and re-traced), saving and reopening the locks.
+
+use image::{Rgba, RgbaImage};
+use sinew::document::{compute_rig, Command, Document, DocumentError};
+use sinew::pipeline::Layer;
+use sinew::rig::Bone;
+use sinew::weights::{BrushMode, BrushOptions, Falloff};
+use std::sync::atomic::AtomicBool;
+
+/// An opaque 300 × 40 px bar on a 320 × 80 canvas, saved as a PNG in `dir`.
+fn bar_layer(dir: &std::path::Path) -> Layer {
+    let image = RgbaImage::from_fn(320, 80, |x, y| {
+        if (10..310).contains(&x) && (20..60).contains(&y) {
+            Rgba([90, 140, 200, 255])
+        } else {
+            Rgba([0, 0, 0, 0])
+        }
+    });
+    let path = dir.join("bar.png");
+    image.save(&path).expect("bar.png written");
+    Layer {
+        name: "bar".into(),
+        path,
+        image,
+    }
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("sinew-paint-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bone {
+    Bone {
+        name: name.into(),
+        parent: parent.map(Into::into),
+        head,
+        tail,
+    }
+}
+
+/// A bar with three bones along it, weights computed.
+fn arm(dir: &std::path::Path) -> Document {
+    let mut doc = Document::new();
+    doc.apply(Command::AddLayer(bar_layer(dir))).unwrap();
+    doc.apply(Command::AddBone(bone(
+        "a",
+        None,
+        [20.0, 40.0],
+        [110.0, 40.0],
+    )))
+    .unwrap();
+    doc.apply(Command::AddBone(bone(
+        "b",
+        Some("a"),
+        [110.0, 40.0],
+        [200.0, 40.0],
+    )))
+    .unwrap();
+    doc.apply(Command::AddBone(bone(
+        "c",
+        Some("b"),
+        [200.0, 40.0],
+        [300.0, 40.0],
+    )))
+    .unwrap();
+    compute(&mut doc);
+    doc
+}
+
+fn compute(doc: &mut Document) {
+    let inputs = doc.rig_inputs();
+    let scene = compute_rig(
+        &inputs,
+        &std::env::temp_dir(),
+        &AtomicBool::new(false),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    doc.apply(Command::SetRig(std::sync::Arc::new(scene), inputs.key()))
+        .unwrap();
+}
+
+/// The bar's weight rows.
+fn rows(doc: &Document) -> Vec<Vec<(u32, f64)>> {
+    doc.posable().expect("current weights").doc.parts[0]
+        .weights
+        .as_ref()
+        .expect("weights")
+        .rows
+        .clone()
+}
+
+fn column(rows: &[Vec<(u32, f64)>], c: u32) -> Vec<f64> {
+    rows.iter()
+        .map(|r| r.iter().find(|e| e.0 == c).map_or(0.0, |e| e.1))
+        .collect()
+}
+
+fn vertices(doc: &Document) -> Vec<[f64; 2]> {
+    doc.state().rig.as_ref().expect("a rig").doc.parts[0]
+        .mesh
+        .vertices
+        .clone()
+}
+
+fn check_rows(rows: &[Vec<(u32, f64)>]) {
+    for row in rows {
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
+        assert!(row.iter().all(|e| (0.0..=1.0).contains(&e.1)), "{row:?}");
+    }
+}
+
+/// A stroke painting `handle` along the bar's middle from x = 130 to 190.
+fn stroke(handle: &str, mode: BrushMode) -> Command {
+    Command::PaintWeights {
+        part: "bar".into(),
+        handle: handle.into(),
+        mode,
+        samples_px: vec![[130.0, 40.0], [160.0, 38.0], [190.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 30.0,
+            strength: 0.6,
+            falloff: Falloff::Smooth,
+            spacing: 0.25,
+        },
+    }
+}
+
+#[test]
+fn painting_keeps_locked_handles_and_undoes_in_one_step() {
+    let dir = scratch("undo");
+    let mut doc = arm(&dir);
+    let before = rows(&doc);
+    // Columns: a = 0, b = 1, c = 2.
+    doc.apply(Command::SetLocked {
+        handle: "c".into(),
+        locked: true,
+    })
+    .unwrap();
+    assert!(doc.posable().is_some(), "locking keeps the weights current");
+    doc.apply(stroke("a", BrushMode::Add)).unwrap();
+    let painted = rows(&doc);
+    check_rows(&painted);
+    let (a0, a1) = (column(&before, 0), column(&painted, 0));
+    let v = vertices(&doc);
+    let raised = (0..v.len())
+        .filter(|&i| (v[i][0] - 160.0).abs() < 20.0)
+        .map(|i| a1[i] - a0[i])
+        .fold(0.0, f64::max);
+    assert!(raised > 0.3, "a rose by at most {raised} under the stroke");
+    for (x, y) in column(&before, 2).iter().zip(column(&painted, 2)) {
+        assert_eq!(x.to_bits(), y.to_bits(), "the locked column changed");
+    }
+    // Far from the stroke nothing moved.
+    for i in (0..v.len()).filter(|&i| (v[i][0] - 160.0).abs() > 70.0) {
+        assert_eq!(painted[i], before[i], "vertex at {:?}", v[i]);
+    }
+    // One stroke is one undo step.
+    assert!(doc.undo());
+    assert_eq!(rows(&doc), before);
+    assert!(doc.state().locked.contains("c"));
+    assert!(doc.redo());
+    assert_eq!(rows(&doc), painted);
+
+    // A locked handle cannot be painted; unknown parts and handles are refused; nothing
+    // changes.
+    let err = doc.apply(stroke("c", BrushMode::Add)).unwrap_err();
+    assert!(matches!(err, DocumentError::LockedHandle(_)), "{err}");
+    assert!(matches!(
+        doc.apply(stroke("nope", BrushMode::Add)),
+        Err(DocumentError::UnknownHandle(_))
+    ));
+    let Command::PaintWeights {
+        handle,
+        mode,
+        samples_px,
+        options,
+        ..
+    } = stroke("a", BrushMode::Smooth)
+    else {
+        unreachable!()
+    };
+    assert!(matches!(
+        doc.apply(Command::PaintWeights {
+            part: "leg".into(),
+            handle,
+            mode,
+            samples_px,
+            options,
+        }),
+        Err(DocumentError::UnknownLayer(_))
+    ));
+    assert!(matches!(
+        doc.apply(Command::SetLocked {
+            handle: "nope".into(),
+            locked: true
+        }),
+        Err(DocumentError::UnknownHandle(_))
+    ));
+    assert_eq!(rows(&doc), painted);
+
+    // Stale weights cannot be painted.
+    doc.apply(Command::MoveBone {
+        name: "a".into(),
+        head: [22.0, 40.0],
+        tail: [110.0, 40.0],
+    })
+    .unwrap();
+    assert!(matches!(
+        doc.apply(stroke("a", BrushMode::Add)),
+        Err(DocumentError::NoWeights)
+    ));
+}
+
+#[test]
+fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
+    let dir = scratch("recompute");
+    let mut doc = arm(&dir);
+    let fresh = rows(&doc);
+    // Paint b far into c's side, lock b, then edit a bone so the weights must be recomputed.
+    let paint = Command::PaintWeights {
+        part: "bar".into(),
+        handle: "b".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[230.0, 40.0], [280.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 30.0,
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            spacing: 0.25,
+        },
+    };
+    doc.apply(paint).unwrap();
+    let painted = rows(&doc);
+    let v_old = vertices(&doc);
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: true,
+    })
+    .unwrap();
+    doc.apply(Command::MoveBone {
+        name: "a".into(),
+        head: [20.0, 44.0],
+        tail: [110.0, 40.0],
+    })
+    .unwrap();
+    compute(&mut doc);
+    let kept = rows(&doc);
+    check_rows(&kept);
+    // Bones are embedded in the mesh, so moving one may move vertices: compare the locked
+    // column where a vertex stayed (elsewhere it is carried over, see below).
+    let v_new = vertices(&doc);
+    let b_painted = column(&painted, 1);
+    let b_fresh = column(&fresh, 1);
+    let b_kept = column(&kept, 1);
+    let mut compared = 0;
+    for (i, p) in v_new.iter().enumerate() {
+        if let Some(j) = v_old.iter().position(|q| q == p) {
+            assert!(
+                (b_kept[i] - b_painted[j]).abs() < 1e-9,
+                "b at {p:?}: kept {} painted {}",
+                b_kept[i],
+                b_painted[j]
+            );
+            compared += 1;
+        }
+    }
+    assert!(
+        compared > 10,
+        "{compared} of {} vertices stayed",
+        v_new.len()
+    );
+    // Where the stroke went, b is far above what a plain recompute gives.
+    let far = v_new
+        .iter()
+        .position(|p| (p[0] - 255.0).abs() < 8.0 && (p[1] - 40.0).abs() < 8.0)
+        .expect("a vertex near (255, 40)");
+    let j = v_old
+        .iter()
+        .position(|q| (q[0] - v_new[far][0]).hypot(q[1] - v_new[far][1]) < 10.0)
+        .expect("an old vertex nearby");
+    assert!(
+        b_kept[far] > 0.9 && b_fresh[j] < 0.2,
+        "{} {}",
+        b_kept[far],
+        b_fresh[j]
+    );
+
+    // Re-trace with another mesh density: the locked weights are carried over by position.
+    let mut options = doc.state().options.clone();
+    options.mesh.max_area_fraction *= 0.5;
+    doc.apply(Command::SetOptions(options)).unwrap();
+    compute(&mut doc);
+    let remeshed = rows(&doc);
+    check_rows(&remeshed);
+    let v_remeshed = vertices(&doc);
+    assert_ne!(v_remeshed.len(), v_new.len(), "the mesh changed");
+    let b_remeshed = column(&remeshed, 1);
+    for (i, p) in v_remeshed.iter().enumerate() {
+        if (p[0] - 255.0).abs() < 15.0 && (p[1] - 40.0).abs() < 12.0 {
+            assert!(b_remeshed[i] > 0.85, "b at {p:?} is {}", b_remeshed[i]);
+        }
+    }
+
+    // Unlocked, a recompute overwrites the painted weights.
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: false,
+    })
+    .unwrap();
+    doc.apply(Command::MoveBone {
+        name: "a".into(),
+        head: [20.0, 40.0],
+        tail: [110.0, 40.0],
+    })
+    .unwrap();
+    compute(&mut doc);
+    let plain = column(&rows(&doc), 1);
+    let v = vertices(&doc);
+    let i = v
+        .iter()
+        .position(|p| (p[0] - 255.0).abs() < 8.0 && (p[1] - 40.0).abs() < 8.0)
+        .expect("a vertex near (255, 40)");
+    assert!(plain[i] < 0.2, "{}", plain[i]);
+}
+
+#[test]
+fn locks_are_saved_and_reopened() {
+    let dir = scratch("save");
+    let mut doc = arm(&dir);
+    let path = dir.join("arm.json");
+    doc.save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(!text.contains("\"locked\""), "no locks, no field");
+    // Paint b where c rules, lock it, rename it: the recompute keeps its weights.
+    doc.apply(Command::PaintWeights {
+        part: "bar".into(),
+        handle: "b".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[250.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 20.0,
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            spacing: 0.25,
+        },
+    })
+    .unwrap();
+    let painted = column(&rows(&doc), 1);
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: true,
+    })
+    .unwrap();
+    doc.apply(Command::Rename {
+        from: "b".into(),
+        to: "mid".into(),
+    })
+    .unwrap();
+    compute(&mut doc);
+    let kept = rows(&doc);
+    let scene = doc.posable().unwrap();
+    assert_eq!(
+        scene.doc.parts[0].weights.as_ref().unwrap().handles,
+        vec!["a", "mid", "c"]
+    );
+    check_rows(&kept);
+    let v = vertices(&doc);
+    let near = (0..v.len())
+        .filter(|&i| (v[i][0] - 250.0).hypot(v[i][1] - 40.0) < 18.0)
+        .collect::<Vec<_>>();
+    assert!(!near.is_empty());
+    for i in near {
+        assert!(
+            painted[i] == 1.0 && column(&kept, 1)[i] == 1.0,
+            "mid at {:?}",
+            v[i]
+        );
+    }
+    doc.save(&path).unwrap();
+    let reopened = Document::open(&path).unwrap();
+    assert_eq!(
+        reopened.state().locked.iter().collect::<Vec<_>>(),
+        vec!["mid"]
+    );
+    assert!(reopened.posable().is_some());
+    doc.apply(Command::Delete { name: "mid".into() }).unwrap();
+    assert!(doc.state().locked.is_empty());
+}
