@@ -635,6 +635,7 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     }
     assert!(wrapped, "playback never looped");
     // Without looping it stops on the last key.
+    h.state_mut().playing = false;
     h.get_by_label("Loop").click();
     h.run();
     h.state_mut().playing = true;
@@ -646,6 +647,14 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     }
     assert!(!h.state().playing);
     assert!((h.state().time_s - 0.5).abs() < 1e-9);
+    // Playing again from the end starts over.
+    h.state_mut().playing = true;
+    h.step();
+    assert_eq!(h.state().time_s, 0.0);
+    h.step();
+    assert!(h.state().time_s > 0.0);
+    h.state_mut().playing = false;
+    h.state_mut().set_time(0.5);
 
     // Onion skins: at the end only earlier frames exist; in the middle both sides.
     h.get_by_label("Onion skin").click();

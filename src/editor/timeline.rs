@@ -191,6 +191,10 @@ pub struct TimelineState {
     onion_cache: OnionCache,
     /// Real time played since the last frame step, s.
     play_clock_s: f64,
+    /// Whether playback ran last frame (starting again from the end rewinds first).
+    was_playing: bool,
+    /// The animation the selection belongs to.
+    selection_of: String,
 }
 
 impl Default for TimelineState {
@@ -206,6 +210,8 @@ impl Default for TimelineState {
             gesture: None,
             onion_cache: OnionCache::default(),
             play_clock_s: 0.0,
+            was_playing: false,
+            selection_of: String::new(),
         }
     }
 }
@@ -322,17 +328,26 @@ impl EditorApp {
     pub(super) fn advance_playback(&mut self, ctx: &egui::Context) {
         if !self.playing || self.mode != Mode::Animate {
             self.timeline.play_clock_s = 0.0;
+            self.timeline.was_playing = false;
             return;
         }
         ctx.request_repaint();
         let frame_s = self.frame_s();
+        let end = self.play_end_s();
+        if !self.timeline.was_playing {
+            self.timeline.was_playing = true;
+            // Play pressed on the last frame starts over.
+            if self.time_s >= end - KEY_TIME_TOLERANCE_S {
+                self.set_time(0.0);
+                return;
+            }
+        }
         self.timeline.play_clock_s += f64::from(ctx.input(|i| i.stable_dt));
         let steps = (self.timeline.play_clock_s / frame_s + 1e-9).floor();
         if steps < 1.0 {
             return;
         }
         self.timeline.play_clock_s = (self.timeline.play_clock_s - steps * frame_s).max(0.0);
-        let end = self.play_end_s();
         let mut t = ((self.time_s / frame_s).round() + steps) * frame_s;
         if t >= end - KEY_TIME_TOLERANCE_S {
             if self.timeline.looping {
@@ -343,6 +358,7 @@ impl EditorApp {
             } else {
                 t = end;
                 self.playing = false;
+                self.timeline.was_playing = false;
             }
         }
         self.set_time(t);
@@ -520,7 +536,11 @@ impl EditorApp {
         });
         let json = crate::document::animation_json(self.doc.state(), &self.animation);
         let timelines = edit::timelines(&json);
-        // Undo, redo and other edits can take selected keys away.
+        // Another animation, undo, redo and other edits can take selected keys away.
+        if self.timeline.selection_of != self.animation {
+            self.timeline.selection_of = self.animation.clone();
+            self.timeline.selection.clear();
+        }
         self.timeline.selection.retain(|k| {
             timelines
                 .iter()
