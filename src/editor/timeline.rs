@@ -932,7 +932,7 @@ impl EditorApp {
             }
         };
         ui.label(format!(
-            "{}: {:.3} s → {:.3} s",
+            "{}: {:.3} s to {:.3} s",
             key.timeline.label(),
             segment.start_s,
             segment.end_s
@@ -1044,6 +1044,28 @@ impl EditorApp {
                 Color32::from_rgb(255, 140, 40),
                 Stroke::NONE,
             ));
+        }
+        // The value range shown, at the graph's top and bottom.
+        let font = egui::FontId::proportional(10.0);
+        for (value, y, align) in [
+            (
+                layout.high,
+                response.rect.top() + 2.0,
+                egui::Align2::LEFT_TOP,
+            ),
+            (
+                layout.low,
+                response.rect.bottom() - 2.0,
+                egui::Align2::LEFT_BOTTOM,
+            ),
+        ] {
+            painter.text(
+                egui::pos2(response.rect.left() + 3.0, y),
+                align,
+                format!("{value:.2}"),
+                font.clone(),
+                Color32::from_gray(150),
+            );
         }
         let handle_pos = handles.map(|h| h.map(|(t, v)| layout.screen(t, v)));
         if let Some(h) = handle_pos {
