@@ -673,3 +673,75 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     h.state_mut().timeline.onion.enabled = false;
     assert!(h.state_mut().onion_shapes(&scene, &placed).is_empty());
 }
+
+#[test]
+fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
+    use crate::anim::edit::{KeyRef, TransformChannel::*};
+    let path = character_rig("keyboard");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    {
+        let app = h.state_mut();
+        for (time_s, degrees) in [(0.0, 0.0), (0.5, 30.0)] {
+            let mut pose = Pose::default();
+            pose.bones.insert(
+                "head".into(),
+                crate::rig::pose::BonePose {
+                    rotate: degrees,
+                    ..Default::default()
+                },
+            );
+            assert!(app.apply(Command::SetKey {
+                animation: "nod".into(),
+                time_s,
+                pose,
+            }));
+        }
+        app.animation = "nod".into();
+    }
+    h.key_press(Key::Num3);
+    h.run();
+    // Click one key, shift-click another: both selected; shift-click again: deselected.
+    let at = key_on_sheet(&h, Rotate, 0.5);
+    click_screen(&mut h, at);
+    let translate = key_on_sheet(&h, Translate, 0.5);
+    // One frame per event: shift down, press, release, shift up.
+    h.event(egui::Event::ModifiersChanged(Modifiers::SHIFT));
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: translate,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::SHIFT,
+        });
+    }
+    h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+    h.step();
+    h.run();
+    let selection = &h.state().timeline.selection;
+    assert_eq!(selection.len(), 2, "{selection:?}");
+    assert!(selection.contains(&KeyRef {
+        timeline: head(Translate),
+        time_s: 0.5
+    }));
+    assert!(
+        (h.state().time_s - 0.5).abs() < 1e-9,
+        "a plain click moves the playhead to its key"
+    );
+    // Ctrl+C, playhead to 1 s, Ctrl+V: both keys pasted at 1 s.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::C);
+    h.run();
+    assert_eq!(h.state().timeline.clipboard.len(), 2);
+    h.state_mut().set_time(1.0);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Scale), vec![0.0, 0.5], "not copied");
+    assert_eq!(head_rotate_keys(&h)[2].1, 30.0);
+    // The pasted keys are the selection now; Delete removes exactly them.
+    h.key_press(Key::Delete);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+}
