@@ -569,25 +569,33 @@ fn pose(args: &PoseArgs) -> Result<()> {
 fn render_animation(args: &RenderArgs) -> Result<()> {
     let scene = Scene::load(&args.rig)?;
     let animation = animation(&scene.doc, &args.anim)?;
-    let background = args
-        .background
-        .as_deref()
-        .map(io::sequence::parse_rgba_hex)
-        .transpose()?;
-    let view = FrameView::new(scene.doc.canvas, args.scale, args.size, background)?;
-    let times = playback::frame_times(animation.duration_s(), args.fps)?;
-    // Check the target before rendering: an unknown extension fails at once.
+    let settings = playback::RenderSettings {
+        fps: args.fps,
+        scale: args.scale,
+        size_px: args.size,
+        background: args
+            .background
+            .as_deref()
+            .map(io::sequence::parse_rgba_hex)
+            .transpose()?,
+        blend: args.blend,
+        sampling: sample_options(args.match_runtime),
+    };
+    // Check the settings and the target before rendering: a bad one fails at once.
+    settings.view(scene.doc.canvas)?;
     io::sequence::format_for_path(&args.output)?;
-    let frames = render_with_progress_bar(
-        &scene,
-        &animation,
-        &times,
-        args.blend,
-        &view,
-        &sample_options(args.match_runtime),
-    )?;
+    let bar = indicatif::ProgressBar::new(
+        playback::frame_times(animation.duration_s(), args.fps)?.len() as u64,
+    );
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("rendering {bar:30} {pos}/{len} frames")
+    {
+        bar.set_style(style);
+    }
+    let frames = playback::render_animation(&scene, &animation, &settings, &|| bar.inc(1));
+    bar.finish_and_clear();
     let report =
-        io::sequence::write_sequence(&frames, args.fps, &args.output, &Default::default())?;
+        io::sequence::write_sequence(&frames?, args.fps, &args.output, &Default::default())?;
     println!(
         "{}: {} frames of {}×{} px, {:.2} s",
         args.output.display(),
@@ -597,27 +605,6 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         report.duration_s
     );
     Ok(())
-}
-
-/// Renders the frames at `times` with a progress bar on a terminal.
-fn render_with_progress_bar(
-    scene: &Scene,
-    animation: &anim::Animation,
-    times: &[f64],
-    blend: Blend,
-    view: &FrameView,
-    sampling: &SampleOptions,
-) -> Result<Vec<image::RgbaImage>> {
-    let bar = indicatif::ProgressBar::new(times.len() as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("rendering {bar:30} {pos}/{len} frames")
-    {
-        bar.set_style(style);
-    }
-    let poses = playback::poses_at_with(animation, times, sampling);
-    let frames = playback::render_poses(scene, &poses, times, blend, view, &|| bar.inc(1));
-    bar.finish_and_clear();
-    Ok(frames?)
 }
 
 /// The document's animation `name`, checked against its rig.

@@ -69,6 +69,8 @@ pub enum DocumentError {
     #[error(transparent)]
     Playback(#[from] crate::playback::PlaybackError),
     #[error(transparent)]
+    Render(#[from] crate::playback::RenderAnimationError),
+    #[error(transparent)]
     Sequence(#[from] crate::io::sequence::SequenceError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
@@ -412,16 +414,15 @@ impl Document {
     }
 }
 
-/// Renders animation `name` of `doc` at `fps` at canvas size to `output`, which is a folder of
+/// Renders animation `name` of `doc` as `settings` say to `output`, which is a folder of
 /// numbered PNGs, a `.gif` or a `.png` sprite sheet, as `sinew render` does.
 pub fn render_animation(
     doc: RigDocument,
     images: &[image::RgbaImage],
     name: &str,
-    fps: f64,
+    settings: &crate::playback::RenderSettings,
     output: &Path,
 ) -> Result<crate::io::sequence::SequenceReport, DocumentError> {
-    use crate::playback::{self, FrameView};
     let animation = crate::anim::load_animations(&doc)?
         .remove(name)
         .ok_or_else(|| {
@@ -431,19 +432,11 @@ pub fn render_animation(
             })
         })?;
     crate::io::sequence::format_for_path(output)?;
-    let view = FrameView::new(doc.canvas, 1.0, None, None)?;
-    let times = playback::frame_times(animation.duration_s(), fps)?;
+    // Settings are checked before the scene is built: a bad scale fails at once.
+    settings.view(doc.canvas)?;
     let scene = Scene::new(doc, images)?;
-    let poses = playback::poses_at_with(&animation, &times, &Default::default());
-    let frames = playback::render_poses(
-        &scene,
-        &poses,
-        &times,
-        crate::skin::Blend::Linear,
-        &view,
-        &|| {},
-    )?;
-    crate::io::sequence::write_sequence(&frames, fps, output, &Default::default())
+    let frames = crate::playback::render_animation(&scene, &animation, settings, &|| {})?;
+    crate::io::sequence::write_sequence(&frames, settings.fps, output, &Default::default())
         .map_err(DocumentError::from)
 }
 

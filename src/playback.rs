@@ -32,6 +32,78 @@ pub struct FrameView {
     pub background: Option<[u8; 4]>,
 }
 
+/// How an animation is rendered to frames: the options `sinew render` takes as flags and the
+/// editor's File → Render as fields, in one place so both render the same.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderSettings {
+    /// Frames per second, in (0, [`MAX_FPS`]]. Default [`DEFAULT_RENDER_FPS`].
+    pub fps: f64,
+    /// Output px per canvas px, > 0. Default 1.
+    pub scale: f64,
+    /// Output size, px; the scaled canvas is centered in it. Default `None`: the scaled canvas.
+    pub size_px: Option<[u32; 2]>,
+    /// Straight RGBA8 background. Default `None`: transparent.
+    pub background: Option<[u8; 4]>,
+    /// How handle transformations blend. Default linear.
+    pub blend: Blend,
+    /// Exact curves, or as Spine's runtimes play them. Default exact.
+    pub sampling: SampleOptions,
+}
+
+/// The frame rate of [`RenderSettings::default`], frames per second.
+pub const DEFAULT_RENDER_FPS: f64 = 24.0;
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            fps: DEFAULT_RENDER_FPS,
+            scale: 1.0,
+            size_px: None,
+            background: None,
+            blend: Blend::Linear,
+            sampling: SampleOptions::default(),
+        }
+    }
+}
+
+impl RenderSettings {
+    /// The output view for a canvas of `canvas_px`.
+    pub fn view(&self, canvas_px: [u32; 2]) -> Result<FrameView, PlaybackError> {
+        FrameView::new(canvas_px, self.scale, self.size_px, self.background)
+    }
+}
+
+/// Plays `animation` on `scene` as `settings` say: the frames at
+/// [`frame_times`]`(duration, fps)`. `on_frame` is called once per frame drawn (progress).
+pub fn render_animation(
+    scene: &Scene,
+    animation: &Animation,
+    settings: &RenderSettings,
+    on_frame: &(dyn Fn() + Sync),
+) -> Result<Vec<RgbaImage>, RenderAnimationError> {
+    let view = settings.view(scene.doc.canvas)?;
+    let times = frame_times(animation.duration_s(), settings.fps)?;
+    let poses = poses_at_with(animation, &times, &settings.sampling);
+    Ok(render_poses(
+        scene,
+        &poses,
+        &times,
+        settings.blend,
+        &view,
+        on_frame,
+    )?)
+}
+
+/// Why [`render_animation`] failed: its settings, or posing and drawing the rig.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderAnimationError {
+    #[error(transparent)]
+    Settings(#[from] PlaybackError),
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+}
+
 /// What is wrong with a playback request.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlaybackError {

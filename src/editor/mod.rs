@@ -13,6 +13,7 @@
 //! dopesheet, curves, playback and onion skins: [`timeline`]).
 
 pub mod canvas;
+pub mod gizmo;
 pub mod timeline;
 pub mod worker;
 
@@ -25,6 +26,7 @@ use crate::ik::RigIk;
 use crate::pipeline::{Layer, Scene};
 use crate::rig::pose::IkDrag;
 use crate::rig::{Bone, PointHandle, Pose};
+use crate::skin::Blend;
 use canvas::{Placed, View};
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
 use std::path::{Path, PathBuf};
@@ -34,8 +36,6 @@ use worker::Worker;
 
 /// Seconds between autosaves of a changed document.
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
-/// Frames per second of the animate mode's frame steps.
-pub const DEFAULT_FPS: f64 = 24.0;
 /// The timeline shows at least this many seconds.
 pub const MIN_TIMELINE_S: f64 = 2.0;
 /// A press and release closer than this (canvas px) is a click, not a drag.
@@ -102,6 +102,8 @@ enum Gesture {
         index: usize,
         pose: Pose,
     },
+    /// Grab, rotate or scale the selected handle by forward kinematics.
+    Fk(gizmo::FkGesture),
     Pan,
 }
 
@@ -110,6 +112,8 @@ struct Posed {
     scene: *const Scene,
     pose: Pose,
     positions: Vec<Vec<Point>>,
+    /// Per handle column, the transform shown (forward kinematics or the IK's solution).
+    transforms: Vec<crate::rig::Affine>,
     /// The handles where the pose puts them (bones' heads and tails, points), for drawing.
     handles: crate::rig::Handles,
 }
@@ -145,14 +149,14 @@ pub struct EditorApp {
     pub animation: String,
     pub time_s: f64,
     pub playing: bool,
-    /// Frames per second of the frame-step buttons.
-    pub fps: f64,
     /// Animate mode: the pose edited since the playhead last moved (not yet keyed).
     shown: Option<Pose>,
     /// Where File → Export writes.
     pub export_dir: String,
     /// Where File → Render writes.
     pub render_path: String,
+    /// File → Render's options (those of `sinew render`).
+    pub render_settings: crate::playback::RenderSettings,
     /// A render under way on another thread: its message when done.
     render: Option<std::sync::mpsc::Receiver<String>>,
     /// Animate mode: key selection, clipboard, loop, onion skins, curve editor.
@@ -196,10 +200,10 @@ impl EditorApp {
             animation: first_animation,
             time_s: 0.0,
             playing: false,
-            fps: DEFAULT_FPS,
             shown: None,
             export_dir: "export".into(),
             render_path: "render.gif".into(),
+            render_settings: Default::default(),
             render: None,
             timeline: Default::default(),
         }
@@ -360,23 +364,23 @@ impl EditorApp {
             }
         };
         let (send, receive) = std::sync::mpsc::channel();
-        let (name, fps, output) = (
+        let (name, settings, output) = (
             self.animation.clone(),
-            self.fps,
+            self.render_settings.clone(),
             PathBuf::from(&self.render_path),
         );
         let ctx = ctx.clone();
         std::thread::spawn(move || {
             let (doc, images) = job;
-            let message = match crate::document::render_animation(doc, &images, &name, fps, &output)
-            {
-                Ok(report) => format!(
-                    "rendered {} frames to {}",
-                    report.frame_count,
-                    output.display()
-                ),
-                Err(e) => e.to_string(),
-            };
+            let message =
+                match crate::document::render_animation(doc, &images, &name, &settings, &output) {
+                    Ok(report) => format!(
+                        "rendered {} frames to {}",
+                        report.frame_count,
+                        output.display()
+                    ),
+                    Err(e) => e.to_string(),
+                };
             // The editor may have closed meanwhile.
             let _ = send.send(message);
             ctx.request_repaint();
@@ -523,7 +527,8 @@ impl EditorApp {
         if redo && self.gesture.is_none() {
             self.doc.redo();
         }
-        if delete {
+        // Pose mode selects handles to pose them; deleting one is a rig edit.
+        if delete && self.mode == Mode::Rig {
             if let Some(name) = self.selected.take() {
                 self.apply(Command::Delete { name });
             }
@@ -581,6 +586,7 @@ impl EditorApp {
                 }
                 ui.label("Render the current animation to (.gif, .png sheet or a folder):");
                 ui.text_edit_singleline(&mut self.render_path);
+                render_settings_ui(ui, &mut self.render_settings);
                 if ui
                     .add_enabled(self.render.is_none(), egui::Button::new("Render"))
                     .clicked()
@@ -839,6 +845,7 @@ impl EditorApp {
             scene: key,
             pose: pose.clone(),
             positions,
+            transforms,
             handles,
         });
         Ok(())
@@ -869,6 +876,7 @@ impl EditorApp {
         let posable = self.doc.posable().cloned();
         let live_pose = match &self.gesture {
             Some(Gesture::PoseDrag { pose, .. }) => Some(pose.clone()),
+            Some(Gesture::Fk(g)) => Some(g.preview.clone()),
             _ => None,
         };
         let mut shapes = Vec::new();
@@ -942,6 +950,15 @@ impl EditorApp {
             _ => {}
         }
         shapes.extend(canvas::handles(&placed, &handles, self.selected.as_deref()));
+        if let (Mode::Pose | Mode::Animate, Some(scene)) = (self.mode, &posable) {
+            if let Some(target) = self.fk_target(scene) {
+                let active = match &self.gesture {
+                    Some(Gesture::Fk(g)) => Some(g.kind),
+                    _ => None,
+                };
+                shapes.extend(gizmo::shapes(&placed, &target, active));
+            }
+        }
         painter.extend(shapes);
         match self.mode {
             Mode::Rig => self.rig_gestures(&ctx, &response, placed),
@@ -1089,6 +1106,9 @@ impl EditorApp {
         placed: Placed,
         scene: &Arc<Scene>,
     ) {
+        if self.fk_gestures(ctx, response, placed, scene) {
+            return;
+        }
         let pointer = response.interact_pointer_pos();
         let shift = ctx.input(|i| i.modifiers.shift);
         let grab = |app: &EditorApp, at: Pos2| -> Option<[f64; 2]> {
@@ -1131,6 +1151,12 @@ impl EditorApp {
                 self.commit_pose(pose);
             }
         }
+        if response.clicked() && !shift {
+            // A click selects the handle under it (for the gizmo and G/R/S), or nothing.
+            if let (Some(at), Some(posed)) = (pointer, &self.posed) {
+                self.selected = canvas::pick(&placed, &posed.handles, at);
+            }
+        }
         if response.clicked() && shift {
             if let Some(at) = pointer {
                 if let Some(rest) = grab(self, at) {
@@ -1144,6 +1170,94 @@ impl EditorApp {
                 }
             }
         }
+    }
+
+    /// Where the selected bone or point is shown, for its gizmo; `None` when nothing posable
+    /// is selected.
+    fn fk_target(&self, scene: &Arc<Scene>) -> Option<crate::rig::fk_edit::FkTarget> {
+        let (name, posed) = (self.selected.as_deref()?, self.posed.as_ref()?);
+        crate::rig::fk_edit::target(&scene.doc.handles, &posed.transforms, name).ok()
+    }
+
+    /// The FK gizmo and the G/R/S keys. Returns whether they took the pointer this frame.
+    fn fk_gestures(
+        &mut self,
+        ctx: &egui::Context,
+        response: &egui::Response,
+        placed: Placed,
+        scene: &Arc<Scene>,
+    ) -> bool {
+        let handles = &scene.doc.handles;
+        let hover = ctx.input(|i| i.pointer.hover_pos());
+        if let Some(Gesture::Fk(g)) = &mut self.gesture {
+            let pointer = if g.modal {
+                hover
+            } else {
+                response.interact_pointer_pos()
+            };
+            if let Some(at) = pointer {
+                if let Err(e) = g.update(handles, placed.canvas_from_screen(at)) {
+                    self.message = Some(e.to_string());
+                }
+            }
+            let (confirm, cancel) = if g.modal {
+                (response.clicked(), response.secondary_clicked())
+            } else {
+                (response.drag_stopped(), false)
+            };
+            if confirm {
+                if let Some(Gesture::Fk(g)) = self.gesture.take() {
+                    self.commit_pose(g.preview);
+                }
+            } else if cancel {
+                self.gesture = None;
+            }
+            return true;
+        }
+        if self.gesture.is_some() {
+            return false;
+        }
+        let (Some(name), Some(target)) = (self.selected.clone(), self.fk_target(scene)) else {
+            return false;
+        };
+        let typing = ctx.text_edit_focused();
+        let key = ctx.input(|i| {
+            [
+                (Key::G, gizmo::FkKind::Grab),
+                (Key::R, gizmo::FkKind::Rotate),
+                (Key::S, gizmo::FkKind::Scale),
+            ]
+            .into_iter()
+            .find(|(k, _)| !typing && i.modifiers.is_none() && i.key_pressed(*k))
+            .map(|(_, kind)| kind)
+        });
+        let pressed = if response.drag_started_by(egui::PointerButton::Primary) {
+            ctx.input(|i| i.pointer.press_origin())
+                .and_then(|at| Some((gizmo::hit(&placed, &target, at)?, at)))
+        } else {
+            None
+        };
+        let (kind, at, modal) = match (key, hover, pressed) {
+            (Some(kind), Some(at), _) => (kind, at, true),
+            (_, _, Some((kind, at))) => (kind, at, false),
+            _ => return false,
+        };
+        let Some(shown) = self.posed.as_ref().map(|p| p.transforms.clone()) else {
+            return false;
+        };
+        match gizmo::FkGesture::start(
+            handles,
+            &self.edited_pose(),
+            &shown,
+            &name,
+            kind,
+            placed.canvas_from_screen(at),
+            modal,
+        ) {
+            Ok(g) => self.gesture = Some(Gesture::Fk(g)),
+            Err(e) => self.message = Some(e.to_string()),
+        }
+        true
     }
 
     /// The pose the canvas edits: the document's in pose mode; in animate mode the pose being
@@ -1268,6 +1382,61 @@ pub fn rest_point_under(
     None
 }
 
+/// The fields of `sinew render`'s options.
+fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderSettings) {
+    use crate::anim::CurveEvaluation;
+    egui::Grid::new("render settings").show(ui, |ui| {
+        ui.label("Frames per second");
+        ui.add(
+            egui::DragValue::new(&mut settings.fps)
+                .range(1.0..=crate::playback::MAX_FPS)
+                .speed(0.2),
+        );
+        ui.end_row();
+        ui.label("Scale (output px per canvas px)");
+        ui.add(
+            egui::DragValue::new(&mut settings.scale)
+                .range(0.05..=8.0)
+                .speed(0.01),
+        );
+        ui.end_row();
+        ui.label("Background");
+        ui.horizontal(|ui| {
+            let mut opaque = settings.background.is_some();
+            ui.checkbox(&mut opaque, "");
+            match (opaque, settings.background) {
+                (true, Some(mut rgba)) => {
+                    ui.color_edit_button_srgba_unmultiplied(&mut rgba);
+                    settings.background = Some(rgba);
+                }
+                (true, None) => settings.background = Some([255, 255, 255, 255]),
+                (false, _) => {
+                    settings.background = None;
+                    ui.label("transparent");
+                }
+            }
+        });
+        ui.end_row();
+        ui.label("Blend");
+        egui::ComboBox::from_id_salt("render blend")
+            .selected_text(format!("{:?}", settings.blend))
+            .show_ui(ui, |ui| {
+                for blend in [Blend::Linear, Blend::Dqs, Blend::Stretch] {
+                    ui.selectable_value(&mut settings.blend, blend, format!("{blend:?}"));
+                }
+            });
+        ui.end_row();
+        let mut spine = settings.sampling.curves == CurveEvaluation::SpineRuntime;
+        ui.checkbox(&mut spine, "Curves as Spine's runtimes play them");
+        settings.sampling.curves = if spine {
+            CurveEvaluation::SpineRuntime
+        } else {
+            CurveEvaluation::Exact
+        };
+        ui.end_row();
+    });
+}
+
 fn help_window(ctx: &egui::Context, open: &mut bool) {
     egui::Window::new("Keyboard shortcuts")
         .open(open)
@@ -1291,9 +1460,15 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Ctrl+Shift+Z", "redo"),
     (
         "Delete",
-        "delete the selected handle (the selected keys in animate mode)",
+        "delete the selected handle (rig mode), the selected keys (animate mode)",
     ),
     ("Shift+click", "pin a point (pose mode)"),
+    ("Click", "select the handle under the pointer (pose mode)"),
+    (
+        "G / R / S",
+        "grab / rotate / scale the selected bone or point (pose mode; click confirms, \
+         Esc or right click cancels); or drag its gizmo's centre / ring / square",
+    ),
     ("Mouse wheel", "zoom about the pointer"),
     ("Middle drag", "pan"),
     ("Esc", "cancel the gesture, close this help"),

@@ -148,6 +148,11 @@ fn rig_weigh_pose_undo_through_the_ui() {
     h.key_press(Key::Num2);
     h.run();
     assert_eq!(h.state().mode, Mode::Pose);
+    // The new bone is still selected, and its gizmo sits where the torso will be gripped: a
+    // click on empty canvas deselects it.
+    assert!(h.state().selected.is_some());
+    click(&mut h, [4.0, 4.0]);
+    assert_eq!(h.state().selected, None);
     let grip = torso_point(&h);
     drag(&mut h, grip, [grip[0] + 25.0, grip[1] - 15.0]);
     let pose = &h.state().doc.state().pose;
@@ -341,7 +346,8 @@ fn renders_the_current_animation_in_the_background() {
             }));
         }
         app.animation = "nod".into();
-        app.fps = 8.0;
+        app.render_settings.fps = 8.0;
+        app.render_settings.scale = 0.5;
         app.render_path = gif.display().to_string();
     }
     h.run();
@@ -358,6 +364,10 @@ fn renders_the_current_animation_in_the_background() {
     assert!(message.starts_with("rendered"), "{message}");
     let bytes = std::fs::read(&gif).expect("the GIF was written");
     assert!(bytes.starts_with(b"GIF89a"));
+    // The settings reached the renderer: the GIF's logical screen is the half-scale canvas.
+    let canvas_width = h.state().doc.state().layers[0].image.width();
+    let width = u16::from_le_bytes([bytes[6], bytes[7]]);
+    assert_eq!(u32::from(width), canvas_width.div_ceil(2));
     // An animation the document does not have: a message, no file.
     h.state_mut().animation = "nope".into();
     h.state_mut().render_path = path.with_file_name("nope.gif").display().to_string();
@@ -372,6 +382,83 @@ fn renders_the_current_animation_in_the_background() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("nope"), "{message}");
     assert!(!path.with_file_name("nope.gif").exists());
+}
+
+/// Press and release at `at` (canvas px) without moving.
+fn click(h: &mut Harness<'_, EditorApp>, at: [f64; 2]) {
+    h.drag_at(screen(h, at));
+    h.step();
+    h.drop_at(screen(h, at));
+    h.step();
+    h.run();
+}
+
+/// Where the document's pose shows `bone`'s head, canvas px.
+fn shown_head(h: &Harness<'_, EditorApp>, bone: &str) -> [f64; 2] {
+    let scene = h.state().doc.posable().expect("posable").clone();
+    let shown = scene
+        .handle_transforms(&h.state().doc.state().pose)
+        .expect("forward kinematics");
+    crate::rig::fk_edit::target(&scene.doc.handles, &shown, bone)
+        .expect("a bone")
+        .pivot_px
+}
+
+#[test]
+fn rotate_with_r_and_grab_with_the_gizmo_in_pose_mode() {
+    let path = character_rig("gizmo");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num2);
+    h.run();
+    // The chest bone runs up from (256, 262) to (256, 198): click its middle to select it.
+    let pivot = [256.0, 262.0];
+    click(&mut h, [256.0, 225.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+
+    // R, then a quarter turn counter-clockwise on screen about the head, then a click.
+    h.hover_at(screen(&h, [pivot[0] + 60.0, pivot[1]]));
+    h.step();
+    h.key_press(Key::R);
+    h.step();
+    for p in [
+        [pivot[0] + 42.0, pivot[1] - 42.0],
+        [pivot[0], pivot[1] - 60.0],
+    ] {
+        h.hover_at(screen(&h, p));
+        h.step();
+    }
+    assert!(
+        h.state().doc.state().pose.bones.is_empty(),
+        "previewed, not committed"
+    );
+    click(&mut h, [pivot[0], pivot[1] - 60.0]);
+    let rotate = h.state().doc.state().pose.bones["chest"].rotate;
+    assert!((rotate - 90.0).abs() < 0.5, "turned {rotate}°");
+
+    // Undo takes the whole turn back.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(h.state().doc.state().pose.bones.is_empty());
+
+    // Escape cancels a modal grab.
+    h.hover_at(screen(&h, [300.0, 300.0]));
+    h.step();
+    h.key_press(Key::G);
+    h.step();
+    h.hover_at(screen(&h, [320.0, 280.0]));
+    h.step();
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(h.state().doc.state().pose.bones.is_empty());
+
+    // Dragging the gizmo's centre moves the head by the drag on the canvas.
+    drag(&mut h, pivot, [pivot[0] + 10.0, pivot[1] - 4.0]);
+    let head = shown_head(&h, "chest");
+    assert!(
+        distance(head, [pivot[0] + 10.0, pivot[1] - 4.0]) < 0.5,
+        "head at {head:?}"
+    );
 }
 
 /// Press at `from`, move in steps, release at `to` (screen points).
@@ -620,7 +707,7 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
             }));
         }
         app.animation = "nod".into();
-        app.fps = 12.0;
+        app.render_settings.fps = 12.0;
         app.playing = true;
     }
     let on_frame = |t: f64| ((t * 12.0) - (t * 12.0).round()).abs() < 1e-6;

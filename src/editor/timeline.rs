@@ -298,9 +298,10 @@ impl EditorApp {
             .max(super::MIN_TIMELINE_S)
     }
 
-    /// Seconds per frame at the editor's frame rate.
+    /// Seconds per frame at the frame rate: File → Render's, so playback shows the frames a
+    /// render writes (the rig document keeps no frame rate of its own).
     fn frame_s(&self) -> f64 {
-        1.0 / self.fps.max(1.0)
+        1.0 / self.render_settings.fps.max(1.0)
     }
 
     /// `time_s` on the nearest frame.
@@ -471,8 +472,8 @@ impl EditorApp {
                 self.set_time(t);
             }
             ui.add(
-                egui::DragValue::new(&mut self.fps)
-                    .range(1.0..=240.0)
+                egui::DragValue::new(&mut self.render_settings.fps)
+                    .range(1.0..=crate::playback::MAX_FPS)
                     .speed(0.1)
                     .suffix(" fps"),
             );
@@ -1148,6 +1149,7 @@ impl EditorApp {
         let Ok(animation) = Animation::from_json(&self.animation, &json) else {
             return Vec::new();
         };
+        let frame_s = self.frame_s();
         let cache = &mut self.timeline.onion_cache;
         let key = Arc::as_ptr(scene);
         if cache.scene != Some(key) {
@@ -1168,7 +1170,6 @@ impl EditorApp {
         if cache.frames.len() > ONION_CACHE_FRAMES {
             cache.frames.clear();
         }
-        let frame_s = 1.0 / self.fps.max(1.0);
         let now = (self.time_s / frame_s).round() * frame_s;
         let end = animation.duration_s();
         let frames = options.frames.min(MAX_ONION_FRAMES);

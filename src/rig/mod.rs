@@ -2,6 +2,7 @@
 //! file and forward kinematics, with classic bone IK constraints ([`bone_ik`]).
 
 pub mod bone_ik;
+pub mod fk_edit;
 pub mod handles;
 pub mod pose;
 
