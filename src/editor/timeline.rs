@@ -549,9 +549,12 @@ impl EditorApp {
         });
         ui.horizontal_top(|ui| {
             let width = (ui.available_width() - CURVE_GRAPH_PT[0] - 24.0).max(240.0);
+            // Ask for the whole sheet (up to the cap), or the panel stays at its last height.
+            let sheet_height = ROW_HEIGHT_PT * (timelines.len() as f32 + 2.0);
             egui::ScrollArea::vertical()
                 .id_salt("dopesheet")
                 .max_height(240.0)
+                .min_scrolled_height(sheet_height.min(240.0))
                 .max_width(width)
                 .show(ui, |ui| self.dopesheet(ui, width, &timelines));
             ui.separator();
