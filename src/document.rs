@@ -19,7 +19,7 @@ use crate::anim::edit::{self, CopiedKey, KeyRef};
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
 use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
-use crate::rig::{Bone, HandleError, Handles, PointHandle, Pose};
+use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle, Pose, Region};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -74,6 +74,14 @@ pub enum DocumentError {
     Sequence(#[from] crate::io::sequence::SequenceError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
+    #[error("'{name}' has {expected} vertices, not {got}")]
+    PolygonSize {
+        name: String,
+        got: usize,
+        expected: usize,
+    },
+    #[error(transparent)]
+    Autorig(#[from] crate::autorig::AutorigError),
     #[error(transparent)]
     KeyEdit(#[from] crate::anim::edit::EditError),
 }
@@ -154,6 +162,18 @@ pub enum Command {
     DeleteKeys {
         animation: String,
         time_s: f64,
+    },
+    /// Replaces every handle (an automatic rig's proposal, say); the pose forgets handles that
+    /// are gone.
+    SetHandles(Handles),
+    /// Adds a cage: a closed polygon (canvas px) whose vertices are handles.
+    AddCage(Cage),
+    /// Adds a region: a closed polygon (canvas px) whose inside moves rigidly.
+    AddRegion(Region),
+    /// Moves a cage's or region's polygon (same vertex count, canvas px).
+    SetPolygon {
+        name: String,
+        polygon: Vec<[f64; 2]>,
     },
     /// Moves keys of `animation` by `delta_s` seconds, all or none: a key would land on another
     /// key of its timeline or before 0 → refused (see [`crate::anim::edit`]).
@@ -440,6 +460,22 @@ pub fn render_animation(
         .map_err(DocumentError::from)
 }
 
+/// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with
+/// [`Command::SetHandles`] and edit like hand-placed ones.
+pub fn propose_handles(
+    layers: &[Arc<Layer>],
+    options: &crate::autorig::AutorigOptions,
+) -> Result<crate::autorig::Proposal, DocumentError> {
+    let refs: Vec<crate::autorig::LayerRef> = layers
+        .iter()
+        .map(|l| crate::autorig::LayerRef {
+            name: &l.name,
+            image: &l.image,
+        })
+        .collect();
+    Ok(crate::autorig::autorig(&refs, options)?)
+}
+
 /// Makes the last state of `from` current, pushing the current one onto `to`.
 fn swap_in(state: &mut State, from: &mut Vec<State>, to: &mut Vec<State>) -> bool {
     match from.pop() {
@@ -620,6 +656,40 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             scene.handle_transforms(&pose)?;
             next.pose = pose;
             inputs_changed = false;
+        }
+        Command::SetHandles(handles) => {
+            next.handles = handles;
+            let names: std::collections::BTreeSet<&str> = next.handles.names().collect();
+            next.pose.bones.retain(|n, _| names.contains(n.as_str()));
+            next.pose.points.retain(|n, _| names.contains(n.as_str()));
+            next.pose.cages.retain(|n, _| names.contains(n.as_str()));
+        }
+        Command::AddCage(cage) => next.handles.cages.push(cage),
+        Command::AddRegion(region) => next.handles.regions.push(region),
+        Command::SetPolygon { name, polygon } => {
+            let target = next
+                .handles
+                .cages
+                .iter_mut()
+                .map(|c| (&c.name, &mut c.polygon))
+                .chain(
+                    next.handles
+                        .regions
+                        .iter_mut()
+                        .map(|r| (&r.name, &mut r.polygon)),
+                )
+                .find(|(n, _)| **n == name)
+                .map(|(_, p)| p)
+                .ok_or_else(|| DocumentError::UnknownHandle(name.clone()))?;
+            if target.len() != polygon.len() {
+                return Err(DocumentError::PolygonSize {
+                    name,
+                    got: polygon.len(),
+                    expected: target.len(),
+                });
+            }
+            *target = polygon;
+            // A posed cage keeps its pose; the rest polygon moved under it.
         }
         Command::MoveKeys {
             animation,

@@ -336,3 +336,72 @@ fn keys_set_replace_sample_and_delete() {
         .apply(key(f64::NAN, Pose::default()))
         .is_err_and(|e| matches!(e, DocumentError::KeyTime(_))));
 }
+
+#[test]
+fn cages_regions_and_proposed_handles_are_commands() {
+    use sinew::rig::{Cage, Region};
+    let mut doc = arm_document();
+    let around = vec![[5.0, 10.0], [315.0, 10.0], [315.0, 70.0], [5.0, 70.0]];
+    doc.apply(Command::AddCage(Cage {
+        name: "cage".into(),
+        polygon: around.clone(),
+    }))
+    .unwrap();
+    doc.apply(Command::AddRegion(Region {
+        name: "grip".into(),
+        polygon: vec![[40.0, 30.0], [60.0, 30.0], [60.0, 50.0]],
+    }))
+    .unwrap();
+    assert_eq!(doc.state().handles.cages.len(), 1);
+    assert_eq!(doc.state().handles.regions.len(), 1);
+    assert!(
+        doc.posable().is_none(),
+        "new handles make the weights stale"
+    );
+
+    // Moving a polygon keeps its vertex count.
+    let moved: Vec<[f64; 2]> = around.iter().map(|p| [p[0], p[1] + 2.0]).collect();
+    doc.apply(Command::SetPolygon {
+        name: "cage".into(),
+        polygon: moved.clone(),
+    })
+    .unwrap();
+    assert_eq!(doc.state().handles.cages[0].polygon, moved);
+    let err = doc
+        .apply(Command::SetPolygon {
+            name: "cage".into(),
+            polygon: moved[..3].to_vec(),
+        })
+        .unwrap_err();
+    assert!(matches!(err, DocumentError::PolygonSize { .. }), "{err}");
+    assert!(matches!(
+        doc.apply(Command::SetPolygon {
+            name: "nope".into(),
+            polygon: moved.clone(),
+        }),
+        Err(DocumentError::UnknownHandle(_))
+    ));
+
+    // The automatic rig's proposal replaces every handle in one undoable step; the pose
+    // forgets the handles that are gone.
+    compute(&mut doc);
+    let mut pose = Pose::default();
+    pose.bones.insert("upper".into(), Default::default());
+    doc.apply(Command::SetPose(pose)).unwrap();
+    let before = doc.state().handles.clone();
+    let proposal = sinew::document::propose_handles(&doc.state().layers, &Default::default())
+        .expect("the bar gets a skeleton");
+    assert!(!proposal.handles.bones.is_empty());
+    doc.apply(Command::SetHandles(proposal.handles.clone()))
+        .unwrap();
+    assert_eq!(doc.state().handles, proposal.handles);
+    let names: Vec<&str> = proposal.handles.names().collect();
+    assert!(doc
+        .state()
+        .pose
+        .bones
+        .keys()
+        .all(|n| names.contains(&n.as_str())));
+    assert!(doc.undo());
+    assert_eq!(doc.state().handles, before);
+}

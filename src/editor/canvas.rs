@@ -225,8 +225,24 @@ pub fn pick(placed: &Placed, handles: &Handles, at: Pos2) -> Option<String> {
         .points
         .iter()
         .map(|p| ((c - pt(p.at)).norm(), &p.name));
+    // Cages and regions are picked by their outline.
+    let outline = |polygon: &[[f64; 2]]| {
+        (0..polygon.len())
+            .map(|k| {
+                let (a, b) = (polygon[k], polygon[(k + 1) % polygon.len()]);
+                segment_distance(c, pt(a), pt(b)).0
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let cages = handles.cages.iter().map(|g| (outline(&g.polygon), &g.name));
+    let regions = handles
+        .regions
+        .iter()
+        .map(|r| (outline(&r.polygon), &r.name));
     bones
         .chain(points)
+        .chain(cages)
+        .chain(regions)
         .map(|(d_px, name)| (d_px as f32 * placed.view.zoom, name))
         .filter(|(d_pt, _)| *d_pt <= PICK_RADIUS_PT)
         .min_by(|a, b| a.0.total_cmp(&b.0))

@@ -14,6 +14,7 @@
 
 pub mod canvas;
 pub mod gizmo;
+pub mod rig_tools;
 pub mod timeline;
 pub mod worker;
 
@@ -83,6 +84,10 @@ pub enum Tool {
     Bone,
     /// Click to place a point handle.
     Point,
+    /// Click vertices of a cage; click the first one again (or press Enter) to close it.
+    Cage,
+    /// Click vertices of a region (its inside moves rigidly); close as a cage.
+    Region,
 }
 
 /// A pointer gesture in progress.
@@ -104,6 +109,11 @@ enum Gesture {
     },
     /// Grab, rotate or scale the selected handle by forward kinematics.
     Fk(gizmo::FkGesture),
+    /// A cage or region being drawn, vertex by vertex (canvas px).
+    NewPolygon {
+        kind: rig_tools::PolygonKind,
+        points: Vec<[f64; 2]>,
+    },
     Pan,
 }
 
@@ -159,6 +169,8 @@ pub struct EditorApp {
     pub render_settings: crate::playback::RenderSettings,
     /// A render under way on another thread: its message when done.
     render: Option<std::sync::mpsc::Receiver<String>>,
+    /// Rig mode's polygon tools, mesh preview and automatic rig.
+    pub rig_tools: rig_tools::RigTools,
     /// Animate mode: key selection, clipboard, loop, onion skins, curve editor.
     pub timeline: timeline::TimelineState,
 }
@@ -204,6 +216,7 @@ impl EditorApp {
             export_dir: "export".into(),
             render_path: "render.gif".into(),
             render_settings: Default::default(),
+            rig_tools: Default::default(),
             render: None,
             timeline: Default::default(),
         }
@@ -420,6 +433,7 @@ impl EditorApp {
         let ctx = ui.ctx().clone();
         self.poll_worker();
         self.poll_render();
+        self.poll_rig_tools(&ctx);
         self.warm_ik();
         self.dropped_files(&ctx);
         self.timeline_shortcuts(&ctx);
@@ -542,6 +556,9 @@ impl EditorApp {
         if help {
             self.show_help = !self.show_help;
         }
+        if !typing && ctx.input(|i| i.key_pressed(Key::Enter)) {
+            self.close_polygon();
+        }
         if escape {
             self.gesture = None;
             self.show_help = false;
@@ -649,6 +666,8 @@ impl EditorApp {
             ui.selectable_value(&mut self.tool, Tool::Select, "Select");
             ui.selectable_value(&mut self.tool, Tool::Bone, "Bone");
             ui.selectable_value(&mut self.tool, Tool::Point, "Point");
+            ui.selectable_value(&mut self.tool, Tool::Cage, "Cage");
+            ui.selectable_value(&mut self.tool, Tool::Region, "Region");
         });
         ui.separator();
         ui.heading("Handles");
@@ -762,6 +781,7 @@ impl EditorApp {
                 }
             }
         }
+        self.rig_tools_panel(ui);
     }
 
     fn pose_panel(&mut self, ui: &mut egui::Ui) {
@@ -949,7 +969,9 @@ impl EditorApp {
             }
             _ => {}
         }
+        shapes.extend(self.mesh_shapes(&placed));
         shapes.extend(canvas::handles(&placed, &handles, self.selected.as_deref()));
+        shapes.extend(self.polygon_shapes(&placed, response.hover_pos()));
         if let (Mode::Pose | Mode::Animate, Some(scene)) = (self.mode, &posable) {
             if let Some(target) = self.fk_target(scene) {
                 let active = match &self.gesture {
@@ -1027,7 +1049,7 @@ impl EditorApp {
                         }
                         None => Some(Gesture::Pan),
                     },
-                    Tool::Point => None,
+                    Tool::Point | Tool::Cage | Tool::Region => None,
                 };
             }
         }
@@ -1070,6 +1092,15 @@ impl EditorApp {
                         });
                     } else if let Some(p) = handles.points.iter().find(|p| p.name == name) {
                         self.apply(Command::MovePoint { name, at: p.at });
+                    } else if let Some(polygon) = handles
+                        .cages
+                        .iter()
+                        .map(|c| (&c.name, &c.polygon))
+                        .chain(handles.regions.iter().map(|r| (&r.name, &r.polygon)))
+                        .find(|(n, _)| **n == name)
+                        .map(|(_, p)| p.clone())
+                    {
+                        self.apply(Command::SetPolygon { name, polygon });
                     }
                 }
                 _ => {}
@@ -1079,6 +1110,8 @@ impl EditorApp {
             if let Some(at) = pointer {
                 let c = placed.canvas_from_screen(at);
                 match self.tool {
+                    Tool::Cage => self.polygon_click(rig_tools::PolygonKind::Cage, c, &placed),
+                    Tool::Region => self.polygon_click(rig_tools::PolygonKind::Region, c, &placed),
                     Tool::Point => {
                         let name = self.unique_name("point");
                         if self.apply(Command::AddPoint(PointHandle {
@@ -1354,6 +1387,19 @@ fn move_handle(handles: &mut crate::rig::Handles, name: &str, delta_px: [f64; 2]
     if let Some(p) = handles.points.iter_mut().find(|p| p.name == name) {
         shift(&mut p.at);
     }
+    let polygons = handles
+        .cages
+        .iter_mut()
+        .map(|c| (&c.name, &mut c.polygon))
+        .chain(
+            handles
+                .regions
+                .iter_mut()
+                .map(|r| (&r.name, &mut r.polygon)),
+        );
+    for (_, polygon) in polygons.filter(|(n, _)| *n == name) {
+        polygon.iter_mut().for_each(shift);
+    }
 }
 
 /// The rest position of the drawing's point shown at `at_px` (canvas px) in the posed
@@ -1464,6 +1510,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ),
     ("Shift+click", "pin a point (pose mode)"),
     ("Click", "select the handle under the pointer (pose mode)"),
+    (
+        "Enter",
+        "close the cage or region being drawn (or click its first vertex)",
+    ),
     (
         "G / R / S",
         "grab / rotate / scale the selected bone or point (pose mode; click confirms, \

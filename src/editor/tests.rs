@@ -461,6 +461,102 @@ fn rotate_with_r_and_grab_with_the_gizmo_in_pose_mode() {
     );
 }
 
+/// Steps frames until `done` holds (50 ms apart), or fails after [`BUILD_FRAMES`].
+fn wait_until(h: &mut Harness<'_, EditorApp>, what: &str, done: impl Fn(&EditorApp) -> bool) {
+    for _ in 0..BUILD_FRAMES {
+        h.step();
+        if done(h.state()) {
+            h.run();
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    panic!("{what} took too long");
+}
+
+#[test]
+fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
+    let path = character_rig("rigtools");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    assert_eq!(h.state().mode, Mode::Rig);
+    let before = h.state().doc.state().handles.clone();
+
+    // A cage: four clicks, then a click on the first vertex closes it.
+    h.get_by_label("Cage").click();
+    h.run();
+    let square = [
+        [150.0, 150.0],
+        [360.0, 150.0],
+        [360.0, 380.0],
+        [150.0, 380.0],
+    ];
+    for p in square {
+        click(&mut h, p);
+    }
+    assert!(h.state().doc.state().handles.cages.is_empty(), "still open");
+    click(&mut h, square[0]);
+    let cages = &h.state().doc.state().handles.cages;
+    assert_eq!(cages.len(), 1);
+    assert_eq!(cages[0].polygon.len(), 4);
+    assert!(distance(cages[0].polygon[2], square[2]) < 0.5);
+    let cage = cages[0].name.clone();
+    assert_eq!(h.state().selected.as_deref(), Some(cage.as_str()));
+
+    // A region: three clicks and Enter.
+    h.get_by_label("Region").click();
+    h.run();
+    for p in [[240.0, 250.0], [270.0, 250.0], [255.0, 280.0]] {
+        click(&mut h, p);
+    }
+    h.key_press(Key::Enter);
+    h.run();
+    assert_eq!(h.state().doc.state().handles.regions.len(), 1);
+
+    // The select tool drags the cage by its outline.
+    h.get_by_label("Select").click();
+    h.run();
+    drag(&mut h, [255.0, 150.0], [265.0, 140.0]);
+    let moved = &h.state().doc.state().handles.cages[0].polygon;
+    assert!(distance(moved[0], [160.0, 140.0]) < 0.5, "{moved:?}");
+
+    // The traced mesh, rebuilt live when a meshing option changes.
+    h.get_by_label("Show the traced mesh").scroll_to_me();
+    h.run();
+    h.get_by_label("Show the traced mesh").click();
+    wait_until(&mut h, "the mesh preview", |app| {
+        !app.previewing() && app.preview_vertex_count().is_some()
+    });
+    let fine = h.state().preview_vertex_count().expect("a preview");
+    let mut options = h.state().doc.state().options.clone();
+    options.mesh.max_area_fraction *= 16.0;
+    assert!(h.state_mut().apply(Command::SetOptions(options)));
+    wait_until(&mut h, "the coarser preview", |app| {
+        !app.previewing() && app.preview_vertex_count() != Some(fine)
+    });
+    let coarse = h.state().preview_vertex_count().expect("a preview");
+    assert!(
+        coarse < fine,
+        "{coarse} vertices at a 16× area limit, {fine} before"
+    );
+
+    // The automatic rig replaces the handles; undo brings the hand-made ones back.
+    let hand_made = h.state().doc.state().handles.clone();
+    h.get_by_label("Propose handles").scroll_to_me();
+    h.run();
+    h.get_by_label("Propose handles").click();
+    wait_until(&mut h, "the automatic rig", |app| {
+        !app.rig_tools.proposing()
+    });
+    let proposed = h.state().doc.state().handles.clone();
+    assert!(!proposed.bones.is_empty(), "{:?}", h.state().message);
+    assert_ne!(proposed, hand_made);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(h.state().doc.state().handles, hand_made);
+    assert_ne!(hand_made, before);
+}
+
 /// Press at `from`, move in steps, release at `to` (screen points).
 fn drag_screen(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2) {
     h.drag_at(from);
