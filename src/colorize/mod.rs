@@ -23,6 +23,9 @@
 //! 6. [`fill`]: weights interpolated to every pixel; flat (largest weight wins) or soft
 //!    (blended) colors; the line art on top.
 //!
+//! [`PreparedLineArt`] keeps steps 1 and 3 (the line art alone) for repeated colorizations of
+//! one drawing; [`session`] is the interactive editing of scribble strokes over it, with undo.
+//!
 //! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
 //! [`synthetic`] draws test line art with known true colorings.
 
@@ -33,6 +36,7 @@ pub mod image_mesh;
 pub mod lineart;
 pub mod score;
 pub mod scribbles;
+pub mod session;
 pub mod synthetic;
 pub mod weights;
 
@@ -45,6 +49,7 @@ pub use weights::{ColorWeights, LiftedStiffness};
 use crate::weights::BbwOptions;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// How to colorize. Every field has a documented default.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -114,6 +119,8 @@ pub enum ColorizeError {
     Mesh(#[from] image_mesh::ImageMeshError),
     #[error("{0}")]
     Weights(#[from] weights::ColorWeightError),
+    #[error("the colorization was cancelled")]
+    Cancelled,
 }
 
 /// The result of a colorization.
@@ -189,6 +196,15 @@ pub fn colorize(
     options: &ColorizeOptions,
     want_layers: bool,
 ) -> Result<Colorized, ColorizeError> {
+    check_size(lineart, scribbles)?;
+    PreparedLineArt::new(lineart.clone(), options.clone())?.colorize(
+        scribbles,
+        want_layers,
+        &AtomicBool::new(false),
+    )
+}
+
+fn check_size(lineart: &RgbaImage, scribbles: &Scribbles) -> Result<(), ColorizeError> {
     if (scribbles.width, scribbles.height) != lineart.dimensions() {
         return Err(ColorizeError::SizeMismatch {
             art_w: lineart.width(),
@@ -197,77 +213,125 @@ pub fn colorize(
             scribbles_h: scribbles.height,
         });
     }
-    if !(options.scale.is_finite() && options.scale >= 0.0) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "the lift scale must be finite and non-negative, not {}",
-            options.scale
-        )));
+    Ok(())
+}
+
+/// The part of a colorization that depends on the line art alone, computed once per image:
+/// the drawing over white, its ink, and its colors with gaps closed (steps 1 and 3). An
+/// interactive session keeps one and re-solves only the scribble-dependent rest (the mesh
+/// follows the scribbles' rims, so it is rebuilt per solve) on every stroke change.
+#[derive(Clone, Debug)]
+pub struct PreparedLineArt {
+    pub image: RgbaImage,
+    pub art: LineArt,
+    /// The colors the lift and the mesh see: [`gap_closing::close_gaps`] of `art.over_white`.
+    pub closed: Vec<[u8; 3]>,
+    pub options: ColorizeOptions,
+}
+
+impl PreparedLineArt {
+    /// Checks `options` and prepares `lineart` for colorizations with them.
+    pub fn new(lineart: RgbaImage, options: ColorizeOptions) -> Result<Self, ColorizeError> {
+        if !(options.scale.is_finite() && options.scale >= 0.0) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "the lift scale must be finite and non-negative, not {}",
+                options.scale
+            )));
+        }
+        if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "line_threshold must lie in (0, 1], not {}",
+                options.line_threshold
+            )));
+        }
+        if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "gap_closing_px must be finite and non-negative, not {}",
+                options.gap_closing_px
+            )));
+        }
+        let art = LineArt::new(&lineart);
+        // The lift and the mesh see the drawing with its gaps closed.
+        let closed = gap_closing::close_gaps(
+            &art.over_white,
+            art.width,
+            art.height,
+            options.gap_closing_px,
+        );
+        Ok(PreparedLineArt {
+            image: lineart,
+            art,
+            closed,
+            options,
+        })
     }
-    if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "line_threshold must lie in (0, 1], not {}",
-            options.line_threshold
-        )));
-    }
-    if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "gap_closing_px must be finite and non-negative, not {}",
-            options.gap_closing_px
-        )));
-    }
-    let art = LineArt::new(lineart);
-    let (labels, dropped) = effective_labels(&art, scribbles, options.line_threshold)?;
-    // The lift and the mesh see the drawing with its gaps closed.
-    let closed = gap_closing::close_gaps(
-        &art.over_white,
-        art.width,
-        art.height,
-        options.gap_closing_px,
-    );
-    let mesh = ImageMesh::new(art.width, art.height, &closed, &labels, &options.mesh)?;
-    let m = scribbles.colors.len();
-    let weights = if m == 1 {
-        // One color: the whole drawing takes it; nothing to solve.
-        None
-    } else {
-        let vertex_pixels = mesh.pixel_indices();
-        let colors: Vec<[f64; 3]> = vertex_pixels
-            .iter()
-            .map(|&i| closed[i].map(|c| c as f64 / 255.0))
-            .collect();
-        let vertex_labels: Vec<u16> = vertex_pixels.iter().map(|&i| labels[i]).collect();
-        Some(weights::color_weights(
+
+    /// Colorizes the prepared line art from `scribbles` (steps 2, 4, 5, 6). Setting `cancel`
+    /// (from another thread) stops it with [`ColorizeError::Cancelled`] before the next step.
+    pub fn colorize(
+        &self,
+        scribbles: &Scribbles,
+        want_layers: bool,
+        cancel: &AtomicBool,
+    ) -> Result<Colorized, ColorizeError> {
+        let (lineart, art, closed, options) = (&self.image, &self.art, &self.closed, &self.options);
+        check_size(lineart, scribbles)?;
+        let cancelled = || {
+            if cancel.load(Ordering::Relaxed) {
+                Err(ColorizeError::Cancelled)
+            } else {
+                Ok(())
+            }
+        };
+        let (labels, dropped) = effective_labels(art, scribbles, options.line_threshold)?;
+        cancelled()?;
+        let mesh = ImageMesh::new(art.width, art.height, closed, &labels, &options.mesh)?;
+        cancelled()?;
+        let m = scribbles.colors.len();
+        let weights = if m == 1 {
+            // One color: the whole drawing takes it; nothing to solve.
+            None
+        } else {
+            let vertex_pixels = mesh.pixel_indices();
+            let colors: Vec<[f64; 3]> = vertex_pixels
+                .iter()
+                .map(|&i| closed[i].map(|c| c as f64 / 255.0))
+                .collect();
+            let vertex_labels: Vec<u16> = vertex_pixels.iter().map(|&i| labels[i]).collect();
+            Some(weights::color_weights(
+                &mesh,
+                &colors,
+                &vertex_labels,
+                m,
+                &weights::ColorWeightOptions {
+                    scale: options.scale,
+                    stiffness: options.stiffness,
+                    method: options.weights,
+                    bbw: options.bbw.clone(),
+                },
+            )?)
+        };
+        cancelled()?;
+        let filled = fill::fill(
             &mesh,
-            &colors,
-            &vertex_labels,
-            m,
-            &weights::ColorWeightOptions {
-                scale: options.scale,
-                stiffness: options.stiffness,
-                method: options.weights,
-                bbw: options.bbw.clone(),
+            weights.as_ref(),
+            &scribbles.colors,
+            art,
+            lineart,
+            options.fill,
+            want_layers,
+        );
+        Ok(Colorized {
+            image: filled.image,
+            fill_only: filled.fill_only,
+            layers: filled.layers,
+            palette: scribbles.colors.clone(),
+            stats: ColorizeStats {
+                pixels: art.pixel_count(),
+                vertices: mesh.vertex_count(),
+                triangles: mesh.triangles.len(),
+                scribble_pixels_on_lines: dropped,
             },
-        )?)
-    };
-    let filled = fill::fill(
-        &mesh,
-        weights.as_ref(),
-        &scribbles.colors,
-        &art,
-        lineart,
-        options.fill,
-        want_layers,
-    );
-    Ok(Colorized {
-        image: filled.image,
-        fill_only: filled.fill_only,
-        layers: filled.layers,
-        palette: scribbles.colors.clone(),
-        stats: ColorizeStats {
-            pixels: art.pixel_count(),
-            vertices: mesh.vertex_count(),
-            triangles: mesh.triangles.len(),
-            scribble_pixels_on_lines: dropped,
-        },
-    })
+        })
+    }
 }

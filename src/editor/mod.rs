@@ -11,8 +11,11 @@
 //! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
 //! shift-click pins a point; every drag stays as a pin of the pose) and **Animate** (keys,
 //! dopesheet, curves, playback and onion skins: [`timeline`]).
+//! **Colorize** ([`colorize`])
+//! scribbles colors on a line-art PNG and shows the colored result as it is solved.
 
 pub mod canvas;
+pub mod colorize;
 pub mod gizmo;
 pub mod rig_tools;
 pub mod timeline;
@@ -73,6 +76,7 @@ pub enum Mode {
     Rig,
     Pose,
     Animate,
+    Colorize,
 }
 
 /// What a press on the canvas does in rig mode.
@@ -171,6 +175,8 @@ pub struct EditorApp {
     render: Option<std::sync::mpsc::Receiver<String>>,
     /// Rig mode's polygon tools, mesh preview and automatic rig.
     pub rig_tools: rig_tools::RigTools,
+    /// Colorize mode: line art, scribbles, the background solve.
+    pub colorize: colorize::ColorizeEditor,
     /// Animate mode: key selection, clipboard, loop, onion skins, curve editor.
     pub timeline: timeline::TimelineState,
 }
@@ -218,6 +224,7 @@ impl EditorApp {
             render_settings: Default::default(),
             rig_tools: Default::default(),
             render: None,
+            colorize: Default::default(),
             timeline: Default::default(),
         }
     }
@@ -290,7 +297,10 @@ impl EditorApp {
     pub fn open(&mut self, path: &Path) {
         match Document::open(path) {
             Ok(doc) => {
+                // Colorize mode's line art and strokes are not part of the rig document.
+                let colorize = std::mem::take(&mut self.colorize);
                 *self = EditorApp::new(doc);
+                self.colorize = colorize;
                 if let Some(view) = load_view(path) {
                     self.restore_view(view);
                 }
@@ -435,6 +445,7 @@ impl EditorApp {
         self.poll_render();
         self.poll_rig_tools(&ctx);
         self.warm_ik();
+        self.colorize_frame_start(&ctx);
         self.dropped_files(&ctx);
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
@@ -611,23 +622,25 @@ impl EditorApp {
                     let ctx = ui.ctx().clone();
                     self.start_render(&ctx);
                 }
+                self.colorize_file_menu(ui);
             });
             if ui
-                .add_enabled(self.doc.can_undo(), egui::Button::new("Undo"))
+                .add_enabled(self.can_undo_in_mode(), egui::Button::new("Undo"))
                 .clicked()
             {
-                self.doc.undo();
+                self.undo_in_mode();
             }
             if ui
-                .add_enabled(self.doc.can_redo(), egui::Button::new("Redo"))
+                .add_enabled(self.can_redo_in_mode(), egui::Button::new("Redo"))
                 .clicked()
             {
-                self.doc.redo();
+                self.redo_in_mode();
             }
             ui.separator();
             ui.selectable_value(&mut self.mode, Mode::Rig, "Rig mode");
             ui.selectable_value(&mut self.mode, Mode::Pose, "Pose mode");
             ui.selectable_value(&mut self.mode, Mode::Animate, "Animate mode");
+            ui.selectable_value(&mut self.mode, Mode::Colorize, "Colorize mode");
             ui.separator();
             if ui.button("Help").clicked() {
                 self.show_help = !self.show_help;
@@ -654,10 +667,12 @@ impl EditorApp {
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
-        match self.mode {
+        // Rig mode's tools outgrow a short window: the panel scrolls.
+        egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),
             Mode::Pose | Mode::Animate => self.pose_panel(ui),
-        }
+            Mode::Colorize => self.colorize_panel(ui),
+        });
     }
 
     fn rig_panel(&mut self, ui: &mut egui::Ui) {
@@ -872,6 +887,9 @@ impl EditorApp {
     }
 
     fn canvas(&mut self, ui: &mut egui::Ui) {
+        if self.mode == Mode::Colorize {
+            return self.colorize_canvas(ui);
+        }
         let ctx = ui.ctx().clone();
         let textures = self.textures(&ctx);
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
@@ -989,6 +1007,7 @@ impl EditorApp {
                     self.pose_gestures(&ctx, &response, placed, &scene)
                 }
             }
+            Mode::Colorize => {}
         }
     }
 
@@ -1500,7 +1519,10 @@ fn help_window(ctx: &egui::Context, open: &mut bool) {
 
 /// The shortcuts the help overlay lists (every one of them works).
 pub const SHORTCUTS: &[(&str, &str)] = &[
-    ("1 / 2 / 3", "rig mode / pose mode / animate mode"),
+    (
+        "1 / 2 / 3 / 4",
+        "rig mode / pose mode / animate mode / colorize mode",
+    ),
     ("Space", "play or pause (animate mode)"),
     ("Ctrl+Z", "undo"),
     ("Ctrl+Shift+Z", "redo"),
@@ -1523,6 +1545,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Middle drag", "pan"),
     ("Esc", "cancel the gesture, close this help"),
     ("F1 or ?", "this help"),
+    (
+        "B / E / V",
+        "colorize mode: brush / eraser / result or scribbles only",
+    ),
     (
         "Ctrl+C / Ctrl+V",
         "copy the selected keys / paste them at the playhead",

@@ -20,6 +20,10 @@ use std::sync::Arc;
 
 /// A click this close (screen points) to a polygon's first vertex closes it.
 pub const CLOSE_RADIUS_PT: f32 = 8.0;
+/// The content-aware color scale S offered when the option is switched on (`--content-aware S`).
+pub const DEFAULT_CONTENT_AWARE: f64 = 100.0;
+/// The influence limit offered when the option is switched on (`--max-influences K`).
+pub const DEFAULT_MAX_INFLUENCES: usize = 4;
 /// Fewest vertices of a cage or region.
 pub const MIN_POLYGON_VERTICES: usize = 3;
 
@@ -159,7 +163,7 @@ impl EditorApp {
     /// automatic rig's section.
     pub(super) fn rig_tools_panel(&mut self, ui: &mut egui::Ui) {
         ui.separator();
-        ui.heading("Mesh");
+        ui.heading("Mesh and weight options");
         ui.checkbox(&mut self.rig_tools.show_mesh, "Show the traced mesh");
         let current = self.doc.state().options.clone();
         let mut draft = self
@@ -193,6 +197,29 @@ impl EditorApp {
                     .text("max triangle area (of canvas)"),
             ),
         );
+        ui.label("Weight options");
+        responses.push(ui.checkbox(
+            &mut draft.weights.monotone,
+            "monotone (no spurious extrema)",
+        ));
+        let mut content = draft.weights.content_aware.is_some();
+        let mut strength = draft.weights.content_aware.unwrap_or(DEFAULT_CONTENT_AWARE);
+        ui.horizontal(|ui| {
+            responses.push(ui.checkbox(&mut content, "content-aware, color scale"));
+            responses.push(ui.add(egui::DragValue::new(&mut strength).range(0.0..=1000.0)));
+        });
+        draft.weights.content_aware = content.then_some(strength);
+        let mut limit = draft.weights.max_influences.is_some();
+        let mut k = draft
+            .weights
+            .max_influences
+            .unwrap_or(DEFAULT_MAX_INFLUENCES);
+        ui.horizontal(|ui| {
+            responses.push(ui.checkbox(&mut limit, "at most"));
+            responses.push(ui.add(egui::DragValue::new(&mut k).range(1..=16)));
+            ui.label("influences per vertex");
+        });
+        draft.weights.max_influences = limit.then_some(k);
         let dragging = responses.iter().any(|r| r.dragged());
         let released = responses.iter().any(|r| r.drag_stopped());
         if draft != current {

@@ -1,0 +1,734 @@
+//! Colorize mode (key 4): scribble colors on line art and see the colored result live.
+//!
+//! In: a line-art PNG (File menu or dropped on the window in this mode), pointer strokes with
+//! the scribble brush or the eraser. Out: [`SessionCommand`]s on a [`ColorizeSession`] (so
+//! undo, checking and the solve live in the library), a picture (the line art, the result
+//! blended over it, the scribbles on top), and the colorized PNG saved atomically.
+//!
+//! Solves run on a background thread, one at a time: while the brush moves, the stroke being
+//! drawn is solved too, so the result follows the pen at the solver's pace; a solve whose
+//! committed strokes changed meanwhile (a new stroke, an erase, undo) is cancelled at its next
+//! step, and a result is installed in the session only for the strokes it was solved for —
+//! the newest strokes win.
+
+use super::canvas::{self, Placed, View};
+use super::{EditorApp, Mode};
+use crate::colorize::session::{
+    ColorizeSession, ScribbleStroke, SessionCommand, SessionError, SolveJob,
+};
+use crate::colorize::{ColorizeError, ColorizeOptions, Colorized};
+use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::sync::Arc;
+
+/// Brush diameter a new session starts with, image px.
+pub const DEFAULT_BRUSH_PX: f32 = 6.0;
+/// The brush color a new editor starts with.
+pub const DEFAULT_COLOR: [u8; 3] = [230, 80, 70];
+/// Ready-made brush colors.
+pub const SWATCHES: [[u8; 3]; 10] = [
+    [230, 80, 70],
+    [240, 140, 40],
+    [240, 200, 60],
+    [90, 190, 90],
+    [60, 200, 200],
+    [70, 140, 230],
+    [170, 90, 200],
+    [240, 150, 190],
+    [150, 110, 70],
+    [250, 245, 225],
+];
+/// A new brush point is recorded once the pointer moved this far from the last, image px.
+const BRUSH_STEP_PX: f64 = 0.75;
+
+/// What a press on the canvas does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorizeTool {
+    Brush,
+    /// Removes whole strokes under the pointer.
+    Eraser,
+}
+
+/// What the canvas shows under the scribbles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorizeView {
+    /// The line art with the colorized result over it.
+    Result,
+    /// The line art alone.
+    ScribblesOnly,
+}
+
+/// A solve under way on another thread.
+struct Solve {
+    job: SolveJob,
+    /// The session's strokes when it started (the stroke being drawn comes on top of them).
+    base: Arc<Vec<ScribbleStroke>>,
+    cancel: Arc<AtomicBool>,
+    result: Receiver<Result<Option<Colorized>, SessionError>>,
+}
+
+/// Colorize mode's state.
+pub struct ColorizeEditor {
+    pub session: Option<ColorizeSession>,
+    /// Where the line art came from.
+    pub path: Option<PathBuf>,
+    /// The File menu's line-art path field.
+    pub lineart_path: String,
+    /// Where "Save colorized PNG" writes.
+    pub save_path: String,
+    pub tool: ColorizeTool,
+    pub color: [u8; 3],
+    /// Brush diameter, image px.
+    pub width_px: f32,
+    pub view_mode: ColorizeView,
+    /// Opacity of the result over the line art, 0..=1.
+    pub opacity: f32,
+    /// This mode's pan and zoom (the line art has its own size); `None` fits it.
+    view: Option<View>,
+    /// The stroke being drawn, image px.
+    drawing: Option<Vec<[f64; 2]>>,
+    solve: Option<Solve>,
+    /// The newest finished solve: its strokes and result, shown until a newer one arrives.
+    latest: Option<(Arc<Vec<ScribbleStroke>>, Arc<Colorized>)>,
+    /// Strokes whose solve failed: not tried again until they change.
+    failed: Option<Vec<ScribbleStroke>>,
+    lineart_texture: Option<TextureHandle>,
+    result_texture: Option<(Arc<Colorized>, TextureHandle)>,
+}
+
+impl Default for ColorizeEditor {
+    fn default() -> Self {
+        ColorizeEditor {
+            session: None,
+            path: None,
+            lineart_path: String::new(),
+            save_path: "colorized.png".into(),
+            tool: ColorizeTool::Brush,
+            color: DEFAULT_COLOR,
+            width_px: DEFAULT_BRUSH_PX,
+            view_mode: ColorizeView::Result,
+            opacity: 1.0,
+            view: None,
+            drawing: None,
+            solve: None,
+            latest: None,
+            failed: None,
+            lineart_texture: None,
+            result_texture: None,
+        }
+    }
+}
+
+impl ColorizeEditor {
+    /// Whether a solve is running or due (the strokes shown have no result yet).
+    pub fn solving(&self) -> bool {
+        self.solve.is_some() || self.due().is_some()
+    }
+
+    /// The newest result shown: the session's for its strokes, else the last one solved.
+    pub fn shown_result(&self) -> Option<&Arc<Colorized>> {
+        let session = self.session.as_ref()?;
+        if self.drawing.is_none() {
+            if let Some(result) = session.result() {
+                return Some(result);
+            }
+            if session.strokes().is_empty() {
+                return None;
+            }
+        }
+        self.latest.as_ref().map(|(_, r)| r)
+    }
+
+    /// The strokes the canvas shows: the session's and the one being drawn.
+    fn wanted(&self) -> Option<Vec<ScribbleStroke>> {
+        let session = self.session.as_ref()?;
+        let mut strokes = session.strokes().to_vec();
+        if let Some(points) = &self.drawing {
+            strokes.push(self.stroke(points.clone()));
+        }
+        Some(strokes)
+    }
+
+    fn stroke(&self, points_px: Vec<[f64; 2]>) -> ScribbleStroke {
+        ScribbleStroke {
+            color: self.color,
+            width_px: self.width_px as f64,
+            points_px,
+        }
+    }
+
+    /// The strokes that need a solve now, if any.
+    fn due(&self) -> Option<Vec<ScribbleStroke>> {
+        let session = self.session.as_ref()?;
+        if self.drawing.is_none() && session.result().is_some() {
+            return None;
+        }
+        let wanted = self.wanted()?;
+        let known = |s: &[ScribbleStroke]| s == wanted.as_slice();
+        if wanted.is_empty()
+            || self.latest.as_ref().is_some_and(|(s, _)| known(s))
+            || self.failed.as_deref().is_some_and(known)
+        {
+            return None;
+        }
+        Some(wanted)
+    }
+
+    fn undo(&mut self) {
+        if self.drawing.is_none() {
+            if let Some(s) = &mut self.session {
+                s.undo();
+            }
+        }
+    }
+
+    fn redo(&mut self) {
+        if self.drawing.is_none() {
+            if let Some(s) = &mut self.session {
+                s.redo();
+            }
+        }
+    }
+
+    fn stop_solve(&mut self) {
+        if let Some(solve) = self.solve.take() {
+            solve.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+impl EditorApp {
+    /// Opens a line-art PNG for colorizing (and switches to colorize mode); on failure the
+    /// current line art and strokes stay.
+    pub fn open_lineart(&mut self, path: &Path) {
+        let opened = crate::io::load_png(path)
+            .map_err(SessionError::from)
+            .and_then(|image| ColorizeSession::new(image, ColorizeOptions::default()));
+        match opened {
+            Ok(session) => {
+                let c = &mut self.colorize;
+                c.stop_solve();
+                let [w, h] = session.size_px();
+                *c = ColorizeEditor {
+                    session: Some(session),
+                    path: Some(path.to_path_buf()),
+                    lineart_path: path.display().to_string(),
+                    save_path: colorized_path(path).display().to_string(),
+                    tool: c.tool,
+                    color: c.color,
+                    width_px: c.width_px,
+                    view_mode: c.view_mode,
+                    opacity: c.opacity,
+                    ..Default::default()
+                };
+                self.mode = Mode::Colorize;
+                self.message = Some(format!("opened line art {} ({w}×{h} px)", path.display()));
+            }
+            Err(e) => self.message = Some(format!("cannot open {}: {e}", path.display())),
+        }
+    }
+
+    /// Saves the colorized image to `path`; returns the message for the status bar.
+    pub fn save_colorized(&mut self, path: &Path) -> String {
+        let Some(session) = &self.colorize.session else {
+            return "open a line-art PNG first".into();
+        };
+        match session.save_result(path) {
+            Ok(()) => format!("saved {}", path.display()),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// Colorize mode's part of every frame, before the rest: key 4, undo and redo (and the
+    /// tool keys) in this mode, dropped PNGs as line art, the background solve.
+    pub(super) fn colorize_frame_start(&mut self, ctx: &egui::Context) {
+        let typing = ctx.text_edit_focused();
+        if !typing && ctx.input(|i| i.key_pressed(Key::Num4)) {
+            self.mode = Mode::Colorize;
+        }
+        if self.mode == Mode::Colorize {
+            // Consumed here, so the document's undo does not also see them.
+            let (undo, redo, brush, eraser, toggle) = ctx.input_mut(|i| {
+                let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+                let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
+                (
+                    undo,
+                    redo,
+                    !typing && i.key_pressed(Key::B),
+                    !typing && i.key_pressed(Key::E),
+                    !typing && i.key_pressed(Key::V),
+                )
+            });
+            let c = &mut self.colorize;
+            if undo {
+                c.undo();
+            }
+            if redo {
+                c.redo();
+            }
+            if brush {
+                c.tool = ColorizeTool::Brush;
+            }
+            if eraser {
+                c.tool = ColorizeTool::Eraser;
+            }
+            if toggle {
+                c.view_mode = match c.view_mode {
+                    ColorizeView::Result => ColorizeView::ScribblesOnly,
+                    ColorizeView::ScribblesOnly => ColorizeView::Result,
+                };
+            }
+            // Dropped PNGs are line art here, not rig layers: taken before the rig code sees them.
+            let dropped: Vec<PathBuf> = ctx.input_mut(|i| {
+                let (png, other): (Vec<_>, Vec<_>) = std::mem::take(&mut i.raw.dropped_files)
+                    .into_iter()
+                    .partition(|f| is_png(f.path()));
+                i.raw.dropped_files = other;
+                png.iter().map(|f| f.path().to_path_buf()).collect()
+            });
+            if let Some(path) = dropped.last() {
+                self.open_lineart(path);
+            }
+        }
+        self.poll_colorize();
+        self.schedule_colorize(ctx);
+    }
+
+    fn poll_colorize(&mut self) {
+        let c = &mut self.colorize;
+        let Some(solve) = &c.solve else { return };
+        let result = match solve.result.try_recv() {
+            Ok(result) => result,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => Err(ColorizeError::Cancelled.into()),
+        };
+        let strokes = solve.job.strokes.clone();
+        c.solve = None;
+        match result {
+            Ok(result) => {
+                let result = result.map(Arc::new);
+                if let Some(session) = &mut c.session {
+                    // Refused when the strokes changed meanwhile: it is still the newest
+                    // picture, so it is shown until the next solve ends.
+                    let _ = session.set_result(&strokes, result.clone());
+                }
+                c.latest = result.map(|r| (strokes, r));
+                c.failed = None;
+            }
+            Err(SessionError::Colorize(ColorizeError::Cancelled)) => {}
+            Err(e) => {
+                self.message = Some(e.to_string());
+                c.failed = Some(strokes.as_ref().clone());
+            }
+        }
+    }
+
+    fn schedule_colorize(&mut self, ctx: &egui::Context) {
+        let c = &mut self.colorize;
+        let Some(session) = &c.session else { return };
+        if let Some(solve) = &c.solve {
+            // Committed strokes changed under it (not just the stroke being drawn): stale.
+            if !Arc::ptr_eq(&solve.base, &session.state().strokes) {
+                c.stop_solve();
+            } else {
+                return;
+            }
+        }
+        if let (None, Some(session), Some((strokes, result))) =
+            (&c.drawing, &mut c.session, &c.latest)
+        {
+            // The stroke just finished was already solved while it was drawn.
+            if session.result().is_none() && session.strokes() == strokes.as_slice() {
+                let _ = session.set_result(strokes, Some(result.clone()));
+            }
+        }
+        let Some(strokes) = c.due() else { return };
+        let Some(session) = &c.session else { return };
+        let base = session.state().strokes.clone();
+        let job = SolveJob {
+            lineart: session.job().lineart,
+            strokes: Arc::new(strokes),
+        };
+        let cancel = Arc::new(AtomicBool::new(false));
+        let (send, result) = mpsc::channel();
+        let (thread_job, thread_cancel, ctx) = (job.clone(), cancel.clone(), ctx.clone());
+        std::thread::spawn(move || {
+            // The editor may have moved on or closed meanwhile; then nobody wants it.
+            let _ = send.send(thread_job.run(&thread_cancel));
+            ctx.request_repaint();
+        });
+        c.solve = Some(Solve {
+            job,
+            base,
+            cancel,
+            result,
+        });
+    }
+
+    /// The File menu's colorize entries.
+    pub(super) fn colorize_file_menu(&mut self, ui: &mut egui::Ui) {
+        ui.separator();
+        ui.label("Line-art PNG to colorize:");
+        ui.text_edit_singleline(&mut self.colorize.lineart_path);
+        if ui.button("Open line art").clicked() {
+            let path = PathBuf::from(&self.colorize.lineart_path);
+            self.open_lineart(&path);
+        }
+        ui.label("Colorized PNG:");
+        ui.text_edit_singleline(&mut self.colorize.save_path);
+        if ui.button("Save colorized PNG").clicked() {
+            let path = PathBuf::from(&self.colorize.save_path);
+            self.message = Some(self.save_colorized(&path));
+        }
+    }
+
+    pub(super) fn colorize_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Colorize");
+        let c = &mut self.colorize;
+        let Some(session) = &c.session else {
+            ui.label("Open a line-art PNG (File menu, or drop it on the window).");
+            return;
+        };
+        let palette = session.palette();
+        let strokes = session.strokes().len();
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut c.tool, ColorizeTool::Brush, "Brush");
+            ui.selectable_value(&mut c.tool, ColorizeTool::Eraser, "Eraser");
+        });
+        ui.horizontal(|ui| {
+            ui.label("Color");
+            ui.color_edit_button_srgb(&mut c.color);
+        });
+        ui.horizontal_wrapped(|ui| {
+            for swatch in SWATCHES {
+                if swatch_button(ui, swatch, swatch == c.color).clicked() {
+                    c.color = swatch;
+                    c.tool = ColorizeTool::Brush;
+                }
+            }
+        });
+        ui.add(egui::Slider::new(&mut c.width_px, 1.0..=64.0).text("brush px"));
+        ui.separator();
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut c.view_mode, ColorizeView::Result, "Result");
+            ui.selectable_value(
+                &mut c.view_mode,
+                ColorizeView::ScribblesOnly,
+                "Scribbles only",
+            );
+        });
+        ui.add(egui::Slider::new(&mut c.opacity, 0.0..=1.0).text("result opacity"));
+        ui.separator();
+        ui.label(format!("{strokes} strokes, {} colors", palette.len()));
+        let mut command = None;
+        for color in &palette {
+            ui.horizontal(|ui| {
+                if swatch_button(ui, *color, *color == c.color).clicked() {
+                    c.color = *color;
+                    c.tool = ColorizeTool::Brush;
+                }
+                if ui
+                    .add_enabled(*color != c.color, egui::Button::new("Recolor to brush"))
+                    .clicked()
+                {
+                    command = Some(SessionCommand::Recolor {
+                        from: *color,
+                        to: c.color,
+                    });
+                }
+            });
+        }
+        if ui
+            .add_enabled(strokes > 0, egui::Button::new("Clear"))
+            .clicked()
+        {
+            command = Some(SessionCommand::Clear);
+        }
+        // A label, not a spinner: a spinner repaints forever, the solve wakes the UI itself.
+        if c.solving() {
+            ui.label("colorizing…");
+        } else if c.shown_result().is_some() {
+            ui.label("colorized");
+        }
+        if ui.button("Save colorized PNG").clicked() {
+            let path = PathBuf::from(&self.colorize.save_path);
+            self.message = Some(self.save_colorized(&path));
+        }
+        if let Some(command) = command {
+            self.apply_colorize(command);
+        }
+    }
+
+    /// Whether the menu's Undo has a step: the colorize session's in colorize mode, the
+    /// document's elsewhere.
+    pub fn can_undo_in_mode(&self) -> bool {
+        match (self.mode, &self.colorize.session) {
+            (Mode::Colorize, Some(s)) => s.can_undo(),
+            (Mode::Colorize, None) => false,
+            _ => self.doc.can_undo(),
+        }
+    }
+
+    pub fn can_redo_in_mode(&self) -> bool {
+        match (self.mode, &self.colorize.session) {
+            (Mode::Colorize, Some(s)) => s.can_redo(),
+            (Mode::Colorize, None) => false,
+            _ => self.doc.can_redo(),
+        }
+    }
+
+    /// Undo in the current mode (the menu's button).
+    pub fn undo_in_mode(&mut self) {
+        match self.mode {
+            Mode::Colorize => self.colorize.undo(),
+            _ => {
+                self.doc.undo();
+            }
+        }
+    }
+
+    pub fn redo_in_mode(&mut self) {
+        match self.mode {
+            Mode::Colorize => self.colorize.redo(),
+            _ => {
+                self.doc.redo();
+            }
+        }
+    }
+
+    /// Applies a session command, reporting a refusal as the message.
+    pub fn apply_colorize(&mut self, command: SessionCommand) -> bool {
+        let Some(session) = &mut self.colorize.session else {
+            return false;
+        };
+        match session.apply(command) {
+            Ok(()) => true,
+            Err(e) => {
+                self.message = Some(e.to_string());
+                false
+            }
+        }
+    }
+
+    /// Colorize mode's canvas: line art, result, scribbles, brush and eraser gestures.
+    pub(super) fn colorize_canvas(&mut self, ui: &mut egui::Ui) {
+        // The shared pan/zoom code works on `self.view`: lend it this mode's view.
+        std::mem::swap(&mut self.view, &mut self.colorize.view);
+        self.colorize_canvas_with_view(ui);
+        std::mem::swap(&mut self.view, &mut self.colorize.view);
+    }
+
+    fn colorize_canvas_with_view(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+        let rect = response.rect;
+        painter.rect_filled(rect, 0.0, Color32::from_gray(40));
+        let Some(size_px) = self.colorize.session.as_ref().map(|s| s.size_px()) else {
+            painter.text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                "Open a line-art PNG to colorize (File menu, or drop it here)",
+                egui::FontId::proportional(16.0),
+                Color32::from_gray(200),
+            );
+            return;
+        };
+        let view = *self
+            .view
+            .get_or_insert_with(|| canvas::fit(size_px, rect.size()));
+        let placed = Placed {
+            view,
+            origin: rect.min,
+        };
+        self.placed = Some(placed);
+        self.zoom_and_pan(&ctx, &response, placed);
+        let mut shapes = Vec::new();
+        if let Some(texture) = self.colorize_textures(&ctx) {
+            shapes.push(canvas::image_quad(&placed, &texture.0, size_px));
+            if let (Some(result), ColorizeView::Result) = (texture.1, self.colorize.view_mode) {
+                let alpha = (self.colorize.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
+                let quad = egui::Rect::from_two_pos(
+                    placed.screen_from_canvas([0.0, 0.0]),
+                    placed.screen_from_canvas([size_px[0] as f64, size_px[1] as f64]),
+                );
+                let uv = egui::Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+                shapes.push(egui::Shape::image(
+                    result.id(),
+                    quad,
+                    uv,
+                    Color32::from_white_alpha(alpha),
+                ));
+            }
+        }
+        for stroke in self.colorize.wanted().unwrap_or_default() {
+            shapes.extend(stroke_shapes(&placed, &stroke));
+        }
+        if let (ColorizeTool::Eraser, Some(at)) = (self.colorize.tool, response.hover_pos()) {
+            let radius = self.eraser_radius_px(&placed) as f32 * placed.view.zoom;
+            shapes.push(egui::Shape::circle_stroke(
+                at,
+                radius,
+                egui::Stroke::new(1.5, Color32::WHITE),
+            ));
+        }
+        painter.extend(shapes);
+        self.colorize_gestures(&ctx, &response, placed);
+    }
+
+    /// The line art's texture and the shown result's, uploaded when they change.
+    fn colorize_textures(
+        &mut self,
+        ctx: &egui::Context,
+    ) -> Option<(TextureHandle, Option<TextureHandle>)> {
+        let c = &mut self.colorize;
+        let session = c.session.as_ref()?;
+        let upload = |name: &str, image: &image::RgbaImage| {
+            let pixels = egui::ColorImage::from_rgba_unmultiplied(
+                [image.width() as usize, image.height() as usize],
+                image.as_raw(),
+            );
+            ctx.load_texture(name, pixels, egui::TextureOptions::LINEAR)
+        };
+        let lineart = c
+            .lineart_texture
+            .get_or_insert_with(|| upload("lineart", session.lineart()))
+            .clone();
+        let shown = c.shown_result().cloned();
+        let result = match shown {
+            None => None,
+            Some(r) => match &c.result_texture {
+                Some((k, t)) if Arc::ptr_eq(k, &r) => Some(t.clone()),
+                _ => {
+                    let t = upload("colorized", &r.image);
+                    c.result_texture = Some((r, t.clone()));
+                    Some(t)
+                }
+            },
+        };
+        Some((lineart, result))
+    }
+
+    /// The eraser's reach, image px: the brush radius, at least a few screen points.
+    fn eraser_radius_px(&self, placed: &Placed) -> f64 {
+        (self.colorize.width_px as f64 / 2.0)
+            .max(canvas::PICK_RADIUS_PT as f64 / placed.view.zoom as f64)
+    }
+
+    fn colorize_gestures(
+        &mut self,
+        ctx: &egui::Context,
+        response: &egui::Response,
+        placed: Placed,
+    ) {
+        let pointer = response.interact_pointer_pos();
+        let primary = ctx.input(|i| i.pointer.primary_down());
+        match self.colorize.tool {
+            ColorizeTool::Brush => {
+                if response.drag_started_by(egui::PointerButton::Primary) {
+                    // Where the button went down, not where the drag was recognized.
+                    let origin = ctx.input(|i| i.pointer.press_origin()).or(pointer);
+                    self.colorize.drawing = origin.map(|at| vec![placed.canvas_from_screen(at)]);
+                }
+                if let (Some(at), true, Some(points)) =
+                    (pointer, response.dragged(), &mut self.colorize.drawing)
+                {
+                    let p = placed.canvas_from_screen(at);
+                    if points
+                        .last()
+                        .is_none_or(|q| super::distance(*q, p) >= BRUSH_STEP_PX)
+                    {
+                        points.push(p);
+                    }
+                }
+                if response.drag_stopped() {
+                    if let Some(points) = self.colorize.drawing.take() {
+                        let stroke = self.colorize.stroke(points);
+                        self.apply_colorize(SessionCommand::AddStroke(stroke));
+                    }
+                }
+                if response.clicked() {
+                    if let Some(at) = pointer {
+                        let stroke = self.colorize.stroke(vec![placed.canvas_from_screen(at)]);
+                        self.apply_colorize(SessionCommand::AddStroke(stroke));
+                    }
+                }
+            }
+            ColorizeTool::Eraser => {
+                self.colorize.drawing = None;
+                let erasing = response.clicked() || (response.dragged() && primary);
+                if let (Some(at), true) = (pointer, erasing) {
+                    let command = SessionCommand::EraseNear {
+                        at_px: placed.canvas_from_screen(at),
+                        radius_px: self.eraser_radius_px(&placed),
+                    };
+                    if let Some(session) = &mut self.colorize.session {
+                        match session.apply(command) {
+                            // Passing over paper erases nothing: no message for that.
+                            Ok(()) | Err(SessionError::NothingToErase { .. }) => {}
+                            Err(e) => self.message = Some(e.to_string()),
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `NAME.colorized.png` beside the line art `NAME.png`.
+pub fn colorized_path(lineart: &Path) -> PathBuf {
+    let stem = lineart
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "lineart".into());
+    lineart.with_file_name(format!("{stem}.colorized.png"))
+}
+
+fn is_png(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
+/// A small square of `color` (framed when `selected`) that picks it.
+fn swatch_button(ui: &mut egui::Ui, color: [u8; 3], selected: bool) -> egui::Response {
+    let fill = Color32::from_rgb(color[0], color[1], color[2]);
+    let frame = if selected {
+        egui::Stroke::new(2.0, Color32::WHITE)
+    } else {
+        egui::Stroke::new(1.0, Color32::from_gray(90))
+    };
+    ui.add(
+        egui::Button::new("")
+            .fill(fill)
+            .stroke(frame)
+            .min_size(egui::vec2(18.0, 18.0)),
+    )
+    .on_hover_text(format!("#{}", crate::colorize::scribbles::hex(color)))
+}
+
+/// A scribble as the brush painted it: its path at its width, round joins and caps.
+fn stroke_shapes(placed: &Placed, stroke: &ScribbleStroke) -> Vec<egui::Shape> {
+    let [r, g, b] = stroke.color;
+    let color = Color32::from_rgb(r, g, b);
+    let width = stroke.width_px as f32 * placed.view.zoom;
+    let points: Vec<Pos2> = stroke
+        .points_px
+        .iter()
+        .map(|p| placed.screen_from_canvas(*p))
+        .collect();
+    // A dark rim first: a scribble stays visible over the region it colored.
+    let rim = Color32::from_black_alpha(150);
+    let mut shapes = Vec::new();
+    for (w, c) in [(width + 2.0, rim), (width, color)] {
+        shapes.extend(
+            points
+                .iter()
+                .map(|p| egui::Shape::circle_filled(*p, w / 2.0, c)),
+        );
+        if points.len() > 1 {
+            shapes.push(egui::Shape::line(points.clone(), egui::Stroke::new(w, c)));
+        }
+    }
+    shapes
+}
