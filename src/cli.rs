@@ -72,6 +72,12 @@ pub struct EditArgs {
     /// A handle to select first (rig mode shows its weights).
     #[arg(long)]
     pub select: Option<String>,
+    /// Line art (PNG) to open in colorize mode.
+    #[arg(long)]
+    pub line_art: Option<PathBuf>,
+    /// Scribbles to draw on the line art (the JSON of `sinew colorize --scribbles`).
+    #[arg(long, requires = "line_art")]
+    pub scribbles: Option<PathBuf>,
 }
 
 #[cfg(feature = "editor")]
@@ -80,6 +86,7 @@ pub enum EditMode {
     Rig,
     Pose,
     Animate,
+    Colorize,
 }
 
 #[derive(Args, Debug)]
@@ -375,6 +382,7 @@ fn edit(args: &EditArgs) -> Result<()> {
         EditMode::Rig => Mode::Rig,
         EditMode::Pose => Mode::Pose,
         EditMode::Animate => Mode::Animate,
+        EditMode::Colorize => Mode::Colorize,
     });
     crate::editor::run(crate::editor::Start {
         rig: args.rig.clone(),
@@ -382,6 +390,8 @@ fn edit(args: &EditArgs) -> Result<()> {
         pose,
         select: args.select.clone(),
         screenshot: args.screenshot.clone(),
+        line_art: args.line_art.clone(),
+        scribbles: args.scribbles.clone(),
     })
 }
 

@@ -52,6 +52,21 @@ impl ScribbleStroke {
         }
     }
 
+    /// A stroke of the JSON scribble file (`#rrggbb` color), as the session keeps it.
+    pub fn from_stroke(stroke: &Stroke) -> Result<Self, SessionError> {
+        let color = super::scribbles::parse_hex_color(&stroke.color).ok_or_else(|| {
+            SessionError::BadStroke(format!(
+                "color '{}' is not of the form #rrggbb",
+                stroke.color
+            ))
+        })?;
+        Ok(ScribbleStroke {
+            color,
+            width_px: stroke.width,
+            points_px: stroke.points.clone(),
+        })
+    }
+
     /// Distance (px) from `at_px` to the painted area: to the path, less the brush radius;
     /// 0 or less on the paint.
     pub fn distance_px(&self, at_px: [f64; 2]) -> f64 {

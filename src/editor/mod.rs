@@ -1346,6 +1346,10 @@ impl EditorApp {
     }
 
     fn take_screenshot(&mut self, ctx: &egui::Context) {
+        // Background work first: the picture shows its result.
+        if self.computing() || self.colorize.solving() || self.rig_tools.proposing() {
+            return;
+        }
         let Some((path, frames)) = &mut self.screenshot else {
             return;
         };
@@ -1568,6 +1572,10 @@ pub struct Start {
     pub select: Option<String>,
     /// Take a picture of the first frames to this PNG, then quit.
     pub screenshot: Option<PathBuf>,
+    /// Line art to open in colorize mode.
+    pub line_art: Option<PathBuf>,
+    /// Scribbles (the JSON file of `sinew colorize --scribbles`) to draw on the line art.
+    pub scribbles: Option<PathBuf>,
 }
 
 /// Opens the editor window.
@@ -1592,6 +1600,30 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         }
         app.rename_to = name.clone();
         app.selected = Some(name);
+    }
+    if let Some(path) = &start.line_art {
+        app.open_lineart(path);
+        if app.colorize.session.is_none() {
+            anyhow::bail!(
+                "{}",
+                app.message
+                    .clone()
+                    .unwrap_or_else(|| format!("{}: cannot open", path.display()))
+            );
+        }
+    }
+    if let Some(path) = &start.scribbles {
+        let file: crate::colorize::scribbles::StrokeFile = serde_json::from_slice(
+            &std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+        )
+        .map_err(|e| anyhow::anyhow!("{}: not a scribble file: {e}", path.display()))?;
+        let Some(session) = app.colorize.session.as_mut() else {
+            anyhow::bail!("--scribbles needs --line-art to draw on");
+        };
+        for stroke in &file.strokes {
+            let stroke = crate::colorize::session::ScribbleStroke::from_stroke(stroke)?;
+            session.apply(crate::colorize::session::SessionCommand::AddStroke(stroke))?;
+        }
     }
     if let Some(shot) = start.screenshot {
         app.screenshot_then_quit(shot);
