@@ -19,6 +19,7 @@
 //! locked ([`Command::SetLocked`]): painting leaves locked handles' weights alone, and
 //! [`compute_rig`] keeps them from the previous rig while it recomputes the others.
 
+use crate::anim::edit::{self, CopiedKey, KeyRef};
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
 use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
@@ -90,6 +91,8 @@ pub enum DocumentError {
     LockedHandle(String),
     #[error("painting weights: {0}")]
     Paint(#[from] crate::weights::PaintError),
+    #[error(transparent)]
+    KeyEdit(#[from] crate::anim::edit::EditError),
 }
 
 /// Everything an edit can change; one undo step restores one of these.
@@ -203,10 +206,34 @@ pub enum Command {
         handle: String,
         locked: bool,
     },
+    /// Moves keys of `animation` by `delta_s` seconds, all or none: a key would land on another
+    /// key of its timeline or before 0 → refused (see [`crate::anim::edit`]).
+    MoveKeys {
+        animation: String,
+        keys: Vec<KeyRef>,
+        delta_s: f64,
+    },
+    /// Writes copied keys at `at_s` plus their offsets, replacing keys at the same times.
+    PasteKeys {
+        animation: String,
+        at_s: f64,
+        keys: Vec<CopiedKey>,
+    },
+    /// Removes the named keys (timeline by timeline, unlike [`Command::DeleteKeys`]).
+    DeleteTimelineKeys {
+        animation: String,
+        keys: Vec<KeyRef>,
+    },
+    /// Sets the curve of a key's outgoing segment.
+    SetCurve {
+        animation: String,
+        key: KeyRef,
+        curve: Curve,
+    },
 }
 
 /// Keys closer in time than this (s) are the same key.
-pub const KEY_TIME_TOLERANCE_S: f64 = 1e-6;
+pub const KEY_TIME_TOLERANCE_S: f64 = crate::anim::edit::KEY_TIME_TOLERANCE_S;
 
 /// Identifies the inputs a rig was built from, to refuse a result that arrives after an edit.
 #[derive(Clone, Debug, PartialEq)]
@@ -736,6 +763,45 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             }
             inputs_changed = false;
         }
+        Command::MoveKeys {
+            animation,
+            keys,
+            delta_s,
+        } => {
+            let edited = edit::move_keys(
+                &animation,
+                &animation_json(state, &animation),
+                &keys,
+                delta_s,
+            )?;
+            next.animations.insert(animation, edited);
+            inputs_changed = false;
+        }
+        Command::PasteKeys {
+            animation,
+            at_s,
+            keys,
+        } => {
+            let edited =
+                edit::paste_keys(&animation, &animation_json(state, &animation), at_s, &keys)?;
+            next.animations.insert(animation, edited);
+            inputs_changed = false;
+        }
+        Command::DeleteTimelineKeys { animation, keys } => {
+            let edited = edit::delete_keys(&animation, &animation_json(state, &animation), &keys)?;
+            next.animations.insert(animation, edited);
+            inputs_changed = false;
+        }
+        Command::SetCurve {
+            animation,
+            key,
+            curve,
+        } => {
+            let edited =
+                edit::set_curve(&animation, &animation_json(state, &animation), &key, &curve)?;
+            next.animations.insert(animation, edited);
+            inputs_changed = false;
+        }
     }
     if inputs_changed {
         next.handles.validate()?;
@@ -836,6 +902,15 @@ pub fn animation_named(state: &State, name: &str) -> Result<Animation, DocumentE
         Some(value) => Ok(Animation::from_json(name, value)?),
         None => Ok(Animation::default()),
     }
+}
+
+/// The animation stored under `name` as JSON, or an empty one.
+pub fn animation_json(state: &State, name: &str) -> serde_json::Value {
+    state
+        .animations
+        .get(name)
+        .cloned()
+        .unwrap_or_else(|| serde_json::json!({}))
 }
 
 fn store_animation(next: &mut State, name: &str, anim: &Animation) -> Result<(), DocumentError> {
@@ -970,3 +1045,7 @@ pub fn key_times(anim: &Animation) -> Vec<f64> {
     times.dedup_by(|a, b| (*a - *b).abs() <= KEY_TIME_TOLERANCE_S);
     times
 }
+
+#[cfg(test)]
+#[path = "document_key_tests.rs"]
+mod key_tests;

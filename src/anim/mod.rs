@@ -10,10 +10,12 @@
 //! - [`timeline`]: keys, timelines, [`Animation`], parsing and per-animation checks;
 //! - [`check`]: names and sizes against a rig;
 //! - [`sample`]: an animation at a time, looping or clamped;
-//! - [`mix`]: the crossfade from one animation into another.
+//! - [`mix`]: the crossfade from one animation into another;
+//! - [`edit`]: keys edited per timeline (move, copy and paste, delete, curves) on the JSON.
 
 pub mod check;
 pub mod curve;
+pub mod edit;
 pub mod mix;
 pub mod sample;
 pub mod timeline;

@@ -9,7 +9,8 @@
 //! Modes: **Rig** (layers, handles, weights: draw bones and points, select, move, rename,
 //! reparent, delete, compute weights with progress and cancel, see a handle's weights as a heat
 //! map) and **Pose** (drag any point of the drawing and the skinning IK moves the whole shape;
-//! shift-click pins a point; every drag stays as a pin of the pose). **Colorize** ([`colorize`])
+//! shift-click pins a point; every drag stays as a pin of the pose) and **Animate** (keys,
+//! dopesheet, curves, playback and onion skins: [`timeline`]). **Colorize** ([`colorize`])
 //! scribbles colors on a line-art PNG and shows the colored result as it is solved. Rig mode's
 //! Paint tool, the handle locks and the per-vertex weights readout live in [`paint`].
 
@@ -18,6 +19,7 @@ pub mod colorize;
 pub mod gizmo;
 pub mod paint;
 pub mod rig_tools;
+pub mod timeline;
 pub mod worker;
 
 #[cfg(test)]
@@ -39,8 +41,6 @@ use worker::Worker;
 
 /// Seconds between autosaves of a changed document.
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
-/// Frames per second of the animate mode's frame steps.
-pub const DEFAULT_FPS: f64 = 24.0;
 /// The timeline shows at least this many seconds.
 pub const MIN_TIMELINE_S: f64 = 2.0;
 /// A press and release closer than this (canvas px) is a click, not a drag.
@@ -167,8 +167,6 @@ pub struct EditorApp {
     pub animation: String,
     pub time_s: f64,
     pub playing: bool,
-    /// Frames per second of the frame-step buttons.
-    pub fps: f64,
     /// Animate mode: the pose edited since the playhead last moved (not yet keyed).
     shown: Option<Pose>,
     /// Where File → Export writes.
@@ -185,6 +183,8 @@ pub struct EditorApp {
     pub colorize: colorize::ColorizeEditor,
     /// Rig mode's brush settings.
     pub paint: paint::PaintSettings,
+    /// Animate mode: key selection, clipboard, loop, onion skins, curve editor.
+    pub timeline: timeline::TimelineState,
 }
 
 impl EditorApp {
@@ -224,7 +224,6 @@ impl EditorApp {
             animation: first_animation,
             time_s: 0.0,
             playing: false,
-            fps: DEFAULT_FPS,
             shown: None,
             export_dir: "export".into(),
             render_path: "render.gif".into(),
@@ -233,6 +232,7 @@ impl EditorApp {
             render: None,
             colorize: Default::default(),
             paint: paint::PaintSettings::default(),
+            timeline: Default::default(),
         }
     }
 
@@ -454,6 +454,7 @@ impl EditorApp {
         self.warm_ik();
         self.colorize_frame_start(&ctx);
         self.dropped_files(&ctx);
+        self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
@@ -865,24 +866,8 @@ impl EditorApp {
         {
             return Ok(());
         }
-        let transforms = if pose.ik.is_empty() {
-            scene.handle_transforms(pose).map_err(|e| e.to_string())?
-        } else {
-            if self.ik.as_ref().is_none_or(|(k, _)| *k != key) {
-                let solver = scene.rig_ik().map_err(|e| e.to_string())?;
-                self.ik = Some((key, solver));
-            }
-            let Some((_, solver)) = self.ik.as_mut() else {
-                return Err("no IK solver".into());
-            };
-            solver
-                .transforms(pose)
-                .map_err(|e| e.to_string())?
-                .transforms
-        };
-        let positions = scene
-            .positions_from_transforms(&transforms, pose, Blend::Linear)
-            .map_err(|e| e.to_string())?;
+        let (transforms, positions) =
+            timeline::transforms_and_positions(scene, pose, &mut self.ik)?;
         let map = |t: &crate::rig::pose::Affine, p: [f64; 2]| {
             let q = t.apply(Point::new(p[0], p[1]));
             [q.x, q.y]
@@ -952,6 +937,7 @@ impl EditorApp {
         match (self.mode, &posable) {
             (Mode::Pose | Mode::Animate, Some(scene)) => {
                 let pose = live_pose.unwrap_or_else(|| self.edited_pose());
+                shapes.extend(self.onion_shapes(scene, &placed));
                 if let Err(e) = self.posed(scene, &pose) {
                     self.message = Some(e);
                 }
@@ -1384,118 +1370,6 @@ impl EditorApp {
         }
     }
 
-    /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
-    pub fn set_time(&mut self, time_s: f64) {
-        self.time_s = time_s.max(0.0);
-        self.shown = None;
-    }
-
-    /// The current animation's length: its last key, at least [`MIN_TIMELINE_S`].
-    pub fn timeline_length_s(&self) -> f64 {
-        crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0)
-            .max(MIN_TIMELINE_S)
-    }
-
-    fn animate_panel(&mut self, ui: &mut egui::Ui) {
-        let frame_s = 1.0 / self.fps;
-        ui.horizontal(|ui| {
-            ui.label("Animation");
-            ui.add(egui::TextEdit::singleline(&mut self.animation).desired_width(120.0));
-            let play = if self.playing { "Pause" } else { "Play" };
-            if ui.button(play).clicked() {
-                self.playing = !self.playing;
-            }
-            if ui.button("Previous frame").clicked() {
-                let t = ((self.time_s / frame_s).round() - 1.0).max(0.0) * frame_s;
-                self.set_time(t);
-            }
-            if ui.button("Next frame").clicked() {
-                let t = ((self.time_s / frame_s).round() + 1.0) * frame_s;
-                self.set_time(t);
-            }
-            let mut t = self.time_s;
-            let length = self.timeline_length_s();
-            if ui
-                .add(egui::Slider::new(&mut t, 0.0..=length).text("s"))
-                .changed()
-            {
-                self.set_time(t);
-            }
-            if ui.button("Set key").clicked() {
-                let pose = self.edited_pose();
-                let animation = self.animation.clone();
-                if self.apply(Command::SetKey {
-                    animation,
-                    time_s: self.time_s,
-                    pose,
-                }) {
-                    self.shown = None;
-                }
-            }
-            if ui.button("Delete key").clicked() {
-                let animation = self.animation.clone();
-                self.apply(Command::DeleteKeys {
-                    animation,
-                    time_s: self.time_s,
-                });
-            }
-        });
-        // The dopesheet: one diamond per key time; clicking one moves the playhead there.
-        let anim =
-            crate::document::animation_named(self.doc.state(), &self.animation).unwrap_or_default();
-        let times = crate::document::key_times(&anim);
-        let (response, painter) =
-            ui.allocate_painter(egui::vec2(ui.available_width(), 28.0), Sense::click());
-        let rect = response.rect;
-        painter.rect_filled(rect, 2.0, Color32::from_gray(30));
-        let length = self.timeline_length_s();
-        let x_of = |t: f64| rect.left() + 8.0 + (rect.width() - 16.0) * (t / length) as f32;
-        for &t in &times {
-            let c = egui::pos2(x_of(t), rect.center().y);
-            let d = 6.0;
-            painter.add(egui::Shape::convex_polygon(
-                vec![
-                    c + egui::vec2(0.0, -d),
-                    c + egui::vec2(d, 0.0),
-                    c + egui::vec2(0.0, d),
-                    c + egui::vec2(-d, 0.0),
-                ],
-                Color32::from_rgb(255, 200, 40),
-                egui::Stroke::NONE,
-            ));
-        }
-        let x = x_of(self.time_s);
-        painter.line_segment(
-            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
-            egui::Stroke::new(2.0, Color32::RED),
-        );
-        if let (true, Some(at)) = (response.clicked(), response.interact_pointer_pos()) {
-            let nearest = times
-                .iter()
-                .copied()
-                .min_by(|a, b| (x_of(*a) - at.x).abs().total_cmp(&(x_of(*b) - at.x).abs()));
-            let t = match nearest {
-                Some(k) if (x_of(k) - at.x).abs() <= canvas::PICK_RADIUS_PT => k,
-                _ => (((at.x - rect.left() - 8.0) / (rect.width() - 16.0)) as f64 * length)
-                    .clamp(0.0, length),
-            };
-            self.set_time(t);
-        }
-    }
-
-    fn advance_playback(&mut self, ctx: &egui::Context) {
-        if !self.playing || self.mode != Mode::Animate {
-            return;
-        }
-        let dt = f64::from(ctx.input(|i| i.stable_dt));
-        let length = self.timeline_length_s();
-        let t = self.time_s + dt;
-        self.set_time(if t > length { t % length } else { t });
-        ctx.request_repaint();
-    }
-
     fn unique_name(&self, stem: &str) -> String {
         let handles = &self.doc.state().handles;
         (1..)
@@ -1689,7 +1563,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("Space", "play or pause (animate mode)"),
     ("Ctrl+Z", "undo"),
     ("Ctrl+Shift+Z", "redo"),
-    ("Delete", "delete the selected handle (rig mode)"),
+    (
+        "Delete",
+        "delete the selected handle (rig mode), the selected keys (animate mode)",
+    ),
     ("Shift+click", "pin a point (pose mode)"),
     ("Click", "select the handle under the pointer (pose mode)"),
     (
@@ -1708,6 +1585,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     (
         "B / E / V",
         "colorize mode: brush / eraser / result or scribbles only",
+    ),
+    (
+        "Ctrl+C / Ctrl+V",
+        "copy the selected keys / paste them at the playhead",
     ),
 ];
 

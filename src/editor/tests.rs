@@ -821,3 +821,375 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
         assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
     }
 }
+
+/// Press at `from`, move in steps, release at `to` (screen points).
+fn drag_screen(h: &mut Harness<'_, EditorApp>, from: Pos2, to: Pos2) {
+    h.drag_at(from);
+    h.step();
+    for k in 1..=4 {
+        h.hover_at(from + (to - from) * (k as f32 / 4.0));
+        h.step();
+    }
+    h.drop_at(to);
+    h.step();
+    h.run();
+}
+
+fn click_screen(h: &mut Harness<'_, EditorApp>, at: Pos2) {
+    h.drag_at(at);
+    h.step();
+    h.drop_at(at);
+    h.step();
+    h.run();
+}
+
+fn head(channel: crate::anim::edit::TransformChannel) -> crate::anim::edit::TimelineId {
+    crate::anim::edit::TimelineId::Bone {
+        bone: "head".into(),
+        channel,
+    }
+}
+
+/// (time, value, curve) of the head's rotate keys in the document.
+fn head_rotate_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, f64, serde_json::Value)> {
+    let json = crate::document::animation_json(h.state().doc.state(), "nod");
+    json["bones"]["head"]["rotate"]
+        .as_array()
+        .map(|keys| {
+            keys.iter()
+                .map(|k| {
+                    (
+                        k["time"].as_f64().unwrap_or(f64::NAN),
+                        k["value"].as_f64().unwrap_or(f64::NAN),
+                        k.get("curve").cloned().unwrap_or(serde_json::Value::Null),
+                    )
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+fn times_of(h: &Harness<'_, EditorApp>, channel: crate::anim::edit::TransformChannel) -> Vec<f64> {
+    let json = crate::document::animation_json(h.state().doc.state(), "nod");
+    crate::anim::edit::timelines(&json)
+        .into_iter()
+        .find(|(t, _)| *t == head(channel))
+        .map(|(_, times)| times)
+        .unwrap_or_default()
+}
+
+fn key_on_sheet(
+    h: &Harness<'_, EditorApp>,
+    channel: crate::anim::edit::TransformChannel,
+    time_s: f64,
+) -> Pos2 {
+    h.state()
+        .timeline
+        .sheet
+        .as_ref()
+        .expect("the dopesheet was drawn")
+        .key_pos(&head(channel), time_s)
+        .expect("a row for the channel")
+}
+
+#[test]
+fn dopesheet_select_move_copy_paste_curve_and_undo() {
+    use crate::anim::edit::{KeyRef, TransformChannel::*};
+    let path = character_rig("dopesheet");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.state_mut().animation = "nod".into();
+    // Two keys from the pose: the head at 0° at 0 s and at 20° at 0.5 s.
+    for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
+        for _ in 0..frames {
+            h.get_by_label("Next frame").click();
+            h.run();
+        }
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "head".into(),
+            crate::rig::pose::BonePose {
+                rotate: degrees,
+                ..Default::default()
+            },
+        );
+        h.state_mut().shown = Some(pose);
+        h.get_by_label("Set key").click();
+        h.run();
+    }
+    assert_eq!(
+        head_rotate_keys(&h),
+        vec![
+            (0.0, 0.0, serde_json::Value::Null),
+            (0.5, 20.0, serde_json::Value::Null)
+        ],
+        "{:?}",
+        h.state().message
+    );
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+
+    // Select the rotate key at 0.5 s: the playhead goes there.
+    let at = key_on_sheet(&h, Rotate, 0.5);
+    click_screen(&mut h, at);
+    let selected = KeyRef {
+        timeline: head(Rotate),
+        time_s: 0.5,
+    };
+    assert_eq!(h.state().timeline.selection, vec![selected.clone()]);
+    assert!((h.state().time_s - 0.5).abs() < 1e-9);
+
+    // Drag it to 0.75 s (a little off: it snaps to the frame); only that channel moves.
+    let sheet = h.state().timeline.sheet.clone().expect("sheet");
+    let to = Pos2::new(
+        sheet.x_of(0.75) + 0.2 * sheet.px_per_s / 24.0,
+        sheet.rows[0].1,
+    );
+    let from = key_on_sheet(&h, Rotate, 0.5);
+    drag_screen(&mut h, from, to);
+    let rotate = head_rotate_keys(&h);
+    assert_eq!(rotate.len(), 2, "{:?}", h.state().message);
+    assert!((rotate[1].0 - 0.75).abs() < 1e-9, "{rotate:?}");
+    assert_eq!(rotate[1].1, 20.0);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+    assert!((h.state().timeline.selection[0].time_s - 0.75).abs() < 1e-9);
+
+    // Copy it, put the playhead at 1 s on the ruler, paste: a 20° key at 1 s.
+    h.get_by_label("Copy keys").click();
+    h.run();
+    let ruler_y = sheet.ruler.center().y;
+    click_screen(&mut h, Pos2::new(sheet.x_of(1.0), ruler_y));
+    assert!(
+        (h.state().time_s - 1.0).abs() < 1e-9,
+        "{}",
+        h.state().time_s
+    );
+    h.get_by_label("Paste keys").click();
+    h.run();
+    let rotate = head_rotate_keys(&h);
+    assert_eq!(rotate.len(), 3, "{:?}", h.state().message);
+    assert!(
+        (rotate[2].0 - 1.0).abs() < 1e-9 && rotate[2].1 == 20.0,
+        "{rotate:?}"
+    );
+
+    // Select the first key and make its segment a Bézier: handles at the thirds.
+    let at = key_on_sheet(&h, Rotate, 0.0);
+    click_screen(&mut h, at);
+    assert_eq!(h.state().timeline.selection.len(), 1);
+    h.get_by_label("Bézier").click();
+    h.run();
+    let curve = head_rotate_keys(&h)[0].2.clone();
+    let numbers: Vec<f64> = serde_json::from_value(curve.clone()).expect("a Bézier: {curve}");
+    let expected = [0.25, 20.0 / 3.0, 0.5, 40.0 / 3.0];
+    assert!(
+        numbers
+            .iter()
+            .zip(expected)
+            .all(|(a, b)| (a - b).abs() < 1e-9),
+        "{numbers:?}"
+    );
+
+    // Drag the first handle down and right: one more undo step, the handle stays in the segment.
+    let layout = h.state().timeline.curve.clone().expect("the curve editor");
+    let [first, _] = layout.handles.expect("Bézier handles");
+    drag_screen(&mut h, first, first + egui::vec2(30.0, 25.0));
+    let dragged: Vec<f64> =
+        serde_json::from_value(head_rotate_keys(&h)[0].2.clone()).expect("still a Bézier");
+    assert!(dragged[0] > numbers[0] + 1e-3, "{dragged:?}");
+    assert!(dragged[1] < numbers[1] - 1e-3, "{dragged:?}");
+    assert!(
+        dragged[0] <= 0.75 && dragged[2..] == numbers[2..],
+        "{dragged:?}"
+    );
+
+    // Undo, step by step, back to the two keys as set.
+    let undo = |h: &mut Harness<'_, EditorApp>| {
+        h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        h.run();
+    };
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h)[0].2, curve);
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h)[0].2, serde_json::Value::Null);
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h).len(), 2);
+    undo(&mut h);
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
+
+    // Box-select the column at 0.5 s (all four channels) and delete it with the Delete key.
+    let sheet = h.state().timeline.sheet.clone().expect("sheet");
+    let (top, bottom) = (
+        sheet.rows.first().expect("rows").1 - 8.0,
+        sheet.rows.last().expect("rows").1 + 8.0,
+    );
+    drag_screen(
+        &mut h,
+        Pos2::new(sheet.x_of(0.5) - 10.0, top),
+        Pos2::new(sheet.x_of(0.5) + 10.0, bottom),
+    );
+    assert_eq!(h.state().timeline.selection.len(), 4);
+    h.key_press(Key::Delete);
+    h.run();
+    for channel in [Rotate, Translate, Scale, Shear] {
+        assert_eq!(times_of(&h, channel), vec![0.0]);
+    }
+    assert!(
+        h.state().doc.state().handles.names().any(|n| n == "head"),
+        "Delete took the keys, not a handle"
+    );
+    undo(&mut h);
+    assert_eq!(times_of(&h, Shear), vec![0.0, 0.5]);
+}
+
+#[test]
+fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
+    let path = character_rig("playback");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    {
+        let app = h.state_mut();
+        for (time_s, degrees) in [(0.0, 0.0), (0.5, 30.0)] {
+            let mut pose = Pose::default();
+            pose.bones.insert(
+                "head".into(),
+                crate::rig::pose::BonePose {
+                    rotate: degrees,
+                    ..Default::default()
+                },
+            );
+            assert!(app.apply(Command::SetKey {
+                animation: "nod".into(),
+                time_s,
+                pose,
+            }));
+        }
+        app.animation = "nod".into();
+        app.render_settings.fps = 12.0;
+        app.playing = true;
+    }
+    let on_frame = |t: f64| ((t * 12.0) - (t * 12.0).round()).abs() < 1e-6;
+    let mut wrapped = false;
+    let mut last = 0.0;
+    for _ in 0..240 {
+        h.step();
+        let t = h.state().time_s;
+        assert!(on_frame(t) && t < 0.5 - 1e-9, "{t}");
+        wrapped |= t < last;
+        last = t;
+    }
+    assert!(wrapped, "playback never looped");
+    // Without looping it stops on the last key.
+    h.state_mut().playing = false;
+    h.get_by_label("Loop").click();
+    h.run();
+    h.state_mut().playing = true;
+    for _ in 0..240 {
+        h.step();
+        if !h.state().playing {
+            break;
+        }
+    }
+    assert!(!h.state().playing);
+    assert!((h.state().time_s - 0.5).abs() < 1e-9);
+    // Playing again from the end starts over.
+    h.state_mut().playing = true;
+    h.step();
+    assert_eq!(h.state().time_s, 0.0);
+    h.step();
+    assert!(h.state().time_s > 0.0);
+    h.state_mut().playing = false;
+    h.state_mut().set_time(0.5);
+
+    // Onion skins: at the end only earlier frames exist; in the middle both sides.
+    h.get_by_label("Onion skin").click();
+    h.run();
+    let scene = h.state().doc.posable().expect("posable").clone();
+    let placed = h.state().placed.expect("placed");
+    let at_end = h.state_mut().onion_shapes(&scene, &placed);
+    h.state_mut().set_time(0.25);
+    let middle = h.state_mut().onion_shapes(&scene, &placed);
+    assert!(!at_end.is_empty());
+    assert_eq!(
+        middle.len(),
+        2 * at_end.len(),
+        "two frames each side vs two before"
+    );
+    h.state_mut().timeline.onion.enabled = false;
+    assert!(h.state_mut().onion_shapes(&scene, &placed).is_empty());
+}
+
+#[test]
+fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
+    use crate::anim::edit::{KeyRef, TransformChannel::*};
+    let path = character_rig("keyboard");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    {
+        let app = h.state_mut();
+        for (time_s, degrees) in [(0.0, 0.0), (0.5, 30.0)] {
+            let mut pose = Pose::default();
+            pose.bones.insert(
+                "head".into(),
+                crate::rig::pose::BonePose {
+                    rotate: degrees,
+                    ..Default::default()
+                },
+            );
+            assert!(app.apply(Command::SetKey {
+                animation: "nod".into(),
+                time_s,
+                pose,
+            }));
+        }
+        app.animation = "nod".into();
+    }
+    h.key_press(Key::Num3);
+    h.run();
+    // Click one key, shift-click another: both selected; shift-click again: deselected.
+    let at = key_on_sheet(&h, Rotate, 0.5);
+    click_screen(&mut h, at);
+    let translate = key_on_sheet(&h, Translate, 0.5);
+    // One frame per event: shift down, press, release, shift up.
+    h.event(egui::Event::ModifiersChanged(Modifiers::SHIFT));
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: translate,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::SHIFT,
+        });
+    }
+    h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+    h.step();
+    h.run();
+    let selection = &h.state().timeline.selection;
+    assert_eq!(selection.len(), 2, "{selection:?}");
+    assert!(selection.contains(&KeyRef {
+        timeline: head(Translate),
+        time_s: 0.5
+    }));
+    assert!(
+        (h.state().time_s - 0.5).abs() < 1e-9,
+        "a plain click moves the playhead to its key"
+    );
+    // Ctrl+C, playhead to 1 s, Ctrl+V: both keys pasted at 1 s.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::C);
+    h.run();
+    assert_eq!(h.state().timeline.clipboard.len(), 2);
+    h.state_mut().set_time(1.0);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Scale), vec![0.0, 0.5], "not copied");
+    assert_eq!(head_rotate_keys(&h)[2].1, 30.0);
+    // The pasted keys are the selection now; Delete removes exactly them.
+    h.key_press(Key::Delete);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+}

@@ -1,0 +1,1225 @@
+//! Animate mode's panel and canvas overlay.
+//!
+//! In: the document's animation being edited, the playhead, pointer and keys. Out: document
+//! commands — `SetKey` and `DeleteKeys` at the playhead, `MoveKeys`, `PasteKeys`,
+//! `DeleteTimelineKeys` and `SetCurve` for the keys selected in the dopesheet (the logic and the
+//! checks are [`crate::anim::edit`]'s) — and pictures: the transport (play, pause, loop at the
+//! frame rate, frame steps), the dopesheet (a row per timeline, one per handle and channel:
+//! click, shift-click and box-select keys, drag them in time snapped to frames, copy, paste at
+//! the playhead, delete), the curve editor of the selected key's outgoing segment (linear,
+//! stepped, Bézier with two draggable handles over the channel's value graph), and onion skins
+//! (the posed outlines of neighbouring frames behind the current pose, cached per frame time).
+
+use super::{canvas, EditorApp, Mode};
+use crate::anim::edit::{self, CopiedKey, KeyRef, Segment, TimelineId, KEY_TIME_TOLERANCE_S};
+use crate::anim::{Animation, Curve};
+use crate::document::Command;
+use crate::geom::Point;
+use crate::ik::RigIk;
+use crate::pipeline::Scene;
+use crate::rig::pose::Affine;
+use crate::rig::Pose;
+use crate::skin::Blend;
+use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Rect, Sense, Shape, Stroke};
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Height of a dopesheet row (the ruler, the summary and each timeline), points.
+pub const ROW_HEIGHT_PT: f32 = 18.0;
+/// Width of the dopesheet's name column, points.
+pub const LABEL_WIDTH_PT: f32 = 150.0;
+/// Horizontal distance within which a click picks a key, points.
+pub const KEY_PICK_PT: f32 = 6.0;
+/// Most neighbouring frames an onion skin shows on each side.
+pub const MAX_ONION_FRAMES: usize = 8;
+/// Posed frames the onion skin keeps; more and the cache starts again.
+const ONION_CACHE_FRAMES: usize = 64;
+/// Size of the curve editor's graph, points.
+const CURVE_GRAPH_PT: [f32; 2] = [300.0, 150.0];
+/// Screen distance within which a press grabs a Bézier handle, points.
+const HANDLE_PICK_PT: f32 = 9.0;
+
+/// Onion skinning: the posed outlines of `frames` frames before (red) and after (green) the
+/// playhead, the nearest at `opacity`, fading with distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OnionOptions {
+    /// Default off.
+    pub enabled: bool,
+    /// Default 2, at most [`MAX_ONION_FRAMES`].
+    pub frames: usize,
+    /// Default 0.5.
+    pub opacity: f32,
+}
+
+impl Default for OnionOptions {
+    fn default() -> Self {
+        OnionOptions {
+            enabled: false,
+            frames: 2,
+            opacity: 0.5,
+        }
+    }
+}
+
+/// Where last frame's dopesheet was drawn (tests convert key times to screen with it).
+#[derive(Clone, Debug)]
+pub struct SheetLayout {
+    pub rect: Rect,
+    /// x of time 0, points.
+    pub zero_x: f32,
+    pub px_per_s: f32,
+    pub ruler: Rect,
+    /// Centre line of the row of all keys.
+    pub summary_y: f32,
+    /// Each timeline's row, centre line.
+    pub rows: Vec<(TimelineId, f32)>,
+}
+
+impl SheetLayout {
+    pub fn x_of(&self, time_s: f64) -> f32 {
+        self.zero_x + self.px_per_s * time_s as f32
+    }
+
+    pub fn time_at(&self, x: f32) -> f64 {
+        f64::from((x - self.zero_x) / self.px_per_s).max(0.0)
+    }
+
+    /// Where the key at `time_s` of `timeline` is drawn.
+    pub fn key_pos(&self, timeline: &TimelineId, time_s: f64) -> Option<Pos2> {
+        let (_, y) = self.rows.iter().find(|(t, _)| t == timeline)?;
+        Some(Pos2::new(self.x_of(time_s), *y))
+    }
+
+    fn row_at(&self, y: f32) -> Option<&TimelineId> {
+        self.rows
+            .iter()
+            .find(|(_, cy)| (y - cy).abs() <= ROW_HEIGHT_PT / 2.0)
+            .map(|(t, _)| t)
+    }
+}
+
+/// Where last frame's curve editor graph was drawn.
+#[derive(Clone, Debug)]
+pub struct CurveLayout {
+    pub rect: Rect,
+    pub start_s: f64,
+    pub end_s: f64,
+    /// Value range shown, bottom to top.
+    pub low: f64,
+    pub high: f64,
+    /// The two Bézier handles of the shown channel, when the curve is a Bézier.
+    pub handles: Option<[Pos2; 2]>,
+}
+
+impl CurveLayout {
+    pub fn screen(&self, time_s: f64, value: f64) -> Pos2 {
+        let fx = ((time_s - self.start_s) / (self.end_s - self.start_s)) as f32;
+        let fy = ((value - self.low) / (self.high - self.low)) as f32;
+        Pos2::new(
+            self.rect.left() + fx * self.rect.width(),
+            self.rect.bottom() - fy * self.rect.height(),
+        )
+    }
+
+    pub fn graph(&self, p: Pos2) -> (f64, f64) {
+        let fx = f64::from((p.x - self.rect.left()) / self.rect.width());
+        let fy = f64::from((self.rect.bottom() - p.y) / self.rect.height());
+        (
+            self.start_s + fx * (self.end_s - self.start_s),
+            self.low + fy * (self.high - self.low),
+        )
+    }
+}
+
+/// What a press in the dopesheet landed on.
+enum Hit {
+    Ruler,
+    Key(KeyRef),
+    /// A key of the row of all keys: every key at that time.
+    Summary(f64),
+    /// A timeline's name: all its keys.
+    Row(TimelineId),
+    Empty,
+}
+
+enum SheetGesture {
+    Scrub,
+    Move {
+        anchor_s: f64,
+        origin_x: f32,
+        delta_s: f64,
+    },
+    Box {
+        from: Pos2,
+        to: Pos2,
+        add: bool,
+    },
+    CurveHandle {
+        key: KeyRef,
+        /// Index of the handle's time in the curve numbers (its value follows).
+        at: usize,
+        numbers: Vec<f64>,
+    },
+}
+
+/// Posed outlines of neighbouring frames, for one rig and one version of the animation.
+#[derive(Default)]
+struct OnionCache {
+    scene: Option<*const Scene>,
+    animation: Option<(String, serde_json::Value)>,
+    /// Boundary edges (vertex pairs) of each part's mesh.
+    outlines: Vec<Vec<[u32; 2]>>,
+    /// Posed vertex positions by frame time (µs).
+    frames: BTreeMap<i64, Vec<Vec<Point>>>,
+    ik: Option<(*const Scene, RigIk)>,
+}
+
+/// Animate mode's state beside the document.
+pub struct TimelineState {
+    /// Keys selected in the dopesheet.
+    pub selection: Vec<KeyRef>,
+    /// The keys last copied.
+    pub clipboard: Vec<CopiedKey>,
+    /// Whether playback starts again at the end (default) or stops there.
+    pub looping: bool,
+    pub onion: OnionOptions,
+    /// Which value channel (x, y; r, g, b, a) the curve editor shows.
+    pub curve_channel: usize,
+    pub sheet: Option<SheetLayout>,
+    pub curve: Option<CurveLayout>,
+    gesture: Option<SheetGesture>,
+    onion_cache: OnionCache,
+    /// Real time played since the last frame step, s.
+    play_clock_s: f64,
+    /// Whether playback ran last frame (starting again from the end rewinds first).
+    was_playing: bool,
+    /// The animation the selection belongs to.
+    selection_of: String,
+}
+
+impl Default for TimelineState {
+    fn default() -> Self {
+        TimelineState {
+            selection: Vec::new(),
+            clipboard: Vec::new(),
+            looping: true,
+            onion: OnionOptions::default(),
+            curve_channel: 0,
+            sheet: None,
+            curve: None,
+            gesture: None,
+            onion_cache: OnionCache::default(),
+            play_clock_s: 0.0,
+            was_playing: false,
+            selection_of: String::new(),
+        }
+    }
+}
+
+/// Skinning transformations and vertex positions of `pose`: forward kinematics, or the
+/// skinning IK when the pose has drags (`ik` holds the solver, made on first need and kept for
+/// warm starts). The canvas and the onion skins both pose through this.
+pub(super) fn transforms_and_positions(
+    scene: &Arc<Scene>,
+    pose: &Pose,
+    ik: &mut Option<(*const Scene, RigIk)>,
+) -> Result<(Vec<Affine>, Vec<Vec<Point>>), String> {
+    let key = Arc::as_ptr(scene);
+    let transforms = if pose.ik.is_empty() {
+        scene.handle_transforms(pose).map_err(|e| e.to_string())?
+    } else {
+        if ik.as_ref().is_none_or(|(k, _)| *k != key) {
+            let solver = scene.rig_ik().map_err(|e| e.to_string())?;
+            *ik = Some((key, solver));
+        }
+        let Some((_, solver)) = ik.as_mut() else {
+            return Err("no IK solver".into());
+        };
+        solver
+            .transforms(pose)
+            .map_err(|e| e.to_string())?
+            .transforms
+    };
+    let positions = scene
+        .positions_from_transforms(&transforms, pose, Blend::Linear)
+        .map_err(|e| e.to_string())?;
+    Ok((transforms, positions))
+}
+
+/// Edges used by one triangle only: the outline of a mesh (holes included).
+fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut count: BTreeMap<[u32; 2], u32> = BTreeMap::new();
+    for t in triangles {
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
+        }
+    }
+    count
+        .into_iter()
+        .filter(|(_, n)| *n == 1)
+        .map(|(e, _)| e)
+        .collect()
+}
+
+fn diamond(center: Pos2, radius: f32, fill: Color32, stroke: Stroke) -> Shape {
+    Shape::convex_polygon(
+        vec![
+            center + egui::vec2(0.0, -radius),
+            center + egui::vec2(radius, 0.0),
+            center + egui::vec2(0.0, radius),
+            center + egui::vec2(-radius, 0.0),
+        ],
+        fill,
+        stroke,
+    )
+}
+
+fn channel_name(channels: usize, c: usize) -> String {
+    match (channels, c) {
+        (2, 0) => "x".into(),
+        (2, 1) => "y".into(),
+        (4, k) => ["red", "green", "blue", "alpha"][k.min(3)].into(),
+        _ => format!("channel {c}"),
+    }
+}
+
+impl EditorApp {
+    /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
+    pub fn set_time(&mut self, time_s: f64) {
+        self.time_s = time_s.max(0.0);
+        self.shown = None;
+    }
+
+    /// The current animation's length: its last key, at least [`super::MIN_TIMELINE_S`].
+    pub fn timeline_length_s(&self) -> f64 {
+        crate::document::animation_named(self.doc.state(), &self.animation)
+            .map(|a| a.duration_s())
+            .unwrap_or(0.0)
+            .max(super::MIN_TIMELINE_S)
+    }
+
+    /// Seconds per frame at the frame rate: File → Render's, so playback shows the frames a
+    /// render writes (the rig document keeps no frame rate of its own).
+    fn frame_s(&self) -> f64 {
+        1.0 / self.render_settings.fps.max(1.0)
+    }
+
+    /// `time_s` on the nearest frame.
+    pub fn snap_to_frame(&self, time_s: f64) -> f64 {
+        (time_s / self.frame_s()).round() * self.frame_s()
+    }
+
+    /// Where playback ends (and loops): the last key, or the timeline's length when every key
+    /// is at 0.
+    fn play_end_s(&self) -> f64 {
+        let end = crate::document::animation_named(self.doc.state(), &self.animation)
+            .map(|a| a.duration_s())
+            .unwrap_or(0.0);
+        if end > KEY_TIME_TOLERANCE_S {
+            end
+        } else {
+            self.timeline_length_s()
+        }
+    }
+
+    /// Plays frame by frame at the frame rate: the playhead only ever shows frames (as a render
+    /// does), stepping as many as the real time elapsed covers. Looping wraps at the last key,
+    /// which a cycle's first key repeats, so it is not shown twice; otherwise playback stops on
+    /// the last key.
+    pub(super) fn advance_playback(&mut self, ctx: &egui::Context) {
+        if !self.playing || self.mode != Mode::Animate {
+            self.timeline.play_clock_s = 0.0;
+            self.timeline.was_playing = false;
+            return;
+        }
+        ctx.request_repaint();
+        let frame_s = self.frame_s();
+        let end = self.play_end_s();
+        if !self.timeline.was_playing {
+            self.timeline.was_playing = true;
+            // Play pressed on the last frame starts over.
+            if self.time_s >= end - KEY_TIME_TOLERANCE_S {
+                self.set_time(0.0);
+                return;
+            }
+        }
+        self.timeline.play_clock_s += f64::from(ctx.input(|i| i.stable_dt));
+        let steps = (self.timeline.play_clock_s / frame_s + 1e-9).floor();
+        if steps < 1.0 {
+            return;
+        }
+        self.timeline.play_clock_s = (self.timeline.play_clock_s - steps * frame_s).max(0.0);
+        let mut t = ((self.time_s / frame_s).round() + steps) * frame_s;
+        if t >= end - KEY_TIME_TOLERANCE_S {
+            if self.timeline.looping {
+                t = self.snap_to_frame(t.rem_euclid(end));
+                if t >= end - KEY_TIME_TOLERANCE_S {
+                    t = 0.0;
+                }
+            } else {
+                t = end;
+                self.playing = false;
+                self.timeline.was_playing = false;
+            }
+        }
+        self.set_time(t);
+    }
+
+    /// Animate mode's keyboard: copy, paste, and delete of the selected keys (run before the
+    /// editor's shortcuts, so Delete deletes keys rather than the selected handle).
+    pub(super) fn timeline_shortcuts(&mut self, ctx: &egui::Context) {
+        if self.mode != Mode::Animate || ctx.text_edit_focused() {
+            return;
+        }
+        let selected = !self.timeline.selection.is_empty();
+        let (copy, paste, delete) = ctx.input_mut(|i| {
+            // Native windows turn Ctrl+C / Ctrl+V into Copy and Paste events.
+            let copy = i.consume_key(Modifiers::COMMAND, Key::C)
+                || i.events.iter().any(|e| matches!(e, egui::Event::Copy));
+            let pasted = i.events.iter().find_map(|e| match e {
+                egui::Event::Paste(text) => Some(text.clone()),
+                _ => None,
+            });
+            let paste = match (i.consume_key(Modifiers::COMMAND, Key::V), pasted) {
+                (_, Some(text)) => Some(Some(text)),
+                (true, None) => Some(None),
+                (false, None) => None,
+            };
+            let delete = selected
+                && (i.consume_key(Modifiers::NONE, Key::Delete)
+                    || i.consume_key(Modifiers::NONE, Key::Backspace));
+            (copy, paste, delete)
+        });
+        if copy && selected {
+            self.copy_keys();
+            // The system clipboard gets them too, so the window's Ctrl+V comes back as a paste.
+            if let Ok(text) = serde_json::to_string(&self.timeline.clipboard) {
+                ctx.copy_text(text);
+            }
+        }
+        if let Some(text) = paste {
+            if let Some(keys) = text.and_then(|t| serde_json::from_str::<Vec<CopiedKey>>(&t).ok()) {
+                self.timeline.clipboard = keys;
+            }
+            self.paste_keys();
+        }
+        if delete {
+            self.delete_selected_keys();
+        }
+    }
+
+    /// Copies the selected keys to the editor's clipboard.
+    pub fn copy_keys(&mut self) {
+        let json = crate::document::animation_json(self.doc.state(), &self.animation);
+        match edit::copy_keys(&json, &self.timeline.selection) {
+            Ok(keys) => self.timeline.clipboard = keys,
+            Err(e) => self.message = Some(e.to_string()),
+        }
+    }
+
+    /// Pastes the clipboard at the playhead (on its frame); the pasted keys become the
+    /// selection.
+    pub fn paste_keys(&mut self) {
+        if self.timeline.clipboard.is_empty() {
+            return;
+        }
+        let at_s = self.snap_to_frame(self.time_s).max(0.0);
+        let keys = self.timeline.clipboard.clone();
+        if self.apply(Command::PasteKeys {
+            animation: self.animation.clone(),
+            at_s,
+            keys: keys.clone(),
+        }) {
+            self.timeline.selection = keys
+                .into_iter()
+                .map(|k| KeyRef {
+                    timeline: k.timeline,
+                    time_s: at_s + k.offset_s,
+                })
+                .collect();
+        }
+    }
+
+    pub fn delete_selected_keys(&mut self) {
+        if self.timeline.selection.is_empty() {
+            return;
+        }
+        if self.apply(Command::DeleteTimelineKeys {
+            animation: self.animation.clone(),
+            keys: self.timeline.selection.clone(),
+        }) {
+            self.timeline.selection.clear();
+        }
+    }
+
+    /// The bottom panel of animate mode.
+    pub(super) fn animate_panel(&mut self, ui: &mut egui::Ui) {
+        let frame_s = self.frame_s();
+        ui.horizontal(|ui| {
+            ui.label("Animation");
+            ui.add(egui::TextEdit::singleline(&mut self.animation).desired_width(120.0));
+            let play = if self.playing { "Pause" } else { "Play" };
+            if ui.button(play).clicked() {
+                self.playing = !self.playing;
+            }
+            ui.checkbox(&mut self.timeline.looping, "Loop");
+            if ui.button("Previous frame").clicked() {
+                let t = ((self.time_s / frame_s).round() - 1.0).max(0.0) * frame_s;
+                self.set_time(t);
+            }
+            if ui.button("Next frame").clicked() {
+                let t = ((self.time_s / frame_s).round() + 1.0) * frame_s;
+                self.set_time(t);
+            }
+            ui.add(
+                egui::DragValue::new(&mut self.render_settings.fps)
+                    .range(1.0..=crate::playback::MAX_FPS)
+                    .speed(0.1)
+                    .suffix(" fps"),
+            );
+            let mut t = self.time_s;
+            let length = self.timeline_length_s();
+            if ui
+                .add(egui::Slider::new(&mut t, 0.0..=length).text("s"))
+                .changed()
+            {
+                self.set_time(t);
+            }
+            if ui.button("Set key").clicked() {
+                let pose = self.edited_pose();
+                let animation = self.animation.clone();
+                if self.apply(Command::SetKey {
+                    animation,
+                    time_s: self.time_s,
+                    pose,
+                }) {
+                    self.shown = None;
+                }
+            }
+            if ui.button("Delete key").clicked() {
+                let animation = self.animation.clone();
+                self.apply(Command::DeleteKeys {
+                    animation,
+                    time_s: self.time_s,
+                });
+            }
+        });
+        ui.horizontal(|ui| {
+            let selected = !self.timeline.selection.is_empty();
+            if ui
+                .add_enabled(selected, egui::Button::new("Copy keys"))
+                .clicked()
+            {
+                self.copy_keys();
+            }
+            let pastable = !self.timeline.clipboard.is_empty();
+            if ui
+                .add_enabled(pastable, egui::Button::new("Paste keys"))
+                .clicked()
+            {
+                self.paste_keys();
+            }
+            if ui
+                .add_enabled(selected, egui::Button::new("Delete selected keys"))
+                .clicked()
+            {
+                self.delete_selected_keys();
+            }
+            ui.separator();
+            let onion = &mut self.timeline.onion;
+            ui.checkbox(&mut onion.enabled, "Onion skin");
+            ui.add(
+                egui::DragValue::new(&mut onion.frames)
+                    .range(1..=MAX_ONION_FRAMES)
+                    .suffix(" frames"),
+            );
+            ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
+        });
+        let json = crate::document::animation_json(self.doc.state(), &self.animation);
+        let timelines = edit::timelines(&json);
+        // Another animation, undo, redo and other edits can take selected keys away.
+        if self.timeline.selection_of != self.animation {
+            self.timeline.selection_of = self.animation.clone();
+            self.timeline.selection.clear();
+        }
+        self.timeline.selection.retain(|k| {
+            timelines
+                .iter()
+                .any(|(t, times)| times.iter().any(|&s| k.is(t, s)))
+        });
+        ui.horizontal_top(|ui| {
+            let width = (ui.available_width() - CURVE_GRAPH_PT[0] - 24.0).max(240.0);
+            // Ask for the whole sheet (up to the cap), or the panel stays at its last height.
+            let sheet_height = ROW_HEIGHT_PT * (timelines.len() as f32 + 2.0);
+            egui::ScrollArea::vertical()
+                .id_salt("dopesheet")
+                .max_height(240.0)
+                .min_scrolled_height(sheet_height.min(240.0))
+                .max_width(width)
+                .show(ui, |ui| self.dopesheet(ui, width, &timelines));
+            ui.separator();
+            ui.vertical(|ui| self.curve_editor(ui, &json));
+        });
+    }
+
+    fn hit(&self, layout: &SheetLayout, p: Pos2, timelines: &[(TimelineId, Vec<f64>)]) -> Hit {
+        if layout.ruler.contains(p) {
+            return Hit::Ruler;
+        }
+        let near = |t: f64| (layout.x_of(t) - p.x).abs() <= KEY_PICK_PT;
+        let nearest = |times: &[f64]| {
+            times.iter().copied().filter(|&t| near(t)).min_by(|a, b| {
+                (layout.x_of(*a) - p.x)
+                    .abs()
+                    .total_cmp(&(layout.x_of(*b) - p.x).abs())
+            })
+        };
+        if (p.y - layout.summary_y).abs() <= ROW_HEIGHT_PT / 2.0 {
+            let all: Vec<f64> = timelines.iter().flat_map(|(_, t)| t.clone()).collect();
+            return nearest(&all).map_or(Hit::Empty, Hit::Summary);
+        }
+        let Some(row) = layout.row_at(p.y) else {
+            return Hit::Empty;
+        };
+        if p.x < layout.zero_x - KEY_PICK_PT {
+            return Hit::Row(row.clone());
+        }
+        timelines
+            .iter()
+            .find(|(t, _)| t == row)
+            .and_then(|(t, times)| {
+                nearest(times).map(|time_s| {
+                    Hit::Key(KeyRef {
+                        timeline: t.clone(),
+                        time_s,
+                    })
+                })
+            })
+            .unwrap_or(Hit::Empty)
+    }
+
+    fn is_selected(&self, timeline: &TimelineId, time_s: f64) -> bool {
+        self.timeline
+            .selection
+            .iter()
+            .any(|k| k.is(timeline, time_s))
+    }
+
+    fn select(&mut self, key: KeyRef) {
+        if !self.is_selected(&key.timeline, key.time_s) {
+            self.timeline.selection.push(key);
+        }
+    }
+
+    fn keys_at(timelines: &[(TimelineId, Vec<f64>)], time_s: f64) -> Vec<KeyRef> {
+        timelines
+            .iter()
+            .filter_map(|(t, times)| {
+                times
+                    .iter()
+                    .find(|&&s| (s - time_s).abs() <= KEY_TIME_TOLERANCE_S)
+                    .map(|&s| KeyRef {
+                        timeline: t.clone(),
+                        time_s: s,
+                    })
+            })
+            .collect()
+    }
+
+    fn dopesheet(&mut self, ui: &mut egui::Ui, width: f32, timelines: &[(TimelineId, Vec<f64>)]) {
+        let height = ROW_HEIGHT_PT * (timelines.len() as f32 + 2.0);
+        let (response, painter) =
+            ui.allocate_painter(egui::vec2(width, height), Sense::click_and_drag());
+        let rect = response.rect;
+        let length = self.timeline_length_s();
+        let zero_x = rect.left() + LABEL_WIDTH_PT;
+        let px_per_s = ((rect.right() - 10.0 - zero_x) / length as f32).max(1.0);
+        let ruler = Rect::from_min_max(
+            rect.min,
+            egui::pos2(rect.right(), rect.top() + ROW_HEIGHT_PT),
+        );
+        let layout = SheetLayout {
+            rect,
+            zero_x,
+            px_per_s,
+            ruler,
+            summary_y: rect.top() + 1.5 * ROW_HEIGHT_PT,
+            rows: timelines
+                .iter()
+                .enumerate()
+                .map(|(i, (t, _))| (t.clone(), rect.top() + (i as f32 + 2.5) * ROW_HEIGHT_PT))
+                .collect(),
+        };
+        self.dopesheet_input(ui, &response, &layout, timelines);
+
+        // Background, ruler with a tick per frame (when they are far enough apart) and seconds.
+        painter.rect_filled(rect, 2.0, Color32::from_gray(30));
+        painter.rect_filled(ruler, 0.0, Color32::from_gray(45));
+        let font = egui::FontId::proportional(11.0);
+        let frame_px = px_per_s * self.frame_s() as f32;
+        let frames = (length / self.frame_s()).ceil() as usize;
+        for f in 0..=frames {
+            let t = f as f64 * self.frame_s();
+            let x = layout.x_of(t);
+            let whole = (t - t.round()).abs() < 1e-9;
+            if whole || frame_px >= 5.0 {
+                let top = if whole {
+                    ruler.top()
+                } else {
+                    ruler.bottom() - 5.0
+                };
+                painter.line_segment(
+                    [egui::pos2(x, top), egui::pos2(x, ruler.bottom())],
+                    Stroke::new(1.0, Color32::from_gray(if whole { 160 } else { 90 })),
+                );
+            }
+            if whole {
+                painter.text(
+                    egui::pos2(x + 2.0, ruler.top()),
+                    egui::Align2::LEFT_TOP,
+                    format!("{}", t.round()),
+                    font.clone(),
+                    Color32::from_gray(190),
+                );
+            }
+        }
+        let label = |y: f32, text: &str| {
+            painter.text(
+                egui::pos2(rect.left() + 4.0, y),
+                egui::Align2::LEFT_CENTER,
+                text,
+                font.clone(),
+                Color32::from_gray(200),
+            )
+        };
+        label(layout.summary_y, "all keys");
+        for (t, y) in &layout.rows {
+            label(*y, &t.label());
+            painter.line_segment(
+                [
+                    egui::pos2(zero_x, y + ROW_HEIGHT_PT / 2.0),
+                    egui::pos2(rect.right(), y + ROW_HEIGHT_PT / 2.0),
+                ],
+                Stroke::new(1.0, Color32::from_gray(38)),
+            );
+        }
+
+        // Keys; selected ones drawn where a move in progress takes them.
+        let shift = match &self.timeline.gesture {
+            Some(SheetGesture::Move { delta_s, .. }) => *delta_s,
+            _ => 0.0,
+        };
+        let key_shape = |at: Pos2, selected: bool| {
+            let (fill, stroke) = if selected {
+                (
+                    Color32::from_rgb(255, 140, 40),
+                    Stroke::new(1.5, Color32::WHITE),
+                )
+            } else {
+                (Color32::from_rgb(230, 190, 60), Stroke::NONE)
+            };
+            diamond(at, 5.5, fill, stroke)
+        };
+        let mut summary: Vec<(f64, bool)> = Vec::new();
+        for ((timeline, times), (_, y)) in timelines.iter().zip(&layout.rows) {
+            for &t in times {
+                let selected = self.is_selected(timeline, t);
+                let shown_t = if selected { t + shift } else { t };
+                painter.add(key_shape(egui::pos2(layout.x_of(shown_t), *y), selected));
+                match summary
+                    .iter_mut()
+                    .find(|(s, _)| (s - shown_t).abs() <= KEY_TIME_TOLERANCE_S)
+                {
+                    Some((_, all)) => *all &= selected,
+                    None => summary.push((shown_t, selected)),
+                }
+            }
+        }
+        for (t, all_selected) in summary {
+            painter.add(key_shape(
+                egui::pos2(layout.x_of(t), layout.summary_y),
+                all_selected,
+            ));
+        }
+        if let Some(SheetGesture::Box { from, to, .. }) = &self.timeline.gesture {
+            let r = Rect::from_two_pos(*from, *to);
+            painter.rect_filled(r, 0.0, Color32::from_rgba_unmultiplied(120, 160, 255, 40));
+            painter.rect_stroke(
+                r,
+                0.0,
+                Stroke::new(1.0, Color32::from_rgb(120, 160, 255)),
+                egui::StrokeKind::Inside,
+            );
+        }
+        let x = layout.x_of(self.time_s);
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+            Stroke::new(2.0, Color32::RED),
+        );
+        self.timeline.sheet = Some(layout);
+    }
+
+    fn dopesheet_input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        layout: &SheetLayout,
+        timelines: &[(TimelineId, Vec<f64>)],
+    ) {
+        let shift = ui.input(|i| i.modifiers.shift);
+        let pointer = response.interact_pointer_pos();
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            let origin = ui.input(|i| i.pointer.press_origin()).or(pointer);
+            if let Some(at) = origin {
+                self.timeline.gesture = Some(match self.hit(layout, at, timelines) {
+                    Hit::Ruler => SheetGesture::Scrub,
+                    Hit::Key(key) => {
+                        if !self.is_selected(&key.timeline, key.time_s) {
+                            if !shift {
+                                self.timeline.selection.clear();
+                            }
+                            self.select(key.clone());
+                        }
+                        SheetGesture::Move {
+                            anchor_s: key.time_s,
+                            origin_x: at.x,
+                            delta_s: 0.0,
+                        }
+                    }
+                    Hit::Summary(time_s) => {
+                        if !shift {
+                            self.timeline.selection.clear();
+                        }
+                        for key in Self::keys_at(timelines, time_s) {
+                            self.select(key);
+                        }
+                        SheetGesture::Move {
+                            anchor_s: time_s,
+                            origin_x: at.x,
+                            delta_s: 0.0,
+                        }
+                    }
+                    Hit::Row(_) | Hit::Empty => SheetGesture::Box {
+                        from: at,
+                        to: at,
+                        add: shift,
+                    },
+                });
+            }
+        }
+        if let (Some(at), true) = (pointer, response.dragged()) {
+            let earliest = self
+                .timeline
+                .selection
+                .iter()
+                .map(|k| k.time_s)
+                .fold(f64::INFINITY, f64::min);
+            let frame_s = self.frame_s();
+            let snapped = move |t: f64| (t / frame_s).round() * frame_s;
+            let mut scrub = None;
+            match &mut self.timeline.gesture {
+                Some(SheetGesture::Scrub) => scrub = Some(snapped(layout.time_at(at.x))),
+                Some(SheetGesture::Move {
+                    anchor_s,
+                    origin_x,
+                    delta_s,
+                }) => {
+                    let raw = *anchor_s + f64::from((at.x - *origin_x) / layout.px_per_s);
+                    // The grabbed key lands on a frame; no key goes before 0.
+                    *delta_s = (snapped(raw) - *anchor_s).max(-earliest);
+                }
+                Some(SheetGesture::Box { to, .. }) => *to = at,
+                _ => {}
+            }
+            if let Some(t) = scrub {
+                self.set_time(t);
+            }
+        }
+        if response.drag_stopped() {
+            match self.timeline.gesture.take() {
+                Some(SheetGesture::Move { delta_s, .. })
+                    if delta_s.abs() > KEY_TIME_TOLERANCE_S =>
+                {
+                    let keys = self.timeline.selection.clone();
+                    if self.apply(Command::MoveKeys {
+                        animation: self.animation.clone(),
+                        keys,
+                        delta_s,
+                    }) {
+                        for k in &mut self.timeline.selection {
+                            k.time_s += delta_s;
+                        }
+                    }
+                }
+                Some(SheetGesture::Box { from, to, add }) => {
+                    let r = Rect::from_two_pos(from, to).expand(2.0);
+                    if !add {
+                        self.timeline.selection.clear();
+                    }
+                    for (timeline, times) in timelines {
+                        for &t in times {
+                            if layout.key_pos(timeline, t).is_some_and(|p| r.contains(p)) {
+                                self.select(KeyRef {
+                                    timeline: timeline.clone(),
+                                    time_s: t,
+                                });
+                            }
+                        }
+                    }
+                }
+                other @ Some(SheetGesture::CurveHandle { .. }) => self.timeline.gesture = other,
+                _ => {}
+            }
+        }
+        if let (true, Some(at)) = (response.clicked(), pointer) {
+            match self.hit(layout, at, timelines) {
+                Hit::Ruler => self.set_time(self.snap_to_frame(layout.time_at(at.x))),
+                Hit::Key(key) => {
+                    if shift {
+                        let before = self.timeline.selection.len();
+                        self.timeline
+                            .selection
+                            .retain(|k| !k.is(&key.timeline, key.time_s));
+                        if self.timeline.selection.len() == before {
+                            self.timeline.selection.push(key);
+                        }
+                    } else {
+                        self.set_time(key.time_s);
+                        self.timeline.selection = vec![key];
+                    }
+                }
+                Hit::Summary(time_s) => {
+                    if !shift {
+                        self.timeline.selection.clear();
+                        self.set_time(time_s);
+                    }
+                    for key in Self::keys_at(timelines, time_s) {
+                        self.select(key);
+                    }
+                }
+                Hit::Row(timeline) => {
+                    if !shift {
+                        self.timeline.selection.clear();
+                    }
+                    if let Some((_, times)) = timelines.iter().find(|(t, _)| *t == timeline) {
+                        for &time_s in times {
+                            self.select(KeyRef {
+                                timeline: timeline.clone(),
+                                time_s,
+                            });
+                        }
+                    }
+                }
+                Hit::Empty => {
+                    if !shift {
+                        self.timeline.selection.clear();
+                    }
+                }
+            }
+        }
+    }
+
+    /// The curve of the one selected key's outgoing segment: its kind, and for a Bézier the
+    /// graph of one channel with its two handles to drag.
+    fn curve_editor(&mut self, ui: &mut egui::Ui, json: &serde_json::Value) {
+        self.timeline.curve = None;
+        let [key] = self.timeline.selection.as_slice() else {
+            ui.label("Select one key to edit the curve to the next key.");
+            return;
+        };
+        let key = key.clone();
+        let segment = match edit::segment(json, &key) {
+            Ok(s) => s,
+            Err(e) => {
+                ui.label(e.to_string());
+                return;
+            }
+        };
+        ui.label(format!(
+            "{}: {:.3} s to {:.3} s",
+            key.timeline.label(),
+            segment.start_s,
+            segment.end_s
+        ));
+        let channels = segment.channels();
+        self.timeline.curve_channel = self.timeline.curve_channel.min(channels.saturating_sub(1));
+        ui.horizontal(|ui| {
+            let kind = match segment.curve {
+                Curve::Linear => 0,
+                Curve::Stepped => 1,
+                Curve::Bezier(_) => 2,
+            };
+            let mut chosen = None;
+            if ui.selectable_label(kind == 0, "Linear").clicked() && kind != 0 {
+                chosen = Some(Curve::Linear);
+            }
+            if ui.selectable_label(kind == 1, "Stepped").clicked() && kind != 1 {
+                chosen = Some(Curve::Stepped);
+            }
+            if ui.selectable_label(kind == 2, "Bézier").clicked() && kind != 2 {
+                chosen = Some(Curve::Bezier(segment.linear_bezier()));
+            }
+            if let Some(curve) = chosen {
+                self.apply(Command::SetCurve {
+                    animation: self.animation.clone(),
+                    key: key.clone(),
+                    curve,
+                });
+            }
+            if channels > 1 {
+                egui::ComboBox::from_id_salt("curve channel")
+                    .selected_text(channel_name(channels, self.timeline.curve_channel))
+                    .show_ui(ui, |ui| {
+                        for c in 0..channels {
+                            ui.selectable_value(
+                                &mut self.timeline.curve_channel,
+                                c,
+                                channel_name(channels, c),
+                            );
+                        }
+                    });
+            }
+        });
+        self.curve_graph(ui, &key, segment);
+    }
+
+    fn curve_graph(&mut self, ui: &mut egui::Ui, key: &KeyRef, mut segment: Segment) {
+        let c = self.timeline.curve_channel;
+        // A handle being dragged shows where it is, not where the document has it.
+        if let Some(SheetGesture::CurveHandle {
+            key: k, numbers, ..
+        }) = &self.timeline.gesture
+        {
+            if k == key {
+                segment.curve = Curve::Bezier(numbers.clone());
+            }
+        }
+        let (response, painter) = ui.allocate_painter(
+            egui::vec2(CURVE_GRAPH_PT[0], CURVE_GRAPH_PT[1]),
+            Sense::drag(),
+        );
+        let rect = response.rect.shrink(10.0);
+        let (t0, t1) = (segment.start_s, segment.end_s);
+        let samples: Vec<(f64, f64)> = (0..=64)
+            .map(|i| {
+                let t = t0 + (t1 - t0) * i as f64 / 64.0;
+                (t, segment.value_at(c, t))
+            })
+            .collect();
+        let handles: Option<[(f64, f64); 2]> = match &segment.curve {
+            Curve::Bezier(n) if n.len() >= 4 * (c + 1) => {
+                Some([(n[4 * c], n[4 * c + 1]), (n[4 * c + 2], n[4 * c + 3])])
+            }
+            _ => None,
+        };
+        let values = samples
+            .iter()
+            .map(|s| s.1)
+            .chain(handles.iter().flatten().map(|h| h.1));
+        let (mut low, mut high) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(v), h.max(v))
+        });
+        if high - low < 1e-9 {
+            (low, high) = (low - 1.0, high + 1.0);
+        }
+        let pad = 0.08 * (high - low);
+        let layout = CurveLayout {
+            rect,
+            start_s: t0,
+            end_s: t1,
+            low: low - pad,
+            high: high + pad,
+            handles: None,
+        };
+        painter.rect_filled(response.rect, 2.0, Color32::from_gray(30));
+        let curve: Vec<Pos2> = samples.iter().map(|&(t, v)| layout.screen(t, v)).collect();
+        painter.add(Shape::line(
+            curve,
+            Stroke::new(2.0, Color32::from_rgb(230, 190, 60)),
+        ));
+        let ends = [
+            layout.screen(t0, segment.start.get(c).copied().unwrap_or(0.0)),
+            layout.screen(t1, segment.end.get(c).copied().unwrap_or(0.0)),
+        ];
+        for end in ends {
+            painter.add(diamond(
+                end,
+                5.0,
+                Color32::from_rgb(255, 140, 40),
+                Stroke::NONE,
+            ));
+        }
+        // The value range shown, at the graph's top and bottom.
+        let font = egui::FontId::proportional(10.0);
+        for (value, y, align) in [
+            (
+                layout.high,
+                response.rect.top() + 2.0,
+                egui::Align2::LEFT_TOP,
+            ),
+            (
+                layout.low,
+                response.rect.bottom() - 2.0,
+                egui::Align2::LEFT_BOTTOM,
+            ),
+        ] {
+            painter.text(
+                egui::pos2(response.rect.left() + 3.0, y),
+                align,
+                format!("{value:.2}"),
+                font.clone(),
+                Color32::from_gray(150),
+            );
+        }
+        let handle_pos = handles.map(|h| h.map(|(t, v)| layout.screen(t, v)));
+        if let Some(h) = handle_pos {
+            for (end, handle) in ends.iter().zip(h) {
+                painter.line_segment([*end, handle], Stroke::new(1.0, Color32::from_gray(170)));
+                painter.circle_filled(handle, 4.5, Color32::from_rgb(120, 180, 255));
+            }
+        }
+        let layout = CurveLayout {
+            handles: handle_pos,
+            ..layout
+        };
+        self.curve_input(ui, &response, &layout, key, &segment);
+        self.timeline.curve = Some(layout);
+    }
+
+    fn curve_input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        layout: &CurveLayout,
+        key: &KeyRef,
+        segment: &Segment,
+    ) {
+        let c = self.timeline.curve_channel;
+        let pointer = response.interact_pointer_pos();
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            let origin = ui.input(|i| i.pointer.press_origin()).or(pointer);
+            if let (Some(at), Some(handles), Curve::Bezier(numbers)) =
+                (origin, layout.handles, &segment.curve)
+            {
+                let grabbed = (0..2)
+                    .filter(|&h| handles[h].distance(at) <= HANDLE_PICK_PT)
+                    .min_by(|&a, &b| handles[a].distance(at).total_cmp(&handles[b].distance(at)));
+                if let Some(h) = grabbed {
+                    self.timeline.gesture = Some(SheetGesture::CurveHandle {
+                        key: key.clone(),
+                        at: 4 * c + 2 * h,
+                        numbers: numbers.clone(),
+                    });
+                }
+            }
+        }
+        if let (Some(p), true) = (pointer, response.dragged()) {
+            if let Some(SheetGesture::CurveHandle { at, numbers, .. }) = &mut self.timeline.gesture
+            {
+                let (t, v) = layout.graph(p);
+                if let Some(pair) = numbers.get_mut(*at..*at + 2) {
+                    // Handle times stay in the segment: time must keep running forward.
+                    pair[0] = t.clamp(layout.start_s, layout.end_s);
+                    pair[1] = v;
+                }
+            }
+        }
+        if response.drag_stopped() {
+            if let Some(SheetGesture::CurveHandle { key, numbers, .. }) =
+                self.timeline.gesture.take()
+            {
+                self.apply(Command::SetCurve {
+                    animation: self.animation.clone(),
+                    key,
+                    curve: Curve::Bezier(numbers),
+                });
+            }
+        }
+    }
+
+    /// Onion skins for the canvas: the posed outlines of the frames around the playhead,
+    /// earlier ones red, later ones green, fading with distance (empty when off).
+    pub(super) fn onion_shapes(
+        &mut self,
+        scene: &Arc<Scene>,
+        placed: &canvas::Placed,
+    ) -> Vec<Shape> {
+        let options = self.timeline.onion;
+        if !options.enabled || self.mode != Mode::Animate {
+            return Vec::new();
+        }
+        let json = crate::document::animation_json(self.doc.state(), &self.animation);
+        let Ok(animation) = Animation::from_json(&self.animation, &json) else {
+            return Vec::new();
+        };
+        let frame_s = self.frame_s();
+        let cache = &mut self.timeline.onion_cache;
+        let key = Arc::as_ptr(scene);
+        if cache.scene != Some(key) {
+            cache.scene = Some(key);
+            cache.outlines = scene
+                .doc
+                .parts
+                .iter()
+                .map(|p| boundary_edges(&p.mesh.triangles))
+                .collect();
+            cache.frames.clear();
+        }
+        let version = (self.animation.clone(), json);
+        if cache.animation.as_ref() != Some(&version) {
+            cache.animation = Some(version);
+            cache.frames.clear();
+        }
+        if cache.frames.len() > ONION_CACHE_FRAMES {
+            cache.frames.clear();
+        }
+        let now = (self.time_s / frame_s).round() * frame_s;
+        let end = animation.duration_s();
+        let frames = options.frames.min(MAX_ONION_FRAMES);
+        if frames == 0 {
+            return Vec::new();
+        }
+        let mut shapes = Vec::new();
+        for k in (1..=frames).rev() {
+            let fade = options.opacity * (frames + 1 - k) as f32 / frames as f32;
+            for (sign, rgb) in [(-1.0, [255, 90, 90]), (1.0, [90, 230, 120])] {
+                let t = now + sign * k as f64 * frame_s;
+                if t < -KEY_TIME_TOLERANCE_S || t > end + KEY_TIME_TOLERANCE_S {
+                    continue;
+                }
+                let micros = (t * 1e6).round() as i64;
+                if !cache.frames.contains_key(&micros) {
+                    let pose = animation.sample(t.max(0.0), false);
+                    // A frame that cannot be posed is left out; the canvas reports the error.
+                    let Ok((_, positions)) = transforms_and_positions(scene, &pose, &mut cache.ik)
+                    else {
+                        continue;
+                    };
+                    cache.frames.insert(micros, positions);
+                }
+                let Some(positions) = cache.frames.get(&micros) else {
+                    continue;
+                };
+                let color =
+                    Color32::from_rgba_unmultiplied(rgb[0], rgb[1], rgb[2], (fade * 255.0) as u8);
+                let stroke = Stroke::new(1.2, color);
+                for (edges, part) in cache.outlines.iter().zip(positions) {
+                    for [a, b] in edges {
+                        let (Some(p), Some(q)) = (part.get(*a as usize), part.get(*b as usize))
+                        else {
+                            continue;
+                        };
+                        shapes.push(Shape::line_segment(
+                            [
+                                placed.screen_from_canvas([p.x, p.y]),
+                                placed.screen_from_canvas([q.x, q.y]),
+                            ],
+                            stroke,
+                        ));
+                    }
+                }
+            }
+        }
+        shapes
+    }
+}
