@@ -1,4 +1,5 @@
-//! Writes the synthetic colorization scenes (line art, scribbles, truth, result, flood fill)
+//! Writes the synthetic colorization scenes (line art, scribbles as a layer and as JSON, truth,
+//! result, flood fill)
 //! to a folder and prints their scores: `cargo run --release --example colorize_scenes [DIR]`.
 
 use image::{Rgba, RgbaImage};
@@ -97,6 +98,15 @@ fn main() -> anyhow::Result<()> {
             }
         });
         layer.save(dir.join(format!("{name}-scribbles.png")))?;
+        // The same strokes as the JSON scribble file (`sinew colorize --scribbles`,
+        // `sinew edit --line-art … --scribbles …`).
+        let file = sinew::colorize::scribbles::StrokeFile {
+            strokes: s.strokes.clone(),
+        };
+        std::fs::write(
+            dir.join(format!("{name}-scribbles.json")),
+            serde_json::to_vec_pretty(&file)?,
+        )?;
     }
     Ok(())
 }

@@ -330,21 +330,7 @@ fn renders_the_current_animation_in_the_background() {
     let gif = path.parent().expect("a folder").join("nod.gif");
     {
         let app = h.state_mut();
-        for (time_s, degrees) in [(0.0, 0.0), (0.5, 20.0)] {
-            let mut pose = Pose::default();
-            pose.bones.insert(
-                "head".into(),
-                crate::rig::pose::BonePose {
-                    rotate: degrees,
-                    ..Default::default()
-                },
-            );
-            assert!(app.apply(Command::SetKey {
-                animation: "nod".into(),
-                time_s,
-                pose,
-            }));
-        }
+        key_nod(app, &[(0.0, 0.0), (0.5, 20.0)]);
         app.animation = "nod".into();
         app.render_settings.fps = 8.0;
         app.render_settings.scale = 0.5;
@@ -382,6 +368,30 @@ fn renders_the_current_animation_in_the_background() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("nope"), "{message}");
     assert!(!path.with_file_name("nope.gif").exists());
+}
+
+/// Keys animation "nod": the head turned `degrees` at each `time_s`.
+fn key_nod(app: &mut EditorApp, keys: &[(f64, f64)]) {
+    for &(time_s, degrees) in keys {
+        assert!(app.apply(Command::SetKey {
+            animation: "nod".into(),
+            time_s,
+            pose: head_turned(degrees),
+        }));
+    }
+}
+
+/// A pose with only the head turned by `degrees`.
+fn head_turned(degrees: f64) -> Pose {
+    let mut pose = Pose::default();
+    pose.bones.insert(
+        "head".into(),
+        crate::rig::pose::BonePose {
+            rotate: degrees,
+            ..Default::default()
+        },
+    );
+    pose
 }
 
 /// Press and release at `at` (canvas px) without moving.
@@ -907,15 +917,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
             h.get_by_label("Next frame").click();
             h.run();
         }
-        let mut pose = Pose::default();
-        pose.bones.insert(
-            "head".into(),
-            crate::rig::pose::BonePose {
-                rotate: degrees,
-                ..Default::default()
-            },
-        );
-        h.state_mut().shown = Some(pose);
+        h.state_mut().shown = Some(head_turned(degrees));
         h.get_by_label("Set key").click();
         h.run();
     }
@@ -1052,21 +1054,7 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     h.run();
     {
         let app = h.state_mut();
-        for (time_s, degrees) in [(0.0, 0.0), (0.5, 30.0)] {
-            let mut pose = Pose::default();
-            pose.bones.insert(
-                "head".into(),
-                crate::rig::pose::BonePose {
-                    rotate: degrees,
-                    ..Default::default()
-                },
-            );
-            assert!(app.apply(Command::SetKey {
-                animation: "nod".into(),
-                time_s,
-                pose,
-            }));
-        }
+        key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);
         app.animation = "nod".into();
         app.render_settings.fps = 12.0;
         app.playing = true;
@@ -1130,21 +1118,7 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     h.run();
     {
         let app = h.state_mut();
-        for (time_s, degrees) in [(0.0, 0.0), (0.5, 30.0)] {
-            let mut pose = Pose::default();
-            pose.bones.insert(
-                "head".into(),
-                crate::rig::pose::BonePose {
-                    rotate: degrees,
-                    ..Default::default()
-                },
-            );
-            assert!(app.apply(Command::SetKey {
-                animation: "nod".into(),
-                time_s,
-                pose,
-            }));
-        }
+        key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);
         app.animation = "nod".into();
     }
     h.key_press(Key::Num3);

@@ -39,6 +39,10 @@ shoot() { # MODE OUT.png [extra args]
     "$sinew" edit "$rig" --mode "$mode" --screenshot "$png" "$@"
 }
 shoot rig "$out/editor-rig.png" --select arm_upper_l
-shoot pose "$out/editor-pose.png" --pose "$root/assets/character/poses/lift.json"
+shoot pose "$out/editor-pose.png" --pose "$root/assets/character/poses/lift.json" --select chest
 shoot animate "$out/editor-animate.png" --pose "$root/assets/character/poses/lift.json"
-echo "wrote $out/editor-{rig,pose,animate}.png"
+# Colorize mode on a generated line-art scene with its scribbles.
+cargo run --quiet --release --locked --example colorize_scenes -- "$work/scenes" >/dev/null
+shoot colorize "$out/editor-colorize.png" --line-art "$work/scenes/closed-art.png" \
+  --scribbles "$work/scenes/closed-scribbles.json"
+echo "wrote $out/editor-{rig,pose,animate,colorize}.png"
