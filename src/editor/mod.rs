@@ -115,7 +115,7 @@ enum Gesture {
         pose: Pose,
     },
     /// Grab, rotate or scale the selected handle by forward kinematics.
-    Fk(gizmo::FkGesture),
+    Fk(Box<gizmo::FkGesture>),
     /// A cage or region being drawn, vertex by vertex (canvas px).
     NewPolygon {
         kind: rig_tools::PolygonKind,
@@ -1339,7 +1339,7 @@ impl EditorApp {
             placed.canvas_from_screen(at),
             modal,
         ) {
-            Ok(g) => self.gesture = Some(Gesture::Fk(g)),
+            Ok(g) => self.gesture = Some(Gesture::Fk(Box::new(g))),
             Err(e) => self.message = Some(e.to_string()),
         }
         true

@@ -43,11 +43,14 @@ struct PreviewKey {
     mesh: crate::mesh::MeshOptions,
 }
 
+/// Traced and meshed parts, or why tracing or meshing failed.
+type PreviewMeshes = Result<Vec<MeshDoc>, String>;
+
 /// The live mesh preview: the last meshes built and the build under way.
 #[derive(Default)]
 pub struct MeshPreview {
-    built: Option<(PreviewKey, Result<Vec<MeshDoc>, String>)>,
-    running: Option<(PreviewKey, Receiver<Result<Vec<MeshDoc>, String>>)>,
+    built: Option<(PreviewKey, PreviewMeshes)>,
+    running: Option<(PreviewKey, Receiver<PreviewMeshes>)>,
 }
 
 /// Rig-mode state the tools keep between frames.
