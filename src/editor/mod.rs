@@ -171,6 +171,8 @@ pub struct EditorApp {
     shown: Option<Pose>,
     /// Where File → Export writes.
     pub export_dir: String,
+    /// File → Export Spine's options (those of `sinew export spine`).
+    pub spine_options: crate::export::spine::SpineOptions,
     /// Where File → Render writes.
     pub render_path: String,
     /// File → Render's options (those of `sinew render`).
@@ -226,6 +228,7 @@ impl EditorApp {
             playing: false,
             shown: None,
             export_dir: "export".into(),
+            spine_options: Default::default(),
             render_path: "render.gif".into(),
             render_settings: Default::default(),
             rig_tools: Default::default(),
@@ -370,7 +373,7 @@ impl EditorApp {
             .and_then(Path::file_stem)
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "skeleton".into());
-        let options = crate::export::spine::SpineOptions::default();
+        let options = self.spine_options.clone();
         match std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))
             .and_then(|()| {
@@ -615,6 +618,7 @@ impl EditorApp {
                 ui.separator();
                 ui.label("Export folder:");
                 ui.text_edit_singleline(&mut self.export_dir);
+                spine_options_ui(ui, &mut self.spine_options);
                 if ui.button("Export Spine").clicked() {
                     let dir = PathBuf::from(&self.export_dir);
                     self.message = Some(self.export_spine(&dir));
@@ -1482,6 +1486,71 @@ pub fn rest_point_under(
         }
     }
     None
+}
+
+/// The fields of `sinew export spine`'s options.
+fn spine_options_ui(ui: &mut egui::Ui, options: &mut crate::export::spine::SpineOptions) {
+    use crate::export::spine::{BakeMode, SpineVersion};
+    egui::Grid::new("spine options").show(ui, |ui| {
+        ui.label("Spine version");
+        egui::ComboBox::from_id_salt("spine version")
+            .selected_text(format!("{:?}", options.version))
+            .show_ui(ui, |ui| {
+                for v in [SpineVersion::V4_1, SpineVersion::V4_2, SpineVersion::V4_3] {
+                    ui.selectable_value(&mut options.version, v, format!("{v:?}"));
+                }
+            });
+        ui.end_row();
+        ui.label("Bake");
+        egui::ComboBox::from_id_salt("spine bake")
+            .selected_text(format!("{:?}", options.bake))
+            .show_ui(ui, |ui| {
+                for b in [BakeMode::Auto, BakeMode::All] {
+                    ui.selectable_value(&mut options.bake, b, format!("{b:?}"));
+                }
+            });
+        ui.end_row();
+        ui.label("Bake keys per second");
+        ui.add(
+            egui::DragValue::new(&mut options.bake_fps)
+                .range(1.0..=crate::playback::MAX_FPS)
+                .speed(0.2),
+        );
+        ui.end_row();
+        optional_count(
+            ui,
+            "At most influences per vertex",
+            &mut options.max_influences,
+            4,
+            1..=16,
+        );
+        optional_count(
+            ui,
+            "At most vertices per mesh",
+            &mut options.max_vertices,
+            200,
+            3..=100_000,
+        );
+    });
+}
+
+/// A checkbox and a number for an optional limit (`None`: unchecked); `default` when checked.
+fn optional_count(
+    ui: &mut egui::Ui,
+    label: &str,
+    value: &mut Option<usize>,
+    default: usize,
+    range: std::ops::RangeInclusive<usize>,
+) {
+    ui.label(label);
+    ui.horizontal(|ui| {
+        let mut on = value.is_some();
+        let mut n = value.unwrap_or(default);
+        ui.checkbox(&mut on, "");
+        ui.add_enabled(on, egui::DragValue::new(&mut n).range(range));
+        *value = on.then_some(n);
+    });
+    ui.end_row();
 }
 
 /// The fields of `sinew render`'s options.

@@ -307,11 +307,19 @@ fn exports_for_spine_from_the_file_menu_function() {
     let path = character_rig("export");
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     let dir = path.parent().expect("a folder").join("spine");
+    // The menu's options reach the exporter: Spine 4.3, at most 2 influences per vertex.
+    app.spine_options.version = crate::export::spine::SpineVersion::V4_3;
+    app.spine_options.max_influences = Some(2);
     let message = app.export_spine(&dir);
     assert!(message.starts_with("exported"), "{message}");
     for file in ["character.json", "character.atlas"] {
         assert!(dir.join(file).is_file(), "{file} missing: {message}");
     }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("character.json")).expect("the skeleton"))
+            .expect("JSON");
+    let version = json["skeleton"]["spine"].as_str().expect("a version");
+    assert!(version.starts_with("4.3"), "{version}");
     // Without current weights there is nothing to export, and nothing is written.
     app.apply(Command::AddPoint(PointHandle {
         name: "extra".into(),
