@@ -3,41 +3,17 @@
 mod command;
 mod common;
 
-use image::{Rgba, RgbaImage};
+use common::document::{bar_layer, bone, compute};
+use image::RgbaImage;
 use sinew::document::{autosave_path, compute_rig, Command, Document, DocumentError};
 use sinew::pipeline::Layer;
 use sinew::rig::pose::IkDrag;
-use sinew::rig::{Bone, PointHandle, Pose};
+use sinew::rig::{PointHandle, Pose};
 use std::sync::atomic::AtomicBool;
-
-/// An opaque 300 × 40 px bar on a 320 × 80 canvas.
-fn bar_layer(name: &str) -> Layer {
-    let image = RgbaImage::from_fn(320, 80, |x, y| {
-        if (10..310).contains(&x) && (20..60).contains(&y) {
-            Rgba([90, 140, 200, 255])
-        } else {
-            Rgba([0, 0, 0, 0])
-        }
-    });
-    Layer {
-        name: name.into(),
-        path: std::env::temp_dir().join(format!("{name}.png")),
-        image,
-    }
-}
-
-fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bone {
-    Bone {
-        name: name.into(),
-        parent: parent.map(Into::into),
-        head,
-        tail,
-    }
-}
 
 /// A document with one bar layer and a two-bone arm along it, weights computed.
 fn arm_document() -> Document {
-    arm_document_with(bar_layer("bar"))
+    arm_document_with(bar_layer("bar", &std::env::temp_dir(), false))
 }
 
 fn arm_document_with(layer: Layer) -> Document {
@@ -59,19 +35,6 @@ fn arm_document_with(layer: Layer) -> Document {
     .unwrap();
     compute(&mut doc);
     doc
-}
-
-fn compute(doc: &mut Document) {
-    let inputs = doc.rig_inputs();
-    let scene = compute_rig(
-        &inputs,
-        &std::env::temp_dir(),
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    )
-    .unwrap();
-    doc.apply(Command::SetRig(std::sync::Arc::new(scene), inputs.key()))
-        .unwrap();
 }
 
 #[test]
@@ -131,7 +94,7 @@ fn a_failing_command_changes_nothing() {
     }
     assert_eq!(doc.can_undo(), undo_depth_probe);
     // A layer of another size is refused too.
-    let mut small = bar_layer("small");
+    let mut small = bar_layer("small", &std::env::temp_dir(), false);
     small.image = RgbaImage::new(10, 10);
     assert!(matches!(
         doc.apply(Command::AddLayer(small)),
@@ -236,7 +199,7 @@ fn posing_needs_current_weights_and_a_valid_pose() {
 fn saves_atomically_and_reopens_ready_to_pose() {
     let dir = command::scratch("document-save");
     // The image must live where the saved file can refer to it.
-    let mut layer = bar_layer("bar");
+    let mut layer = bar_layer("bar", &std::env::temp_dir(), false);
     layer.path = dir.join("bar.png");
     layer.image.save(&layer.path).unwrap();
     let mut doc = arm_document_with(layer);

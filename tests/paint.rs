@@ -1,30 +1,11 @@
 //! Weight painting and locked handles through the document: commands, undo, recomputes that
 //! keep locked weights (same mesh and re-traced), saving and reopening the locks.
 
-use image::{Rgba, RgbaImage};
-use sinew::document::{compute_rig, Command, Document, DocumentError};
-use sinew::pipeline::Layer;
-use sinew::rig::Bone;
-use sinew::weights::{BrushMode, BrushOptions, Falloff};
-use std::sync::atomic::AtomicBool;
+mod common;
 
-/// An opaque 300 × 40 px bar on a 320 × 80 canvas, saved as a PNG in `dir`.
-fn bar_layer(dir: &std::path::Path) -> Layer {
-    let image = RgbaImage::from_fn(320, 80, |x, y| {
-        if (10..310).contains(&x) && (20..60).contains(&y) {
-            Rgba([90, 140, 200, 255])
-        } else {
-            Rgba([0, 0, 0, 0])
-        }
-    });
-    let path = dir.join("bar.png");
-    image.save(&path).expect("bar.png written");
-    Layer {
-        name: "bar".into(),
-        path,
-        image,
-    }
-}
+use common::document::{bar_layer, bone, compute};
+use sinew::document::{Command, Document, DocumentError};
+use sinew::weights::{BrushMode, BrushOptions, Falloff};
 
 fn scratch(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("sinew-paint-{name}-{}", std::process::id()));
@@ -33,19 +14,11 @@ fn scratch(name: &str) -> std::path::PathBuf {
     dir
 }
 
-fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bone {
-    Bone {
-        name: name.into(),
-        parent: parent.map(Into::into),
-        head,
-        tail,
-    }
-}
-
 /// A bar with three bones along it, weights computed.
 fn arm(dir: &std::path::Path) -> Document {
     let mut doc = Document::new();
-    doc.apply(Command::AddLayer(bar_layer(dir))).unwrap();
+    doc.apply(Command::AddLayer(bar_layer("bar", dir, true)))
+        .unwrap();
     doc.apply(Command::AddBone(bone(
         "a",
         None,
@@ -69,19 +42,6 @@ fn arm(dir: &std::path::Path) -> Document {
     .unwrap();
     compute(&mut doc);
     doc
-}
-
-fn compute(doc: &mut Document) {
-    let inputs = doc.rig_inputs();
-    let scene = compute_rig(
-        &inputs,
-        &std::env::temp_dir(),
-        &AtomicBool::new(false),
-        &mut |_, _| {},
-    )
-    .unwrap();
-    doc.apply(Command::SetRig(std::sync::Arc::new(scene), inputs.key()))
-        .unwrap();
 }
 
 /// The bar's weight rows.

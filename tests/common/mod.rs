@@ -3,6 +3,7 @@
 //! image, soft alpha), drawn antialiased with tiny-skia.
 #![allow(dead_code)]
 
+pub mod document;
 pub mod golden;
 
 use image::RgbaImage;
