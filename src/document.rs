@@ -311,6 +311,16 @@ impl Document {
             .collect();
         let weighted = !doc.handles.is_empty() && doc.parts.iter().all(|p| p.weights.is_some());
         let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
+        let mut doc = doc;
+        if !weighted {
+            // The stale rig as it was when saved: the next computation keeps locked columns
+            // from it. Not posable (`rig_current` is false).
+            for part in &mut doc.parts {
+                if let Some(stale) = part.stale_weights.take() {
+                    part.weights = Some(stale);
+                }
+            }
+        }
         let state = State {
             layers,
             handles: doc.handles.clone(),
@@ -384,7 +394,8 @@ impl Document {
 
     /// The rig document as it would be saved at `path`. A stale rig is saved with its meshes
     /// but without weights, so that reopening asks for them again instead of posing with
-    /// weights of other handles.
+    /// weights of other handles; while some handle is locked, those weights are saved aside
+    /// (`stale_weights`), so that the computation after reopening still keeps the locked ones.
     pub fn to_rig_document(&self, path: &Path) -> Result<RigDocument, DocumentError> {
         let state = &self.state;
         let dir = path.parent().unwrap_or(Path::new("."));
@@ -398,10 +409,15 @@ impl Document {
                 pipeline::build_rig(&layers, dir, &state.options, &Handles::default())?.0
             }
         };
-        if !state.rig_current {
-            for part in &mut doc.parts {
-                part.weights = None;
-            }
+        for part in &mut doc.parts {
+            // A stale rig's weights are not saved as weights (reopening must not pose with
+            // weights of other handles), but kept aside while locked handles need them.
+            let stale = if state.rig_current {
+                None
+            } else {
+                part.weights.take().or(part.stale_weights.take())
+            };
+            part.stale_weights = stale.filter(|_| !state.locked.is_empty());
         }
         for (part, layer) in doc.parts.iter_mut().zip(&state.layers) {
             part.image = pipeline::relative_path(dir, &layer.path);

@@ -281,6 +281,7 @@ pub fn build_rig_cancellable(
             image: relative_path(doc_dir, &layer.path),
             mesh: MeshDoc::from(&mesh),
             weights,
+            stale_weights: None,
         });
     }
     progress(layers.len(), "");

@@ -352,3 +352,84 @@ fn locks_are_saved_and_reopened() {
     doc.apply(Command::Delete { name: "mid".into() }).unwrap();
     assert!(doc.state().locked.is_empty());
 }
+
+#[test]
+fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
+    let dir = scratch("stale");
+    let mut doc = arm(&dir);
+    doc.apply(Command::PaintWeights {
+        part: "bar".into(),
+        handle: "b".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[250.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 20.0,
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            spacing: 0.25,
+        },
+    })
+    .unwrap();
+    let v = vertices(&doc);
+    let near: Vec<usize> = (0..v.len())
+        .filter(|&i| (v[i][0] - 250.0).hypot(v[i][1] - 40.0) < 18.0)
+        .collect();
+    assert!(!near.is_empty());
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: true,
+    })
+    .unwrap();
+    // A point handle added far from the stroke makes the weights stale; save and reopen.
+    doc.apply(Command::AddPoint(sinew::rig::PointHandle {
+        name: "tip".into(),
+        at: [40.0, 40.0],
+    }))
+    .unwrap();
+    let path = dir.join("stale.json");
+    doc.save(&path).unwrap();
+    let saved: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let part = &saved["parts"][0];
+    assert!(
+        part.get("weights").is_none(),
+        "stale weights are not weights"
+    );
+    assert!(
+        part.get("stale_weights").is_some(),
+        "kept aside for the lock"
+    );
+    let mut reopened = Document::open(&path).unwrap();
+    assert!(
+        reopened.posable().is_none(),
+        "the reopened rig needs computing"
+    );
+    compute(&mut reopened);
+    let kept = rows(&reopened);
+    check_rows(&kept);
+    let v_new = vertices(&reopened);
+    let handles = &reopened.posable().unwrap().doc.parts[0]
+        .weights
+        .as_ref()
+        .unwrap()
+        .handles;
+    let b = handles.iter().position(|h| h == "b").unwrap() as u32;
+    for i in near {
+        let j = v_new
+            .iter()
+            .position(|p| *p == v[i])
+            .expect("the stroke's vertices stay where they were");
+        assert_eq!(column(&kept, b)[j], 1.0, "b at {:?}", v[i]);
+    }
+
+    // Without locks nothing is kept aside: the file is as before.
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: false,
+    })
+    .unwrap();
+    doc.save(&path).unwrap();
+    assert!(!std::fs::read_to_string(&path)
+        .unwrap()
+        .contains("stale_weights"));
+}

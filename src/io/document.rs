@@ -65,6 +65,11 @@ pub struct PartDoc {
     pub mesh: MeshDoc,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<WeightsDoc>,
+    /// Weights computed for earlier handles, saved only while some handle is locked and the
+    /// weights need computing again: the next computation keeps the locked handles' columns
+    /// from them. Never used to pose.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stale_weights: Option<WeightsDoc>,
 }
 
 /// A mesh as stored: vertices in canvas px, triangles as vertex indices.
@@ -252,20 +257,29 @@ fn validate_part(part: &PartDoc) -> Result<(), String> {
         }
     }
     if let Some(w) = &part.weights {
-        if w.rows.len() != n {
-            return Err(format!("{} weight rows for {n} vertices", w.rows.len()));
-        }
-        for (i, row) in w.rows.iter().enumerate() {
-            for &(h, value) in row {
-                if h as usize >= w.handles.len() {
-                    return Err(format!(
-                        "vertex {i} has a weight for handle {h} of {}",
-                        w.handles.len()
-                    ));
-                }
-                if !value.is_finite() {
-                    return Err(format!("vertex {i} has a weight that is not finite"));
-                }
+        validate_weights(w, n)?;
+    }
+    if let Some(w) = &part.stale_weights {
+        validate_weights(w, n).map_err(|e| format!("stale weights: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Checks one weight table against a mesh of `n` vertices.
+fn validate_weights(w: &WeightsDoc, n: usize) -> Result<(), String> {
+    if w.rows.len() != n {
+        return Err(format!("{} weight rows for {n} vertices", w.rows.len()));
+    }
+    for (i, row) in w.rows.iter().enumerate() {
+        for &(h, value) in row {
+            if h as usize >= w.handles.len() {
+                return Err(format!(
+                    "vertex {i} has a weight for handle {h} of {}",
+                    w.handles.len()
+                ));
+            }
+            if !value.is_finite() {
+                return Err(format!("vertex {i} has a weight that is not finite"));
             }
         }
     }
@@ -286,6 +300,7 @@ mod tests {
                 triangles: vec![[0, 1, 2]],
             },
             weights: None,
+            stale_weights: None,
         });
         doc
     }
