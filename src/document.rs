@@ -296,7 +296,7 @@ impl Document {
     /// Opens a rig file and its images. A rig whose parts all have weights for its handles
     /// opens ready to pose.
     pub fn open(path: &Path) -> Result<Self, DocumentError> {
-        let doc = RigDocument::load(path)?;
+        let mut doc = RigDocument::load(path)?;
         let layers: Vec<Arc<Layer>> = doc
             .parts
             .iter()
@@ -311,7 +311,6 @@ impl Document {
             .collect();
         let weighted = !doc.handles.is_empty() && doc.parts.iter().all(|p| p.weights.is_some());
         let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
-        let mut doc = doc;
         if !weighted {
             // The stale rig as it was when saved: the next computation keeps locked columns
             // from it. Not posable (`rig_current` is false).

@@ -155,6 +155,24 @@ impl Mesh {
     }
 }
 
+/// Per vertex of a mesh of `vertex_count` vertices, its neighbours along triangle edges
+/// (sorted, no duplicates). Every triangle index must be below `vertex_count`.
+pub fn vertex_neighbours(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut neighbours = vec![Vec::new(); vertex_count];
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            neighbours[a as usize].push(b);
+            neighbours[b as usize].push(a);
+        }
+    }
+    for list in &mut neighbours {
+        list.sort_unstable();
+        list.dedup();
+    }
+    neighbours
+}
+
 /// The smallest interior angle of a triangle, degrees (0 for a degenerate one).
 pub fn triangle_min_angle_deg(p: [Point; 3]) -> f64 {
     (0..3)

@@ -75,6 +75,23 @@ fn check_rows(rows: &[Vec<(u32, f64)>]) {
     }
 }
 
+/// A stroke adding handle b's weight at full strength over discs of `radius_px` along
+/// `samples_px`.
+fn fill_b(samples_px: Vec<[f64; 2]>, radius_px: f64) -> Command {
+    Command::PaintWeights {
+        part: "bar".into(),
+        handle: "b".into(),
+        mode: BrushMode::Add,
+        samples_px,
+        options: BrushOptions {
+            radius_px,
+            strength: 1.0,
+            falloff: Falloff::Constant,
+            spacing: 0.25,
+        },
+    }
+}
+
 /// A stroke painting `handle` along the bar's middle from x = 130 to 190.
 fn stroke(handle: &str, mode: BrushMode) -> Command {
     Command::PaintWeights {
@@ -183,19 +200,8 @@ fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     let mut doc = arm(&dir);
     let fresh = rows(&doc);
     // Paint b far into c's side, lock b, then edit a bone so the weights must be recomputed.
-    let paint = Command::PaintWeights {
-        part: "bar".into(),
-        handle: "b".into(),
-        mode: BrushMode::Add,
-        samples_px: vec![[230.0, 40.0], [280.0, 40.0]],
-        options: BrushOptions {
-            radius_px: 30.0,
-            strength: 1.0,
-            falloff: Falloff::Constant,
-            spacing: 0.25,
-        },
-    };
-    doc.apply(paint).unwrap();
+    doc.apply(fill_b(vec![[230.0, 40.0], [280.0, 40.0]], 30.0))
+        .unwrap();
     let painted = rows(&doc);
     let v_old = vertices(&doc);
     doc.apply(Command::SetLocked {
@@ -298,19 +304,7 @@ fn locks_are_saved_and_reopened() {
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(!text.contains("\"locked\""), "no locks, no field");
     // Paint b where c rules, lock it, rename it: the recompute keeps its weights.
-    doc.apply(Command::PaintWeights {
-        part: "bar".into(),
-        handle: "b".into(),
-        mode: BrushMode::Add,
-        samples_px: vec![[250.0, 40.0]],
-        options: BrushOptions {
-            radius_px: 20.0,
-            strength: 1.0,
-            falloff: Falloff::Constant,
-            spacing: 0.25,
-        },
-    })
-    .unwrap();
+    doc.apply(fill_b(vec![[250.0, 40.0]], 20.0)).unwrap();
     let painted = column(&rows(&doc), 1);
     doc.apply(Command::SetLocked {
         handle: "b".into(),
@@ -357,19 +351,7 @@ fn locks_are_saved_and_reopened() {
 fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
     let dir = scratch("stale");
     let mut doc = arm(&dir);
-    doc.apply(Command::PaintWeights {
-        part: "bar".into(),
-        handle: "b".into(),
-        mode: BrushMode::Add,
-        samples_px: vec![[250.0, 40.0]],
-        options: BrushOptions {
-            radius_px: 20.0,
-            strength: 1.0,
-            falloff: Falloff::Constant,
-            spacing: 0.25,
-        },
-    })
-    .unwrap();
+    doc.apply(fill_b(vec![[250.0, 40.0]], 20.0)).unwrap();
     let v = vertices(&doc);
     let near: Vec<usize> = (0..v.len())
         .filter(|&i| (v[i][0] - 250.0).hypot(v[i][1] - 40.0) < 18.0)

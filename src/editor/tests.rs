@@ -46,6 +46,14 @@ fn character_rig(name: &str) -> PathBuf {
     path
 }
 
+/// The editor on [`character_rig`]`(name)`, after its first frames.
+fn open_character(name: &str) -> Harness<'static, EditorApp> {
+    let path = character_rig(name);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h
+}
+
 fn screen(h: &Harness<'_, EditorApp>, canvas_px: [f64; 2]) -> Pos2 {
     h.state()
         .placed
@@ -105,9 +113,7 @@ fn torso_point(h: &Harness<'_, EditorApp>) -> [f64; 2] {
 
 #[test]
 fn rig_weigh_pose_undo_through_the_ui() {
-    let path = character_rig("flow");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("flow");
     h.get_by_label("Weights are up to date");
     let bones_before = h.state().doc.state().handles.bones.len();
     let inside = torso_point(&h);
@@ -230,9 +236,7 @@ fn the_help_overlay_lists_the_shortcuts() {
 
 #[test]
 fn set_two_keys_and_scrub_the_timeline() {
-    let path = character_rig("animate");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("animate");
     h.key_press(Key::Num3);
     h.run();
     assert_eq!(h.state().mode, Mode::Animate);
@@ -424,9 +428,7 @@ fn shown_head(h: &Harness<'_, EditorApp>, bone: &str) -> [f64; 2] {
 
 #[test]
 fn rotate_with_r_and_grab_with_the_gizmo_in_pose_mode() {
-    let path = character_rig("gizmo");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("gizmo");
     h.key_press(Key::Num2);
     h.run();
     // The chest bone runs up from (256, 262) to (256, 198): click its middle to select it.
@@ -494,9 +496,7 @@ fn wait_until(h: &mut Harness<'_, EditorApp>, what: &str, done: impl Fn(&EditorA
 
 #[test]
 fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
-    let path = character_rig("rigtools");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("rigtools");
     assert_eq!(h.state().mode, Mode::Rig);
     let before = h.state().doc.state().handles.clone();
 
@@ -729,9 +729,7 @@ fn colorize_two_scribbles_then_undo_one() {
 
 #[test]
 fn paint_weights_with_a_locked_handle_through_the_ui() {
-    let path = character_rig("paint");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("paint");
     h.get_by_label("Weights are up to date");
     let torso = |app: &EditorApp| {
         let scene = app.doc.posable().expect("posable").clone();
@@ -913,9 +911,7 @@ fn key_on_sheet(
 #[test]
 fn dopesheet_select_move_copy_paste_curve_and_undo() {
     use crate::anim::edit::{KeyRef, TransformChannel::*};
-    let path = character_rig("dopesheet");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("dopesheet");
     h.key_press(Key::Num3);
     h.run();
     h.state_mut().animation = "nod".into();
@@ -1055,9 +1051,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
 
 #[test]
 fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
-    let path = character_rig("playback");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("playback");
     h.key_press(Key::Num3);
     h.run();
     {
@@ -1121,9 +1115,7 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
 #[test]
 fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     use crate::anim::edit::{KeyRef, TransformChannel::*};
-    let path = character_rig("keyboard");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
+    let mut h = open_character("keyboard");
     {
         let app = h.state_mut();
         key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);

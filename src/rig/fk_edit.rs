@@ -126,21 +126,17 @@ pub fn apply(
         return Err(FkEditError::BadEdit);
     }
     let target = target(handles, shown, name)?;
-    // The local pose of every handle as shown; only `name`'s is taken from it. Without drags
-    // what is shown is the pose itself, whose own entry is exact (no round trip through
-    // matrices).
-    let as_shown = if pose.ik.is_empty() && !pose_names(pose, name) {
+    // Where the handle is shown: with drags, the local pose decomposed from the IK's
+    // transforms; without, the pose's own entry (exact, no round trip through matrices).
+    let decomposed = if pose.ik.is_empty() {
         None
-    } else if pose.ik.is_empty() {
-        Some(pose.clone())
     } else {
         Some(pose_from_transforms(handles, shown)?)
     };
+    let as_shown = decomposed.as_ref().unwrap_or(pose);
     let mut out = pose.clone();
     if target.is_bone {
-        let mut local = as_shown
-            .and_then(|p| p.bones.get(name).cloned())
-            .unwrap_or_default();
+        let mut local = as_shown.bones.get(name).cloned().unwrap_or_default();
         let bone = &handles.bones[target.column];
         // The parent's posed frame: offsets and angles on screen are measured in it.
         let world_from_parent = match bone
@@ -175,9 +171,7 @@ pub fn apply(
         }
         out.bones.insert(name.to_string(), local);
     } else {
-        let mut local = as_shown
-            .and_then(|p| p.points.get(name).cloned())
-            .unwrap_or_default();
+        let mut local = as_shown.points.get(name).cloned().unwrap_or_default();
         match edit {
             FkEdit::Grab { delta_px } => {
                 local.translate[0] += delta_px[0];
@@ -192,11 +186,6 @@ pub fn apply(
         out.points.insert(name.to_string(), local);
     }
     Ok(out)
-}
-
-/// Whether the pose already has an entry for `name`.
-fn pose_names(pose: &Pose, name: &str) -> bool {
-    pose.bones.contains_key(name) || pose.points.contains_key(name)
 }
 
 /// Where `column`'s transform in `shown` puts a rest point, canvas px.

@@ -131,7 +131,6 @@ pub struct PaintMesh {
 impl PaintMesh {
     pub fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Result<Self, PaintError> {
         let n = vertices.len();
-        let mut neighbours = vec![Vec::new(); n];
         for (t, tri) in triangles.iter().enumerate() {
             if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
                 return Err(PaintError::Triangle {
@@ -140,19 +139,10 @@ impl PaintMesh {
                     vertices: n,
                 });
             }
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                neighbours[a as usize].push(b);
-                neighbours[b as usize].push(a);
-            }
-        }
-        for list in &mut neighbours {
-            list.sort_unstable();
-            list.dedup();
         }
         Ok(PaintMesh {
             vertices: vertices.to_vec(),
-            neighbours,
+            neighbours: crate::mesh::vertex_neighbours(n, triangles),
         })
     }
 }

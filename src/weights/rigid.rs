@@ -33,7 +33,7 @@ pub fn rigid_weights(
 ) -> WeightMatrix {
     let n = vertices.len();
     let m = bc.handle_count;
-    let neighbors = vertex_neighbors(n, triangles);
+    let neighbors = crate::mesh::vertex_neighbours(n, triangles);
     let distances: Vec<Vec<f64>> = (0..m)
         .map(|j| {
             let sources: Vec<usize> = bc
@@ -80,23 +80,6 @@ pub fn rigid_weights(
         handle_count: m,
         data,
     }
-}
-
-/// Per vertex, its neighbors along triangle edges (sorted, no duplicates).
-fn vertex_neighbors(n: usize, triangles: &[[u32; 3]]) -> Vec<Vec<u32>> {
-    let mut neighbors = vec![Vec::new(); n];
-    for t in triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            neighbors[a as usize].push(b);
-            neighbors[b as usize].push(a);
-        }
-    }
-    for list in &mut neighbors {
-        list.sort_unstable();
-        list.dedup();
-    }
-    neighbors
 }
 
 /// Shortest distances (px) along mesh edges from any of `sources`; infinite where unreached.

@@ -137,13 +137,8 @@ impl SharedPattern {
             }
             col_ptr.push(row_idx.len());
         }
-        let symbolic = faer::sparse::SymbolicSparseColMat::new_checked(
-            len,
-            len,
-            col_ptr.clone(),
-            None,
-            row_idx.clone(),
-        );
+        let symbolic =
+            faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
         let assembly = |e: faer::sparse::FaerError| SolveError::Assembly(format!("{e:?}"));
         // The fill-reducing order, from faer's own analysis of the caller's order.
         let amd = factorize_symbolic_cholesky(
@@ -162,6 +157,7 @@ impl SharedPattern {
         };
         // Entry (r, c) of the lower triangle moves to (inverse[r], inverse[c]), mirrored into
         // the lower triangle; then columns are sorted by row.
+        let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
         let mut entries: Vec<(usize, usize, usize)> = Vec::with_capacity(values.len());
         for c in 0..len {
             for (k, &r) in row_idx
@@ -175,41 +171,15 @@ impl SharedPattern {
             }
         }
         entries.sort_unstable();
-        let mut permuted_col_ptr = vec![0usize; len + 1];
-        let mut permuted_row_idx = Vec::with_capacity(entries.len());
         let mut scatter = vec![0usize; values.len()];
-        for (at, &(col, row, k)) in entries.iter().enumerate() {
-            permuted_col_ptr[col + 1] += 1;
-            permuted_row_idx.push(row);
+        for (at, &(_, _, k)) in entries.iter().enumerate() {
             scatter[k] = at;
         }
-        for c in 0..len {
-            permuted_col_ptr[c + 1] += permuted_col_ptr[c];
-        }
-        let permuted = faer::sparse::SymbolicSparseColMat::new_checked(
-            len,
-            len,
-            permuted_col_ptr,
-            None,
-            permuted_row_idx,
-        );
+        let permuted = compressed_columns(len, entries.iter().map(|&(c, r, _)| (c, r)));
         // faer's analysis without reordering reads the upper triangle as given.
         let mut upper: Vec<(usize, usize)> = entries.iter().map(|&(c, r, _)| (r, c)).collect();
         upper.sort_unstable();
-        let mut upper_col_ptr = vec![0usize; len + 1];
-        for &(col, _) in &upper {
-            upper_col_ptr[col + 1] += 1;
-        }
-        for c in 0..len {
-            upper_col_ptr[c + 1] += upper_col_ptr[c];
-        }
-        let upper = faer::sparse::SymbolicSparseColMat::new_checked(
-            len,
-            len,
-            upper_col_ptr,
-            None,
-            upper.into_iter().map(|(_, r)| r).collect(),
-        );
+        let upper = compressed_columns(len, upper.into_iter());
         let cholesky = factorize_symbolic_cholesky(
             upper.as_ref(),
             Side::Upper,
@@ -283,6 +253,23 @@ impl SharedPattern {
         }
         y
     }
+}
+
+/// The pattern of an n × n matrix from its (column, row) entries, sorted by column then row.
+fn compressed_columns(
+    n: usize,
+    entries: impl ExactSizeIterator<Item = (usize, usize)>,
+) -> faer::sparse::SymbolicSparseColMat<usize> {
+    let mut col_ptr = vec![0usize; n + 1];
+    let mut row_idx = Vec::with_capacity(entries.len());
+    for (col, row) in entries {
+        col_ptr[col + 1] += 1;
+        row_idx.push(row);
+    }
+    for c in 0..n {
+        col_ptr[c + 1] += col_ptr[c];
+    }
+    faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
 }
 
 /// A numeric Cholesky factorization over a [`SharedPattern`].
