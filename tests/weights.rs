@@ -12,6 +12,8 @@ use sinew::weights::boundary::segment_distance;
 use sinew::weights::WeightOptions;
 use std::path::Path;
 
+mod common;
+
 const SUM_TOLERANCE: f64 = 1e-9;
 
 fn character() -> (Vec<Layer>, Handles) {
@@ -115,6 +117,48 @@ fn cross_bone(name: &str, x: f64) -> Bone {
         parent: None,
         head: [x, 10.0],
         tail: [x, 70.0],
+    }
+}
+
+/// A bone chain's bounded solve reaches the rounding floor of its gradient residual long before
+/// an absolute 1e-10 (|H||x| ~ 3e6 on the critter's hip): the solver must stop there rather than
+/// spin to its iteration limit and report the bone unconverged.
+#[test]
+fn a_bone_chain_on_the_critter_converges_on_every_handle() {
+    let point = |name: &str, at: [f64; 2]| PointHandle {
+        name: name.into(),
+        at,
+    };
+    let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
+        name: name.into(),
+        parent: parent.map(Into::into),
+        head,
+        tail,
+    };
+    let handles = Handles {
+        bones: vec![
+            bone("hip", None, [128.0, 195.0], [128.0, 140.0]),
+            bone("chest", Some("hip"), [128.0, 140.0], [128.0, 90.0]),
+        ],
+        points: vec![
+            point("antenna", [145.6, 17.0]),
+            point("ring", [205.0, 130.5]),
+            point("blob", [40.0, 230.0]),
+            point("cheek", [150.0, 72.0]),
+            point("belly", [88.0, 175.0]),
+        ],
+        ..Default::default()
+    };
+    let layers = [layer("critter", common::critter(256))];
+    let (_, reports) = pipeline::build_rig(
+        &layers,
+        &std::env::temp_dir(),
+        &BuildOptions::default(),
+        &handles,
+    )
+    .unwrap();
+    for report in &reports {
+        assert!(report.unconverged.is_empty(), "{report:?}");
     }
 }
 
