@@ -321,8 +321,9 @@ pub fn bounded_biharmonic_weights(
 
 /// The gradient residual Hx + g − z + w cannot be computed more exactly than a few rounding
 /// errors of its largest product term: this many machine epsilons of max_i Σ_j |H_ij x_j|.
-/// (Measured at 0.1–4.5 ε·‖|H||x|‖∞ once the residual stops falling; bone handles, with large
-/// |H||x|, otherwise never reach an absolute 1e-10 and run to the iteration limit.)
+/// (Measured at 0.1–4.5 ε·‖|H||x|‖∞ once the residual stops falling; handles with a large
+/// |H||x|, such as the critter's hip bone and ring point at ~3e6, otherwise never reach an
+/// absolute 1e-10 and run to the iteration limit.)
 const RESIDUAL_ROUND_OFF: f64 = 10.0;
 
 /// The smallest gradient residual that rounding lets the iterate `x` show, for the scaled

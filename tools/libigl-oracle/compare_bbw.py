@@ -347,7 +347,8 @@ def main():
     if suboptimal:
         print(
             f"note: sinew stopped short of the optimum in {', '.join(suboptimal)} "
-            "(see its iteration limit)"
+            "(its interior point ends within its tolerances, not at the strict KKT point this "
+            "script checks; the unconverged handles above, if any, hit its iteration limit)"
         )
     if failed:
         print(f"FAIL: {', '.join(failed)} differ from libigl by more than {args.tolerance:g}")
