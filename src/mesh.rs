@@ -558,8 +558,11 @@ fn drop_unused_vertices(mesh: Mesh) -> Mesh {
     }
 }
 
+/// Points and the constraint edges between them (pairs of point indices).
+type ConstraintGraph = (Vec<Point2<f64>>, Vec<[usize; 2]>);
+
 /// The rings' points (deduplicated exactly) and the constraint edges between them.
-fn constraint_graph(rings: &[&[Point]]) -> Result<(Vec<Point2<f64>>, Vec<[usize; 2]>), MeshError> {
+fn constraint_graph(rings: &[&[Point]]) -> Result<ConstraintGraph, MeshError> {
     let mut points = Vec::new();
     let mut index_of: HashMap<(u64, u64), usize> = HashMap::new();
     let mut edges = Vec::new();

@@ -727,7 +727,7 @@ mod tests {
                 &[&|x: f64, y: f64| {
                     (4.0..44.0).contains(&x)
                         && (4.0..28.0).contains(&y)
-                        && (x as u32 % 2 == 0 || y < 6.0)
+                        && ((x as u32).is_multiple_of(2) || y < 6.0)
                 }],
             ),
             // A spiral-ish curve.

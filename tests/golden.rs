@@ -20,7 +20,6 @@ use common::golden::{premultiplied_difference, premultiplied_tolerance};
 use image::RgbaImage;
 use sinew::pipeline::Scene;
 use sinew::render;
-use sinew::rig::pose::BonePose;
 use sinew::rig::Pose;
 use std::path::PathBuf;
 use std::sync::OnceLock;
@@ -97,10 +96,7 @@ fn bundled_animations_match_golden_at_fixed_times() {
 fn a_two_degree_turn_fails() {
     // The reach pose with one forearm turned 2° further must not pass as the reach pose.
     let mut pose = load_pose("reach");
-    let forearm = pose
-        .bones
-        .entry("arm_lower_l".into())
-        .or_insert_with(BonePose::default);
+    let forearm = pose.bones.entry("arm_lower_l".into()).or_default();
     forearm.rotate += 2.0;
     let turned = render_pose(&pose);
     let reference = render_pose(&load_pose("reach"));

@@ -511,8 +511,7 @@ fn a_bound_handle_leaves_other_parts_alone() {
         &BuildOptions::default(),
         &handles,
     )
-    .err()
-    .expect("an unknown part is an error");
+    .expect_err("an unknown part is an error");
     assert!(err.to_string().contains("'nowhere'"), "{err}");
 }
 

@@ -48,7 +48,11 @@ pub fn triangle_area(l2: [f64; 3]) -> f64 {
 fn corner_cotangents(l2: [f64; 3]) -> Option<[f64; 3]> {
     let area = triangle_area(l2);
     let longest = l2.iter().cloned().fold(0.0, f64::max);
-    if !(area > DEGENERATE_AREA_RATIO * longest) {
+    // Written to also reject a NaN area or length.
+    if !matches!(
+        area.partial_cmp(&(DEGENERATE_AREA_RATIO * longest)),
+        Some(std::cmp::Ordering::Greater)
+    ) {
         return None;
     }
     // cot(angle at k) = (l_i² + l_j² − l_k²) / (4 · area), with l_k opposite corner k.

@@ -287,7 +287,9 @@ pub fn bounded_biharmonic_weights(
     let free = free_vertices(n, bc);
     let pattern = SharedPattern::new(&q, &free)?;
     let unconstrained = pattern.factor(&pattern.values)?;
-    let results: Vec<Result<(Vec<f64>, usize, bool), SolveError>> = (0..bc.handle_count)
+    // Per handle: the weight column, the iterations taken and whether they converged.
+    type HandleSolve = (Vec<f64>, usize, bool);
+    let results: Vec<Result<HandleSolve, SolveError>> = (0..bc.handle_count)
         .into_par_iter()
         .map(|j| {
             let mut w = fixed_column(n, bc, j);

@@ -154,8 +154,10 @@ pub fn sprites() -> Vec<(&'static str, RgbaImage)> {
         Transform::identity(),
     )
     .unwrap();
-    let mut sp = Paint::default();
-    sp.shader = shader;
+    let sp = Paint {
+        shader,
+        ..Paint::default()
+    };
     soft.fill_rect(
         tiny_skia::Rect::from_xywh(0.0, 0.0, 80.0, 80.0).unwrap(),
         &sp,
