@@ -2,8 +2,10 @@
 //! result of the current strokes.
 //!
 //! In: a line-art image, [`ColorizeOptions`], and [`SessionCommand`]s (add a stroke, erase the
-//! strokes near a point, clear, recolor). Out: the current strokes and, once solved, the
-//! [`Colorized`] result for exactly those strokes, saved atomically as a PNG on request.
+//! strokes near a point, clear, recolor, replace them all from a scribble file). Out: the
+//! current strokes and, once solved, the [`Colorized`] result for exactly those strokes, saved
+//! atomically as a PNG on request; the strokes themselves save and load as the JSON scribble
+//! file of `sinew colorize --scribbles`.
 //!
 //! The line-art-dependent part is prepared once ([`PreparedLineArt`]); a solve rasterizes the
 //! strokes and runs the rest of [`super`]'s pipeline. Solving takes longer than a frame on
@@ -96,6 +98,8 @@ pub enum SessionCommand {
     /// Gives every stroke of color `from` the color `to` (`to` may be a color already used:
     /// the two regions then become one color).
     Recolor { from: [u8; 3], to: [u8; 3] },
+    /// Replaces every stroke with these (a scribble file loaded).
+    Replace(Vec<ScribbleStroke>),
 }
 
 /// What a session command, solve or save got wrong. The session is unchanged.
@@ -125,6 +129,16 @@ pub enum SessionError {
     Colorize(#[from] ColorizeError),
     #[error(transparent)]
     Image(#[from] crate::io::ImageError),
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot write {path}: {source}")]
+    Write {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// What one undo step restores.
@@ -290,6 +304,34 @@ impl ColorizeSession {
         Ok(())
     }
 
+    /// Writes the strokes to `path` as a JSON scribble file (`sinew colorize --scribbles`),
+    /// atomically. Refused ([`SessionError::NoStrokes`]) when there are none.
+    pub fn save_strokes(&self, path: &Path) -> Result<(), SessionError> {
+        if self.state.strokes.is_empty() {
+            return Err(SessionError::NoStrokes);
+        }
+        let write = |source| SessionError::Write {
+            path: path.to_path_buf(),
+            source,
+        };
+        let text = serde_json::to_string_pretty(&self.stroke_file())
+            .map_err(|e| write(std::io::Error::other(e)))?;
+        crate::io::write_atomic(path, text.as_bytes()).map_err(write)
+    }
+
+    /// Replaces the strokes with those of the JSON scribble file at `path`, as one undo step;
+    /// returns how many there are. On error nothing changes.
+    pub fn load_strokes(&mut self, path: &Path) -> Result<usize, SessionError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SessionError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let strokes = strokes_from_json(&text)?;
+        let count = strokes.len();
+        self.apply(SessionCommand::Replace(strokes))?;
+        Ok(count)
+    }
+
     /// The strokes after `command`, or why it cannot apply.
     fn apply_to(&self, command: SessionCommand) -> Result<Vec<ScribbleStroke>, SessionError> {
         let mut strokes = self.state.strokes.as_ref().clone();
@@ -327,6 +369,12 @@ impl ColorizeSession {
                 if !found {
                     return Err(SessionError::UnknownColor(hex(from)));
                 }
+            }
+            SessionCommand::Replace(new) => {
+                for stroke in &new {
+                    self.check_stroke(stroke)?;
+                }
+                strokes = new;
             }
         }
         let colors = palette_of(&strokes).len();
@@ -382,6 +430,16 @@ impl ColorizeSession {
 }
 
 /// Distinct stroke colors in order of first use.
+/// The strokes of a JSON scribble file's text, as a session keeps them.
+pub fn strokes_from_json(text: &str) -> Result<Vec<ScribbleStroke>, SessionError> {
+    let file: StrokeFile =
+        serde_json::from_str(text).map_err(|e| ScribbleError::Json(e.to_string()))?;
+    file.strokes
+        .iter()
+        .map(ScribbleStroke::from_stroke)
+        .collect()
+}
+
 fn palette_of(strokes: &[ScribbleStroke]) -> Vec<[u8; 3]> {
     let mut colors: Vec<[u8; 3]> = Vec::new();
     for s in strokes {
@@ -629,6 +687,61 @@ mod tests {
             session.job().run(&AtomicBool::new(true)),
             Err(SessionError::Colorize(ColorizeError::Cancelled))
         ));
+    }
+
+    #[test]
+    fn strokes_save_and_load_as_a_scribble_file_with_one_undo_step() {
+        let (s, background, inside) = circle();
+        let mut session = session(&s);
+        let dir = std::env::temp_dir().join(format!("sinew-strokes-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("lineart.scribbles.json");
+        assert!(matches!(
+            session.save_strokes(&path),
+            Err(SessionError::NoStrokes)
+        ));
+        assert!(!path.exists());
+        session
+            .apply(SessionCommand::AddStroke(background.clone()))
+            .unwrap();
+        session
+            .apply(SessionCommand::AddStroke(inside.clone()))
+            .unwrap();
+        session.save_strokes(&path).unwrap();
+        // The file is what `sinew colorize --scribbles` reads.
+        let text = std::fs::read_to_string(&path).unwrap();
+        let rasterized = Scribbles::from_json(&text, 128, 128, &Default::default()).unwrap();
+        assert_eq!(rasterized.colors, vec![PALETTE[10], PALETTE[0]]);
+
+        let mut other = super::tests::session(&s);
+        other
+            .apply(SessionCommand::AddStroke(inside.clone()))
+            .unwrap();
+        assert_eq!(other.load_strokes(&path).unwrap(), 2);
+        assert_eq!(other.strokes(), &[background, inside.clone()]);
+        assert!(other.undo());
+        assert_eq!(other.strokes(), &[inside.clone()]);
+
+        // A file that is not a scribble file, or is missing, changes nothing.
+        let bad = dir.join("bad.json");
+        std::fs::write(&bad, "{\"strokes\": [{\"color\": \"red\"}]}").unwrap();
+        assert!(matches!(
+            other.load_strokes(&bad),
+            Err(SessionError::Scribbles(ScribbleError::Json(_)))
+        ));
+        assert!(matches!(
+            other.load_strokes(&dir.join("missing.json")),
+            Err(SessionError::Read { .. })
+        ));
+        let off_image = dir.join("off.json");
+        std::fs::write(
+            &off_image,
+            r##"{"strokes": [{"color": "#ff0000", "width": 3, "points": [[900, 900]]}]}"##,
+        )
+        .unwrap();
+        assert!(other.load_strokes(&off_image).is_err());
+        assert_eq!(other.strokes(), &[inside]);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

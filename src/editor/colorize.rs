@@ -78,6 +78,10 @@ pub struct ColorizeEditor {
     pub lineart_path: String,
     /// Where "Save colorized PNG" writes.
     pub save_path: String,
+    /// Where "Save scribbles" writes and "Load scribbles" reads (a JSON scribble file).
+    pub scribbles_path: String,
+    /// The strokes last saved or autosaved, to autosave only changes.
+    saved_strokes: Option<Arc<Vec<ScribbleStroke>>>,
     pub tool: ColorizeTool,
     pub color: [u8; 3],
     /// Brush diameter, image px.
@@ -105,6 +109,8 @@ impl Default for ColorizeEditor {
             path: None,
             lineart_path: String::new(),
             save_path: "colorized.png".into(),
+            scribbles_path: "scribbles.json".into(),
+            saved_strokes: None,
             tool: ColorizeTool::Brush,
             color: DEFAULT_COLOR,
             width_px: DEFAULT_BRUSH_PX,
@@ -216,6 +222,7 @@ impl EditorApp {
                     path: Some(path.to_path_buf()),
                     lineart_path: path.display().to_string(),
                     save_path: colorized_path(path).display().to_string(),
+                    scribbles_path: scribbles_path(path).display().to_string(),
                     tool: c.tool,
                     color: c.color,
                     width_px: c.width_px,
@@ -238,6 +245,69 @@ impl EditorApp {
         match session.save_result(path) {
             Ok(()) => format!("saved {}", path.display()),
             Err(e) => e.to_string(),
+        }
+    }
+
+    /// Saves the strokes to `path` as a JSON scribble file; returns the status-bar message.
+    pub fn save_scribbles(&mut self, path: &Path) -> String {
+        let c = &mut self.colorize;
+        let Some(session) = &c.session else {
+            return "open a line-art PNG first".into();
+        };
+        match session.save_strokes(path) {
+            Ok(()) => {
+                c.saved_strokes = Some(session.state().strokes.clone());
+                format!(
+                    "saved {} strokes to {}",
+                    session.strokes().len(),
+                    path.display()
+                )
+            }
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// Replaces the strokes with those of the JSON scribble file at `path` (one undo step);
+    /// on failure the strokes stay. Sets the status-bar message; true when loaded.
+    pub fn load_scribbles(&mut self, path: &Path) -> bool {
+        let Some(session) = self.colorize.session.as_mut() else {
+            self.message = Some("open a line-art PNG first".into());
+            return false;
+        };
+        let (message, loaded) = match session.load_strokes(path) {
+            Ok(count) => {
+                self.colorize.scribbles_path = path.display().to_string();
+                self.colorize.saved_strokes = Some(session.state().strokes.clone());
+                (
+                    format!("loaded {count} strokes from {}", path.display()),
+                    true,
+                )
+            }
+            Err(e) => (format!("cannot load {}: {e}", path.display()), false),
+        };
+        self.message = Some(message);
+        loaded
+    }
+
+    /// Writes the strokes beside the scribble file (`NAME.autosave.json`) when they changed
+    /// since the last save; a failure goes to the status bar.
+    pub(super) fn autosave_scribbles(&mut self) {
+        let c = &mut self.colorize;
+        let Some(session) = &c.session else {
+            return;
+        };
+        let strokes = &session.state().strokes;
+        let unchanged = c
+            .saved_strokes
+            .as_ref()
+            .is_some_and(|saved| saved.as_slice() == strokes.as_slice());
+        if unchanged || strokes.is_empty() {
+            return;
+        }
+        let target = crate::document::autosave_path(Path::new(&c.scribbles_path));
+        match session.save_strokes(&target) {
+            Ok(()) => c.saved_strokes = Some(strokes.clone()),
+            Err(e) => self.message = Some(format!("autosave failed: {e}")),
         }
     }
 
@@ -382,6 +452,18 @@ impl EditorApp {
             let path = PathBuf::from(&self.colorize.save_path);
             self.message = Some(self.save_colorized(&path));
         }
+        ui.label("Scribbles JSON:");
+        ui.text_edit_singleline(&mut self.colorize.scribbles_path);
+        ui.horizontal(|ui| {
+            if ui.button("Save scribbles").clicked() {
+                let path = PathBuf::from(&self.colorize.scribbles_path);
+                self.message = Some(self.save_scribbles(&path));
+            }
+            if ui.button("Load scribbles").clicked() {
+                let path = PathBuf::from(&self.colorize.scribbles_path);
+                self.load_scribbles(&path);
+            }
+        });
     }
 
     pub(super) fn colorize_panel(&mut self, ui: &mut egui::Ui) {
@@ -455,6 +537,14 @@ impl EditorApp {
         if ui.button("Save colorized PNG").clicked() {
             let path = PathBuf::from(&self.colorize.save_path);
             self.message = Some(self.save_colorized(&path));
+        }
+        if ui
+            .add_enabled(strokes > 0, egui::Button::new("Save scribbles"))
+            .on_hover_text(self.colorize.scribbles_path.clone())
+            .clicked()
+        {
+            let path = PathBuf::from(&self.colorize.scribbles_path);
+            self.message = Some(self.save_scribbles(&path));
         }
         if let Some(command) = command {
             self.apply_colorize(command);
@@ -683,6 +773,11 @@ pub fn colorized_path(lineart: &Path) -> PathBuf {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "lineart".into());
     lineart.with_file_name(format!("{stem}.colorized.png"))
+}
+
+/// `NAME.scribbles.json` beside the line art `NAME.png`.
+pub fn scribbles_path(lineart: &Path) -> PathBuf {
+    crate::document::side_file(lineart, "scribbles")
 }
 
 fn is_png(path: &Path) -> bool {

@@ -588,10 +588,14 @@ impl EditorApp {
 
     fn autosave(&mut self, ctx: &egui::Context) {
         let now = ctx.input(|i| i.time);
-        if !self.doc.dirty || now - self.last_autosave_s < AUTOSAVE_INTERVAL_S {
+        if now - self.last_autosave_s < AUTOSAVE_INTERVAL_S {
             return;
         }
         self.last_autosave_s = now;
+        self.autosave_scribbles();
+        if !self.doc.dirty {
+            return;
+        }
         if let Some(path) = self.doc.path.clone() {
             if let Err(e) = self.doc.autosave(&path) {
                 self.message = Some(format!("autosave failed: {e}"));
@@ -1715,16 +1719,11 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         }
     }
     if let Some(path) = &start.scribbles {
-        let file: crate::colorize::scribbles::StrokeFile = serde_json::from_slice(
-            &std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
-        )
-        .map_err(|e| anyhow::anyhow!("{}: not a scribble file: {e}", path.display()))?;
-        let Some(session) = app.colorize.session.as_mut() else {
+        if app.colorize.session.is_none() {
             anyhow::bail!("--scribbles needs --line-art to draw on");
-        };
-        for stroke in &file.strokes {
-            let stroke = crate::colorize::session::ScribbleStroke::from_stroke(stroke)?;
-            session.apply(crate::colorize::session::SessionCommand::AddStroke(stroke))?;
+        }
+        if !app.load_scribbles(path) {
+            anyhow::bail!("{}", app.message.clone().unwrap_or_default());
         }
     }
     if let Some(shot) = start.screenshot {

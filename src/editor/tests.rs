@@ -728,6 +728,96 @@ fn colorize_two_scribbles_then_undo_one() {
 }
 
 #[test]
+fn colorize_scribbles_save_load_and_autosave() {
+    use crate::colorize::session::{ScribbleStroke, SessionCommand};
+    use crate::colorize::synthetic::{scene, SceneSpec, PALETTE};
+    let s = scene(&SceneSpec {
+        size: 96,
+        shapes: 1,
+        ..Default::default()
+    });
+    let dir = std::env::temp_dir().join(format!("sinew-editor-scribbles-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let lineart = dir.join("cat.png");
+    crate::io::save_png(&lineart, &s.lineart).expect("written");
+    let strokes: Vec<ScribbleStroke> = [PALETTE[10], PALETTE[0]]
+        .iter()
+        .zip(&s.strokes)
+        .map(|(&color, stroke)| ScribbleStroke {
+            color,
+            width_px: stroke.width,
+            points_px: stroke.points.clone(),
+        })
+        .collect();
+    let count = |h: &Harness<'_, EditorApp>| {
+        h.state()
+            .colorize
+            .session
+            .as_ref()
+            .map(|s| s.strokes().len())
+    };
+
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.state_mut().open_lineart(&lineart);
+    h.run();
+    let saved = dir.join("cat.scribbles.json");
+    assert_eq!(
+        h.state().colorize.scribbles_path,
+        saved.display().to_string()
+    );
+    for stroke in &strokes {
+        assert!(h
+            .state_mut()
+            .apply_colorize(SessionCommand::AddStroke(stroke.clone())));
+    }
+    h.run();
+
+    // The panel's button writes the scribble file `sinew colorize --scribbles` reads.
+    h.get_by_label("Save scribbles").click();
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("saved 2 strokes"), "{message}");
+    let text = std::fs::read_to_string(&saved).expect("saved");
+    assert_eq!(
+        crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
+        strokes
+    );
+
+    // Saved strokes are not autosaved again; a change is, beside the scribble file.
+    let autosaved = dir.join("cat.scribbles.autosave.json");
+    h.state_mut().autosave_scribbles();
+    assert!(!autosaved.exists());
+    assert!(h.state_mut().apply_colorize(SessionCommand::Clear));
+    assert!(h
+        .state_mut()
+        .apply_colorize(SessionCommand::AddStroke(strokes[1].clone())));
+    h.state_mut().autosave_scribbles();
+    let text = std::fs::read_to_string(&autosaved).expect("autosaved");
+    assert_eq!(
+        crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
+        strokes[1..]
+    );
+
+    // Loading replaces the strokes as one undo step; a bad file leaves them.
+    assert!(h.state_mut().load_scribbles(&saved));
+    assert_eq!(count(&h), Some(2));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(count(&h), Some(1));
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "not json").expect("written");
+    assert!(!h.state_mut().load_scribbles(&bad));
+    assert!(h
+        .state()
+        .message
+        .as_deref()
+        .is_some_and(|m| m.starts_with("cannot load")));
+    assert_eq!(count(&h), Some(1));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn paint_weights_with_a_locked_handle_through_the_ui() {
     let mut h = open_character("paint");
     h.get_by_label("Weights are up to date");
