@@ -396,36 +396,7 @@ impl Document {
     /// weights of other handles; while some handle is locked, those weights are saved aside
     /// (`stale_weights`), so that the computation after reopening still keeps the locked ones.
     pub fn to_rig_document(&self, path: &Path) -> Result<RigDocument, DocumentError> {
-        let state = &self.state;
-        let dir = path.parent().unwrap_or(Path::new("."));
-        let mut doc = match &state.rig {
-            Some(scene) if same_layers(&scene.doc, &state.layers) => scene.doc.clone(),
-            _ => {
-                if state.layers.is_empty() {
-                    return Err(DocumentError::NothingToSave);
-                }
-                let layers: Vec<Layer> = state.layers.iter().map(|l| (**l).clone()).collect();
-                pipeline::build_rig(&layers, dir, &state.options, &Handles::default())?.0
-            }
-        };
-        for part in &mut doc.parts {
-            // A stale rig's weights are not saved as weights (reopening must not pose with
-            // weights of other handles), but kept aside while locked handles need them.
-            let stale = if state.rig_current {
-                None
-            } else {
-                part.weights.take().or(part.stale_weights.take())
-            };
-            part.stale_weights = stale.filter(|_| !state.locked.is_empty());
-        }
-        for (part, layer) in doc.parts.iter_mut().zip(&state.layers) {
-            part.image = pipeline::relative_path(dir, &layer.path);
-        }
-        doc.handles = state.handles.clone();
-        doc.options = state.options.clone();
-        doc.animations = state.animations.clone();
-        doc.locked = state.locked.iter().cloned().collect();
-        Ok(doc)
+        rig_document(&self.state, path)
     }
 
     /// Saves to `path` atomically and remembers it as the document's path.
@@ -474,10 +445,71 @@ impl Document {
     /// Writes the current state to the autosave side file of the document's path (or of
     /// `fallback` for a document never saved); returns where it went.
     pub fn autosave(&self, fallback: &Path) -> Result<PathBuf, DocumentError> {
-        let target = autosave_path(self.path.as_deref().unwrap_or(fallback));
-        let doc = self.to_rig_document(&target)?;
-        doc.save(&target)?;
-        Ok(target)
+        self.autosave_job(fallback).run()
+    }
+
+    /// [`Document::autosave`] as a snapshot to write on another thread.
+    pub fn autosave_job(&self, fallback: &Path) -> AutosaveJob {
+        AutosaveJob {
+            state: self.state.clone(),
+            target: autosave_path(self.path.as_deref().unwrap_or(fallback)),
+        }
+    }
+}
+
+/// The rig document of `state` as it would be saved at `path` (see
+/// [`Document::to_rig_document`]). Traces and meshes the layers when `state` has no rig of
+/// them yet, which takes long on large images: [`AutosaveJob`] runs it off the UI thread.
+fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut doc = match &state.rig {
+        Some(scene) if same_layers(&scene.doc, &state.layers) => scene.doc.clone(),
+        _ => {
+            if state.layers.is_empty() {
+                return Err(DocumentError::NothingToSave);
+            }
+            let layers: Vec<Layer> = state.layers.iter().map(|l| (**l).clone()).collect();
+            pipeline::build_rig(&layers, dir, &state.options, &Handles::default())?.0
+        }
+    };
+    for part in &mut doc.parts {
+        // A stale rig's weights are not saved as weights (reopening must not pose with
+        // weights of other handles), but kept aside while locked handles need them.
+        let stale = if state.rig_current {
+            None
+        } else {
+            part.weights.take().or(part.stale_weights.take())
+        };
+        part.stale_weights = stale.filter(|_| !state.locked.is_empty());
+    }
+    for (part, layer) in doc.parts.iter_mut().zip(&state.layers) {
+        part.image = pipeline::relative_path(dir, &layer.path);
+    }
+    doc.handles = state.handles.clone();
+    doc.options = state.options.clone();
+    doc.animations = state.animations.clone();
+    doc.locked = state.locked.iter().cloned().collect();
+    Ok(doc)
+}
+
+/// A snapshot of a document to autosave on another thread: [`Document::autosave_job`] copies
+/// the state (layers and rig are shared), [`AutosaveJob::run`] writes it.
+#[derive(Clone)]
+pub struct AutosaveJob {
+    state: State,
+    target: PathBuf,
+}
+
+impl AutosaveJob {
+    /// Where the autosave goes.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Writes the snapshot to its autosave file (atomically); returns where it went.
+    pub fn run(&self) -> Result<PathBuf, DocumentError> {
+        rig_document(&self.state, &self.target)?.save(&self.target)?;
+        Ok(self.target.clone())
     }
 }
 

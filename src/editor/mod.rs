@@ -161,6 +161,9 @@ pub struct EditorApp {
     open_path: String,
     rename_to: String,
     last_autosave_s: f64,
+    /// The autosave being written on another thread (a document never rigged is traced and
+    /// meshed to be saved, too slow for the UI thread on large images).
+    autosaving: Option<std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>>,
     /// Screenshot to take after a few frames, then quit (for `--screenshot`).
     screenshot: Option<(PathBuf, u32)>,
     /// Animate mode: the animation edited, the playhead, playback.
@@ -222,6 +225,7 @@ impl EditorApp {
             open_path,
             rename_to: String::new(),
             last_autosave_s: 0.0,
+            autosaving: None,
             screenshot: None,
             animation: first_animation,
             time_s: 0.0,
@@ -587,20 +591,52 @@ impl EditorApp {
     }
 
     fn autosave(&mut self, ctx: &egui::Context) {
+        self.poll_autosave();
         let now = ctx.input(|i| i.time);
         if now - self.last_autosave_s < AUTOSAVE_INTERVAL_S {
             return;
         }
         self.last_autosave_s = now;
         self.autosave_scribbles();
-        if !self.doc.dirty {
-            return;
-        }
-        if let Some(path) = self.doc.path.clone() {
-            if let Err(e) = self.doc.autosave(&path) {
-                self.message = Some(format!("autosave failed: {e}"));
+        if self.doc.dirty && self.autosaving.is_none() {
+            if let Some(path) = self.doc.path.clone() {
+                self.start_autosave(&path, ctx);
             }
         }
+    }
+
+    /// Writes the document's autosave on another thread, a snapshot of the current state.
+    pub fn start_autosave(&mut self, fallback: &Path, ctx: &egui::Context) {
+        let job = self.doc.autosave_job(fallback);
+        let (send, receive) = std::sync::mpsc::channel();
+        let ctx = ctx.clone();
+        std::thread::spawn(move || {
+            let _ = send.send(job.run());
+            ctx.request_repaint();
+        });
+        self.autosaving = Some(receive);
+    }
+
+    /// Picks up a finished autosave: a failure goes to the status bar.
+    fn poll_autosave(&mut self) {
+        use std::sync::mpsc::TryRecvError;
+        let Some(receive) = &self.autosaving else {
+            return;
+        };
+        let outcome = match receive.try_recv() {
+            Err(TryRecvError::Empty) => return,
+            Ok(outcome) => outcome.map(|_| ()).map_err(|e| e.to_string()),
+            Err(TryRecvError::Disconnected) => Err("its thread stopped".into()),
+        };
+        self.autosaving = None;
+        if let Err(e) = outcome {
+            self.message = Some(format!("autosave failed: {e}"));
+        }
+    }
+
+    /// Whether an autosave is being written.
+    pub fn autosaving(&self) -> bool {
+        self.autosaving.is_some()
     }
 
     fn menu_bar(&mut self, ui: &mut egui::Ui) {

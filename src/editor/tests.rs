@@ -224,6 +224,55 @@ fn bad_files_show_a_message_and_keep_the_document() {
 }
 
 #[test]
+fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
+    let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let png = dir.join("bar.png");
+    let bar = image::RgbaImage::from_fn(96, 48, |x, y| {
+        let inside = (8..88).contains(&x) && (8..40).contains(&y);
+        image::Rgba([200, 80, 40, if inside { 255 } else { 0 }])
+    });
+    crate::io::save_png(&png, &bar).expect("written");
+    let mut app = EditorApp::new(Document::new());
+    app.import_layer(&png);
+    let mut h = harness(app);
+    h.run();
+    // Saving needs meshes: a document never rigged is traced and meshed to be written.
+    assert!(h.state().doc.posable().is_none());
+    let path = dir.join("bar.json");
+    let ctx = h.ctx.clone();
+    h.state_mut().start_autosave(&path, &ctx);
+    assert!(h.state().autosaving());
+    for _ in 0..500 {
+        if !h.state().autosaving() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    assert!(!h.state().autosaving(), "the autosave did not finish");
+    assert_eq!(h.state().message, None);
+    let autosaved = crate::document::autosave_path(&path);
+    let reopened = Document::open(&autosaved).expect("the autosave opens");
+    assert_eq!(reopened.state().layers.len(), 1);
+
+    // A failure reaches the status bar.
+    let nowhere = dir.join("missing/bar.json");
+    h.state_mut().start_autosave(&nowhere, &ctx);
+    for _ in 0..500 {
+        if !h.state().autosaving() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("autosave failed"), "{message}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn the_help_overlay_lists_the_shortcuts() {
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
