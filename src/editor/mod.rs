@@ -57,6 +57,19 @@ pub struct ViewState {
     pub selected: Option<String>,
     pub animation: String,
     pub time_s: f64,
+    /// Animate mode's playback starts again at the end (default true).
+    #[serde(default = "loops_by_default")]
+    pub looping: bool,
+    /// Animate mode's onion skins (default off).
+    #[serde(default)]
+    pub onion: timeline::OnionOptions,
+    /// File → Render's settings; the timeline plays at their frame rate.
+    #[serde(default)]
+    pub render: crate::playback::RenderSettings,
+}
+
+fn loops_by_default() -> bool {
+    true
 }
 
 /// The view side file of the document at `path`.
@@ -333,6 +346,9 @@ impl EditorApp {
             selected: self.selected.clone(),
             animation: self.animation.clone(),
             time_s: self.time_s,
+            looping: self.timeline.looping,
+            onion: self.timeline.onion,
+            render: self.render_settings.clone(),
         }
     }
 
@@ -353,6 +369,17 @@ impl EditorApp {
         } else {
             0.0
         };
+        self.timeline.looping = state.looping;
+        self.timeline.onion = timeline::OnionOptions {
+            frames: state.onion.frames.clamp(1, timeline::MAX_ONION_FRAMES),
+            opacity: if state.onion.opacity.is_finite() {
+                state.onion.opacity.clamp(0.05, 1.0)
+            } else {
+                timeline::OnionOptions::default().opacity
+            },
+            ..state.onion
+        };
+        self.render_settings = state.render;
     }
 
     /// Saves the document and, beside it, the view; returns the message for the status bar.

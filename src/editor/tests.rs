@@ -347,12 +347,24 @@ fn reopening_restores_the_view() {
     });
     app.selected = Some("head".into());
     app.time_s = 0.75;
+    app.timeline.looping = false;
+    app.timeline.onion.enabled = true;
+    app.timeline.onion.frames = 3;
+    app.render_settings.fps = 12.0;
     let message = app.save_to(&path);
     assert!(message.starts_with("saved"), "{message}");
     let mut reopened = EditorApp::new(Document::new());
     reopened.open(&path);
     assert_eq!(reopened.view_state(), app.view_state());
     assert!(reopened.message.is_none());
+    // A view file written before loop, onion skins and render settings were kept still opens,
+    // with their defaults.
+    let old = r#"{"zoom": 1.5, "pan": [0, 0], "mode": "pose", "selected": null,
+        "animation": "animation", "time_s": 0.0}"#;
+    let state: ViewState = serde_json::from_str(old).expect("an older view file");
+    assert!(state.looping);
+    assert_eq!(state.onion, timeline::OnionOptions::default());
+    assert_eq!(state.render, crate::playback::RenderSettings::default());
 }
 
 #[test]

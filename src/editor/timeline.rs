@@ -41,7 +41,8 @@ const HANDLE_PICK_PT: f32 = 9.0;
 
 /// Onion skinning: the posed outlines of `frames` frames before (red) and after (green) the
 /// playhead, the nearest at `opacity`, fading with distance.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct OnionOptions {
     /// Default off.
     pub enabled: bool,
