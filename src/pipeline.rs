@@ -771,6 +771,8 @@ fn column_owners(handles: &Handles) -> Vec<(String, String)> {
 /// A part whose mesh changed (a re-trace) gets the previous rows carried over by locating its
 /// vertices in the previous mesh ([`weights::transfer_rows`]). A locked handle the previous
 /// part had no weights for, or that may no longer weigh the part (`bind`), is recomputed.
+/// Rows keep the document's influence limit (`max_influences`) as far as the locked weights
+/// allow.
 pub fn keep_locked_weights(
     fresh: &mut RigDocument,
     previous: &RigDocument,
@@ -847,7 +849,13 @@ pub fn keep_locked_weights(
             )
             .map_err(error)?
         };
-        weights::keep_locked(&mut weights.rows, &before, &mask).map_err(error)?;
+        weights::keep_locked(
+            &mut weights.rows,
+            &before,
+            &mask,
+            fresh.options.weights.max_influences,
+        )
+        .map_err(error)?;
     }
     Ok(())
 }

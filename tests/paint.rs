@@ -195,6 +195,41 @@ fn painting_keeps_locked_handles_and_undoes_in_one_step() {
 }
 
 #[test]
+fn recomputing_with_a_lock_keeps_the_influence_limit() {
+    let dir = scratch("limit");
+    let mut doc = arm(&dir);
+    doc.apply(fill_b(vec![[230.0, 40.0], [280.0, 40.0]], 30.0))
+        .unwrap();
+    doc.apply(Command::SetLocked {
+        handle: "b".into(),
+        locked: true,
+    })
+    .unwrap();
+    // A point where b was painted: the fresh rows there pair it with c, beside the locked b.
+    doc.apply(Command::AddPoint(sinew::rig::PointHandle {
+        name: "p".into(),
+        at: [250.0, 40.0],
+    }))
+    .unwrap();
+    let mut options = doc.state().options.clone();
+    options.weights.max_influences = Some(2);
+    doc.apply(Command::SetOptions(options)).unwrap();
+    compute(&mut doc);
+    let kept = rows(&doc);
+    check_rows(&kept);
+    let widest = kept.iter().map(Vec::len).max().unwrap_or(0);
+    assert!(widest <= 2, "a row has {widest} influences");
+    // b stays where it was painted.
+    let v = vertices(&doc);
+    let b = column(&kept, 1);
+    let i = v
+        .iter()
+        .position(|p| (p[0] - 270.0).abs() < 8.0 && (p[1] - 40.0).abs() < 8.0)
+        .expect("a vertex near (270, 40)");
+    assert!(b[i] > 0.5, "b at {:?} is {}", v[i], b[i]);
+}
+
+#[test]
 fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     let dir = scratch("recompute");
     let mut doc = arm(&dir);

@@ -51,10 +51,16 @@ fn check_columns(rows: &[Vec<(u32, f64)>], columns: usize) -> Result<(), LockErr
 /// rescales the fresh unlocked columns to fill the rest of one. Where the fresh unlocked
 /// columns are all zero, the previous unlocked ones are rescaled instead; where those are zero
 /// too, the vertex keeps its previous row. `locked` has one flag per column.
+///
+/// With `max_influences` K, a row keeps only the largest unlocked weights that fit beside its
+/// non-zero locked ones (K minus their count), rescaled to fill the rest; where the locked
+/// weights alone already take K influences but leave room, the largest unlocked one still
+/// fills it, so that rows sum to one (that row has K + 1).
 pub fn keep_locked(
     fresh: &mut [Vec<(u32, f64)>],
     previous: &[Vec<(u32, f64)>],
     locked: &[bool],
+    max_influences: Option<usize>,
 ) -> Result<(), LockError> {
     if fresh.len() != previous.len() {
         return Err(LockError::RowCount {
@@ -83,7 +89,7 @@ pub fn keep_locked(
         };
         let sum = |r: &[(u32, f64)]| -> f64 { r.iter().map(|e| e.1).sum() };
         let (fresh_free, old_free) = (unlocked(row), unlocked(before));
-        let source = if sum(&fresh_free) > 0.0 {
+        let mut source = if sum(&fresh_free) > 0.0 {
             fresh_free
         } else if sum(&old_free) > 0.0 {
             old_free
@@ -91,6 +97,18 @@ pub fn keep_locked(
             *row = before.clone();
             continue;
         };
+        if let Some(k) = max_influences {
+            let locked_count = before
+                .iter()
+                .filter(|(c, w)| locked[*c as usize] && *w > 0.0)
+                .count();
+            let fits = k.saturating_sub(locked_count).max(1);
+            if source.len() > fits {
+                // Largest first; ties by column, so the choice is deterministic.
+                source.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+                source.truncate(fits);
+            }
+        }
         let scale = room / sum(&source);
         let mut merged: Vec<(u32, f64)> = before
             .iter()
@@ -276,7 +294,7 @@ mod tests {
             vec![(0, 0.25), (2, 0.75)],
             vec![(1, 1.0)],
         ];
-        keep_locked(&mut fresh, &previous, &[false, true, false]).unwrap();
+        keep_locked(&mut fresh, &previous, &[false, true, false], None).unwrap();
         sums_to_one(&fresh);
         // Vertex 0: column 1 stays 0.3, the fresh column 0 fills 0.7 (the fresh 1 was locked).
         assert_eq!(fresh[0], vec![(0, 0.7), (1, 0.3)]);
@@ -289,10 +307,39 @@ mod tests {
         assert_eq!(fresh[0][1].1.to_bits(), 0.3f64.to_bits());
         // Nothing locked: nothing changes.
         let mut untouched = vec![vec![(0, 1.0)]; 3];
-        keep_locked(&mut untouched, &previous, &[false; 3]).unwrap();
+        keep_locked(&mut untouched, &previous, &[false; 3], None).unwrap();
         assert_eq!(untouched, vec![vec![(0, 1.0)]; 3]);
-        assert!(keep_locked(&mut untouched, &previous[..2], &[true; 3]).is_err());
-        assert!(keep_locked(&mut untouched, &previous, &[true; 2]).is_err());
+        assert!(keep_locked(&mut untouched, &previous[..2], &[true; 3], None).is_err());
+        assert!(keep_locked(&mut untouched, &previous, &[true; 2], None).is_err());
+    }
+
+    #[test]
+    fn kept_rows_respect_the_influence_limit() {
+        // Column 0 locked at 0.4; the fresh unlocked weights spread over three columns.
+        let previous = vec![vec![(0, 0.4), (1, 0.6)], vec![(0, 0.5), (3, 0.5)]];
+        let mut fresh = vec![
+            vec![(1, 0.5), (2, 0.3), (3, 0.2)],
+            vec![(1, 0.5), (2, 0.25), (3, 0.25)],
+        ];
+        let locked = [true, false, false, false];
+        keep_locked(&mut fresh, &previous, &locked, Some(2)).unwrap();
+        sums_to_one(&fresh);
+        // K = 2: the locked weight and the largest fresh one, which fills the rest.
+        assert_eq!(fresh[0], vec![(0, 0.4), (1, 0.6)]);
+        assert_eq!(fresh[1], vec![(0, 0.5), (1, 0.5)]);
+        assert_eq!(fresh[0][0].1.to_bits(), 0.4f64.to_bits());
+        // K = 1 with a locked weight below one: the largest fresh weight still fills the rest.
+        let mut one = vec![vec![(1, 0.5), (2, 0.3), (3, 0.2)]];
+        keep_locked(&mut one, &previous[..1], &locked, Some(1)).unwrap();
+        assert_eq!(one[0], vec![(0, 0.4), (1, 0.6)]);
+        // K = 3 leaves two places beside the lock: ties go to the lower column.
+        let mut three = vec![vec![(1, 0.5), (2, 0.25), (3, 0.25)]];
+        keep_locked(&mut three, &previous[1..], &locked, Some(3)).unwrap();
+        sums_to_one(&three);
+        assert_eq!(
+            three[0].iter().map(|e| e.0).collect::<Vec<_>>(),
+            vec![0, 1, 2]
+        );
     }
 
     #[test]
