@@ -17,6 +17,7 @@
 pub mod canvas;
 pub mod colorize;
 pub mod gizmo;
+mod identity;
 pub mod paint;
 pub mod rig_tools;
 pub mod timeline;
@@ -34,6 +35,7 @@ use crate::rig::{Bone, PointHandle, Pose};
 use crate::skin::Blend;
 use canvas::{Placed, View};
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
+use identity::Identity;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -140,7 +142,7 @@ enum Gesture {
 
 /// Posed vertex positions of a built rig, for one pose.
 struct Posed {
-    scene: *const Scene,
+    scene: Identity<Scene>,
     pose: Pose,
     positions: Vec<Vec<Point>>,
     /// Per handle column, the transform shown (forward kinematics or the IK's solution).
@@ -164,12 +166,12 @@ pub struct EditorApp {
     /// Time spent in the editor's own code for the last frame (solve, skin, mesh build), ms.
     pub last_frame_ms: f64,
     pub show_help: bool,
-    textures: Vec<(*const Layer, TextureHandle)>,
+    textures: Vec<(Identity<Layer>, TextureHandle)>,
     worker: Option<Worker>,
     gesture: Option<Gesture>,
-    ik: Option<(*const Scene, RigIk)>,
+    ik: Option<(Identity<Scene>, RigIk)>,
     /// The rig whose skinning-IK precomputation was started in the background.
-    ik_warmed: *const Scene,
+    ik_warmed: Option<Identity<Scene>>,
     posed: Option<Posed>,
     open_path: String,
     rename_to: String,
@@ -233,7 +235,7 @@ impl EditorApp {
             worker: None,
             gesture: None,
             ik: None,
-            ik_warmed: std::ptr::null(),
+            ik_warmed: None,
             posed: None,
             open_path,
             rename_to: String::new(),
@@ -514,10 +516,10 @@ impl EditorApp {
         let Some(scene) = self.doc.posable() else {
             return;
         };
-        if Arc::as_ptr(scene) == self.ik_warmed {
+        if self.ik_warmed.as_ref().is_some_and(|k| k.is(scene)) {
             return;
         }
-        self.ik_warmed = Arc::as_ptr(scene);
+        self.ik_warmed = Some(Identity::of(scene));
         let scene = scene.clone();
         std::thread::spawn(move || {
             // Errors show up again, with a message, when the editor asks for the solver.
@@ -909,8 +911,7 @@ impl EditorApp {
         let layers = self.doc.state().layers.clone();
         let mut out = Vec::with_capacity(layers.len());
         for layer in &layers {
-            let key = Arc::as_ptr(layer);
-            if let Some((_, t)) = self.textures.iter().find(|(k, _)| *k == key) {
+            if let Some((_, t)) = self.textures.iter().find(|(k, _)| k.is(layer)) {
                 out.push(t.clone());
                 continue;
             }
@@ -919,21 +920,20 @@ impl EditorApp {
                 layer.image.as_raw(),
             );
             let texture = ctx.load_texture(&layer.name, image, egui::TextureOptions::LINEAR);
-            self.textures.push((key, texture.clone()));
+            self.textures.push((Identity::of(layer), texture.clone()));
             out.push(texture);
         }
         self.textures
-            .retain(|(k, _)| layers.iter().any(|l| Arc::as_ptr(l) == *k));
+            .retain(|(k, _)| layers.iter().any(|l| k.is(l)));
         out
     }
 
     /// Posed positions of `scene` for `pose`, solved with the kept IK solver when it has drags.
     fn posed(&mut self, scene: &Arc<Scene>, pose: &Pose) -> Result<(), String> {
-        let key = Arc::as_ptr(scene);
         if self
             .posed
             .as_ref()
-            .is_some_and(|p| p.scene == key && p.pose == *pose)
+            .is_some_and(|p| p.scene.is(scene) && p.pose == *pose)
         {
             return Ok(());
         }
@@ -963,7 +963,7 @@ impl EditorApp {
             }
         }
         self.posed = Some(Posed {
-            scene: key,
+            scene: Identity::of(scene),
             pose: pose.clone(),
             positions,
             transforms,

@@ -8,6 +8,7 @@
 //! wins and the UI never waits for them.
 
 use super::canvas::{self, Placed};
+use super::identity::Identity;
 use super::{EditorApp, Gesture};
 use crate::autorig::{AutorigOptions, Proposal};
 use crate::document::Command;
@@ -16,7 +17,6 @@ use crate::pipeline::Layer;
 use crate::rig::{Cage, Handles, Region};
 use eframe::egui::{self, Color32, Pos2, Shape, Stroke};
 use std::sync::mpsc::Receiver;
-use std::sync::Arc;
 
 /// A click this close (screen points) to a polygon's first vertex closes it.
 pub const CLOSE_RADIUS_PT: f32 = 8.0;
@@ -38,7 +38,7 @@ pub enum PolygonKind {
 /// tracing and meshing options, so a change of either starts a new build.
 #[derive(Clone, PartialEq)]
 struct PreviewKey {
-    layers: Vec<*const Layer>,
+    layers: Vec<Identity<Layer>>,
     trace: crate::trace::TraceOptions,
     mesh: crate::mesh::MeshOptions,
 }
@@ -349,7 +349,7 @@ impl EditorApp {
         }
         let options = self.rig_tools.draft.as_ref().unwrap_or(&state.options);
         Some(PreviewKey {
-            layers: state.layers.iter().map(Arc::as_ptr).collect(),
+            layers: state.layers.iter().map(Identity::of).collect(),
             trace: options.trace.clone(),
             mesh: options.mesh.clone(),
         })

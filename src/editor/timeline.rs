@@ -10,6 +10,7 @@
 //! stepped, Bézier with two draggable handles over the channel's value graph), and onion skins
 //! (the posed outlines of neighbouring frames behind the current pose, cached per frame time).
 
+use super::identity::Identity;
 use super::{canvas, EditorApp, Mode};
 use crate::anim::edit::{self, CopiedKey, KeyRef, Segment, TimelineId, KEY_TIME_TOLERANCE_S};
 use crate::anim::{Animation, Curve};
@@ -166,13 +167,13 @@ enum SheetGesture {
 /// Posed outlines of neighbouring frames, for one rig and one version of the animation.
 #[derive(Default)]
 struct OnionCache {
-    scene: Option<*const Scene>,
+    scene: Option<Identity<Scene>>,
     animation: Option<(String, serde_json::Value)>,
     /// Boundary edges (vertex pairs) of each part's mesh.
     outlines: Vec<Vec<[u32; 2]>>,
     /// Posed vertex positions by frame time (µs).
     frames: BTreeMap<i64, Vec<Vec<Point>>>,
-    ik: Option<(*const Scene, RigIk)>,
+    ik: Option<(Identity<Scene>, RigIk)>,
 }
 
 /// Animate mode's state beside the document.
@@ -223,15 +224,14 @@ impl Default for TimelineState {
 pub(super) fn transforms_and_positions(
     scene: &Arc<Scene>,
     pose: &Pose,
-    ik: &mut Option<(*const Scene, RigIk)>,
+    ik: &mut Option<(Identity<Scene>, RigIk)>,
 ) -> Result<(Vec<Affine>, Vec<Vec<Point>>), String> {
-    let key = Arc::as_ptr(scene);
     let transforms = if pose.ik.is_empty() {
         scene.handle_transforms(pose).map_err(|e| e.to_string())?
     } else {
-        if ik.as_ref().is_none_or(|(k, _)| *k != key) {
+        if ik.as_ref().is_none_or(|(k, _)| !k.is(scene)) {
             let solver = scene.rig_ik().map_err(|e| e.to_string())?;
-            *ik = Some((key, solver));
+            *ik = Some((Identity::of(scene), solver));
         }
         let Some((_, solver)) = ik.as_mut() else {
             return Err("no IK solver".into());
@@ -1155,9 +1155,8 @@ impl EditorApp {
         };
         let frame_s = self.frame_s();
         let cache = &mut self.timeline.onion_cache;
-        let key = Arc::as_ptr(scene);
-        if cache.scene != Some(key) {
-            cache.scene = Some(key);
+        if cache.scene.as_ref().is_none_or(|k| !k.is(scene)) {
+            cache.scene = Some(Identity::of(scene));
             cache.outlines = scene
                 .doc
                 .parts
