@@ -492,6 +492,14 @@ mod tests {
         (s, background, inside)
     }
 
+    /// An empty scratch folder of this process.
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("sinew-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
     fn session(s: &crate::colorize::synthetic::Scene) -> ColorizeSession {
         ColorizeSession::new(s.lineart.clone(), ColorizeOptions::default()).unwrap()
     }
@@ -693,8 +701,7 @@ mod tests {
     fn strokes_save_and_load_as_a_scribble_file_with_one_undo_step() {
         let (s, background, inside) = circle();
         let mut session = session(&s);
-        let dir = std::env::temp_dir().join(format!("sinew-strokes-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("strokes");
         let path = dir.join("lineart.scribbles.json");
         assert!(matches!(
             session.save_strokes(&path),
@@ -748,8 +755,7 @@ mod tests {
     fn saves_the_result_atomically_and_only_once_solved() {
         let (s, background, _) = circle();
         let mut session = session(&s);
-        let dir = std::env::temp_dir().join(format!("sinew-session-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("session");
         let path = dir.join("colored.png");
         session
             .apply(SessionCommand::AddStroke(background))

@@ -223,6 +223,17 @@ fn bad_files_show_a_message_and_keep_the_document() {
     h.get_by_label(&message);
 }
 
+/// Steps frames (up to 5 s) until the background autosave is done.
+fn wait_for_autosave(h: &mut Harness<'_, EditorApp>) {
+    for _ in 0..500 {
+        if !h.state().autosaving() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+        h.step();
+    }
+}
+
 #[test]
 fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
@@ -244,13 +255,7 @@ fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     let ctx = h.ctx.clone();
     h.state_mut().start_autosave(&path, &ctx);
     assert!(h.state().autosaving());
-    for _ in 0..500 {
-        if !h.state().autosaving() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-        h.step();
-    }
+    wait_for_autosave(&mut h);
     assert!(!h.state().autosaving(), "the autosave did not finish");
     assert_eq!(h.state().message, None);
     let autosaved = crate::document::autosave_path(&path);
@@ -260,13 +265,7 @@ fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     // A failure reaches the status bar.
     let nowhere = dir.join("missing/bar.json");
     h.state_mut().start_autosave(&nowhere, &ctx);
-    for _ in 0..500 {
-        if !h.state().autosaving() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-        h.step();
-    }
+    wait_for_autosave(&mut h);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("autosave failed"), "{message}");
     let _ = std::fs::remove_dir_all(&dir);
