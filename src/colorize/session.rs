@@ -709,10 +709,10 @@ mod tests {
         ));
         assert!(!path.exists());
         session
-            .apply(SessionCommand::AddStroke(background.clone()))
-            .unwrap();
-        session
-            .apply(SessionCommand::AddStroke(inside.clone()))
+            .apply(SessionCommand::Replace(vec![
+                background.clone(),
+                inside.clone(),
+            ]))
             .unwrap();
         session.save_strokes(&path).unwrap();
         // The file is what `sinew colorize --scribbles` reads.
