@@ -310,6 +310,12 @@ impl ColorizeSession {
         if self.state.strokes.is_empty() {
             return Err(SessionError::NoStrokes);
         }
+        self.write_strokes(path)
+    }
+
+    /// [`ColorizeSession::save_strokes`], an empty file too (an autosave mirrors the strokes
+    /// as they are, none included).
+    pub fn write_strokes(&self, path: &Path) -> Result<(), SessionError> {
         let write = |source| SessionError::Write {
             path: path.to_path_buf(),
             source,
@@ -429,7 +435,6 @@ impl ColorizeSession {
     }
 }
 
-/// Distinct stroke colors in order of first use.
 /// The strokes of a JSON scribble file's text, as a session keeps them.
 pub fn strokes_from_json(text: &str) -> Result<Vec<ScribbleStroke>, SessionError> {
     let file: StrokeFile =
@@ -440,6 +445,7 @@ pub fn strokes_from_json(text: &str) -> Result<Vec<ScribbleStroke>, SessionError
         .collect()
 }
 
+/// Distinct stroke colors in order of first use.
 fn palette_of(strokes: &[ScribbleStroke]) -> Vec<[u8; 3]> {
     let mut colors: Vec<[u8; 3]> = Vec::new();
     for s in strokes {

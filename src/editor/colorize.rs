@@ -80,6 +80,9 @@ pub struct ColorizeEditor {
     pub save_path: String,
     /// Where "Save scribbles" writes and "Load scribbles" reads (a JSON scribble file).
     pub scribbles_path: String,
+    /// The scribble file last saved or loaded (or the default beside the line art): its
+    /// autosave side file is where the strokes are autosaved, whatever the field holds.
+    scribbles_file: Option<PathBuf>,
     /// The strokes last saved or autosaved, to autosave only changes.
     saved_strokes: Option<Arc<Vec<ScribbleStroke>>>,
     pub tool: ColorizeTool,
@@ -110,6 +113,7 @@ impl Default for ColorizeEditor {
             lineart_path: String::new(),
             save_path: "colorized.png".into(),
             scribbles_path: "scribbles.json".into(),
+            scribbles_file: None,
             saved_strokes: None,
             tool: ColorizeTool::Brush,
             color: DEFAULT_COLOR,
@@ -223,6 +227,7 @@ impl EditorApp {
                     lineart_path: path.display().to_string(),
                     save_path: colorized_path(path).display().to_string(),
                     scribbles_path: scribbles_path(path).display().to_string(),
+                    scribbles_file: Some(scribbles_path(path)),
                     tool: c.tool,
                     color: c.color,
                     width_px: c.width_px,
@@ -257,6 +262,7 @@ impl EditorApp {
         match session.save_strokes(path) {
             Ok(()) => {
                 c.saved_strokes = Some(session.state().strokes.clone());
+                c.scribbles_file = Some(path.to_path_buf());
                 format!(
                     "saved {} strokes to {}",
                     session.strokes().len(),
@@ -277,6 +283,7 @@ impl EditorApp {
         let (message, loaded) = match session.load_strokes(path) {
             Ok(count) => {
                 self.colorize.scribbles_path = path.display().to_string();
+                self.colorize.scribbles_file = Some(path.to_path_buf());
                 self.colorize.saved_strokes = Some(session.state().strokes.clone());
                 (
                     format!("loaded {count} strokes from {}", path.display()),
@@ -290,22 +297,23 @@ impl EditorApp {
     }
 
     /// Writes the strokes beside the scribble file (`NAME.autosave.json`) when they changed
-    /// since the last save; a failure goes to the status bar.
+    /// since the last save, load or autosave (none at all included, once there were some); a
+    /// failure goes to the status bar.
     pub(super) fn autosave_scribbles(&mut self) {
         let c = &mut self.colorize;
-        let Some(session) = &c.session else {
+        let (Some(session), Some(file)) = (&c.session, &c.scribbles_file) else {
             return;
         };
         let strokes = &session.state().strokes;
-        let unchanged = c
-            .saved_strokes
-            .as_ref()
-            .is_some_and(|saved| saved.as_slice() == strokes.as_slice());
-        if unchanged || strokes.is_empty() {
+        let unchanged = match &c.saved_strokes {
+            Some(saved) => saved.as_slice() == strokes.as_slice(),
+            None => strokes.is_empty(),
+        };
+        if unchanged {
             return;
         }
-        let target = crate::document::autosave_path(Path::new(&c.scribbles_path));
-        match session.save_strokes(&target) {
+        let target = crate::document::autosave_path(file);
+        match session.write_strokes(&target) {
             Ok(()) => c.saved_strokes = Some(strokes.clone()),
             Err(e) => self.message = Some(format!("autosave failed: {e}")),
         }

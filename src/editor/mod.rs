@@ -45,6 +45,8 @@ use worker::Worker;
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
 /// The timeline shows at least this many seconds.
 pub const MIN_TIMELINE_S: f64 = 2.0;
+/// File → Render's output scale, output px per canvas px.
+const RENDER_SCALE_RANGE: (f64, f64) = (0.05, 8.0);
 /// A press and release closer than this (canvas px) is a click, not a drag.
 pub const CLICK_SLOP_PX: f64 = 2.0;
 
@@ -328,7 +330,11 @@ impl EditorApp {
             Ok(doc) => {
                 // Colorize mode's line art and strokes are not part of the rig document.
                 let colorize = std::mem::take(&mut self.colorize);
+                // An autosave still being written stays watched, so a new one for the same
+                // file does not start beside it.
+                let autosaving = self.autosaving.take();
                 *self = EditorApp::new(doc);
+                self.autosaving = autosaving;
                 self.colorize = colorize;
                 if let Some(view) = load_view(path) {
                     self.restore_view(view);
@@ -381,7 +387,31 @@ impl EditorApp {
             },
             ..state.onion
         };
-        self.render_settings = state.render;
+        // The settings' ranges as File → Render edits them (a hand-edited file could ask
+        // the timeline for 1e300 frames per second).
+        let defaults = crate::playback::RenderSettings::default();
+        let within = |v: f64, lo: f64, hi: f64, default: f64| {
+            if v.is_finite() {
+                v.clamp(lo, hi)
+            } else {
+                default
+            }
+        };
+        self.render_settings = crate::playback::RenderSettings {
+            fps: within(
+                state.render.fps,
+                1.0,
+                crate::playback::MAX_FPS,
+                defaults.fps,
+            ),
+            scale: within(
+                state.render.scale,
+                RENDER_SCALE_RANGE.0,
+                RENDER_SCALE_RANGE.1,
+                defaults.scale,
+            ),
+            ..state.render
+        };
     }
 
     /// Saves the document and, beside it, the view; returns the message for the status bar.
@@ -634,8 +664,12 @@ impl EditorApp {
         }
     }
 
-    /// Writes the document's autosave on another thread, a snapshot of the current state.
+    /// Writes the document's autosave on another thread, a snapshot of the current state; does
+    /// nothing while the previous one is still being written.
     pub fn start_autosave(&mut self, fallback: &Path, ctx: &egui::Context) {
+        if self.autosaving.is_some() {
+            return;
+        }
         let job = self.doc.autosave_job(fallback);
         let (send, receive) = std::sync::mpsc::channel();
         let ctx = ctx.clone();
@@ -1634,7 +1668,7 @@ fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderS
         ui.label("Scale (output px per canvas px)");
         ui.add(
             egui::DragValue::new(&mut settings.scale)
-                .range(0.05..=8.0)
+                .range(RENDER_SCALE_RANGE.0..=RENDER_SCALE_RANGE.1)
                 .speed(0.01),
         );
         ui.end_row();

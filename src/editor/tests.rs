@@ -364,6 +364,18 @@ fn reopening_restores_the_view() {
     assert!(state.looping);
     assert_eq!(state.onion, timeline::OnionOptions::default());
     assert_eq!(state.render, crate::playback::RenderSettings::default());
+    // Hand-edited values come back inside the ranges the UI edits.
+    let mut wild = state;
+    wild.render.fps = 1e300;
+    wild.render.scale = f64::NAN;
+    wild.onion.frames = 1000;
+    wild.onion.opacity = -3.0;
+    reopened.restore_view(wild);
+    let restored = reopened.view_state();
+    assert_eq!(restored.render.fps, crate::playback::MAX_FPS);
+    assert_eq!(restored.render.scale, 1.0);
+    assert_eq!(restored.onion.frames, timeline::MAX_ONION_FRAMES);
+    assert_eq!(restored.onion.opacity, 0.05);
 }
 
 #[test]
@@ -874,6 +886,16 @@ fn colorize_scribbles_save_load_and_autosave() {
         .as_deref()
         .is_some_and(|m| m.starts_with("cannot load")));
     assert_eq!(count(&h), Some(1));
+
+    // Cleared strokes are autosaved as none, whatever the path field holds.
+    h.state_mut().colorize.scribbles_path = String::new();
+    assert!(h.state_mut().apply_colorize(SessionCommand::Clear));
+    h.state_mut().autosave_scribbles();
+    let text = std::fs::read_to_string(&autosaved).expect("autosaved");
+    assert_eq!(
+        crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
+        Vec::new()
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

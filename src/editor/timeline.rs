@@ -302,7 +302,10 @@ impl EditorApp {
     /// Seconds per frame at the frame rate: File → Render's, so playback shows the frames a
     /// render writes (the rig document keeps no frame rate of its own).
     fn frame_s(&self) -> f64 {
-        1.0 / self.render_settings.fps.max(1.0)
+        1.0 / self
+            .render_settings
+            .fps
+            .clamp(1.0, crate::playback::MAX_FPS)
     }
 
     /// `time_s` on the nearest frame.

@@ -54,8 +54,9 @@ fn check_columns(rows: &[Vec<(u32, f64)>], columns: usize) -> Result<(), LockErr
 ///
 /// With `max_influences` K, a row keeps only the largest unlocked weights that fit beside its
 /// non-zero locked ones (K minus their count), rescaled to fill the rest; where the locked
-/// weights alone already take K influences but leave room, the largest unlocked one still
-/// fills it, so that rows sum to one (that row has K + 1).
+/// weights alone already take K or more influences but leave room, the largest unlocked one
+/// still fills it, so that rows sum to one (that row has one more than its locked count). A
+/// vertex that keeps its previous row (no unlocked weight anywhere) keeps its count too.
 pub fn keep_locked(
     fresh: &mut [Vec<(u32, f64)>],
     previous: &[Vec<(u32, f64)>],
