@@ -11,12 +11,12 @@
 //!
 //! Groups, each `<verts>x<handles>` (e.g. `bbw/5kx10`):
 //! - `bbw`: the whole `bounded_biharmonic_weights` call (bi-Laplacian assembly, the unconstrained
-//!   warm start and the active-set iterations), default `BbwOptions`.
+//!   warm start and the interior-point iterations), default `BbwOptions`.
 //! - `biharmonic`: one unconstrained biharmonic solve on the same mesh, the floor under `bbw`.
 //! - `harmonic`: one harmonic (Laplace) solve.
 //!
 //! The domain (cotangent stiffness, mass) is built once outside the timing. Before measuring, each
-//! method and handle count is timed once at 1k and 5k (printed, with BBW's active-set iterations
+//! method and handle count is timed once at 1k and 5k (printed, with BBW's interior-point iterations
 //! per handle; this pilot runs whatever the filter); larger cases whose time extrapolated from
 //! those two (exponent measured between them, at least 1.5) exceeds 20 s per call are skipped
 //! and reported as skipped rather than left to hang (`SINEW_BENCH_SKIP_ABOVE_SECS=<s>` changes
@@ -234,7 +234,7 @@ fn weights(c: &mut Criterion) {
                 }
             }
             println!(
-                "pilot {}x{h}: bbw {:.3} s (active-set iterations per handle {:?}{}), biharmonic {:.3} s, harmonic {:.3} s",
+                "pilot {}x{h}: bbw {:.3} s (interior-point iterations per handle {:?}{}), biharmonic {:.3} s, harmonic {:.3} s",
                 case.label,
                 pilot[ci][hi][0],
                 report.iterations,

@@ -188,7 +188,7 @@ impl Default for BbwOptions {
 /// How the bounded solve went, for reports and tests.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BbwReport {
-    /// Active-set iterations per handle.
+    /// Interior-point iterations per handle.
     pub iterations: Vec<usize>,
     /// Handles whose active set had not settled within the iteration limit.
     pub unconverged: Vec<usize>,
