@@ -190,7 +190,7 @@ impl Default for BbwOptions {
 pub struct BbwReport {
     /// Interior-point iterations per handle.
     pub iterations: Vec<usize>,
-    /// Handles whose active set had not settled within the iteration limit.
+    /// Handles that had not met the tolerances within the iteration limit.
     pub unconverged: Vec<usize>,
 }
 
