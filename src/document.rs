@@ -264,6 +264,9 @@ pub struct Document {
     redo: Vec<State>,
     /// Whether there are changes since the last save.
     pub dirty: bool,
+    /// Counts changes (commands, undo and redo steps), so that a save written from a snapshot
+    /// on another thread clears `dirty` only if nothing changed meanwhile.
+    revision: u64,
 }
 
 impl Default for Document {
@@ -290,6 +293,7 @@ impl Document {
             undo: Vec::new(),
             redo: Vec::new(),
             dirty: false,
+            revision: 0,
         }
     }
 
@@ -336,6 +340,7 @@ impl Document {
             undo: Vec::new(),
             redo: Vec::new(),
             dirty: false,
+            revision: 0,
         })
     }
 
@@ -374,6 +379,7 @@ impl Document {
         }
         self.redo.clear();
         self.dirty = true;
+        self.revision += 1;
         Ok(())
     }
 
@@ -381,6 +387,7 @@ impl Document {
     pub fn undo(&mut self) -> bool {
         let stepped = swap_in(&mut self.state, &mut self.undo, &mut self.redo);
         self.dirty |= stepped;
+        self.revision += stepped as u64;
         stepped
     }
 
@@ -388,6 +395,7 @@ impl Document {
     pub fn redo(&mut self) -> bool {
         let stepped = swap_in(&mut self.state, &mut self.redo, &mut self.undo);
         self.dirty |= stepped;
+        self.revision += stepped as u64;
         stepped
     }
 
@@ -401,10 +409,38 @@ impl Document {
 
     /// Saves to `path` atomically and remembers it as the document's path.
     pub fn save(&mut self, path: &Path) -> Result<(), DocumentError> {
-        self.to_rig_document(path)?.save(path)?;
-        self.path = Some(path.to_path_buf());
-        self.dirty = false;
+        let job = self.save_job(path);
+        job.run()?;
+        self.saved(&job);
         Ok(())
+    }
+
+    /// Whether saving must first trace and mesh the layers (no rig of them has been built),
+    /// which takes long on large images: callers with a UI save through [`Document::save_job`]
+    /// on another thread then.
+    pub fn save_needs_build(&self) -> bool {
+        let state = &self.state;
+        !state.layers.is_empty()
+            && !matches!(&state.rig, Some(scene) if same_layers(&scene.doc, &state.layers))
+    }
+
+    /// [`Document::save`] as a snapshot to write on another thread; once it has run, hand it
+    /// to [`Document::saved`].
+    pub fn save_job(&self, path: &Path) -> SaveJob {
+        SaveJob {
+            state: self.state.clone(),
+            target: path.to_path_buf(),
+            revision: self.revision,
+        }
+    }
+
+    /// Records that `job` (from [`Document::save_job`]) was written: its file becomes the
+    /// document's path, and the document is clean unless it changed since the snapshot.
+    pub fn saved(&mut self, job: &SaveJob) {
+        self.path = Some(job.target.clone());
+        if self.revision == job.revision {
+            self.dirty = false;
+        }
     }
 
     /// Exports the current state for Spine's runtimes into `dir` (see [`crate::export::spine`]):
@@ -448,18 +484,20 @@ impl Document {
         self.autosave_job(fallback).run()
     }
 
-    /// [`Document::autosave`] as a snapshot to write on another thread.
-    pub fn autosave_job(&self, fallback: &Path) -> AutosaveJob {
-        AutosaveJob {
+    /// [`Document::autosave`] as a snapshot to write on another thread (not to hand to
+    /// [`Document::saved`]: an autosave leaves the document's path and `dirty` alone).
+    pub fn autosave_job(&self, fallback: &Path) -> SaveJob {
+        SaveJob {
             state: self.state.clone(),
             target: autosave_path(self.path.as_deref().unwrap_or(fallback)),
+            revision: self.revision,
         }
     }
 }
 
 /// The rig document of `state` as it would be saved at `path` (see
 /// [`Document::to_rig_document`]). Traces and meshes the layers when `state` has no rig of
-/// them yet, which takes long on large images: [`AutosaveJob`] runs it off the UI thread.
+/// them yet, which takes long on large images: [`SaveJob`] runs it off the UI thread.
 fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut doc = match &state.rig {
@@ -492,21 +530,24 @@ fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError
     Ok(doc)
 }
 
-/// A snapshot of a document to autosave on another thread: [`Document::autosave_job`] copies
-/// the state (layers and rig are shared), [`AutosaveJob::run`] writes it.
+/// A snapshot of a document to save or autosave, possibly on another thread:
+/// [`Document::save_job`] and [`Document::autosave_job`] copy the state (layers and rig are
+/// shared), [`SaveJob::run`] writes it.
 #[derive(Clone)]
-pub struct AutosaveJob {
+pub struct SaveJob {
     state: State,
     target: PathBuf,
+    /// The document's revision when the snapshot was taken.
+    revision: u64,
 }
 
-impl AutosaveJob {
-    /// Where the autosave goes.
+impl SaveJob {
+    /// Where the file goes.
     pub fn target(&self) -> &Path {
         &self.target
     }
 
-    /// Writes the snapshot to its autosave file (atomically); returns where it went.
+    /// Writes the snapshot to its file (atomically); returns where it went.
     pub fn run(&self) -> Result<PathBuf, DocumentError> {
         rig_document(&self.state, &self.target)?.save(&self.target)?;
         Ok(self.target.clone())

@@ -181,6 +181,14 @@ pub struct EditorApp {
     /// The autosave being written on another thread (a document never rigged is traced and
     /// meshed to be saved, too slow for the UI thread on large images).
     autosaving: Option<std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>>,
+    /// A save being written on another thread (one that must trace and mesh first), with its
+    /// snapshot for [`Document::saved`].
+    saving: Option<(
+        crate::document::SaveJob,
+        std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>,
+    )>,
+    /// The UI's context, for threads started outside a frame's call chain to wake it.
+    repaint: Option<egui::Context>,
     /// Screenshot to take after a few frames, then quit (for `--screenshot`).
     screenshot: Option<(PathBuf, u32)>,
     /// Animate mode: the animation edited, the playhead, playback.
@@ -243,6 +251,8 @@ impl EditorApp {
             rename_to: String::new(),
             last_autosave_s: 0.0,
             autosaving: None,
+            saving: None,
+            repaint: None,
             screenshot: None,
             animation: first_animation,
             time_s: 0.0,
@@ -415,15 +425,68 @@ impl EditorApp {
     }
 
     /// Saves the document and, beside it, the view; returns the message for the status bar.
+    /// A document that must first be traced and meshed (never rigged) is written on another
+    /// thread: the message then says it is being saved, and the status bar says when it is.
     pub fn save_to(&mut self, path: &Path) -> String {
+        if self.saving.is_some() {
+            return "still saving: try again when it is done".into();
+        }
+        if self.doc.save_needs_build() {
+            let job = self.doc.save_job(path);
+            let (send, receive) = std::sync::mpsc::channel();
+            let thread_job = job.clone();
+            let repaint = self.repaint.clone();
+            std::thread::spawn(move || {
+                let _ = send.send(thread_job.run());
+                if let Some(ctx) = repaint {
+                    ctx.request_repaint();
+                }
+            });
+            self.saving = Some((job, receive));
+            return format!("saving {}…", path.display());
+        }
         if let Err(e) = self.doc.save(path) {
             return e.to_string();
         }
+        self.save_view(path)
+    }
+
+    /// Writes the view beside the document saved at `path`; returns the status-bar message.
+    fn save_view(&self, path: &Path) -> String {
         let view = serde_json::to_vec_pretty(&self.view_state()).unwrap_or_default();
         match crate::io::atomic::write_atomic(&view_path(path), &view) {
             Ok(()) => format!("saved {}", path.display()),
             Err(e) => format!("saved {}, but not the view: {e}", path.display()),
         }
+    }
+
+    /// Picks up a save finished on another thread: the document takes its path (and is clean
+    /// if unchanged since), the view is written beside it.
+    fn poll_saving(&mut self) {
+        use std::sync::mpsc::TryRecvError;
+        let Some((_, receive)) = &self.saving else {
+            return;
+        };
+        let outcome = match receive.try_recv() {
+            Err(TryRecvError::Empty) => return,
+            Ok(outcome) => outcome.map_err(|e| e.to_string()),
+            Err(TryRecvError::Disconnected) => Err("the saving thread stopped".into()),
+        };
+        let Some((job, _)) = self.saving.take() else {
+            return;
+        };
+        self.message = Some(match outcome {
+            Ok(path) => {
+                self.doc.saved(&job);
+                self.save_view(&path)
+            }
+            Err(e) => format!("cannot save {}: {e}", job.target().display()),
+        });
+    }
+
+    /// Whether a save is being written on another thread.
+    pub fn saving(&self) -> bool {
+        self.saving.is_some()
     }
 
     /// Exports the document for Spine's runtimes (default options, as `sinew export spine`)
@@ -514,6 +577,7 @@ impl EditorApp {
     pub fn frame(&mut self, ui: &mut egui::Ui) {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
+        self.repaint = Some(ctx.clone());
         self.poll_worker();
         self.poll_render();
         self.poll_rig_tools(&ctx);
@@ -651,6 +715,7 @@ impl EditorApp {
 
     fn autosave(&mut self, ctx: &egui::Context) {
         self.poll_autosave();
+        self.poll_saving();
         let now = ctx.input(|i| i.time);
         if now - self.last_autosave_s < AUTOSAVE_INTERVAL_S {
             return;

@@ -223,10 +223,10 @@ fn bad_files_show_a_message_and_keep_the_document() {
     h.get_by_label(&message);
 }
 
-/// Steps frames (up to 5 s) until the background autosave is done.
-fn wait_for_autosave(h: &mut Harness<'_, EditorApp>) {
+/// Steps frames (up to 5 s) until `done` says the background work is.
+fn wait_for(h: &mut Harness<'_, EditorApp>, done: impl Fn(&EditorApp) -> bool) {
     for _ in 0..500 {
-        if !h.state().autosaving() {
+        if done(h.state()) {
             break;
         }
         std::thread::sleep(std::time::Duration::from_millis(10));
@@ -234,11 +234,10 @@ fn wait_for_autosave(h: &mut Harness<'_, EditorApp>) {
     }
 }
 
-#[test]
-fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
-    let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+/// An editor on a document of one 96×48 bar layer (saved as `DIR/bar.png`), never rigged.
+fn never_rigged_bar(dir: &Path) -> Harness<'static, EditorApp> {
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).expect("scratch dir");
     let png = dir.join("bar.png");
     let bar = image::RgbaImage::from_fn(96, 48, |x, y| {
         let inside = (8..88).contains(&x) && (8..40).contains(&y);
@@ -250,12 +249,53 @@ fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     let mut h = harness(app);
     h.run();
     // Saving needs meshes: a document never rigged is traced and meshed to be written.
-    assert!(h.state().doc.posable().is_none());
+    assert!(h.state().doc.save_needs_build());
+    h
+}
+
+#[test]
+fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
+    let dir = std::env::temp_dir().join(format!("sinew-editor-save-{}", std::process::id()));
+    let mut h = never_rigged_bar(&dir);
+    let path = dir.join("bar.json");
+    let message = h.state_mut().save_to(&path);
+    assert!(message.starts_with("saving"), "{message}");
+    assert!(h.state().saving());
+    // A second save waits for the first.
+    let again = h.state_mut().save_to(&path);
+    assert!(again.starts_with("still saving"), "{again}");
+    wait_for(&mut h, |app| !app.saving());
+    assert!(!h.state().saving(), "the save did not finish");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("saved"), "{message}");
+    assert_eq!(h.state().doc.path.as_deref(), Some(path.as_path()));
+    assert!(!h.state().doc.dirty);
+    assert!(view_path(&path).is_file());
+    assert_eq!(
+        Document::open(&path).expect("opens").state().layers.len(),
+        1
+    );
+
+    // An edit made while the save is written keeps the document modified.
+    h.state_mut().save_to(&path);
+    h.state_mut().apply(Command::AddPoint(PointHandle {
+        name: "late".into(),
+        at: [40.0, 24.0],
+    }));
+    wait_for(&mut h, |app| !app.saving());
+    assert!(h.state().doc.dirty);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
+    let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
+    let mut h = never_rigged_bar(&dir);
     let path = dir.join("bar.json");
     let ctx = h.ctx.clone();
     h.state_mut().start_autosave(&path, &ctx);
     assert!(h.state().autosaving());
-    wait_for_autosave(&mut h);
+    wait_for(&mut h, |app| !app.autosaving());
     assert!(!h.state().autosaving(), "the autosave did not finish");
     assert_eq!(h.state().message, None);
     let autosaved = crate::document::autosave_path(&path);
@@ -265,7 +305,7 @@ fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     // A failure reaches the status bar.
     let nowhere = dir.join("missing/bar.json");
     h.state_mut().start_autosave(&nowhere, &ctx);
-    wait_for_autosave(&mut h);
+    wait_for(&mut h, |app| !app.autosaving());
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("autosave failed"), "{message}");
     let _ = std::fs::remove_dir_all(&dir);
