@@ -431,12 +431,17 @@ impl Document {
             state: self.state.clone(),
             target: path.to_path_buf(),
             revision: self.revision,
+            autosave: false,
         }
     }
 
     /// Records that `job` (from [`Document::save_job`]) was written: its file becomes the
-    /// document's path, and the document is clean unless it changed since the snapshot.
+    /// document's path, and the document is clean unless it changed since the snapshot. An
+    /// autosave's job changes nothing.
     pub fn saved(&mut self, job: &SaveJob) {
+        if job.autosave {
+            return;
+        }
         self.path = Some(job.target.clone());
         if self.revision == job.revision {
             self.dirty = false;
@@ -484,13 +489,14 @@ impl Document {
         self.autosave_job(fallback).run()
     }
 
-    /// [`Document::autosave`] as a snapshot to write on another thread (not to hand to
-    /// [`Document::saved`]: an autosave leaves the document's path and `dirty` alone).
+    /// [`Document::autosave`] as a snapshot to write on another thread (an autosave leaves the
+    /// document's path and `dirty` alone).
     pub fn autosave_job(&self, fallback: &Path) -> SaveJob {
         SaveJob {
             state: self.state.clone(),
             target: autosave_path(self.path.as_deref().unwrap_or(fallback)),
             revision: self.revision,
+            autosave: true,
         }
     }
 }
@@ -539,6 +545,8 @@ pub struct SaveJob {
     target: PathBuf,
     /// The document's revision when the snapshot was taken.
     revision: u64,
+    /// An autosave: [`Document::saved`] ignores it.
+    autosave: bool,
 }
 
 impl SaveJob {
