@@ -9,6 +9,7 @@
 //!
 //! Rows are sparse: per vertex its non-zero `(column, weight)` pairs, sorted by column.
 
+use super::rows::{check_columns, check_row_count, check_triangles, RowsError};
 use crate::geom::{barycentric, Point};
 
 /// What does not fit. Nothing was changed.
@@ -16,35 +17,10 @@ use crate::geom::{barycentric, Point};
 pub enum LockError {
     #[error("{fresh} fresh weight rows but {previous} previous ones")]
     RowCount { fresh: usize, previous: usize },
-    #[error("{rows} weight rows for {vertices} mesh vertices")]
-    MeshRows { rows: usize, vertices: usize },
-    #[error("vertex {vertex} has a weight in column {column} of {columns}")]
-    Column {
-        vertex: usize,
-        column: u32,
-        columns: usize,
-    },
-    #[error("triangle {triangle} uses vertex {vertex} of {vertices}")]
-    Triangle {
-        triangle: usize,
-        vertex: u32,
-        vertices: usize,
-    },
+    #[error(transparent)]
+    Rows(#[from] RowsError),
     #[error("the previous mesh has no vertices to carry weights from")]
     EmptyMesh,
-}
-
-fn check_columns(rows: &[Vec<(u32, f64)>], columns: usize) -> Result<(), LockError> {
-    for (vertex, row) in rows.iter().enumerate() {
-        if let Some(&(c, _)) = row.iter().find(|(c, _)| *c as usize >= columns) {
-            return Err(LockError::Column {
-                vertex,
-                column: c,
-                columns,
-            });
-        }
-    }
-    Ok(())
 }
 
 /// Replaces the locked columns of `fresh` by those of `previous`, vertex by vertex, and
@@ -140,24 +116,11 @@ pub fn transfer_rows(
     to_px: &[[f64; 2]],
 ) -> Result<Vec<Vec<(u32, f64)>>, LockError> {
     let n = from_vertices.len();
-    if from_rows.len() != n {
-        return Err(LockError::MeshRows {
-            rows: from_rows.len(),
-            vertices: n,
-        });
-    }
+    check_row_count(from_rows, n)?;
     if n == 0 {
         return Err(LockError::EmptyMesh);
     }
-    for (triangle, t) in from_triangles.iter().enumerate() {
-        if let Some(&vertex) = t.iter().find(|&&v| v as usize >= n) {
-            return Err(LockError::Triangle {
-                triangle,
-                vertex,
-                vertices: n,
-            });
-        }
-    }
+    check_triangles(from_triangles, n)?;
     let grid = TriangleGrid::new(from_vertices, from_triangles);
     let pt = |p: [f64; 2]| Point::new(p[0], p[1]);
     Ok(to_px
@@ -365,11 +328,11 @@ mod tests {
         assert_eq!(carried[3], vec![(1, 1.0)]);
         assert_eq!(
             transfer_rows(&from, &[[0, 1, 9]], &rows, &to),
-            Err(LockError::Triangle {
+            Err(LockError::Rows(RowsError::Triangle {
                 triangle: 0,
                 vertex: 9,
                 vertices: 4
-            })
+            }))
         );
     }
 }

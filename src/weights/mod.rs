@@ -11,6 +11,7 @@
 //! - [`part`]: one part end to end: boundary conditions, solve, normalize, sparsify.
 //! - [`paint`]: brush dabs (add, subtract, smooth) on a part's weights, locked columns kept.
 //! - [`locked`]: locked columns kept through a recompute, rows carried over to a new mesh.
+//! - [`rows`]: the checks of weight rows and meshes that `paint` and `locked` share.
 
 pub mod boundary;
 pub mod laplacian;
@@ -21,6 +22,7 @@ pub mod paint;
 pub mod part;
 pub mod reference;
 pub mod rigid;
+pub mod rows;
 pub mod solve;
 pub mod sparse;
 

@@ -18,6 +18,7 @@
 //! sample, so the dabs of a stroke's prefix are a prefix of its dabs: an editor can preview a
 //! stroke dab by dab and commit the whole stroke once, getting the same weights.
 
+use super::rows::{check_columns, check_row_count, check_triangles, RowsError};
 use serde::{Deserialize, Serialize};
 
 /// What a dab does to the painted column.
@@ -103,20 +104,8 @@ pub enum PaintError {
     UnknownColumn { column: usize, columns: usize },
     #[error("column {0} is locked")]
     LockedColumn(usize),
-    #[error("{rows} weight rows for {vertices} mesh vertices")]
-    RowCount { rows: usize, vertices: usize },
-    #[error("vertex {vertex} has a weight in column {column} of {columns}")]
-    RowColumn {
-        vertex: usize,
-        column: u32,
-        columns: usize,
-    },
-    #[error("triangle {triangle} uses vertex {vertex} of {vertices}")]
-    Triangle {
-        triangle: usize,
-        vertex: u32,
-        vertices: usize,
-    },
+    #[error(transparent)]
+    Rows(#[from] RowsError),
 }
 
 /// A part's rest mesh prepared for painting: positions and, per vertex, its mesh neighbours.
@@ -131,15 +120,7 @@ pub struct PaintMesh {
 impl PaintMesh {
     pub fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Result<Self, PaintError> {
         let n = vertices.len();
-        for (t, tri) in triangles.iter().enumerate() {
-            if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
-                return Err(PaintError::Triangle {
-                    triangle: t,
-                    vertex: v,
-                    vertices: n,
-                });
-            }
-        }
+        check_triangles(triangles, n)?;
         Ok(PaintMesh {
             vertices: vertices.to_vec(),
             neighbours: crate::mesh::vertex_neighbours(n, triangles),
@@ -229,21 +210,8 @@ fn check_target(
     if locked[column] {
         return Err(PaintError::LockedColumn(column));
     }
-    if rows.len() != mesh.vertices.len() {
-        return Err(PaintError::RowCount {
-            rows: rows.len(),
-            vertices: mesh.vertices.len(),
-        });
-    }
-    for (vertex, row) in rows.iter().enumerate() {
-        if let Some(&(c, _)) = row.iter().find(|(c, _)| *c as usize >= columns) {
-            return Err(PaintError::RowColumn {
-                vertex,
-                column: c,
-                columns,
-            });
-        }
-    }
+    check_row_count(rows, mesh.vertices.len())?;
+    check_columns(rows, columns)?;
     Ok(columns)
 }
 
@@ -690,7 +658,7 @@ mod tests {
                 &[[0.0, 0.0]],
                 &options
             ),
-            Err(PaintError::RowColumn { .. })
+            Err(PaintError::Rows(RowsError::Column { .. }))
         ));
         assert!(matches!(
             paint_stroke(
