@@ -667,6 +667,17 @@ pub fn compute_rig(
 }
 
 /// The state after `command`, or why it cannot apply.
+/// Replaces animation `name` of `state` by `apply(name, its JSON)` (a key edit: `anim::edit`).
+fn edit_animation(
+    state: &mut State,
+    name: String,
+    apply: impl FnOnce(&str, &serde_json::Value) -> Result<serde_json::Value, edit::EditError>,
+) -> Result<(), DocumentError> {
+    let edited = apply(&name, &animation_json(state, &name))?;
+    state.animations.insert(name, edited);
+    Ok(())
+}
+
 fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
     let mut next = state.clone();
     let mut inputs_changed = true;
@@ -864,13 +875,9 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             keys,
             delta_s,
         } => {
-            let edited = edit::move_keys(
-                &animation,
-                &animation_json(state, &animation),
-                &keys,
-                delta_s,
-            )?;
-            next.animations.insert(animation, edited);
+            edit_animation(&mut next, animation, |name, json| {
+                edit::move_keys(name, json, &keys, delta_s)
+            })?;
             inputs_changed = false;
         }
         Command::PasteKeys {
@@ -878,14 +885,15 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             at_s,
             keys,
         } => {
-            let edited =
-                edit::paste_keys(&animation, &animation_json(state, &animation), at_s, &keys)?;
-            next.animations.insert(animation, edited);
+            edit_animation(&mut next, animation, |name, json| {
+                edit::paste_keys(name, json, at_s, &keys)
+            })?;
             inputs_changed = false;
         }
         Command::DeleteTimelineKeys { animation, keys } => {
-            let edited = edit::delete_keys(&animation, &animation_json(state, &animation), &keys)?;
-            next.animations.insert(animation, edited);
+            edit_animation(&mut next, animation, |name, json| {
+                edit::delete_keys(name, json, &keys)
+            })?;
             inputs_changed = false;
         }
         Command::SetCurve {
@@ -893,9 +901,9 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             key,
             curve,
         } => {
-            let edited =
-                edit::set_curve(&animation, &animation_json(state, &animation), &key, &curve)?;
-            next.animations.insert(animation, edited);
+            edit_animation(&mut next, animation, |name, json| {
+                edit::set_curve(name, json, &key, &curve)
+            })?;
             inputs_changed = false;
         }
     }
