@@ -76,6 +76,33 @@ fn loops_by_default() -> bool {
     true
 }
 
+/// A save or autosave being written on another thread: its outcome arrives here.
+type Writing = std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>;
+
+/// Writes `job` on another thread, waking the UI (`ctx`) when it is done.
+fn write_in_background(job: crate::document::SaveJob, ctx: Option<egui::Context>) -> Writing {
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        // The editor may have closed meanwhile.
+        let _ = send.send(job.run());
+        if let Some(ctx) = ctx {
+            ctx.request_repaint();
+        }
+    });
+    receive
+}
+
+/// The outcome of a background write once it is done (`None` while it runs).
+fn written(receive: &Writing) -> Option<Result<PathBuf, String>> {
+    match receive.try_recv() {
+        Err(std::sync::mpsc::TryRecvError::Empty) => None,
+        Ok(outcome) => Some(outcome.map_err(|e| e.to_string())),
+        Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+            Some(Err("the writing thread stopped".into()))
+        }
+    }
+}
+
 /// The view side file of the document at `path`.
 pub fn view_path(path: &Path) -> PathBuf {
     crate::document::side_file(path, "view")
@@ -180,13 +207,10 @@ pub struct EditorApp {
     last_autosave_s: f64,
     /// The autosave being written on another thread (a document never rigged is traced and
     /// meshed to be saved, too slow for the UI thread on large images).
-    autosaving: Option<std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>>,
+    autosaving: Option<Writing>,
     /// A save being written on another thread (one that must trace and mesh first), with its
     /// snapshot for [`Document::saved`].
-    saving: Option<(
-        crate::document::SaveJob,
-        std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>,
-    )>,
+    saving: Option<(crate::document::SaveJob, Writing)>,
     /// The UI's context, for threads started outside a frame's call chain to wake it.
     repaint: Option<egui::Context>,
     /// Screenshot to take after a few frames, then quit (for `--screenshot`).
@@ -433,15 +457,7 @@ impl EditorApp {
         }
         if self.doc.save_needs_build() {
             let job = self.doc.save_job(path);
-            let (send, receive) = std::sync::mpsc::channel();
-            let thread_job = job.clone();
-            let repaint = self.repaint.clone();
-            std::thread::spawn(move || {
-                let _ = send.send(thread_job.run());
-                if let Some(ctx) = repaint {
-                    ctx.request_repaint();
-                }
-            });
+            let receive = write_in_background(job.clone(), self.repaint.clone());
             self.saving = Some((job, receive));
             return format!("saving {}…", path.display());
         }
@@ -463,14 +479,8 @@ impl EditorApp {
     /// Picks up a save finished on another thread: the document takes its path (and is clean
     /// if unchanged since), the view is written beside it.
     fn poll_saving(&mut self) {
-        use std::sync::mpsc::TryRecvError;
-        let Some((_, receive)) = &self.saving else {
+        let Some(outcome) = self.saving.as_ref().and_then(|(_, r)| written(r)) else {
             return;
-        };
-        let outcome = match receive.try_recv() {
-            Err(TryRecvError::Empty) => return,
-            Ok(outcome) => outcome.map_err(|e| e.to_string()),
-            Err(TryRecvError::Disconnected) => Err("the saving thread stopped".into()),
         };
         let Some((job, _)) = self.saving.take() else {
             return;
@@ -736,25 +746,13 @@ impl EditorApp {
             return;
         }
         let job = self.doc.autosave_job(fallback);
-        let (send, receive) = std::sync::mpsc::channel();
-        let ctx = ctx.clone();
-        std::thread::spawn(move || {
-            let _ = send.send(job.run());
-            ctx.request_repaint();
-        });
-        self.autosaving = Some(receive);
+        self.autosaving = Some(write_in_background(job, Some(ctx.clone())));
     }
 
     /// Picks up a finished autosave: a failure goes to the status bar.
     fn poll_autosave(&mut self) {
-        use std::sync::mpsc::TryRecvError;
-        let Some(receive) = &self.autosaving else {
+        let Some(outcome) = self.autosaving.as_ref().and_then(written) else {
             return;
-        };
-        let outcome = match receive.try_recv() {
-            Err(TryRecvError::Empty) => return,
-            Ok(outcome) => outcome.map(|_| ()).map_err(|e| e.to_string()),
-            Err(TryRecvError::Disconnected) => Err("its thread stopped".into()),
         };
         self.autosaving = None;
         if let Err(e) = outcome {
