@@ -633,15 +633,7 @@ impl EditorApp {
             );
             return;
         };
-        let view = *self
-            .view
-            .get_or_insert_with(|| canvas::fit(size_px, rect.size()));
-        let placed = Placed {
-            view,
-            origin: rect.min,
-        };
-        self.placed = Some(placed);
-        self.zoom_and_pan(&ctx, &response, placed);
+        let placed = self.place_canvas(&ctx, &response, size_px);
         let mut shapes = Vec::new();
         if let Some(texture) = self.colorize_textures(&ctx) {
             shapes.push(canvas::image_quad(&placed, &texture.0, size_px));

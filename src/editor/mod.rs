@@ -1085,15 +1085,7 @@ impl EditorApp {
             .first()
             .map(|l| [l.image.width(), l.image.height()])
             .unwrap_or([512, 512]);
-        let view = *self
-            .view
-            .get_or_insert_with(|| canvas::fit(canvas_px, rect.size()));
-        let placed = Placed {
-            view,
-            origin: rect.min,
-        };
-        self.placed = Some(placed);
-        self.zoom_and_pan(&ctx, &response, placed);
+        let placed = self.place_canvas(&ctx, &response, canvas_px);
         let posable = self.doc.posable().cloned();
         let live_pose = match &self.gesture {
             Some(Gesture::PoseDrag { pose, .. }) => Some(pose.clone()),
@@ -1206,6 +1198,28 @@ impl EditorApp {
             }
             Mode::Colorize => {}
         }
+    }
+
+    /// Places an image of `size_px` on the canvas `response` covers (fitted the first time,
+    /// then as zoomed and panned), remembers it for picking and applies this frame's zoom and
+    /// pan.
+    fn place_canvas(
+        &mut self,
+        ctx: &egui::Context,
+        response: &egui::Response,
+        size_px: [u32; 2],
+    ) -> Placed {
+        let rect = response.rect;
+        let view = *self
+            .view
+            .get_or_insert_with(|| canvas::fit(size_px, rect.size()));
+        let placed = Placed {
+            view,
+            origin: rect.min,
+        };
+        self.placed = Some(placed);
+        self.zoom_and_pan(ctx, response, placed);
+        placed
     }
 
     fn zoom_and_pan(&mut self, ctx: &egui::Context, response: &egui::Response, placed: Placed) {
