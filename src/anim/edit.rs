@@ -869,16 +869,21 @@ mod tests {
         assert!(move_keys("walk", &walk, &both, 1.0).is_err());
     }
 
+    /// `walk` with a Bézier segment from the arm's key at 0 to its key at 1.
+    fn curved_walk() -> Value {
+        set_curve(
+            "walk",
+            &walk(),
+            &key(&rotate("arm"), 0.0),
+            &Curve::Bezier(vec![0.25, 10.0, 0.75, 80.0]),
+        )
+        .unwrap()
+    }
+
     #[test]
     fn bezier_handles_keep_their_fraction_of_the_segment() {
         let arm = rotate("arm");
-        let curved = set_curve(
-            "walk",
-            &walk(),
-            &key(&arm, 0.0),
-            &Curve::Bezier(vec![0.25, 10.0, 0.75, 80.0]),
-        )
-        .unwrap();
+        let curved = curved_walk();
         // Stretching the segment to 0 → 2 doubles the handle times; values stay.
         let stretched = move_keys("walk", &curved, &[key(&arm, 1.0), key(&arm, 2.0)], 1.0).unwrap();
         assert_eq!(
@@ -957,13 +962,7 @@ mod tests {
     #[test]
     fn pasted_bezier_handles_fit_their_new_segment() {
         let arm = rotate("arm");
-        let curved = set_curve(
-            "walk",
-            &walk(),
-            &key(&arm, 0.0),
-            &Curve::Bezier(vec![0.25, 10.0, 0.75, 80.0]),
-        )
-        .unwrap();
+        let curved = curved_walk();
         let copied = copy_keys(&curved, &[key(&arm, 0.0)]).unwrap();
         let pasted = paste_keys("walk", &curved, 1.5, &copied).unwrap();
         // The segment 1.5 → 2 is half as long as the copied 0 → 1.
