@@ -608,16 +608,19 @@ mod tests {
         assert_eq!(same, rows);
         // Painting a locked column is refused, as are bad options and rows.
         let mut copy = rows.clone();
-        assert_eq!(
+        let mut add_at = |locked: &[bool], column: usize, at: [f64; 2], options: &BrushOptions| {
             paint_stroke(
                 &mesh,
                 &mut copy,
-                &[true, false, false],
-                0,
+                locked,
+                column,
                 BrushMode::Add,
-                &[[0.0, 0.0]],
-                &options
-            ),
+                &[at],
+                options,
+            )
+        };
+        assert_eq!(
+            add_at(&[true, false, false], 0, [0.0, 0.0], &options),
             Err(PaintError::LockedColumn(0))
         );
         let bad = BrushOptions {
@@ -625,51 +628,19 @@ mod tests {
             ..options
         };
         assert!(matches!(
-            paint_stroke(
-                &mesh,
-                &mut copy,
-                &[false; 3],
-                0,
-                BrushMode::Add,
-                &[[0.0, 0.0]],
-                &bad
-            ),
+            add_at(&[false; 3], 0, [0.0, 0.0], &bad),
             Err(PaintError::InvalidOptions(_))
         ));
         assert!(matches!(
-            paint_stroke(
-                &mesh,
-                &mut copy,
-                &[false; 3],
-                3,
-                BrushMode::Add,
-                &[[0.0, 0.0]],
-                &options
-            ),
+            add_at(&[false; 3], 3, [0.0, 0.0], &options),
             Err(PaintError::UnknownColumn { .. })
         ));
         assert!(matches!(
-            paint_stroke(
-                &mesh,
-                &mut copy,
-                &[false; 2],
-                0,
-                BrushMode::Add,
-                &[[0.0, 0.0]],
-                &options
-            ),
+            add_at(&[false; 2], 0, [0.0, 0.0], &options),
             Err(PaintError::Rows(RowsError::Column { .. }))
         ));
         assert!(matches!(
-            paint_stroke(
-                &mesh,
-                &mut copy,
-                &[false; 3],
-                0,
-                BrushMode::Add,
-                &[[f64::NAN, 0.0]],
-                &options
-            ),
+            add_at(&[false; 3], 0, [f64::NAN, 0.0], &options),
             Err(PaintError::NotFinite(_))
         ));
         assert_eq!(copy, rows);
