@@ -512,8 +512,7 @@ fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError
             if state.layers.is_empty() {
                 return Err(DocumentError::NothingToSave);
             }
-            let layers: Vec<Layer> = state.layers.iter().map(|l| (**l).clone()).collect();
-            pipeline::build_rig(&layers, dir, &state.options, &Handles::default())?.0
+            pipeline::build_rig(&state.layers, dir, &state.options, &Handles::default())?.0
         }
     };
     for part in &mut doc.parts {
@@ -644,11 +643,10 @@ pub fn compute_rig(
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Scene, DocumentError> {
-    let layers: Vec<Layer> = inputs.layers.iter().map(|l| (**l).clone()).collect();
-    let total = layers.len();
+    let total = inputs.layers.len();
     let mut report = |done: usize, _: &str| progress(done, total);
     let built = pipeline::build_rig_cancellable(
-        &layers,
+        &inputs.layers,
         dir,
         &inputs.options,
         &inputs.handles,
@@ -662,11 +660,10 @@ pub fn compute_rig(
     if let Some(previous) = &inputs.previous {
         pipeline::keep_locked_weights(&mut doc, &previous.doc, &inputs.locked)?;
     }
-    let images: Vec<_> = layers.into_iter().map(|l| l.image).collect();
+    let images: Vec<&image::RgbaImage> = inputs.layers.iter().map(|l| &l.image).collect();
     Ok(Scene::new(doc, &images)?)
 }
 
-/// The state after `command`, or why it cannot apply.
 /// Replaces animation `name` of `state` by `apply(name, its JSON)` (a key edit: `anim::edit`).
 fn edit_animation(
     state: &mut State,
@@ -678,6 +675,7 @@ fn edit_animation(
     Ok(())
 }
 
+/// The state after `command`, or why it cannot apply.
 fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
     let mut next = state.clone();
     let mut inputs_changed = true;

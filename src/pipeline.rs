@@ -18,6 +18,7 @@ use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
 use crate::trace::{self, TraceError};
 use crate::weights::{self, WeightError};
 use image::RgbaImage;
+use std::borrow::Borrow;
 use std::collections::{BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -159,8 +160,9 @@ pub fn load_layers(paths: &[PathBuf]) -> Result<Vec<Layer>, PipelineError> {
 /// Traces and meshes every layer and, when there are handles, embeds their geometry in every
 /// mesh and computes weights. `doc_dir` is the folder the document will be saved in: image
 /// paths are stored relative to it. Returns the document and each part's mesh statistics.
-pub fn build_rig(
-    layers: &[Layer],
+/// `layers` may be owned or shared (`Arc<Layer>`, as the editor keeps them): nothing is copied.
+pub fn build_rig<L: Borrow<Layer>>(
+    layers: &[L],
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
@@ -170,8 +172,8 @@ pub fn build_rig(
 
 /// [`build_rig`], calling `progress(parts_done, part_name)` before each part and once at the
 /// end (with an empty name), for progress bars.
-pub fn build_rig_with_progress(
-    layers: &[Layer],
+pub fn build_rig_with_progress<L: Borrow<Layer>>(
+    layers: &[L],
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
@@ -183,15 +185,15 @@ pub fn build_rig_with_progress(
 
 /// [`build_rig_with_progress`] that stops with [`PipelineError::Cancelled`] before the next
 /// part once `cancel` is set (the editor builds rigs on a background thread).
-pub fn build_rig_cancellable(
-    layers: &[Layer],
+pub fn build_rig_cancellable<L: Borrow<Layer>>(
+    layers: &[L],
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
     progress: &mut dyn FnMut(usize, &str),
     cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
-    let first = layers.first().ok_or(PipelineError::NoImages)?;
+    let first: &Layer = layers.first().ok_or(PipelineError::NoImages)?.borrow();
     let canvas = [first.image.width(), first.image.height()];
     let canvas_area = canvas[0] as f64 * canvas[1] as f64;
     let mut doc = RigDocument::new(canvas);
@@ -202,7 +204,7 @@ pub fn build_rig_cancellable(
     if let Some((handle, part)) = handles.bind.iter().find_map(|(handle, parts)| {
         parts
             .iter()
-            .find(|p| !layers.iter().any(|l| &l.name == *p))
+            .find(|p| !layers.iter().any(|l| &l.borrow().name == *p))
             .map(|p| (handle, p))
     }) {
         return Err(PipelineError::UnknownBindPart {
@@ -213,6 +215,7 @@ pub fn build_rig_cancellable(
     let mut touched = vec![0usize; columns.len()];
     let mut stats = Vec::with_capacity(layers.len());
     for (done, layer) in layers.iter().enumerate() {
+        let layer: &Layer = layer.borrow();
         if cancel.load(std::sync::atomic::Ordering::Relaxed) {
             return Err(PipelineError::Cancelled);
         }
@@ -394,10 +397,15 @@ impl Scene {
         Scene::new(doc, &images)
     }
 
-    /// A scene from a document and its parts' images (in part order).
-    pub fn new(doc: RigDocument, images: &[RgbaImage]) -> Result<Self, PipelineError> {
+    /// A scene from a document and its parts' images (in part order; owned or borrowed: they
+    /// are only read).
+    pub fn new<I: Borrow<RgbaImage>>(
+        doc: RigDocument,
+        images: &[I],
+    ) -> Result<Self, PipelineError> {
         let mut parts = Vec::with_capacity(images.len());
         for (part, image) in doc.parts.iter().zip(images) {
+            let image: &RgbaImage = image.borrow();
             let got = [image.width(), image.height()];
             if got != doc.canvas {
                 return Err(PipelineError::TextureSize {

@@ -376,13 +376,7 @@ impl EditorApp {
         if have || preview.running.is_some() {
             return;
         }
-        let layers: Vec<Layer> = self
-            .doc
-            .state()
-            .layers
-            .iter()
-            .map(|l| (**l).clone())
-            .collect();
+        let layers = self.doc.state().layers.clone();
         let options = BuildOptions {
             trace: wanted.trace.clone(),
             mesh: wanted.mesh.clone(),
