@@ -706,19 +706,30 @@ fn wait_for_colorize(h: &mut Harness<'_, EditorApp>) {
     );
 }
 
-#[test]
-fn colorize_two_scribbles_then_undo_one() {
-    use crate::colorize::synthetic::{scene, SceneSpec, PALETTE};
-    let s = scene(&SceneSpec {
-        size: 128,
+/// A generated one-circle colorize scene of `size` px, its line art written as `file` in a
+/// fresh scratch folder `sinew-editor-NAME-PID`: the scene, the folder and the line art's path.
+fn one_circle_lineart(
+    name: &str,
+    size: u32,
+    file: &str,
+) -> (crate::colorize::synthetic::Scene, PathBuf, PathBuf) {
+    let s = crate::colorize::synthetic::scene(&crate::colorize::synthetic::SceneSpec {
+        size,
         shapes: 1,
         ..Default::default()
     });
-    let dir = std::env::temp_dir().join(format!("sinew-editor-colorize-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("scratch dir");
-    let lineart = dir.join("lineart.png");
+    let lineart = dir.join(file);
     crate::io::save_png(&lineart, &s.lineart).expect("written");
+    (s, dir, lineart)
+}
+
+#[test]
+fn colorize_two_scribbles_then_undo_one() {
+    use crate::colorize::synthetic::PALETTE;
+    let (s, dir, lineart) = one_circle_lineart("colorize", 128, "lineart.png");
     let corrupt = dir.join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").expect("written");
     // Share of the non-line pixels of true color `region` that `image` colors `want`.
@@ -842,17 +853,8 @@ fn colorize_two_scribbles_then_undo_one() {
 #[test]
 fn colorize_scribbles_save_load_and_autosave() {
     use crate::colorize::session::{ScribbleStroke, SessionCommand};
-    use crate::colorize::synthetic::{scene, SceneSpec, PALETTE};
-    let s = scene(&SceneSpec {
-        size: 96,
-        shapes: 1,
-        ..Default::default()
-    });
-    let dir = std::env::temp_dir().join(format!("sinew-editor-scribbles-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    let lineart = dir.join("cat.png");
-    crate::io::save_png(&lineart, &s.lineart).expect("written");
+    use crate::colorize::synthetic::PALETTE;
+    let (s, dir, lineart) = one_circle_lineart("scribbles", 96, "cat.png");
     let strokes: Vec<ScribbleStroke> = [PALETTE[10], PALETTE[0]]
         .iter()
         .zip(&s.strokes)
