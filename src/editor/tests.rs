@@ -706,6 +706,18 @@ fn wait_for_colorize(h: &mut Harness<'_, EditorApp>) {
     );
 }
 
+/// Colorize mode's stroke count, if a line art is open.
+fn stroke_count(h: &Harness<'_, EditorApp>) -> Option<usize> {
+    let session = h.state().colorize.session.as_ref()?;
+    Some(session.strokes().len())
+}
+
+/// Colorize mode's current result (the test fails without one).
+fn colorize_result(h: &Harness<'_, EditorApp>) -> Arc<crate::colorize::Colorized> {
+    let session = h.state().colorize.session.as_ref().expect("a session");
+    session.result().expect("a result").clone()
+}
+
 /// A generated one-circle colorize scene of `size` px, its line art written as `file` in a
 /// fresh scratch folder `sinew-editor-NAME-PID`: the scene, the folder and the line art's path.
 fn one_circle_lineart(
@@ -775,50 +787,20 @@ fn colorize_two_scribbles_then_undo_one() {
     assert!(distance(drawn[0], circle[0]) < 1.0, "{drawn:?}");
     assert!(distance(*drawn.last().expect("points"), circle[1]) < 1.0);
     wait_for_colorize(&mut h);
-    let two = h
-        .state()
-        .colorize
-        .session
-        .as_ref()
-        .expect("a session")
-        .result()
-        .expect("a result")
-        .clone();
+    let two = colorize_result(&h);
     assert!(share(&two.image, PALETTE[0], PALETTE[0]) > 0.98);
     assert!(share(&two.image, PALETTE[10], PALETTE[10]) > 0.98);
 
     // Bad line art now keeps the open one and its strokes.
     h.state_mut().open_lineart(&corrupt);
-    assert_eq!(
-        h.state()
-            .colorize
-            .session
-            .as_ref()
-            .map(|s| s.strokes().len()),
-        Some(2)
-    );
+    assert_eq!(stroke_count(&h), Some(2));
 
     // Undo the circle's scribble with the keyboard: the background's color takes everything.
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    assert_eq!(
-        h.state()
-            .colorize
-            .session
-            .as_ref()
-            .map(|s| s.strokes().len()),
-        Some(1)
-    );
+    assert_eq!(stroke_count(&h), Some(1));
     wait_for_colorize(&mut h);
-    let one = h
-        .state()
-        .colorize
-        .session
-        .as_ref()
-        .expect("a session")
-        .result()
-        .expect("a result")
-        .clone();
+    let one = colorize_result(&h);
     assert!(share(&one.image, PALETTE[0], PALETTE[10]) > 0.99);
 
     // Saved atomically, as shown.
@@ -864,13 +846,6 @@ fn colorize_scribbles_save_load_and_autosave() {
             points_px: stroke.points.clone(),
         })
         .collect();
-    let count = |h: &Harness<'_, EditorApp>| {
-        h.state()
-            .colorize
-            .session
-            .as_ref()
-            .map(|s| s.strokes().len())
-    };
 
     let mut h = harness(EditorApp::new(Document::new()));
     h.state_mut().open_lineart(&lineart);
@@ -915,10 +890,10 @@ fn colorize_scribbles_save_load_and_autosave() {
 
     // Loading replaces the strokes as one undo step; a bad file leaves them.
     assert!(h.state_mut().load_scribbles(&saved));
-    assert_eq!(count(&h), Some(2));
+    assert_eq!(stroke_count(&h), Some(2));
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    assert_eq!(count(&h), Some(1));
+    assert_eq!(stroke_count(&h), Some(1));
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "not json").expect("written");
     assert!(!h.state_mut().load_scribbles(&bad));
@@ -927,7 +902,7 @@ fn colorize_scribbles_save_load_and_autosave() {
         .message
         .as_deref()
         .is_some_and(|m| m.starts_with("cannot load")));
-    assert_eq!(count(&h), Some(1));
+    assert_eq!(stroke_count(&h), Some(1));
 
     // Cleared strokes are autosaved as none, whatever the path field holds.
     h.state_mut().colorize.scribbles_path = String::new();
