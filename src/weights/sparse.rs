@@ -176,7 +176,10 @@ impl SharedPattern {
             scatter[k] = at;
         }
         let permuted = compressed_columns(len, entries.iter().map(|&(c, r, _)| (c, r)));
-        // faer's analysis without reordering reads the upper triangle as given.
+        // faer's analysis without reordering reads the upper triangle as given. Supernodal is
+        // forced: faer's flop-ratio heuristic picks the simplicial factorization for meshes of
+        // about 1k vertices and for some sub-meshes, where it is 2–4× slower per numeric
+        // factorization, and every interior-point iteration pays for one.
         let mut upper: Vec<(usize, usize)> = entries.iter().map(|&(c, r, _)| (r, c)).collect();
         upper.sort_unstable();
         let upper = compressed_columns(len, upper.into_iter());
@@ -184,7 +187,11 @@ impl SharedPattern {
             upper.as_ref(),
             Side::Upper,
             SymmetricOrdering::Identity,
-            CholeskySymbolicParams::default(),
+            CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold:
+                    faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
         )
         .map_err(assembly)?;
         Ok(SharedPattern {
