@@ -192,7 +192,8 @@ pub enum Command {
     },
     /// Paints one brush stroke (press to release) on `handle`'s weights over `part` (see
     /// [`crate::weights::paint`]): one undo step. Needs current weights; locked handles keep
-    /// theirs, and a locked `handle` is refused.
+    /// theirs, and a locked `handle` is refused. Rows keep the document's influence limit
+    /// (`max_influences`).
     PaintWeights {
         part: String,
         handle: String,
@@ -970,7 +971,16 @@ fn paint_weights(
     }
     let mesh = PaintMesh::new(&part_doc.mesh.vertices, &part_doc.mesh.triangles)?;
     let mut rows = weights.rows.clone();
-    crate::weights::paint_stroke(&mesh, &mut rows, &locked, column, mode, samples_px, options)?;
+    crate::weights::paint_stroke(
+        &mesh,
+        &mut rows,
+        &locked,
+        column,
+        mode,
+        samples_px,
+        options,
+        scene.doc.options.weights.max_influences,
+    )?;
     let painted = crate::io::WeightsDoc {
         handles: weights.handles.clone(),
         rows,

@@ -230,6 +230,37 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
 }
 
 #[test]
+fn painting_keeps_the_influence_limit() {
+    let dir = scratch("paint-limit");
+    let mut doc = arm(&dir);
+    let mut options = doc.state().options.clone();
+    options.weights.max_influences = Some(2);
+    doc.apply(Command::SetOptions(options)).unwrap();
+    compute(&mut doc);
+    // c painted over a's end of the bar, where a and b already weigh every vertex.
+    doc.apply(Command::PaintWeights {
+        part: "bar".into(),
+        handle: "c".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[40.0, 40.0], [100.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 30.0,
+            strength: 0.5,
+            ..Default::default()
+        },
+    })
+    .unwrap();
+    let painted = rows(&doc);
+    check_rows(&painted);
+    let widest = painted.iter().map(Vec::len).max().unwrap_or(0);
+    assert!(widest <= 2, "a row has {widest} influences");
+    assert!(
+        column(&painted, 2).iter().any(|&w| w > 0.3),
+        "c was not painted"
+    );
+}
+
+#[test]
 fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     let dir = scratch("recompute");
     let mut doc = arm(&dir);

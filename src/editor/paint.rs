@@ -35,6 +35,8 @@ pub struct PaintStroke {
     pub handle: String,
     column: usize,
     locked: Vec<bool>,
+    /// The document's influence limit, as the committed stroke will apply it.
+    max_influences: Option<usize>,
     mesh: PaintMesh,
     pub samples_px: Vec<[f64; 2]>,
     dabs_done: usize,
@@ -111,6 +113,7 @@ impl EditorApp {
             handle,
             column,
             locked,
+            max_influences: scene.doc.options.weights.max_influences,
             mesh,
             samples_px: Vec::new(),
             dabs_done: 0,
@@ -139,6 +142,7 @@ impl EditorApp {
                 self.paint.mode,
                 centre,
                 &self.paint.options,
+                stroke.max_influences,
             ) {
                 self.message = Some(e.to_string());
                 return;

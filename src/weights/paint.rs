@@ -14,6 +14,13 @@
 //! rigid zone), the weight taken from `j` goes to the unlocked columns the vertex's mesh
 //! neighbours use, in their proportions; with none there either, the vertex stays as it is.
 //!
+//! With an influence limit K (the document's `max_influences`), a row the dab leaves with more
+//! than K weights loses its smallest unlocked ones other than the painted column, and their
+//! weight goes to the unlocked others it keeps: painting a new handle onto a vertex at the
+//! limit replaces its weakest one. Where nothing unlocked besides the painted column would be
+//! left to take that weight, the vertex stays as it is. Locked weights are never dropped, so a
+//! row whose locked weights alone reach K keeps them plus the painted column.
+//!
 //! A stroke is resampled into dabs at a fixed spacing along its polyline, starting at its first
 //! sample, so the dabs of a stroke's prefix are a prefix of its dabs: an editor can preview a
 //! stroke dab by dab and commit the whole stroke once, getting the same weights.
@@ -104,6 +111,8 @@ pub enum PaintError {
     UnknownColumn { column: usize, columns: usize },
     #[error("column {0} is locked")]
     LockedColumn(usize),
+    #[error("the influence limit must be at least 1")]
+    NoInfluences,
     #[error(transparent)]
     Rows(#[from] RowsError),
 }
@@ -202,7 +211,11 @@ fn check_target(
     rows: &[Vec<(u32, f64)>],
     locked: &[bool],
     column: usize,
+    max_influences: Option<usize>,
 ) -> Result<usize, PaintError> {
+    if max_influences == Some(0) {
+        return Err(PaintError::NoInfluences);
+    }
     let columns = locked.len();
     if column >= columns {
         return Err(PaintError::UnknownColumn { column, columns });
@@ -216,7 +229,8 @@ fn check_target(
 }
 
 /// Paints one stroke: every dab of [`dab_centres`] in order. `locked` has one flag per weight
-/// column; `column` must not be locked. On error nothing is changed.
+/// column; `column` must not be locked; `max_influences` is the limit K of non-zero weights per
+/// row (see the module doc; `None`: no limit). On error nothing is changed.
 #[allow(clippy::too_many_arguments)]
 pub fn paint_stroke(
     mesh: &PaintMesh,
@@ -226,21 +240,32 @@ pub fn paint_stroke(
     mode: BrushMode,
     samples_px: &[[f64; 2]],
     options: &BrushOptions,
+    max_influences: Option<usize>,
 ) -> Result<StrokeReport, PaintError> {
-    check_target(mesh, rows, locked, column)?;
+    check_target(mesh, rows, locked, column, max_influences)?;
     let dabs = dab_centres(samples_px, options)?;
     let mut report = StrokeReport {
         dabs: dabs.len(),
         vertex_changes: 0,
     };
     for centre in dabs {
-        report.vertex_changes += apply_dab(mesh, rows, locked, column, mode, centre, options);
+        report.vertex_changes += apply_dab(
+            mesh,
+            rows,
+            locked,
+            column,
+            mode,
+            centre,
+            options,
+            max_influences,
+        );
     }
     Ok(report)
 }
 
-/// Paints one dab at `centre_px`; returns how many vertices changed. On error nothing is
-/// changed.
+/// Paints one dab at `centre_px` (arguments as for [`paint_stroke`]); returns how many
+/// vertices changed. On error nothing is changed.
+#[allow(clippy::too_many_arguments)]
 pub fn paint_dab(
     mesh: &PaintMesh,
     rows: &mut [Vec<(u32, f64)>],
@@ -249,14 +274,22 @@ pub fn paint_dab(
     mode: BrushMode,
     centre_px: [f64; 2],
     options: &BrushOptions,
+    max_influences: Option<usize>,
 ) -> Result<usize, PaintError> {
-    check_target(mesh, rows, locked, column)?;
+    check_target(mesh, rows, locked, column, max_influences)?;
     check_options(options)?;
     if !(centre_px[0].is_finite() && centre_px[1].is_finite()) {
         return Err(PaintError::NotFinite(centre_px));
     }
     Ok(apply_dab(
-        mesh, rows, locked, column, mode, centre_px, options,
+        mesh,
+        rows,
+        locked,
+        column,
+        mode,
+        centre_px,
+        options,
+        max_influences,
     ))
 }
 
@@ -268,6 +301,7 @@ pub fn weight_in(row: &[(u32, f64)], column: usize) -> f64 {
 }
 
 /// One dab, inputs checked.
+#[allow(clippy::too_many_arguments)]
 fn apply_dab(
     mesh: &PaintMesh,
     rows: &mut [Vec<(u32, f64)>],
@@ -276,6 +310,7 @@ fn apply_dab(
     mode: BrushMode,
     centre: [f64; 2],
     options: &BrushOptions,
+    max_influences: Option<usize>,
 ) -> usize {
     let r = options.radius_px;
     // Targets first, all read from the rows before the dab, then the writes: smoothing must
@@ -315,7 +350,14 @@ fn apply_dab(
     }
     let mut changed = 0;
     for (i, target, spread) in changes {
-        if set_weight(&mut rows[i], column, target, locked, &spread) {
+        if set_weight(
+            &mut rows[i],
+            column,
+            target,
+            locked,
+            &spread,
+            max_influences,
+        ) {
             changed += 1;
         }
     }
@@ -325,15 +367,17 @@ fn apply_dab(
 /// Sets `column` of `row` to `target` (clamped to what the locked columns leave) and rescales
 /// the unlocked other columns so the row sums to one; locked columns are copied bit for bit.
 /// When the unlocked others all weigh zero, weight taken from `column` goes to them in the
-/// proportions of `spread` (one value per column; the neighbours' weights). Returns whether
-/// the row changed; it does not when every other column is locked, or when the weight would
-/// have nowhere to go.
+/// proportions of `spread` (one value per column; the neighbours' weights). With
+/// `max_influences`, the row is then cut back to that many weights as the module doc says.
+/// Returns whether the row changed; it does not when every other column is locked, or when the
+/// weight would have nowhere to go.
 pub fn set_weight(
     row: &mut Vec<(u32, f64)>,
     column: usize,
     target: f64,
     locked: &[bool],
     spread: &[f64],
+    max_influences: Option<usize>,
 ) -> bool {
     let columns = locked.len();
     let free = |k: usize| k != column && !locked[k];
@@ -368,6 +412,11 @@ pub fn set_weight(
         }
     }
     dense[column] = t;
+    if let Some(k) = max_influences {
+        if !limit_influences(&mut dense, column, locked, k) {
+            return false;
+        }
+    }
     // Locked entries go back exactly as they were (a locked zero stays absent).
     let next: Vec<(u32, f64)> = dense
         .iter()
@@ -379,6 +428,45 @@ pub fn set_weight(
         return false;
     }
     *row = next;
+    true
+}
+
+/// Cuts a dense row with the painted `column` set back to at most `max_influences` non-zero
+/// weights: the smallest unlocked others go first (ties: the higher column), and their weight
+/// is shared among the unlocked others that stay, in proportion. Returns false, leaving the
+/// row unusable, when weight was cut but no unlocked other stays to take it.
+fn limit_influences(
+    dense: &mut [f64],
+    column: usize,
+    locked: &[bool],
+    max_influences: usize,
+) -> bool {
+    let count = dense
+        .iter()
+        .enumerate()
+        .filter(|&(k, &w)| if locked[k] { w != 0.0 } else { w > 0.0 })
+        .count();
+    if count <= max_influences {
+        return true;
+    }
+    let mut others: Vec<usize> = (0..dense.len())
+        .filter(|&k| k != column && !locked[k] && dense[k] > 0.0)
+        .collect();
+    others.sort_by(|&a, &b| dense[a].total_cmp(&dense[b]).then(b.cmp(&a)));
+    let cut = (count - max_influences).min(others.len());
+    let dropped: f64 = others[..cut].iter().map(|&k| dense[k]).sum();
+    for &k in &others[..cut] {
+        dense[k] = 0.0;
+    }
+    let kept = &others[cut..];
+    let kept_sum: f64 = kept.iter().map(|&k| dense[k]).sum();
+    if dropped > 0.0 && kept_sum <= 0.0 {
+        return false;
+    }
+    let scale = (kept_sum + dropped) / kept_sum.max(f64::MIN_POSITIVE);
+    for &k in kept {
+        dense[k] = (dense[k] * scale).clamp(0.0, 1.0);
+    }
     true
 }
 
@@ -462,6 +550,7 @@ mod tests {
             BrushMode::Add,
             &stroke,
             &options,
+            None,
         )
         .unwrap();
         assert!(report.dabs > 5 && report.vertex_changes > 0, "{report:?}");
@@ -502,6 +591,7 @@ mod tests {
             BrushMode::Add,
             &stroke,
             &strong,
+            None,
         )
         .unwrap();
         check_rows(&full);
@@ -519,6 +609,7 @@ mod tests {
             BrushMode::Subtract,
             &stroke,
             &strong,
+            None,
         )
         .unwrap();
         check_rows(&less);
@@ -561,6 +652,7 @@ mod tests {
             BrushMode::Smooth,
             &stroke,
             &options,
+            None,
         )
         .unwrap();
         check_rows(&rows);
@@ -602,6 +694,7 @@ mod tests {
             BrushMode::Add,
             &[[20.0, 20.0]],
             &options,
+            None,
         )
         .unwrap();
         assert_eq!(report.vertex_changes, 0);
@@ -617,6 +710,7 @@ mod tests {
                 BrushMode::Add,
                 &[at],
                 options,
+                None,
             )
         };
         assert_eq!(
@@ -682,6 +776,7 @@ mod tests {
             BrushMode::Subtract,
             [0.0, 10.0],
             &options,
+            None,
         )
         .unwrap();
         assert_eq!(rows[3], vec![(0, 1.0)]);
@@ -694,6 +789,7 @@ mod tests {
             BrushMode::Subtract,
             [10.0, 0.0],
             &options,
+            None,
         )
         .unwrap();
         assert_eq!(rows[1], vec![(0, 0.5), (1, 0.5)]);
@@ -732,5 +828,113 @@ mod tests {
         }
         assert!((Falloff::Smooth.factor(5.0, 10.0) - 0.5625).abs() < 1e-15);
         assert!((Falloff::Linear.factor(5.0, 10.0) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_new_handle_at_the_influence_limit_replaces_the_weakest() {
+        let free = [false; 3];
+        // Two equal influences: the tie drops the higher column.
+        let mut row = vec![(0, 0.5), (1, 0.5)];
+        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], Some(2)));
+        assert_eq!(row.len(), 2, "{row:?}");
+        assert_eq!(row[0].0, 0);
+        assert!(
+            (row[0].1 - 0.9).abs() < 1e-15 && row[1] == (2, 0.1),
+            "{row:?}"
+        );
+        // Without a limit the same dab gives three influences.
+        let mut row = vec![(0, 0.5), (1, 0.5)];
+        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], None));
+        assert_eq!(row.len(), 3);
+        // The weakest goes, whatever its column.
+        let mut row = vec![(0, 0.2), (1, 0.8)];
+        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], Some(2)));
+        assert_eq!(row.iter().map(|e| e.0).collect::<Vec<_>>(), vec![1, 2]);
+        assert!((row.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_influence_limit_keeps_locked_weights_and_refuses_when_nothing_can_take_the_rest() {
+        // Column 0 locked at 0.3; K = 2 leaves room for one unlocked column only, so painting
+        // column 2 would need column 1's 0.7 to go somewhere: the row stays.
+        let locked = [true, false, false];
+        let mut row = vec![(0, 0.3), (1, 0.7)];
+        assert!(!set_weight(&mut row, 2, 0.2, &locked, &[0.0; 3], Some(2)));
+        assert_eq!(row, vec![(0, 0.3), (1, 0.7)]);
+        // With room for two unlocked columns, the painted one joins and the locked one is exact.
+        let mut row = vec![(0, 0.3), (1, 0.7)];
+        assert!(set_weight(&mut row, 2, 0.2, &locked, &[0.0; 3], Some(3)));
+        assert_eq!(row[0], (0, 0.3));
+        assert_eq!(row.len(), 3);
+        // K = 1 cannot blend: subtracting from a lone influence leaves it as it is.
+        let mut row = vec![(0, 1.0)];
+        assert!(!set_weight(
+            &mut row,
+            0,
+            0.6,
+            &[false; 2],
+            &[0.0, 1.0],
+            Some(1)
+        ));
+        assert_eq!(row, vec![(0, 1.0)]);
+    }
+
+    #[test]
+    fn strokes_respect_the_influence_limit_everywhere() {
+        let (v, t) = grid(21, 5.0);
+        let mesh = PaintMesh::new(&v, &t).unwrap();
+        // Rows with at most two influences; then paint the bump column across them.
+        let mut rows: Vec<Vec<(u32, f64)>> = rows_for(&v, 100.0)
+            .into_iter()
+            .map(|row| {
+                let dense: Vec<f64> = (0..3).map(|c| weight_in(&row, c)).collect();
+                crate::weights::part::sparse_row(
+                    &dense,
+                    &crate::weights::WeightOptions {
+                        max_influences: Some(2),
+                        ..Default::default()
+                    },
+                )
+            })
+            .collect();
+        let options = BrushOptions {
+            radius_px: 30.0,
+            strength: 0.3,
+            ..Default::default()
+        };
+        let stroke = [[10.0, 20.0], [90.0, 80.0]];
+        let report = paint_stroke(
+            &mesh,
+            &mut rows,
+            &[false; 3],
+            2,
+            BrushMode::Add,
+            &stroke,
+            &options,
+            Some(2),
+        )
+        .unwrap();
+        assert!(report.vertex_changes > 0);
+        check_rows(&rows);
+        assert!(rows.iter().all(|r| r.len() <= 2));
+        // The painted column did arrive under the stroke.
+        assert!(
+            weight_in(&rows[4 * 21 + 2], 2) > 0.3,
+            "{:?}",
+            rows[4 * 21 + 2]
+        );
+        assert_eq!(
+            paint_stroke(
+                &mesh,
+                &mut rows,
+                &[false; 3],
+                2,
+                BrushMode::Add,
+                &stroke,
+                &options,
+                Some(0),
+            ),
+            Err(PaintError::NoInfluences)
+        );
     }
 }
