@@ -15,6 +15,7 @@
 //! Paint tool, the handle locks and the per-vertex weights readout live in [`paint`].
 
 pub mod canvas;
+pub mod closing;
 pub mod colorize;
 pub mod gizmo;
 mod identity;
@@ -78,6 +79,15 @@ fn loops_by_default() -> bool {
 
 /// A save or autosave being written on another thread: its outcome arrives here.
 type Writing = std::sync::mpsc::Receiver<Result<PathBuf, DocumentError>>;
+
+/// A save being written on another thread (one that must trace and mesh first).
+struct Saving {
+    /// The snapshot written, for [`Document::saved`].
+    job: crate::document::SaveJob,
+    receive: Writing,
+    /// False once another document was opened meanwhile: its outcome is then only reported.
+    this_document: bool,
+}
 
 /// Writes `job` on another thread, waking the UI (`ctx`) when it is done.
 fn write_in_background(job: crate::document::SaveJob, ctx: Option<egui::Context>) -> Writing {
@@ -208,9 +218,10 @@ pub struct EditorApp {
     /// The autosave being written on another thread (a document never rigged is traced and
     /// meshed to be saved, too slow for the UI thread on large images).
     autosaving: Option<Writing>,
-    /// A save being written on another thread (one that must trace and mesh first), with its
-    /// snapshot for [`Document::saved`].
-    saving: Option<(crate::document::SaveJob, Writing)>,
+    /// A save being written on another thread.
+    saving: Option<Saving>,
+    /// Where a request to close the window stands.
+    closing: closing::Closing,
     /// The UI's context, for threads started outside a frame's call chain to wake it.
     repaint: Option<egui::Context>,
     /// Screenshot to take after a few frames, then quit (for `--screenshot`).
@@ -276,6 +287,7 @@ impl EditorApp {
             last_autosave_s: 0.0,
             autosaving: None,
             saving: None,
+            closing: Default::default(),
             repaint: None,
             screenshot: None,
             animation: first_animation,
@@ -365,10 +377,16 @@ impl EditorApp {
                 // Colorize mode's line art and strokes are not part of the rig document.
                 let colorize = std::mem::take(&mut self.colorize);
                 // An autosave still being written stays watched, so a new one for the same
-                // file does not start beside it.
+                // file does not start beside it; a save still being written is reported when
+                // it is done.
                 let autosaving = self.autosaving.take();
+                let saving = self.saving.take().map(|saving| Saving {
+                    this_document: false,
+                    ..saving
+                });
                 *self = EditorApp::new(doc);
                 self.autosaving = autosaving;
+                self.saving = saving;
                 self.colorize = colorize;
                 if let Some(view) = load_view(path) {
                     self.restore_view(view);
@@ -458,7 +476,11 @@ impl EditorApp {
         if self.doc.save_needs_build() {
             let job = self.doc.save_job(path);
             let receive = write_in_background(job.clone(), self.repaint.clone());
-            self.saving = Some((job, receive));
+            self.saving = Some(Saving {
+                job,
+                receive,
+                this_document: true,
+            });
             return format!("saving {}…", path.display());
         }
         if let Err(e) = self.doc.save(path) {
@@ -477,20 +499,22 @@ impl EditorApp {
     }
 
     /// Picks up a save finished on another thread: the document takes its path (and is clean
-    /// if unchanged since), the view is written beside it.
+    /// if unchanged since), the view is written beside it. A save of a document since closed
+    /// is only reported.
     fn poll_saving(&mut self) {
-        let Some(outcome) = self.saving.as_ref().and_then(|(_, r)| written(r)) else {
+        let Some(outcome) = self.saving.as_ref().and_then(|s| written(&s.receive)) else {
             return;
         };
-        let Some((job, _)) = self.saving.take() else {
+        let Some(saving) = self.saving.take() else {
             return;
         };
         self.message = Some(match outcome {
-            Ok(path) => {
-                self.doc.saved(&job);
+            Ok(path) if saving.this_document => {
+                self.doc.saved(&saving.job);
                 self.save_view(&path)
             }
-            Err(e) => format!("cannot save {}: {e}", job.target().display()),
+            Ok(path) => format!("saved {}", path.display()),
+            Err(e) => format!("cannot save {}: {e}", saving.job.target().display()),
         });
     }
 
@@ -597,6 +621,7 @@ impl EditorApp {
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
+        self.guard_close(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         self.advance_playback(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
@@ -610,6 +635,7 @@ impl EditorApp {
         if self.show_help {
             help_window(&ctx, &mut self.show_help);
         }
+        self.close_dialog(&ctx);
         self.take_screenshot(&ctx);
         self.last_frame_ms = started.elapsed().as_secs_f64() * 1e3;
     }
@@ -1605,6 +1631,10 @@ const SCREENSHOT_AFTER_FRAMES: u32 = 5;
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame(ui);
+    }
+
+    fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {
+        self.finish_writes();
     }
 }
 

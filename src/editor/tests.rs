@@ -288,6 +288,86 @@ fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
 }
 
 #[test]
+fn closing_with_unsaved_changes_asks_first() {
+    use closing::Closing;
+    let dir = std::env::temp_dir().join(format!("sinew-editor-close-{}", std::process::id()));
+    let mut h = never_rigged_bar(&dir);
+    assert!(h.state().doc.dirty);
+    let ask = |h: &mut Harness<'_, EditorApp>| {
+        h.state_mut().request_close();
+        h.run();
+        assert_eq!(h.state().closing(), Closing::Asking);
+        h.get_by_label("Save the changes to the document before closing?");
+    };
+    ask(&mut h);
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert_eq!(h.state().closing(), Closing::Open);
+
+    // Saving without a file name keeps the window open and says why.
+    h.state_mut().open_path.clear();
+    ask(&mut h);
+    h.get_by_label("Save").click();
+    h.run();
+    assert_eq!(h.state().closing(), Closing::Open);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("file name"), "{message}");
+
+    // With one, the save runs off the UI thread and the window closes once it is written.
+    let path = dir.join("bar.json");
+    h.state_mut().open_path = path.display().to_string();
+    ask(&mut h);
+    h.get_by_label("Save").click();
+    h.run();
+    assert!(h.state().saving());
+    assert_eq!(h.state().closing(), Closing::AfterSave);
+    wait_for(&mut h, |app| app.closing() == Closing::Allowed);
+    assert_eq!(h.state().closing(), Closing::Allowed);
+    assert!(!h.state().doc.dirty);
+    assert!(path.is_file());
+
+    // Discarding closes at once; a clean document closes without asking.
+    let mut h = never_rigged_bar(&dir);
+    ask(&mut h);
+    h.get_by_label("Don't save").click();
+    h.run();
+    assert_eq!(h.state().closing(), Closing::Allowed);
+    let mut clean = harness(EditorApp::new(Document::new()));
+    clean.state_mut().request_close();
+    assert_eq!(clean.state().closing(), Closing::Allowed);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_save_still_running_is_reported_after_reopening_and_finished_at_exit() {
+    let dir = std::env::temp_dir().join(format!("sinew-editor-reopen-{}", std::process::id()));
+    let mut h = never_rigged_bar(&dir);
+    let path = dir.join("bar.json");
+    h.state_mut().save_to(&path);
+    let other = character_rig("reopen-save");
+    h.state_mut().open(&other);
+    assert!(h.state().saving());
+    wait_for(&mut h, |app| !app.saving());
+    let message = h.state().message.clone().unwrap_or_default();
+    assert_eq!(message, format!("saved {}", path.display()));
+    // The save belonged to the closed document: the open one is untouched.
+    assert_eq!(h.state().doc.path.as_deref(), Some(other.as_path()));
+    assert!(!view_path(&path).exists());
+
+    // At exit the editor waits for writes still under way.
+    let mut h = never_rigged_bar(&dir);
+    let path = dir.join("exit.json");
+    h.state_mut().save_to(&path);
+    let ctx = h.ctx.clone();
+    h.state_mut().start_autosave(&path, &ctx);
+    h.state_mut().finish_writes();
+    assert!(path.is_file());
+    assert!(crate::document::autosave_path(&path).is_file());
+    assert!(!h.state().saving() && !h.state().autosaving());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
     let mut h = never_rigged_bar(&dir);
