@@ -4,7 +4,8 @@
 //! flag and the saves being written on other threads. Out: the close cancelled while a dialog
 //! asks whether to save the changes (Save, Don't save, Cancel); a save still being written
 //! finishes before the window closes; at exit the process waits for background writes, so
-//! neither a save nor an autosave is cut off halfway (which left its temporary file behind).
+//! neither a save nor an autosave is cut off halfway (which left its temporary file behind),
+//! and colorize strokes changed since their last autosave are autosaved.
 
 use super::EditorApp;
 use eframe::egui;
@@ -122,8 +123,10 @@ impl EditorApp {
         }
     }
 
-    /// Waits for the saves and autosaves being written on other threads (at exit).
+    /// At exit: autosaves colorize strokes changed since their last save or autosave, and
+    /// waits for the saves and autosaves being written on other threads.
     pub fn finish_writes(&mut self) {
+        self.autosave_scribbles();
         if let Some(saving) = self.saving.take() {
             let _ = saving.receive.recv();
         }

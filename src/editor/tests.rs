@@ -993,6 +993,17 @@ fn colorize_scribbles_save_load_and_autosave() {
         crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
         Vec::new()
     );
+
+    // At exit, strokes changed since the last autosave are written too.
+    assert!(h
+        .state_mut()
+        .apply_colorize(SessionCommand::AddStroke(strokes[0].clone())));
+    h.state_mut().finish_writes();
+    let text = std::fs::read_to_string(&autosaved).expect("autosaved");
+    assert_eq!(
+        crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
+        strokes[..1]
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
