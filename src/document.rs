@@ -91,8 +91,24 @@ pub enum DocumentError {
     LockedHandle(String),
     #[error("painting weights: {0}")]
     Paint(#[from] crate::weights::PaintError),
+    #[error("the stroke changed no weights{}", at_limit_note(*.at_limit, *.limit))]
+    NothingPainted {
+        at_limit: usize,
+        limit: Option<usize>,
+    },
     #[error(transparent)]
     KeyEdit(#[from] crate::anim::edit::EditError),
+}
+
+/// Why a stroke may change nothing: the vertices the influence limit held back.
+fn at_limit_note(at_limit: usize, limit: Option<usize>) -> String {
+    match limit {
+        Some(k) if at_limit > 0 => format!(
+            " ({at_limit} vertex dabs were held back by the influence limit of {k}: paint \
+             harder, or take a handle off those vertices first)"
+        ),
+        _ => String::new(),
+    }
 }
 
 /// Everything an edit can change; one undo step restores one of these.
@@ -193,7 +209,7 @@ pub enum Command {
     /// Paints one brush stroke (press to release) on `handle`'s weights over `part` (see
     /// [`crate::weights::paint`]): one undo step. Needs current weights; locked handles keep
     /// theirs, and a locked `handle` is refused. Rows keep the document's influence limit
-    /// (`max_influences`).
+    /// (`max_influences`). A stroke that changes no weight is refused.
     PaintWeights {
         part: String,
         handle: String,
@@ -971,16 +987,17 @@ fn paint_weights(
     }
     let mesh = PaintMesh::new(&part_doc.mesh.vertices, &part_doc.mesh.triangles)?;
     let mut rows = weights.rows.clone();
-    crate::weights::paint_stroke(
-        &mesh,
-        &mut rows,
-        &locked,
-        column,
-        mode,
-        samples_px,
-        options,
-        scene.doc.options.weights.max_influences,
+    let limit = scene.doc.options.weights.max_influences;
+    let report = crate::weights::paint_stroke(
+        &mesh, &mut rows, &locked, column, mode, samples_px, options, limit,
     )?;
+    // A stroke that changed nothing is no undo step.
+    if report.vertex_changes == 0 {
+        return Err(DocumentError::NothingPainted {
+            at_limit: report.at_limit,
+            limit,
+        });
+    }
     let painted = crate::io::WeightsDoc {
         handles: weights.handles.clone(),
         rows,

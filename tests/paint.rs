@@ -258,6 +258,33 @@ fn painting_keeps_the_influence_limit() {
         column(&painted, 2).iter().any(|&w| w > 0.3),
         "c was not painted"
     );
+
+    // With one influence per vertex a light stroke cannot take any vertex over: refused, and
+    // no undo step.
+    let mut options = doc.state().options.clone();
+    options.weights.max_influences = Some(1);
+    doc.apply(Command::SetOptions(options)).unwrap();
+    compute(&mut doc);
+    let before = rows(&doc);
+    let light = Command::PaintWeights {
+        part: "bar".into(),
+        handle: "c".into(),
+        mode: BrushMode::Add,
+        samples_px: vec![[40.0, 40.0], [100.0, 40.0]],
+        options: BrushOptions {
+            radius_px: 30.0,
+            strength: 0.05,
+            ..Default::default()
+        },
+    };
+    match doc.apply(light) {
+        Err(DocumentError::NothingPainted {
+            at_limit,
+            limit: Some(1),
+        }) => assert!(at_limit > 0),
+        other => panic!("expected the limit to refuse the stroke, got {other:?}"),
+    }
+    assert_eq!(rows(&doc), before);
 }
 
 #[test]

@@ -14,12 +14,16 @@
 //! rigid zone), the weight taken from `j` goes to the unlocked columns the vertex's mesh
 //! neighbours use, in their proportions; with none there either, the vertex stays as it is.
 //!
-//! With an influence limit K (the document's `max_influences`), a row the dab leaves with more
-//! than K weights loses its smallest unlocked ones other than the painted column, and their
-//! weight goes to the unlocked others it keeps: painting a new handle onto a vertex at the
-//! limit replaces its weakest one. Where nothing unlocked besides the painted column would be
-//! left to take that weight, the vertex stays as it is. Locked weights are never dropped, so a
-//! row whose locked weights alone reach K keeps them plus the painted column.
+//! With an influence limit K (the document's `max_influences`), a row the dab would leave with
+//! more than K weights drops its smallest unlocked ones, and their weight goes to the unlocked
+//! others it keeps (to the painted column when it is the only one). So a handle painted onto a
+//! vertex at the limit enters only once the dab gives it at least the weight of the vertex's
+//! weakest unlocked handle, which it then replaces; a weaker dab (a brush's rim, a light
+//! stroke, smoothing) leaves the vertex as it is and is counted in [`StrokeReport::at_limit`],
+//! and a dab that lowers the painted column below the weakest hands it over likewise. The
+//! changes thus stay as large as the brush's effect. Locked weights are never dropped; a row
+//! whose locked weights alone reach K keeps one unlocked weight beside them (as recomputes do,
+//! [`super::keep_locked`]).
 //!
 //! A stroke is resampled into dabs at a fixed spacing along its polyline, starting at its first
 //! sample, so the dabs of a stroke's prefix are a prefix of its dabs: an editor can preview a
@@ -137,12 +141,25 @@ impl PaintMesh {
     }
 }
 
-/// What a stroke did.
+/// What a stroke (or one dab) did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StrokeReport {
     pub dabs: usize,
     /// Vertex changes summed over the dabs (a vertex changed by two dabs counts twice).
     pub vertex_changes: usize,
+    /// Vertex dabs the influence limit refused, summed the same way.
+    pub at_limit: usize,
+}
+
+/// What a dab did to one vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DabOutcome {
+    Changed,
+    /// Nothing changed: the target was the weight already, every other column is locked, or
+    /// the weight taken from the painted column had nowhere to go.
+    Unchanged,
+    /// The influence limit refused the change (see the module doc).
+    AtLimit,
 }
 
 /// Checks `options` (radius, strength and spacing in range, finite).
@@ -244,12 +261,9 @@ pub fn paint_stroke(
 ) -> Result<StrokeReport, PaintError> {
     check_target(mesh, rows, locked, column, max_influences)?;
     let dabs = dab_centres(samples_px, options)?;
-    let mut report = StrokeReport {
-        dabs: dabs.len(),
-        vertex_changes: 0,
-    };
+    let mut report = StrokeReport::default();
     for centre in dabs {
-        report.vertex_changes += apply_dab(
+        report += apply_dab(
             mesh,
             rows,
             locked,
@@ -263,8 +277,8 @@ pub fn paint_stroke(
     Ok(report)
 }
 
-/// Paints one dab at `centre_px` (arguments as for [`paint_stroke`]); returns how many
-/// vertices changed. On error nothing is changed.
+/// Paints one dab at `centre_px` (arguments as for [`paint_stroke`]); returns what it did. On
+/// error nothing is changed.
 #[allow(clippy::too_many_arguments)]
 pub fn paint_dab(
     mesh: &PaintMesh,
@@ -275,7 +289,7 @@ pub fn paint_dab(
     centre_px: [f64; 2],
     options: &BrushOptions,
     max_influences: Option<usize>,
-) -> Result<usize, PaintError> {
+) -> Result<StrokeReport, PaintError> {
     check_target(mesh, rows, locked, column, max_influences)?;
     check_options(options)?;
     if !(centre_px[0].is_finite() && centre_px[1].is_finite()) {
@@ -311,7 +325,7 @@ fn apply_dab(
     centre: [f64; 2],
     options: &BrushOptions,
     max_influences: Option<usize>,
-) -> usize {
+) -> StrokeReport {
     let r = options.radius_px;
     // Targets first, all read from the rows before the dab, then the writes: smoothing must
     // not see half a dab, and the fallback spread reads the neighbours as they were.
@@ -348,9 +362,12 @@ fn apply_dab(
         }
         changes.push((i, target, spread));
     }
-    let mut changed = 0;
+    let mut report = StrokeReport {
+        dabs: 1,
+        ..Default::default()
+    };
     for (i, target, spread) in changes {
-        if set_weight(
+        match set_weight(
             &mut rows[i],
             column,
             target,
@@ -358,19 +375,28 @@ fn apply_dab(
             &spread,
             max_influences,
         ) {
-            changed += 1;
+            DabOutcome::Changed => report.vertex_changes += 1,
+            DabOutcome::AtLimit => report.at_limit += 1,
+            DabOutcome::Unchanged => {}
         }
     }
-    changed
+    report
+}
+
+impl std::ops::AddAssign for StrokeReport {
+    fn add_assign(&mut self, other: StrokeReport) {
+        self.dabs += other.dabs;
+        self.vertex_changes += other.vertex_changes;
+        self.at_limit += other.at_limit;
+    }
 }
 
 /// Sets `column` of `row` to `target` (clamped to what the locked columns leave) and rescales
 /// the unlocked other columns so the row sums to one; locked columns are copied bit for bit.
 /// When the unlocked others all weigh zero, weight taken from `column` goes to them in the
 /// proportions of `spread` (one value per column; the neighbours' weights). With
-/// `max_influences`, the row is then cut back to that many weights as the module doc says.
-/// Returns whether the row changed; it does not when every other column is locked, or when the
-/// weight would have nowhere to go.
+/// `max_influences`, the row then keeps that limit as the module doc says. The row is written
+/// only when the outcome is [`DabOutcome::Changed`].
 pub fn set_weight(
     row: &mut Vec<(u32, f64)>,
     column: usize,
@@ -378,11 +404,11 @@ pub fn set_weight(
     locked: &[bool],
     spread: &[f64],
     max_influences: Option<usize>,
-) -> bool {
+) -> DabOutcome {
     let columns = locked.len();
     let free = |k: usize| k != column && !locked[k];
     if !(0..columns).any(free) || !target.is_finite() {
-        return false;
+        return DabOutcome::Unchanged;
     }
     let mut dense = vec![0.0; columns];
     for &(c, w) in row.iter() {
@@ -404,17 +430,20 @@ pub fn set_weight(
             .map(|k| spread.get(k).copied().unwrap_or(0.0).max(0.0))
             .sum();
         if spread_sum.is_nan() || spread_sum <= 0.0 {
-            return false;
+            return DabOutcome::Unchanged;
         }
         for k in (0..columns).filter(|&k| free(k)) {
             let share = spread.get(k).copied().unwrap_or(0.0).max(0.0) / spread_sum;
             dense[k] = (rest * share).clamp(0.0, 1.0);
         }
     }
+    let raising = t > dense[column];
     dense[column] = t;
+    let mut limited = false;
     if let Some(k) = max_influences {
-        if !limit_influences(&mut dense, column, locked, k) {
-            return false;
+        match limit_influences(&mut dense, column, raising, locked, k) {
+            Some(cut) => limited = cut,
+            None => return DabOutcome::AtLimit,
         }
     }
     // Locked entries go back exactly as they were (a locked zero stays absent).
@@ -425,49 +454,75 @@ pub fn set_weight(
         .map(|(k, &w)| (k as u32, w))
         .collect();
     if next == *row {
-        return false;
+        // The limit may have cut the change back to the row as it was.
+        return if limited {
+            DabOutcome::AtLimit
+        } else {
+            DabOutcome::Unchanged
+        };
     }
     *row = next;
-    true
+    DabOutcome::Changed
 }
 
-/// Cuts a dense row with the painted `column` set back to at most `max_influences` non-zero
-/// weights: the smallest unlocked others go first (ties: the higher column), and their weight
-/// is shared among the unlocked others that stay, in proportion. Returns false, leaving the
-/// row unusable, when weight was cut but no unlocked other stays to take it.
+/// Cuts a dense row, its painted `column` just set (up when `raising`), back to at most
+/// `max_influences` non-zero weights, or to its locked ones plus one unlocked where those
+/// already reach the limit. The smallest unlocked weights go first; on a tie the painted column
+/// stays when raised and goes when lowered, then the higher column goes first. The weight cut
+/// goes to the unlocked others that stay, in proportion, or to the painted column when no
+/// other stays. Returns whether anything was cut, or `None` (the row unusable) when a raised
+/// painted column would be.
 fn limit_influences(
     dense: &mut [f64],
     column: usize,
+    raising: bool,
     locked: &[bool],
     max_influences: usize,
-) -> bool {
-    let count = dense
-        .iter()
-        .enumerate()
-        .filter(|&(k, &w)| if locked[k] { w != 0.0 } else { w > 0.0 })
+) -> Option<bool> {
+    let locked_count = (0..dense.len())
+        .filter(|&k| locked[k] && dense[k] != 0.0)
         .count();
-    if count <= max_influences {
-        return true;
-    }
-    let mut others: Vec<usize> = (0..dense.len())
-        .filter(|&k| k != column && !locked[k] && dense[k] > 0.0)
+    let mut unlocked: Vec<usize> = (0..dense.len())
+        .filter(|&k| !locked[k] && dense[k] > 0.0)
         .collect();
-    others.sort_by(|&a, &b| dense[a].total_cmp(&dense[b]).then(b.cmp(&a)));
-    let cut = (count - max_influences).min(others.len());
-    let dropped: f64 = others[..cut].iter().map(|&k| dense[k]).sum();
-    for &k in &others[..cut] {
+    let limit = max_influences.max(locked_count + 1);
+    if locked_count + unlocked.len() <= limit {
+        return Some(false);
+    }
+    // Ascending weight; ties: the column to keep sorts last.
+    let keep_rank = |k: usize| match (k == column, raising) {
+        (true, true) => 2,
+        (true, false) => 0,
+        (false, _) => 1,
+    };
+    unlocked.sort_by(|&a, &b| {
+        dense[a]
+            .total_cmp(&dense[b])
+            .then(keep_rank(a).cmp(&keep_rank(b)))
+            .then(b.cmp(&a))
+    });
+    let (cut, kept) = unlocked.split_at(locked_count + unlocked.len() - limit);
+    if raising && cut.contains(&column) {
+        return None;
+    }
+    let dropped: f64 = cut.iter().map(|&k| dense[k]).sum();
+    for &k in cut {
         dense[k] = 0.0;
     }
-    let kept = &others[cut..];
-    let kept_sum: f64 = kept.iter().map(|&k| dense[k]).sum();
-    if dropped > 0.0 && kept_sum <= 0.0 {
-        return false;
+    let takers: Vec<usize> = match kept
+        .iter()
+        .copied()
+        .filter(|&k| k != column)
+        .collect::<Vec<_>>()
+    {
+        others if !others.is_empty() => others,
+        _ => kept.to_vec(),
+    };
+    let takers_sum: f64 = takers.iter().map(|&k| dense[k]).sum();
+    for &k in &takers {
+        dense[k] = (dense[k] * (takers_sum + dropped) / takers_sum).clamp(0.0, 1.0);
     }
-    let scale = (kept_sum + dropped) / kept_sum.max(f64::MIN_POSITIVE);
-    for &k in kept {
-        dense[k] = (dense[k] * scale).clamp(0.0, 1.0);
-    }
-    true
+    Some(true)
 }
 
 #[cfg(test)]
@@ -831,52 +886,69 @@ mod tests {
     }
 
     #[test]
-    fn a_new_handle_at_the_influence_limit_replaces_the_weakest() {
+    fn a_new_handle_at_the_influence_limit_replaces_the_weakest_once_it_outweighs_it() {
+        use DabOutcome::{AtLimit, Changed, Unchanged};
         let free = [false; 3];
-        // Two equal influences: the tie drops the higher column.
+        let set = |row: &mut Vec<(u32, f64)>, column, target, limit| {
+            set_weight(row, column, target, &free, &[0.0; 3], limit)
+        };
+        // A light dab (a brush's rim) cannot push out a handle weighing far more.
         let mut row = vec![(0, 0.5), (1, 0.5)];
-        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], Some(2)));
-        assert_eq!(row.len(), 2, "{row:?}");
-        assert_eq!(row[0].0, 0);
-        assert!(
-            (row[0].1 - 0.9).abs() < 1e-15 && row[1] == (2, 0.1),
-            "{row:?}"
-        );
+        assert_eq!(set(&mut row, 2, 1e-4, Some(2)), AtLimit);
+        assert_eq!(row, vec![(0, 0.5), (1, 0.5)]);
         // Without a limit the same dab gives three influences.
-        let mut row = vec![(0, 0.5), (1, 0.5)];
-        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], None));
-        assert_eq!(row.len(), 3);
-        // The weakest goes, whatever its column.
+        assert_eq!(set(&mut row.clone(), 2, 1e-4, None), Changed);
+        // Outweighing the weakest replaces it; its weight goes to the one that stays.
         let mut row = vec![(0, 0.2), (1, 0.8)];
-        assert!(set_weight(&mut row, 2, 0.1, &free, &[0.0; 3], Some(2)));
+        assert_eq!(set(&mut row, 2, 0.3, Some(2)), Changed);
         assert_eq!(row.iter().map(|e| e.0).collect::<Vec<_>>(), vec![1, 2]);
-        assert!((row.iter().map(|e| e.1).sum::<f64>() - 1.0).abs() < 1e-12);
+        assert!((row[1].1 - 0.3).abs() < 1e-15);
+        assert!((row[0].1 + row[1].1 - 1.0).abs() < 1e-12);
+        // A handle already on the vertex is painted as without a limit.
+        let mut row = vec![(0, 0.2), (1, 0.8)];
+        assert_eq!(set(&mut row, 0, 0.5, Some(2)), Changed);
+        assert_eq!(row, vec![(0, 0.5), (1, 0.5)]);
+        assert_eq!(set(&mut row, 0, 0.5, Some(2)), Unchanged);
     }
 
     #[test]
-    fn the_influence_limit_keeps_locked_weights_and_refuses_when_nothing_can_take_the_rest() {
-        // Column 0 locked at 0.3; K = 2 leaves room for one unlocked column only, so painting
-        // column 2 would need column 1's 0.7 to go somewhere: the row stays.
-        let locked = [true, false, false];
-        let mut row = vec![(0, 0.3), (1, 0.7)];
-        assert!(!set_weight(&mut row, 2, 0.2, &locked, &[0.0; 3], Some(2)));
-        assert_eq!(row, vec![(0, 0.3), (1, 0.7)]);
-        // With room for two unlocked columns, the painted one joins and the locked one is exact.
-        let mut row = vec![(0, 0.3), (1, 0.7)];
-        assert!(set_weight(&mut row, 2, 0.2, &locked, &[0.0; 3], Some(3)));
-        assert_eq!(row[0], (0, 0.3));
-        assert_eq!(row.len(), 3);
-        // K = 1 cannot blend: subtracting from a lone influence leaves it as it is.
+    fn one_influence_per_vertex_flips_at_half_and_locked_rows_keep_one_unlocked() {
+        use DabOutcome::{AtLimit, Changed};
+        // K = 1: the painted handle takes the vertex once it would weigh at least half.
         let mut row = vec![(0, 1.0)];
-        assert!(!set_weight(
-            &mut row,
-            0,
-            0.6,
-            &[false; 2],
-            &[0.0, 1.0],
-            Some(1)
-        ));
+        assert_eq!(
+            set_weight(&mut row, 1, 0.4, &[false; 2], &[0.0; 2], Some(1)),
+            AtLimit
+        );
+        assert_eq!(
+            set_weight(&mut row, 1, 0.5, &[false; 2], &[0.0; 2], Some(1)),
+            Changed
+        );
+        assert_eq!(row, vec![(1, 1.0)]);
+        // Lowering it below half hands the vertex to the neighbours' handle.
+        assert_eq!(
+            set_weight(&mut row, 1, 0.6, &[false; 2], &[1.0, 0.0], Some(1)),
+            AtLimit
+        );
+        assert_eq!(row, vec![(1, 1.0)]);
+        assert_eq!(
+            set_weight(&mut row, 1, 0.4, &[false; 2], &[1.0, 0.0], Some(1)),
+            Changed
+        );
         assert_eq!(row, vec![(0, 1.0)]);
+        // Locked weights that reach K alone keep one unlocked weight beside them, which a
+        // painted handle replaces once it outweighs it; the locked ones stay bit for bit.
+        let locked = [true, true, false, false];
+        let mut row = vec![(0, 0.3), (1, 0.3), (2, 0.4)];
+        assert_eq!(
+            set_weight(&mut row, 3, 0.1, &locked, &[0.0; 4], Some(2)),
+            AtLimit
+        );
+        assert_eq!(
+            set_weight(&mut row, 3, 0.25, &locked, &[0.0; 4], Some(2)),
+            Changed
+        );
+        assert_eq!(row, vec![(0, 0.3), (1, 0.3), (3, 0.4)]);
     }
 
     #[test]
@@ -914,7 +986,10 @@ mod tests {
             Some(2),
         )
         .unwrap();
-        assert!(report.vertex_changes > 0);
+        assert!(
+            report.vertex_changes > 0 && report.at_limit > 0,
+            "{report:?}"
+        );
         check_rows(&rows);
         assert!(rows.iter().all(|r| r.len() <= 2));
         // The painted column did arrive under the stroke.
