@@ -594,14 +594,22 @@ impl EditorApp {
         }
     }
 
+    /// Where Save writes: the document's file, or else the File menu's path when it names a
+    /// `.json` file (the field also takes the PNGs to import, which must never be written
+    /// over).
+    fn save_target(&self) -> Option<PathBuf> {
+        self.doc.path.clone().or_else(|| {
+            let typed = PathBuf::from(self.open_path.trim());
+            typed
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+                .then_some(typed)
+        })
+    }
+
     fn save(&mut self) {
-        let Some(path) = self
-            .doc
-            .path
-            .clone()
-            .or_else(|| (!self.open_path.is_empty()).then(|| PathBuf::from(&self.open_path)))
-        else {
-            self.message = Some("type a file name in the File menu first".into());
+        let Some(path) = self.save_target() else {
+            self.message = Some("type a .json file name in the File menu first".into());
             return;
         };
         self.message = Some(self.save_to(&path));
@@ -612,6 +620,7 @@ impl EditorApp {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
         self.repaint = Some(ctx.clone());
+        self.dialog_takes_input(&ctx);
         self.poll_worker();
         self.poll_render();
         self.poll_rig_tools(&ctx);
@@ -1618,7 +1627,7 @@ impl EditorApp {
             if let Err(e) = saved {
                 eprintln!("sinew edit: screenshot: {e}");
             }
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            self.close(ctx);
         } else {
             ctx.request_repaint();
         }
@@ -1631,6 +1640,10 @@ const SCREENSHOT_AFTER_FRAMES: u32 = 5;
 impl eframe::App for EditorApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         self.frame(ui);
+    }
+
+    fn logic(&mut self, ctx: &egui::Context, _frame: &mut eframe::Frame) {
+        self.close_requests(ctx);
     }
 
     fn on_exit(&mut self, _gl: Option<&eframe::glow::Context>) {

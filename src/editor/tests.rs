@@ -287,53 +287,94 @@ fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Presses the window's close button, as eframe reports it; true when the editor cancelled
+/// the close.
+fn press_close_button(h: &mut Harness<'_, EditorApp>) -> bool {
+    h.input_mut()
+        .viewports
+        .entry(egui::ViewportId::ROOT)
+        .or_default()
+        .events
+        .push(egui::ViewportEvent::Close);
+    h.step();
+    let cancelled = h
+        .output()
+        .viewport_output
+        .get(&egui::ViewportId::ROOT)
+        .is_some_and(|v| v.commands.contains(&egui::ViewportCommand::CancelClose));
+    h.run();
+    cancelled
+}
+
 #[test]
 fn closing_with_unsaved_changes_asks_first() {
     use closing::Closing;
     let dir = std::env::temp_dir().join(format!("sinew-editor-close-{}", std::process::id()));
     let mut h = never_rigged_bar(&dir);
     assert!(h.state().doc.dirty);
-    let ask = |h: &mut Harness<'_, EditorApp>| {
-        h.state_mut().request_close();
-        h.run();
-        assert_eq!(h.state().closing(), Closing::Asking);
-        h.get_by_label("Save the changes to the document before closing?");
-    };
-    ask(&mut h);
-    h.get_by_label("Cancel").click();
-    h.run();
-    assert_eq!(h.state().closing(), Closing::Open);
-
-    // Saving without a file name keeps the window open and says why.
-    h.state_mut().open_path.clear();
-    ask(&mut h);
+    let png = dir.join("bar.png");
+    let png_bytes = std::fs::read(&png).expect("bar.png");
+    // The File menu's path field holds the imported PNG: Save must not write over it.
+    h.state_mut().open_path = png.display().to_string();
+    assert!(press_close_button(&mut h), "the close was not cancelled");
+    assert_eq!(h.state().closing(), Closing::Asking);
+    h.get_by_label(
+        "Save the changes before closing? (Type a .json file name in the File menu first.)",
+    );
     h.get_by_label("Save").click();
     h.run();
     assert_eq!(h.state().closing(), Closing::Open);
     let message = h.state().message.clone().unwrap_or_default();
-    assert!(message.contains("file name"), "{message}");
+    assert!(message.contains(".json file name"), "{message}");
+    assert_eq!(std::fs::read(&png).expect("bar.png"), png_bytes);
 
-    // With one, the save runs off the UI thread and the window closes once it is written.
+    // Keys and drops do not reach the document behind the dialog; Escape cancels it.
+    h.state_mut().request_close();
+    h.run();
+    let handles = h.state().doc.state().handles.clone();
+    h.key_press(Key::P);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(h.state().closing(), Closing::Asking);
+    assert_eq!(h.state().doc.state().handles, handles);
+    assert_eq!(
+        h.state().doc.state().layers.len(),
+        1,
+        "undo ran behind the dialog"
+    );
+    h.key_press(Key::Escape);
+    h.run();
+    assert_eq!(h.state().closing(), Closing::Open);
+
+    // With a file name, the save runs off the UI thread and the window closes once it is
+    // written.
     let path = dir.join("bar.json");
     h.state_mut().open_path = path.display().to_string();
-    ask(&mut h);
+    assert!(press_close_button(&mut h));
+    h.get_by_label(&format!(
+        "Save the changes to {} before closing?",
+        path.display()
+    ));
     h.get_by_label("Save").click();
     h.run();
     assert!(h.state().saving());
-    assert_eq!(h.state().closing(), Closing::AfterSave);
+    assert_eq!(h.state().closing(), Closing::Waiting);
     wait_for(&mut h, |app| app.closing() == Closing::Allowed);
     assert_eq!(h.state().closing(), Closing::Allowed);
     assert!(!h.state().doc.dirty);
     assert!(path.is_file());
+    // Once allowed, the close button is no longer cancelled.
+    assert!(!press_close_button(&mut h));
 
     // Discarding closes at once; a clean document closes without asking.
     let mut h = never_rigged_bar(&dir);
-    ask(&mut h);
+    h.state_mut().request_close();
+    h.run();
     h.get_by_label("Don't save").click();
     h.run();
     assert_eq!(h.state().closing(), Closing::Allowed);
     let mut clean = harness(EditorApp::new(Document::new()));
-    clean.state_mut().request_close();
+    assert!(!press_close_button(&mut clean));
     assert_eq!(clean.state().closing(), Closing::Allowed);
     let _ = std::fs::remove_dir_all(&dir);
 }
