@@ -120,6 +120,25 @@ pub enum MeshError {
     CrossingOutlines,
     #[error("invalid mesh option: {0}")]
     InvalidOptions(String),
+    #[error(
+        "the area limit asks for about {expected:.0} mesh vertices, more than {MAX_MESH_VERTICES}: \
+         raise max_area_fraction"
+    )]
+    TooFine { expected: f64 },
+}
+
+/// The most vertices a mesh may be asked for (outline points plus region area over the largest
+/// triangle area): a sprite's mesh is far smaller, and a tiny area limit would otherwise refine
+/// for minutes and fill the memory.
+pub const MAX_MESH_VERTICES: f64 = 2_000_000.0;
+
+/// The refinement budget for a mesh of about `expected` vertices, or why it is too fine to
+/// refine.
+fn steiner_budget(expected: f64, options: &MeshOptions) -> Result<usize, MeshError> {
+    if options.refine && !(expected <= MAX_MESH_VERTICES) {
+        return Err(MeshError::TooFine { expected });
+    }
+    Ok((options.steiner_budget_factor * expected).ceil() as usize)
 }
 
 impl Mesh {
@@ -213,7 +232,7 @@ pub fn triangulate(
     let max_area_px2 = options.max_area_fraction * canvas_area_px2;
     let region_area: f64 = rings.iter().map(|r| ring_signed_area(r)).sum();
     let expected = outline_points as f64 + region_area.abs() / max_area_px2;
-    let budget = (options.steiner_budget_factor * expected).ceil() as usize;
+    let budget = steiner_budget(expected, options)?;
     let params = refinement_parameters(options, max_area_px2, budget, true);
     let result = cdt.refine(params);
     let excluded: HashSet<_> = result.excluded_faces.into_iter().collect();
@@ -342,7 +361,7 @@ pub fn triangulate_with_handles(
     // hull and classify faces by their centroids afterwards.
     let max_area_px2 = options.max_area_fraction * canvas_area_px2;
     let expected = cdt.num_vertices() as f64 + bounds.area() / max_area_px2;
-    let budget = (options.steiner_budget_factor * expected).ceil() as usize;
+    let budget = steiner_budget(expected, options)?;
     cdt.refine(refinement_parameters(options, max_area_px2, budget, false));
 
     let in_shape = |c: Point| rings.iter().filter(|r| point_in_ring(c, r)).count() % 2 == 1;
@@ -798,5 +817,22 @@ mod tests {
             triangulate(&nan, 1.0, &MeshOptions::default()),
             Err(MeshError::NonFinite)
         );
+        // A tiny area limit is refused up front instead of refining for minutes.
+        let tiny = MeshOptions {
+            max_area_fraction: 1e-30,
+            ..MeshOptions::default()
+        };
+        assert!(matches!(
+            triangulate(&sq, 1.0, &tiny),
+            Err(MeshError::TooFine { .. })
+        ));
+        let geometry = HandleGeometry {
+            points: vec![Point::new(0.5, 0.5)],
+            ..Default::default()
+        };
+        assert!(matches!(
+            triangulate_with_handles(&sq, &geometry, 1.0, &tiny),
+            Err(MeshError::TooFine { .. })
+        ));
     }
 }
