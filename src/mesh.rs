@@ -121,7 +121,7 @@ pub enum MeshError {
     #[error("invalid mesh option: {0}")]
     InvalidOptions(String),
     #[error(
-        "the area limit asks for about {expected:.0} mesh vertices, more than {MAX_MESH_VERTICES}: \
+        "the area limit asks for about {expected:.3e} mesh vertices, more than {MAX_MESH_VERTICES}: \
          raise max_area_fraction"
     )]
     TooFine { expected: f64 },

@@ -22,6 +22,13 @@ use rayon::prelude::*;
 /// Frame rates above this are refused: nothing plays them, and a typo (`--fps 2400`) would
 /// otherwise render for minutes.
 pub const MAX_FPS: f64 = 240.0;
+/// Most frames one animation may play as (duration × fps): beyond, a typo'd key time (1e6 s)
+/// would allocate and render for ever.
+pub const MAX_FRAMES: f64 = 100_000.0;
+/// Largest output frame side, px.
+pub const MAX_FRAME_SIDE_PX: u32 = 16_384;
+/// Most memory a render may hold in frames (they are all kept until written), bytes: 4 GiB.
+pub const MAX_RENDER_BYTES: f64 = 4.0 * 1024.0 * 1024.0 * 1024.0;
 
 /// Where frames are drawn: an output of `size_px`, the canvas scaled by `scale` about its
 /// center and centered in it, over `background` (straight RGBA8; transparent when `None`).
@@ -84,6 +91,7 @@ pub fn render_animation(
 ) -> Result<Vec<RgbaImage>, RenderAnimationError> {
     let view = settings.view(scene.doc.canvas)?;
     let times = frame_times(animation.duration_s(), settings.fps)?;
+    check_render_memory(times.len(), &view)?;
     let poses = poses_at_with(animation, &times, &settings.sampling);
     Ok(render_poses(
         scene,
@@ -113,6 +121,25 @@ pub enum PlaybackError {
     Scale(f64),
     #[error("the output size must be at least 1×1 px")]
     Size,
+    #[error(
+        "the output frames would be {0:.0}×{1:.0} px: at most {MAX_FRAME_SIDE_PX} px a side \
+         (lower the scale or the size)"
+    )]
+    TooLarge(f64, f64),
+    #[error(
+        "the animation would play as {0:.3e} frames (duration × frame rate): at most {MAX_FRAMES}"
+    )]
+    TooManyFrames(f64),
+    #[error(
+        "the render would hold {frames} frames of {width}×{height} px, {gib:.1} GiB: at most 4 \
+         GiB (lower the frame rate, the scale or the duration)"
+    )]
+    TooMuchMemory {
+        frames: usize,
+        width: u32,
+        height: u32,
+        gib: f64,
+    },
 }
 
 impl FrameView {
@@ -127,11 +154,17 @@ impl FrameView {
         if !(scale.is_finite() && scale > 0.0) {
             return Err(PlaybackError::Scale(scale));
         }
-        let size_px = size_px
-            .unwrap_or_else(|| canvas_px.map(|c| (f64::from(c) * scale).ceil().max(1.0) as u32));
-        if size_px.contains(&0) {
+        let size = size_px.map_or_else(
+            || canvas_px.map(|c| (f64::from(c) * scale).ceil().max(1.0)),
+            |s| s.map(f64::from),
+        );
+        if size.contains(&0.0) {
             return Err(PlaybackError::Size);
         }
+        if size.iter().any(|&side| side > f64::from(MAX_FRAME_SIDE_PX)) {
+            return Err(PlaybackError::TooLarge(size[0], size[1]));
+        }
+        let size_px = size.map(|side| side as u32);
         Ok(FrameView {
             size_px,
             scale,
@@ -156,8 +189,26 @@ pub fn frame_times(duration_s: f64, fps: f64) -> Result<Vec<f64>, PlaybackError>
         return Err(PlaybackError::Fps(fps));
     }
     // A frame that lands on the duration up to rounding is the loop's start again.
-    let count = ((duration_s * fps) - FRAME_TIME_SLACK).ceil().max(1.0) as usize;
-    Ok((0..count).map(|i| i as f64 / fps).collect())
+    let count = ((duration_s * fps) - FRAME_TIME_SLACK).ceil().max(1.0);
+    if !(count <= MAX_FRAMES) {
+        return Err(PlaybackError::TooManyFrames(count));
+    }
+    Ok((0..count as usize).map(|i| i as f64 / fps).collect())
+}
+
+/// Fails when `frames` frames of `view`'s size would take more than [`MAX_RENDER_BYTES`].
+pub fn check_render_memory(frames: usize, view: &FrameView) -> Result<(), PlaybackError> {
+    let [width, height] = view.size_px;
+    let bytes = frames as f64 * f64::from(width) * f64::from(height) * 4.0;
+    if bytes > MAX_RENDER_BYTES {
+        return Err(PlaybackError::TooMuchMemory {
+            frames,
+            width,
+            height,
+            gib: bytes / (1024.0 * 1024.0 * 1024.0),
+        });
+    }
+    Ok(())
 }
 
 /// How far below a whole frame count `duration · fps` may fall and still count as it.
@@ -429,6 +480,29 @@ fn linear_key<V>(time: f64, value: V) -> crate::anim::timeline::Key<V> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn absurd_durations_and_sizes_are_refused_before_anything_is_allocated() {
+        assert_eq!(
+            frame_times(1e300, 24.0),
+            Err(PlaybackError::TooManyFrames(2.4e301))
+        );
+        assert!(frame_times(100_000.0 / 24.0, 24.0).is_ok());
+        assert!(matches!(
+            FrameView::new([64, 64], 1000.0, None, None),
+            Err(PlaybackError::TooLarge(..))
+        ));
+        assert!(matches!(
+            FrameView::new([64, 64], 1.0, Some([100_000, 10]), None),
+            Err(PlaybackError::TooLarge(..))
+        ));
+        let view = FrameView::new([64, 64], 1.0, Some([4096, 4096]), None).unwrap();
+        assert!(check_render_memory(64, &view).is_ok());
+        assert!(matches!(
+            check_render_memory(65, &view),
+            Err(PlaybackError::TooMuchMemory { frames: 65, .. })
+        ));
+    }
 
     #[test]
     fn frame_times_stop_before_the_loop_end() {

@@ -150,6 +150,73 @@ fn bad_rig_documents_fail_cleanly_without_output() {
 }
 
 #[test]
+fn absurd_sizes_and_durations_fail_cleanly_without_output() {
+    let dir = scratch("absurd");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let rig = dir.join("rig.json");
+    assert_bad_input(
+        &[
+            "rig",
+            s(&sprite),
+            "--max-area-fraction",
+            "1e-30",
+            "-o",
+            s(&rig),
+        ],
+        "raise max_area_fraction",
+    );
+    assert!(!rig.exists());
+
+    let handles = dir.join("handles.json");
+    std::fs::write(
+        &handles,
+        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
+    )
+    .unwrap();
+    assert!(
+        sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)])
+            .status
+            .success()
+    );
+    // One key at a typo'd time: 1e6 s of animation.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
+        {"time": 0, "value": 0}, {"time": 1e6, "value": 30}
+    ]}}}});
+    let long = dir.join("long.json");
+    std::fs::write(&long, doc.to_string()).unwrap();
+    let gif = dir.join("out.gif");
+    assert_bad_input(
+        &["render", s(&long), "--anim", "go", "-o", s(&gif)],
+        "frames (duration × frame rate)",
+    );
+    doc["animations"]["go"]["bones"]["a"]["rotate"][1]["time"] = 1.0.into();
+    let short = dir.join("short.json");
+    std::fs::write(&short, doc.to_string()).unwrap();
+    assert_bad_input(
+        &[
+            "render",
+            s(&short),
+            "--anim",
+            "go",
+            "--scale",
+            "1000",
+            "-o",
+            s(&gif),
+        ],
+        "px a side",
+    );
+    assert!(!gif.exists());
+    let export = dir.join("export");
+    assert_bad_input(
+        &["export", "spine", s(&long), "-o", s(&export)],
+        "duration × bake fps",
+    );
+}
+
+#[test]
 fn bad_handles_fail_cleanly_without_output() {
     let dir = scratch("bad-handles");
     let sprite = dir.join("critter.png");

@@ -122,12 +122,21 @@ impl Default for SpineOptions {
     }
 }
 
+/// Most times an animation is sampled to decide what to bake (duration × bake fps): a typo'd
+/// key time (1e6 s) would otherwise fill the memory.
+pub const MAX_BAKE_SAMPLES: f64 = 100_000.0;
+
 /// Highest bake rate accepted; a typo (`--fps 3000`) would otherwise write huge files.
 pub const MAX_BAKE_FPS: f64 = 240.0;
 
 /// What stops an export.
 #[derive(Debug, thiserror::Error)]
 pub enum SpineError {
+    #[error(
+        "animation '{animation}' would be sampled {samples:.3e} times (duration × bake fps): at \
+         most {MAX_BAKE_SAMPLES}"
+    )]
+    TooLong { animation: String, samples: f64 },
     #[error("part '{0}' has no weights: rig it with handles (sinew rig --handles) before exporting to Spine")]
     NoWeights(String),
     #[error("part '{part}': vertex {vertex} has no positive weight")]
@@ -353,6 +362,13 @@ pub fn export_spine(
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
     for (anim_name, animation) in &animations {
+        let samples = animation.duration_s() * options.bake_fps;
+        if !(samples <= MAX_BAKE_SAMPLES) {
+            return Err(SpineError::TooLong {
+                animation: anim_name.clone(),
+                samples,
+            });
+        }
         let times = bake::bake_times(animation.duration_s(), options.bake_fps);
         let samples = bake::sample_path(animation, &times, &path).map_err(SpineError::Pose)?;
         let mut baked = bake::bones_to_bake(
