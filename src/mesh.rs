@@ -135,7 +135,7 @@ pub const MAX_MESH_VERTICES: f64 = 2_000_000.0;
 /// The refinement budget for a mesh of about `expected` vertices, or why it is too fine to
 /// refine.
 fn steiner_budget(expected: f64, options: &MeshOptions) -> Result<usize, MeshError> {
-    if options.refine && !(expected <= MAX_MESH_VERTICES) {
+    if options.refine && (expected.is_nan() || expected > MAX_MESH_VERTICES) {
         return Err(MeshError::TooFine { expected });
     }
     Ok((options.steiner_budget_factor * expected).ceil() as usize)

@@ -190,7 +190,7 @@ pub fn frame_times(duration_s: f64, fps: f64) -> Result<Vec<f64>, PlaybackError>
     }
     // A frame that lands on the duration up to rounding is the loop's start again.
     let count = ((duration_s * fps) - FRAME_TIME_SLACK).ceil().max(1.0);
-    if !(count <= MAX_FRAMES) {
+    if count.is_nan() || count > MAX_FRAMES {
         return Err(PlaybackError::TooManyFrames(count));
     }
     Ok((0..count as usize).map(|i| i as f64 / fps).collect())

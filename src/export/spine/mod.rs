@@ -363,7 +363,7 @@ pub fn export_spine(
     let mut baked_report = Vec::new();
     for (anim_name, animation) in &animations {
         let samples = animation.duration_s() * options.bake_fps;
-        if !(samples <= MAX_BAKE_SAMPLES) {
+        if samples.is_nan() || samples > MAX_BAKE_SAMPLES {
             return Err(SpineError::TooLong {
                 animation: anim_name.clone(),
                 samples,
