@@ -217,6 +217,22 @@ fn absurd_sizes_and_durations_fail_cleanly_without_output() {
 }
 
 #[test]
+fn argument_errors_are_one_line() {
+    assert_bad_input(&["rig"], "required arguments were not provided: --output");
+    assert_bad_input(
+        &["autorig", "x.png", "--template", "robot", "-o", "x.json"],
+        "[possible values: humanoid, quadruped]",
+    );
+    assert_bad_input(
+        &["render", "r.json", "--fps", "abc", "-o", "x.gif"],
+        "'abc'",
+    );
+    let help = sinew(&["--help"]);
+    assert!(help.status.success());
+    assert!(String::from_utf8_lossy(&help.stdout).contains("Usage"));
+}
+
+#[test]
 fn bad_handles_fail_cleanly_without_output() {
     let dir = scratch("bad-handles");
     let sprite = dir.join("critter.png");
