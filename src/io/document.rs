@@ -239,6 +239,12 @@ impl RigDocument {
     }
 }
 
+/// Mesh coordinates beyond this (px, either sign) are refused: no canvas is that large, and
+/// skinning such a vertex overflows.
+pub const MAX_COORDINATE_PX: f64 = 1e6;
+/// How far a weight may lie outside [0, 1], and a row's sum from one, by rounding.
+pub const WEIGHT_TOLERANCE: f64 = 1e-6;
+
 fn validate_part(part: &PartDoc) -> Result<(), String> {
     let n = part.mesh.vertices.len();
     if let Some(i) = part
@@ -249,11 +255,24 @@ fn validate_part(part: &PartDoc) -> Result<(), String> {
     {
         return Err(format!("vertex {i} is not finite"));
     }
+    if let Some(i) = part
+        .mesh
+        .vertices
+        .iter()
+        .position(|v| v[0].abs() > MAX_COORDINATE_PX || v[1].abs() > MAX_COORDINATE_PX)
+    {
+        return Err(format!(
+            "vertex {i} lies beyond ±{MAX_COORDINATE_PX} px of the canvas origin"
+        ));
+    }
     for (t, tri) in part.mesh.triangles.iter().enumerate() {
         if let Some(&i) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(format!(
                 "triangle {t} uses vertex {i}, but the mesh has {n} vertices"
             ));
+        }
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+            return Err(format!("triangle {t} repeats a vertex: {tri:?}"));
         }
     }
     if let Some(w) = &part.weights {
@@ -281,6 +300,23 @@ fn validate_weights(w: &WeightsDoc, n: usize) -> Result<(), String> {
             if !value.is_finite() {
                 return Err(format!("vertex {i} has a weight that is not finite"));
             }
+            if !(-WEIGHT_TOLERANCE..=1.0 + WEIGHT_TOLERANCE).contains(&value) {
+                return Err(format!(
+                    "vertex {i} has weight {value} for handle {h}, outside [0, 1]"
+                ));
+            }
+        }
+        let mut columns: Vec<u32> = row.iter().map(|e| e.0).collect();
+        columns.sort_unstable();
+        if columns.windows(2).any(|p| p[0] == p[1]) {
+            return Err(format!("vertex {i} lists a handle twice"));
+        }
+        if row.is_empty() {
+            return Err(format!("vertex {i} has no weights"));
+        }
+        let sum: f64 = row.iter().map(|e| e.1).sum();
+        if (sum - 1.0).abs() > WEIGHT_TOLERANCE {
+            return Err(format!("vertex {i}'s weights sum to {sum}, not 1"));
         }
     }
     Ok(())
@@ -373,5 +409,48 @@ mod tests {
             RigDocument::from_json("{", p),
             Err(DocumentError::Json { .. })
         ));
+    }
+
+    #[test]
+    fn rejects_weights_that_do_not_form_rows_summing_to_one_and_absurd_meshes() {
+        let p = Path::new("r.json");
+        let mut doc = sample();
+        doc.parts[0].weights = Some(WeightsDoc {
+            handles: vec!["a".into(), "b".into()],
+            rows: vec![vec![(0, 1.0)], vec![(0, 0.25), (1, 0.75)], vec![(1, 1.0)]],
+        });
+        let good = serde_json::to_value(&doc).unwrap();
+        assert!(RigDocument::from_json(&good.to_string(), p).is_ok());
+        let reason = |edit: &dyn Fn(&mut serde_json::Value)| {
+            let mut v = good.clone();
+            edit(&mut v);
+            RigDocument::from_json(&v.to_string(), p)
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(reason(
+            &|v| v["parts"][0]["weights"]["rows"][1] = serde_json::json!([[0, -5.0], [1, 6.0]])
+        )
+        .contains("outside [0, 1]"));
+        assert!(reason(
+            &|v| v["parts"][0]["weights"]["rows"][1] = serde_json::json!([[0, 0.25], [1, 0.5]])
+        )
+        .contains("sum to 0.75, not 1"));
+        assert!(
+            reason(&|v| v["parts"][0]["weights"]["rows"][1] = serde_json::json!([]))
+                .contains("has no weights")
+        );
+        assert!(reason(
+            &|v| v["parts"][0]["weights"]["rows"][1] = serde_json::json!([[1, 0.5], [1, 0.5]])
+        )
+        .contains("lists a handle twice"));
+        assert!(
+            reason(&|v| v["parts"][0]["mesh"]["vertices"][0] = serde_json::json!([1e300, 0]))
+                .contains("beyond")
+        );
+        assert!(
+            reason(&|v| v["parts"][0]["mesh"]["triangles"][0] = serde_json::json!([0, 0, 0]))
+                .contains("repeats a vertex")
+        );
     }
 }
