@@ -273,10 +273,15 @@ impl Handles {
             problem,
         };
         let find = |name: &str| self.bones.iter().find(|b| b.name == name);
+        let mut names = HashSet::new();
         for c in &self.ik {
+            if !names.insert(c.name.as_str()) {
+                return Err(bad(c, "two ik constraints have this name".into()));
+            }
             if c.bones.is_empty() {
                 return Err(bad(c, "names no bones".into()));
             }
+            // A mix outside [0, 1] is clamped (see `BoneIk::mix`), only NaN is meaningless.
             if !(c.mix.is_finite() && c.softness_px.is_finite() && c.softness_px >= 0.0) {
                 return Err(bad(
                     c,
@@ -303,6 +308,64 @@ impl Handles {
                     ));
                 }
                 at = find(name).and_then(|b| b.parent.as_deref());
+            }
+        }
+        self.check_ik_cycles()
+    }
+
+    /// No ik constraint may (through others) move its own target: a constraint depends on each
+    /// one whose chain its target hangs from, and those dependencies must not form a cycle.
+    fn check_ik_cycles(&self) -> Result<(), HandleError> {
+        let parent = |name: &str| {
+            self.bones
+                .iter()
+                .find(|b| b.name == name)
+                .and_then(|b| b.parent.as_deref())
+        };
+        // Constraint i depends on j when j's chain holds the target of i or one of its ancestors.
+        let depends: Vec<Vec<usize>> = self
+            .ik
+            .iter()
+            .map(|c| {
+                let mut up = Vec::new();
+                let mut at = Some(c.target.as_str());
+                while let Some(name) = at {
+                    up.push(name);
+                    at = parent(name);
+                }
+                (0..self.ik.len())
+                    .filter(|&j| self.ik[j].bones.iter().any(|b| up.contains(&b.as_str())))
+                    .collect()
+            })
+            .collect();
+        // Depth-first search; 1 = on the current path, 2 = done.
+        fn visit(i: usize, depends: &[Vec<usize>], state: &mut [u8]) -> Option<usize> {
+            state[i] = 1;
+            for &j in &depends[i] {
+                match state[j] {
+                    1 => return Some(j),
+                    0 => {
+                        if let Some(found) = visit(j, depends, state) {
+                            return Some(found);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            state[i] = 2;
+            None
+        }
+        let mut state = vec![0u8; self.ik.len()];
+        for i in 0..self.ik.len() {
+            if state[i] == 0 {
+                if let Some(j) = visit(i, &depends, &mut state) {
+                    return Err(HandleError::BadIkConstraint {
+                        name: self.ik[j].name.clone(),
+                        problem: "its target is moved, through other ik constraints, by its own \
+                                  chain"
+                            .into(),
+                    });
+                }
             }
         }
         Ok(())
@@ -461,5 +524,38 @@ mod tests {
         h.bind.remove("ghost");
         h.bind.insert("p".into(), vec![]);
         assert_eq!(h.validate(), Err(HandleError::EmptyBind("p".into())));
+    }
+
+    #[test]
+    fn ik_constraints_have_distinct_names_and_do_not_chase_each_other() {
+        let bone = |name: &str, x: f64| Bone {
+            name: name.into(),
+            parent: None,
+            head: [x, 0.0],
+            tail: [x, 10.0],
+        };
+        let ik = |name: &str, chain: &str, target: &str| super::super::bone_ik::BoneIk {
+            name: name.into(),
+            bones: vec![chain.into()],
+            target: target.into(),
+            bend_positive: true,
+            mix: 1.0,
+            softness_px: 0.0,
+        };
+        let mut h = Handles {
+            bones: vec![bone("a", 0.0), bone("b", 20.0), bone("c", 40.0)],
+            ik: vec![ik("k", "a", "b"), ik("m", "c", "b")],
+            ..Default::default()
+        };
+        assert_eq!(h.validate(), Ok(()));
+        h.ik[1].name = "k".into();
+        assert!(matches!(
+            h.validate(),
+            Err(HandleError::BadIkConstraint { .. })
+        ));
+        // k moves a toward b while m moves b toward a.
+        h.ik[1] = ik("m", "b", "a");
+        let e = h.validate().unwrap_err().to_string();
+        assert!(e.contains("through other ik constraints"), "{e}");
     }
 }
