@@ -397,6 +397,14 @@ fn edit(args: &EditArgs) -> Result<()> {
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
     use crate::autorig::{self as ar, AutorigOptions, LayerRef};
+    let inputs: Vec<&Path> = args.images.iter().map(PathBuf::as_path).collect();
+    refuse_overwriting(
+        &inputs,
+        &[Some(args.output.as_path()), args.preview.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+    )?;
     let layers = pipeline::load_layers(&args.images)?;
     let mut options = AutorigOptions {
         template: args.template,
@@ -440,14 +448,77 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
     Ok(())
 }
 
+/// The file `path` names, resolved through links when it (or its folder) exists.
+fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    match (
+        path.parent().map(|d| {
+            if d.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                d
+            }
+        }),
+        path.file_name(),
+    ) {
+        (Some(dir), Some(name)) => dir
+            .canonicalize()
+            .map(|d| d.join(name))
+            .unwrap_or_else(|_| path.to_path_buf()),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Fails when an output names an input (the input would be written over, say a sprite with
+/// rig JSON) or another output.
+fn refuse_overwriting(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
+    let inputs: Vec<PathBuf> = inputs.iter().map(|p| resolved(p)).collect();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for output in outputs {
+        let at = resolved(output);
+        if inputs.contains(&at) {
+            bail!("{}: the output would overwrite an input", output.display());
+        }
+        if seen.contains(&at) {
+            bail!("{}: two outputs name the same file", output.display());
+        }
+        seen.push(at);
+    }
+    Ok(())
+}
+
 /// Reads a JSON file into `T`, naming the file in every error.
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
+    // Every file read here is a JSON object; serde would also take an array for a struct.
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a valid {what}", path.display()))?;
+    if !value.is_object() {
+        bail!(
+            "{}: not a valid {what}: expected a JSON object",
+            path.display()
+        );
+    }
     serde_json::from_str(&text).with_context(|| format!("{}: not a valid {what}", path.display()))
 }
 
 fn rig(args: &RigArgs) -> Result<()> {
+    let inputs: Vec<&Path> = args
+        .images
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(args.handles.as_deref())
+        .collect();
+    refuse_overwriting(
+        &inputs,
+        &[Some(args.output.as_path()), args.preview.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+    )?;
     let layers = pipeline::load_layers(&args.images)?;
     let handles: Handles = match &args.handles {
         Some(path) => read_json(path, "handles file")?,
@@ -541,6 +612,17 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
+    let inputs: Vec<&Path> = [Some(args.rig.as_path()), args.pose.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    refuse_overwriting(
+        &inputs,
+        &[args.output.as_deref(), args.vertices.as_deref()]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>(),
+    )?;
     let scene = Scene::load(&args.rig)?;
     let pose: Pose = match (&args.pose, &args.anim) {
         (Some(path), _) => read_json(path, "pose file")?,
@@ -577,6 +659,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
+    refuse_overwriting(&[&args.rig], &[&args.output])?;
     let scene = Scene::load(&args.rig)?;
     let animation = animation(&scene.doc, &args.anim)?;
     let settings = playback::RenderSettings {

@@ -251,6 +251,14 @@ fn bad_handles_fail_cleanly_without_output() {
         &["rig", s(&sprite), "--handles", s(&cyclic), "-o", s(&out)],
         "cyclic",
     );
+    let array = write("array.json", "[]");
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&array), "-o", s(&out)],
+        "expected a JSON object",
+    );
+    // An output that names an input is refused before the input is read over.
+    assert_bad_input(&["rig", s(&sprite), "-o", s(&sprite)], "would overwrite");
+    assert!(image::open(&sprite).is_ok());
     let unknown = write(
         "unknown.json",
         r#"{"bones": [{"name": "a", "parent": "zz", "head": [10, 10], "tail": [20, 20]}]}"#,

@@ -345,6 +345,13 @@ fn check_draw_order_keys(keys: &[StepKey<Vec<String>>]) -> Result<(), TimelineEr
 impl Animation {
     /// Parses and checks the animation `name` from its JSON value.
     pub fn from_json(name: &str, value: &serde_json::Value) -> Result<Animation, AnimError> {
+        // serde would also take an array for the struct (its fields in order).
+        if !value.is_object() {
+            return Err(AnimError::Malformed {
+                animation: name.into(),
+                reason: "expected an object: kind → timelines".into(),
+            });
+        }
         match Animation::deserialize(value) {
             Ok(animation) => {
                 animation.validate(name)?;

@@ -40,6 +40,11 @@ fn is_json(path: &Path) -> bool {
 
 pub fn run(args: &ColorizeArgs) -> Result<()> {
     let start = Instant::now();
+    let outputs: Vec<&Path> = [Some(args.output.as_path()), args.layers.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    super::refuse_overwriting(&[&args.lineart, &args.scribbles], &outputs)?;
     let options = ColorizeOptions {
         scale: args.scale,
         weights: args.weights,
