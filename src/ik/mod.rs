@@ -162,6 +162,8 @@ pub enum IkError {
     NoWeights,
     #[error("an ik drag or a handle transform is not a finite number")]
     NonFinite,
+    #[error("ik drag target ({0:e}, {1:e}) lies beyond ±{max} px", max = crate::rig::pose::MAX_POSED_PX)]
+    TargetTooFar(f64, f64),
     #[error(transparent)]
     Pose(#[from] crate::rig::pose::PoseError),
     #[error("the problem has {got} handle columns but the rig has {expected}")]

@@ -318,6 +318,13 @@ impl RigIk {
         if values.iter().any(|v| !v.is_finite()) || drag.weight.is_some_and(|w| w < 0.0) {
             return Err(IkError::NonFinite);
         }
+        if drag
+            .to
+            .iter()
+            .any(|v| v.abs() > crate::rig::pose::MAX_POSED_PX)
+        {
+            return Err(IkError::TargetTooFar(drag.to[0], drag.to[1]));
+        }
         let at = Point::new(drag.at[0], drag.at[1]);
         let (mesh, triangle, barycentric) =
             grip(&self.meshes, at, self.solver.options.grip_tolerance_px)

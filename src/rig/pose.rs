@@ -194,6 +194,32 @@ pub enum PoseError {
     NonFinite(String),
     #[error("the pose of '{0}' makes its transformation singular (a zero scale?)")]
     Singular(String),
+    #[error(
+        "the pose of '{0}' moves it beyond ±{MAX_POSED_PX} px or scales it by more than \
+         {MAX_POSED_SCALE}"
+    )]
+    OutOfRange(String),
+}
+
+/// How far a posed handle may move anything, px (either sign): no canvas is that large, and
+/// beyond it skinning and drawing overflow.
+pub const MAX_POSED_PX: f64 = 1e6;
+/// How much a posed handle may scale anything.
+pub const MAX_POSED_SCALE: f64 = 1e4;
+
+/// Fails when `transform`, handle `name`'s, reaches beyond [`MAX_POSED_PX`] or
+/// [`MAX_POSED_SCALE`].
+fn check_reach(transform: &Affine, name: &str) -> Result<(), PoseError> {
+    let moves = transform
+        .translation
+        .iter()
+        .all(|v| v.abs() <= MAX_POSED_PX);
+    let scales = transform.linear.iter().all(|v| v.abs() <= MAX_POSED_SCALE);
+    if moves && scales {
+        Ok(())
+    } else {
+        Err(PoseError::OutOfRange(name.to_string()))
+    }
 }
 
 /// A bone's rest frame: origin at the head, x axis along head → tail.
@@ -484,6 +510,9 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         }
     }
     out.extend(handles.regions.iter().map(|_| Affine::identity()));
+    for (transform, name) in out.iter().zip(handle_columns(handles)) {
+        check_reach(transform, &name)?;
+    }
     Ok(out)
 }
 
@@ -731,5 +760,23 @@ mod tests {
             handle_transforms(&arm(), &nan),
             Err(PoseError::NonFinite(_))
         ));
+        // Finite but absurd: thrown a light-year away, or scaled beyond any canvas.
+        for local in [
+            BonePose {
+                translate: [1e300, 0.0],
+                ..Default::default()
+            },
+            BonePose {
+                scale: [1e300, 1.0],
+                ..Default::default()
+            },
+        ] {
+            let mut far = Pose::default();
+            far.bones.insert("upper".into(), local);
+            assert_eq!(
+                handle_transforms(&arm(), &far).err(),
+                Some(PoseError::OutOfRange("upper".into()))
+            );
+        }
     }
 }
