@@ -398,7 +398,7 @@ fn edit(args: &EditArgs) -> Result<()> {
 fn autorig(args: &AutorigArgs) -> Result<()> {
     use crate::autorig::{self as ar, AutorigOptions, LayerRef};
     let inputs: Vec<&Path> = args.images.iter().map(PathBuf::as_path).collect();
-    refuse_overwriting(
+    check_outputs(
         &inputs,
         &[Some(args.output.as_path()), args.preview.as_deref()]
             .into_iter()
@@ -471,12 +471,21 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
-/// Fails when an output names an input (the input would be written over, say a sprite with
-/// rig JSON) or another output.
-fn refuse_overwriting(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
+/// Fails, before any work, when an output names an input (the input would be written over,
+/// say a sprite with rig JSON) or another output, or lies in a folder that does not exist
+/// (the outputs written before it would be left behind).
+fn check_outputs(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
     let inputs: Vec<PathBuf> = inputs.iter().map(|p| resolved(p)).collect();
     let mut seen: Vec<PathBuf> = Vec::new();
     for output in outputs {
+        let folder = parent_dir(output);
+        if !folder.as_os_str().is_empty() && !folder.is_dir() {
+            bail!(
+                "{}: cannot write there: folder {} does not exist",
+                output.display(),
+                folder.display()
+            );
+        }
         let at = resolved(output);
         if inputs.contains(&at) {
             bail!("{}: the output would overwrite an input", output.display());
@@ -512,7 +521,7 @@ fn rig(args: &RigArgs) -> Result<()> {
         .map(PathBuf::as_path)
         .chain(args.handles.as_deref())
         .collect();
-    refuse_overwriting(
+    check_outputs(
         &inputs,
         &[Some(args.output.as_path()), args.preview.as_deref()]
             .into_iter()
@@ -616,7 +625,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
         .into_iter()
         .flatten()
         .collect();
-    refuse_overwriting(
+    check_outputs(
         &inputs,
         &[args.output.as_deref(), args.vertices.as_deref()]
             .into_iter()
@@ -659,7 +668,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    refuse_overwriting(&[&args.rig], &[&args.output])?;
+    check_outputs(&[&args.rig], &[&args.output])?;
     let scene = Scene::load(&args.rig)?;
     let animation = animation(&scene.doc, &args.anim)?;
     let settings = playback::RenderSettings {

@@ -22,6 +22,9 @@ use rayon::prelude::*;
 /// Frame rates above this are refused: nothing plays them, and a typo (`--fps 2400`) would
 /// otherwise render for minutes.
 pub const MAX_FPS: f64 = 240.0;
+/// Lowest frame rate, frames per second (a frame every 10 s): below, GIF frame delays and
+/// sprite-sheet durations overflow their fields.
+pub const MIN_FPS: f64 = 0.1;
 /// Most frames one animation may play as (duration × fps): beyond, a typo'd key time (1e6 s)
 /// would allocate and render for ever.
 pub const MAX_FRAMES: f64 = 100_000.0;
@@ -44,7 +47,7 @@ pub struct FrameView {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RenderSettings {
-    /// Frames per second, in (0, [`MAX_FPS`]]. Default [`DEFAULT_RENDER_FPS`].
+    /// Frames per second, in [[`MIN_FPS`], [`MAX_FPS`]]. Default [`DEFAULT_RENDER_FPS`].
     pub fps: f64,
     /// Output px per canvas px, > 0. Default 1.
     pub scale: f64,
@@ -115,7 +118,9 @@ pub enum RenderAnimationError {
 /// What is wrong with a playback request.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlaybackError {
-    #[error("the frame rate must be a number in (0, {MAX_FPS}] frames per second, not {0}")]
+    #[error(
+        "the frame rate must be a number in [{MIN_FPS}, {MAX_FPS}] frames per second, not {0:e}"
+    )]
     Fps(f64),
     #[error("the scale must be a positive number, not {0}")]
     Scale(f64),
@@ -185,7 +190,7 @@ impl FrameView {
 /// Frame times (s) of an animation lasting `duration_s` played at `fps`: 0, 1/fps, … while
 /// below the duration; a single frame at 0 for an animation without duration.
 pub fn frame_times(duration_s: f64, fps: f64) -> Result<Vec<f64>, PlaybackError> {
-    if !(fps.is_finite() && fps > 0.0 && fps <= MAX_FPS) {
+    if !(MIN_FPS..=MAX_FPS).contains(&fps) {
         return Err(PlaybackError::Fps(fps));
     }
     // A frame that lands on the duration up to rounding is the loop's start again.

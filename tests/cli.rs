@@ -208,7 +208,19 @@ fn absurd_sizes_and_durations_fail_cleanly_without_output() {
         ],
         "px a side",
     );
+    assert_bad_input(
+        &["render", s(&short), "--anim", "go", "--fps", "0.001", "-o", s(&gif)],
+        "frame rate",
+    );
     assert!(!gif.exists());
+    // A second output in a missing folder fails before the first is written.
+    let nowhere = dir.join("missing/preview.png");
+    let other = dir.join("other.json");
+    assert_bad_input(
+        &["rig", s(&sprite), "-o", s(&other), "--preview", s(&nowhere)],
+        "does not exist",
+    );
+    assert!(!other.exists());
     let export = dir.join("export");
     assert_bad_input(
         &["export", "spine", s(&long), "-o", s(&export)],

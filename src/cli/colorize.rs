@@ -44,7 +44,7 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         .into_iter()
         .flatten()
         .collect();
-    super::refuse_overwriting(&[&args.lineart, &args.scribbles], &outputs)?;
+    super::check_outputs(&[&args.lineart, &args.scribbles], &outputs)?;
     let options = ColorizeOptions {
         scale: args.scale,
         weights: args.weights,

@@ -104,7 +104,7 @@ pub enum DocumentError {
     },
     #[error("{path}: not valid JSON: {reason}")]
     Json { path: PathBuf, reason: String },
-    #[error("{path}: not a sinew rig (format is {found:?}, expected \"{RIG_FORMAT}\")")]
+    #[error("{path}: not a sinew rig (format is {found}, expected \"{RIG_FORMAT}\")")]
     WrongFormat { path: PathBuf, found: String },
     #[error("{path}: unsupported rig version {found} (this sinew reads version {RIG_VERSION})")]
     WrongVersion { path: PathBuf, found: String },
@@ -184,7 +184,12 @@ impl RigDocument {
                 found: field("version"),
             });
         }
-        let doc: RigDocument = serde_json::from_value(value).map_err(json_error)?;
+        // Valid JSON by now: what is left is a field of the wrong shape.
+        let doc: RigDocument =
+            serde_json::from_value(value).map_err(|e| DocumentError::Invalid {
+                path: path.into(),
+                reason: format!("not a valid rig document: {e}"),
+            })?;
         doc.validate().map_err(|reason| DocumentError::Invalid {
             path: path.into(),
             reason,
