@@ -397,13 +397,9 @@ fn edit(args: &EditArgs) -> Result<()> {
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
     use crate::autorig::{self as ar, AutorigOptions, LayerRef};
-    let inputs: Vec<&Path> = args.images.iter().map(PathBuf::as_path).collect();
     check_outputs(
-        &inputs,
-        &[Some(args.output.as_path()), args.preview.as_deref()]
-            .into_iter()
-            .flatten()
-            .collect::<Vec<_>>(),
+        args.images.iter().map(PathBuf::as_path),
+        [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
     let layers = pipeline::load_layers(&args.images)?;
     let mut options = AutorigOptions {
@@ -474,10 +470,14 @@ fn resolved(path: &Path) -> PathBuf {
 /// Fails, before any work, when an output names an input (the input would be written over,
 /// say a sprite with rig JSON) or another output, or lies in a folder that does not exist
 /// (the outputs written before it would be left behind).
-fn check_outputs(inputs: &[&Path], outputs: &[&Path]) -> Result<()> {
-    let inputs: Vec<PathBuf> = inputs.iter().map(|p| resolved(p)).collect();
+/// Absent (`None`) outputs are skipped.
+fn check_outputs<'a>(
+    inputs: impl IntoIterator<Item = &'a Path>,
+    outputs: impl IntoIterator<Item = Option<&'a Path>>,
+) -> Result<()> {
+    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
     let mut seen: Vec<PathBuf> = Vec::new();
-    for output in outputs {
+    for output in outputs.into_iter().flatten() {
         let folder = parent_dir(output);
         if !folder.as_os_str().is_empty() && !folder.is_dir() {
             bail!(
@@ -515,18 +515,12 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<
 }
 
 fn rig(args: &RigArgs) -> Result<()> {
-    let inputs: Vec<&Path> = args
-        .images
-        .iter()
-        .map(PathBuf::as_path)
-        .chain(args.handles.as_deref())
-        .collect();
     check_outputs(
-        &inputs,
-        &[Some(args.output.as_path()), args.preview.as_deref()]
-            .into_iter()
-            .flatten()
-            .collect::<Vec<_>>(),
+        args.images
+            .iter()
+            .map(PathBuf::as_path)
+            .chain(args.handles.as_deref()),
+        [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
     let layers = pipeline::load_layers(&args.images)?;
     let handles: Handles = match &args.handles {
@@ -621,16 +615,11 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
-    let inputs: Vec<&Path> = [Some(args.rig.as_path()), args.pose.as_deref()]
-        .into_iter()
-        .flatten()
-        .collect();
     check_outputs(
-        &inputs,
-        &[args.output.as_deref(), args.vertices.as_deref()]
+        [Some(args.rig.as_path()), args.pose.as_deref()]
             .into_iter()
-            .flatten()
-            .collect::<Vec<_>>(),
+            .flatten(),
+        [args.output.as_deref(), args.vertices.as_deref()],
     )?;
     let scene = Scene::load(&args.rig)?;
     let pose: Pose = match (&args.pose, &args.anim) {
@@ -668,7 +657,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    check_outputs(&[&args.rig], &[&args.output])?;
+    check_outputs([args.rig.as_path()], [Some(args.output.as_path())])?;
     let scene = Scene::load(&args.rig)?;
     let animation = animation(&scene.doc, &args.anim)?;
     let settings = playback::RenderSettings {

@@ -209,7 +209,16 @@ fn absurd_sizes_and_durations_fail_cleanly_without_output() {
         "px a side",
     );
     assert_bad_input(
-        &["render", s(&short), "--anim", "go", "--fps", "0.001", "-o", s(&gif)],
+        &[
+            "render",
+            s(&short),
+            "--anim",
+            "go",
+            "--fps",
+            "0.001",
+            "-o",
+            s(&gif),
+        ],
         "frame rate",
     );
     assert!(!gif.exists());

@@ -233,23 +233,26 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
 fn painting_keeps_the_influence_limit() {
     let dir = scratch("paint-limit");
     let mut doc = arm(&dir);
-    let mut options = doc.state().options.clone();
-    options.weights.max_influences = Some(2);
-    doc.apply(Command::SetOptions(options)).unwrap();
-    compute(&mut doc);
+    let limit_and_compute = |doc: &mut Document, k: usize| {
+        let mut options = doc.state().options.clone();
+        options.weights.max_influences = Some(k);
+        doc.apply(Command::SetOptions(options)).unwrap();
+        compute(doc);
+    };
     // c painted over a's end of the bar, where a and b already weigh every vertex.
-    doc.apply(Command::PaintWeights {
+    let paint_c = |strength: f64| Command::PaintWeights {
         part: "bar".into(),
         handle: "c".into(),
         mode: BrushMode::Add,
         samples_px: vec![[40.0, 40.0], [100.0, 40.0]],
         options: BrushOptions {
             radius_px: 30.0,
-            strength: 0.5,
+            strength,
             ..Default::default()
         },
-    })
-    .unwrap();
+    };
+    limit_and_compute(&mut doc, 2);
+    doc.apply(paint_c(0.5)).unwrap();
     let painted = rows(&doc);
     check_rows(&painted);
     let widest = painted.iter().map(Vec::len).max().unwrap_or(0);
@@ -261,23 +264,9 @@ fn painting_keeps_the_influence_limit() {
 
     // With one influence per vertex a light stroke cannot take any vertex over: refused, and
     // no undo step.
-    let mut options = doc.state().options.clone();
-    options.weights.max_influences = Some(1);
-    doc.apply(Command::SetOptions(options)).unwrap();
-    compute(&mut doc);
+    limit_and_compute(&mut doc, 1);
     let before = rows(&doc);
-    let light = Command::PaintWeights {
-        part: "bar".into(),
-        handle: "c".into(),
-        mode: BrushMode::Add,
-        samples_px: vec![[40.0, 40.0], [100.0, 40.0]],
-        options: BrushOptions {
-            radius_px: 30.0,
-            strength: 0.05,
-            ..Default::default()
-        },
-    };
-    match doc.apply(light) {
+    match doc.apply(paint_c(0.05)) {
         Err(DocumentError::NothingPainted {
             at_limit,
             limit: Some(1),

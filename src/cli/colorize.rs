@@ -40,11 +40,10 @@ fn is_json(path: &Path) -> bool {
 
 pub fn run(args: &ColorizeArgs) -> Result<()> {
     let start = Instant::now();
-    let outputs: Vec<&Path> = [Some(args.output.as_path()), args.layers.as_deref()]
-        .into_iter()
-        .flatten()
-        .collect();
-    super::check_outputs(&[&args.lineart, &args.scribbles], &outputs)?;
+    super::check_outputs(
+        [args.lineart.as_path(), args.scribbles.as_path()],
+        [Some(args.output.as_path()), args.layers.as_deref()],
+    )?;
     let options = ColorizeOptions {
         scale: args.scale,
         weights: args.weights,

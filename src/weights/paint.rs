@@ -975,17 +975,19 @@ mod tests {
             ..Default::default()
         };
         let stroke = [[10.0, 20.0], [90.0, 80.0]];
-        let report = paint_stroke(
-            &mesh,
-            &mut rows,
-            &[false; 3],
-            2,
-            BrushMode::Add,
-            &stroke,
-            &options,
-            Some(2),
-        )
-        .unwrap();
+        let mut paint = |rows: &mut Vec<Vec<(u32, f64)>>, limit| {
+            paint_stroke(
+                &mesh,
+                rows,
+                &[false; 3],
+                2,
+                BrushMode::Add,
+                &stroke,
+                &options,
+                limit,
+            )
+        };
+        let report = paint(&mut rows, Some(2)).unwrap();
         assert!(
             report.vertex_changes > 0 && report.at_limit > 0,
             "{report:?}"
@@ -998,18 +1000,6 @@ mod tests {
             "{:?}",
             rows[4 * 21 + 2]
         );
-        assert_eq!(
-            paint_stroke(
-                &mesh,
-                &mut rows,
-                &[false; 3],
-                2,
-                BrushMode::Add,
-                &stroke,
-                &options,
-                Some(0),
-            ),
-            Err(PaintError::NoInfluences)
-        );
+        assert_eq!(paint(&mut rows, Some(0)), Err(PaintError::NoInfluences));
     }
 }
