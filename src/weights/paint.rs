@@ -975,7 +975,7 @@ mod tests {
             ..Default::default()
         };
         let stroke = [[10.0, 20.0], [90.0, 80.0]];
-        let mut paint = |rows: &mut Vec<Vec<(u32, f64)>>, limit| {
+        let paint = |rows: &mut Vec<Vec<(u32, f64)>>, limit| {
             paint_stroke(
                 &mesh,
                 rows,
