@@ -229,12 +229,16 @@ pub struct PreparedLineArt {
     pub options: ColorizeOptions,
 }
 
+/// Largest lift scale, px per full color change: far beyond any image's size, where the
+/// lifted Laplacian loses its positive definiteness to rounding.
+pub const MAX_LIFT_SCALE_PX: f64 = 1e5;
+
 impl PreparedLineArt {
     /// Checks `options` and prepares `lineart` for colorizations with them.
     pub fn new(lineart: RgbaImage, options: ColorizeOptions) -> Result<Self, ColorizeError> {
-        if !(options.scale.is_finite() && options.scale >= 0.0) {
+        if !(0.0..=MAX_LIFT_SCALE_PX).contains(&options.scale) {
             return Err(ColorizeError::InvalidOptions(format!(
-                "the lift scale must be finite and non-negative, not {}",
+                "the lift scale must lie in [0, {MAX_LIFT_SCALE_PX}] px, not {:e}",
                 options.scale
             )));
         }

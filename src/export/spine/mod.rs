@@ -257,6 +257,13 @@ pub fn export_spine(
         return Err(SpineError::MaxVertices(n));
     }
     check_name("file", name, true)?;
+    if name.contains(['/', '\\']) {
+        return Err(SpineError::BadName {
+            kind: "file",
+            name: name.to_string(),
+            reason: "a file name cannot contain / or \\ (the output folder is -o)",
+        });
+    }
     check_name("root bone", &options.root_bone, false)?;
     for part in &doc.parts {
         check_name("part", &part.name, true)?;
