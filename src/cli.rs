@@ -746,6 +746,17 @@ struct LayerList {
 }
 
 fn demo(args: &DemoArgs) -> Result<()> {
+    let created = !args.output.exists();
+    let result = demo_steps(args);
+    // A run that failed before writing anything leaves no empty folder behind (remove_dir only
+    // removes an empty one).
+    if result.is_err() && created {
+        let _ = std::fs::remove_dir(&args.output);
+    }
+    result
+}
+
+fn demo_steps(args: &DemoArgs) -> Result<()> {
     let started = Instant::now();
     let list_path = args.assets.join("layers.json");
     let list: LayerList = serde_json::from_str(

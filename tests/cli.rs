@@ -254,6 +254,23 @@ fn argument_errors_are_one_line() {
 }
 
 #[test]
+fn a_failed_demo_leaves_no_empty_folder() {
+    let dir = scratch("demo-fail");
+    let assets = dir.join("assets");
+    std::fs::create_dir_all(&assets).unwrap();
+    common::critter(64).save(assets.join("body.png")).unwrap();
+    std::fs::write(assets.join("layers.json"), r#"{"layers": ["body"]}"#).unwrap();
+    std::fs::write(
+        assets.join("handles.json"),
+        r#"{"bones": [{"name": "a", "parent": "a", "head": [10, 10], "tail": [20, 20]}]}"#,
+    )
+    .unwrap();
+    let out = dir.join("out");
+    assert_bad_input(&["demo", "--assets", s(&assets), "-o", s(&out)], "cyclic");
+    assert!(!out.exists());
+}
+
+#[test]
 fn bad_handles_fail_cleanly_without_output() {
     let dir = scratch("bad-handles");
     let sprite = dir.join("critter.png");
