@@ -24,7 +24,7 @@ use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelin
 use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle, Pose, Region};
-use crate::weights::{BrushMode, BrushOptions, PaintMesh};
+use crate::weights::{BrushMode, BrushOptions, PaintMesh, PaintTarget};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -989,7 +989,16 @@ fn paint_weights(
     let mut rows = weights.rows.clone();
     let limit = scene.doc.options.weights.max_influences;
     let report = crate::weights::paint_stroke(
-        &mesh, &mut rows, &locked, column, mode, samples_px, options, limit,
+        &mesh,
+        &mut rows,
+        &PaintTarget {
+            column,
+            locked: &locked,
+            max_influences: limit,
+        },
+        mode,
+        samples_px,
+        options,
     )?;
     // A stroke that changed nothing is no undo step.
     if report.vertex_changes == 0 {

@@ -137,12 +137,14 @@ impl EditorApp {
             if let Err(e) = crate::weights::paint_dab(
                 &stroke.mesh,
                 &mut stroke.rows,
-                &stroke.locked,
-                stroke.column,
+                &crate::weights::PaintTarget {
+                    column: stroke.column,
+                    locked: &stroke.locked,
+                    max_influences: stroke.max_influences,
+                },
                 self.paint.mode,
                 centre,
                 &self.paint.options,
-                stroke.max_influences,
             ) {
                 self.message = Some(e.to_string());
                 return;

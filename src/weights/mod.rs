@@ -32,6 +32,7 @@ pub use monotone::{
 };
 pub use paint::{
     dab_centres, paint_dab, paint_stroke, BrushMode, BrushOptions, Falloff, PaintError, PaintMesh,
+    PaintTarget,
 };
 pub use part::{part_weights, PartWeights, WeightError, WeightMethod, WeightOptions};
 pub use solve::{

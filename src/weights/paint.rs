@@ -1,10 +1,11 @@
 //! Weight painting: brush dabs on one part's skinning weights, with locked columns.
 //!
 //! In: a part's rest mesh ([`PaintMesh`]: vertices in canvas px and their mesh neighbours), its
-//! sparse weight rows (per vertex its non-zero `(column, weight)` pairs, summing to one), one
-//! locked flag per weight column, the column painted, a [`BrushMode`], the stroke's samples in
-//! canvas px and [`BrushOptions`]. Out: the rows changed in place, still summing to one (to
-//! 1e-9), every weight in [0, 1], locked columns bit-identical.
+//! sparse weight rows (per vertex its non-zero `(column, weight)` pairs, summing to one), a
+//! [`PaintTarget`] (the column painted, one locked flag per weight column, the influence
+//! limit), a [`BrushMode`], the stroke's samples in canvas px and [`BrushOptions`]. Out: the
+//! rows changed in place, still summing to one (to 1e-9), every weight in [0, 1], locked
+//! columns bit-identical, and a [`StrokeReport`].
 //!
 //! A dab sets the painted column `j` of each vertex within the radius to a target (add,
 //! subtract, or move toward the neighbours' average), and then rescales the *unlocked other*
@@ -221,15 +222,29 @@ pub fn dab_centres(
     Ok(dabs)
 }
 
-/// Checks that `rows` and `locked` fit `mesh` and that `column` can be painted; returns the
-/// number of columns.
+/// Which column a brush paints, and what it must leave as it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PaintTarget<'a> {
+    /// The column painted; it must not be locked.
+    pub column: usize,
+    /// One flag per weight column: locked columns never change.
+    pub locked: &'a [bool],
+    /// The most non-zero weights a row may have (see the module doc); `None`: no limit.
+    pub max_influences: Option<usize>,
+}
+
+/// Checks that `rows` and the target's locks fit `mesh` and that its column can be painted;
+/// returns the number of columns.
 fn check_target(
     mesh: &PaintMesh,
     rows: &[Vec<(u32, f64)>],
-    locked: &[bool],
-    column: usize,
-    max_influences: Option<usize>,
+    target: &PaintTarget,
 ) -> Result<usize, PaintError> {
+    let PaintTarget {
+        column,
+        locked,
+        max_influences,
+    } = *target;
     if max_influences == Some(0) {
         return Err(PaintError::NoInfluences);
     }
@@ -245,66 +260,41 @@ fn check_target(
     Ok(columns)
 }
 
-/// Paints one stroke: every dab of [`dab_centres`] in order. `locked` has one flag per weight
-/// column; `column` must not be locked; `max_influences` is the limit K of non-zero weights per
-/// row (see the module doc; `None`: no limit). On error nothing is changed.
-#[allow(clippy::too_many_arguments)]
+/// Paints one stroke on `target`: every dab of [`dab_centres`] in order. On error nothing is
+/// changed.
 pub fn paint_stroke(
     mesh: &PaintMesh,
     rows: &mut [Vec<(u32, f64)>],
-    locked: &[bool],
-    column: usize,
+    target: &PaintTarget,
     mode: BrushMode,
     samples_px: &[[f64; 2]],
     options: &BrushOptions,
-    max_influences: Option<usize>,
 ) -> Result<StrokeReport, PaintError> {
-    check_target(mesh, rows, locked, column, max_influences)?;
+    check_target(mesh, rows, target)?;
     let dabs = dab_centres(samples_px, options)?;
     let mut report = StrokeReport::default();
     for centre in dabs {
-        report += apply_dab(
-            mesh,
-            rows,
-            locked,
-            column,
-            mode,
-            centre,
-            options,
-            max_influences,
-        );
+        report += apply_dab(mesh, rows, target, mode, centre, options);
     }
     Ok(report)
 }
 
 /// Paints one dab at `centre_px` (arguments as for [`paint_stroke`]); returns what it did. On
 /// error nothing is changed.
-#[allow(clippy::too_many_arguments)]
 pub fn paint_dab(
     mesh: &PaintMesh,
     rows: &mut [Vec<(u32, f64)>],
-    locked: &[bool],
-    column: usize,
+    target: &PaintTarget,
     mode: BrushMode,
     centre_px: [f64; 2],
     options: &BrushOptions,
-    max_influences: Option<usize>,
 ) -> Result<StrokeReport, PaintError> {
-    check_target(mesh, rows, locked, column, max_influences)?;
+    check_target(mesh, rows, target)?;
     check_options(options)?;
     if !(centre_px[0].is_finite() && centre_px[1].is_finite()) {
         return Err(PaintError::NotFinite(centre_px));
     }
-    Ok(apply_dab(
-        mesh,
-        rows,
-        locked,
-        column,
-        mode,
-        centre_px,
-        options,
-        max_influences,
-    ))
+    Ok(apply_dab(mesh, rows, target, mode, centre_px, options))
 }
 
 /// The weight of `column` in a sparse row.
@@ -315,17 +305,19 @@ pub fn weight_in(row: &[(u32, f64)], column: usize) -> f64 {
 }
 
 /// One dab, inputs checked.
-#[allow(clippy::too_many_arguments)]
 fn apply_dab(
     mesh: &PaintMesh,
     rows: &mut [Vec<(u32, f64)>],
-    locked: &[bool],
-    column: usize,
+    target: &PaintTarget,
     mode: BrushMode,
     centre: [f64; 2],
     options: &BrushOptions,
-    max_influences: Option<usize>,
 ) -> StrokeReport {
+    let PaintTarget {
+        column,
+        locked,
+        max_influences,
+    } = *target;
     let r = options.radius_px;
     // Targets first, all read from the rows before the dab, then the writes: smoothing must
     // not see half a dab, and the fallback spread reads the neighbours as they were.
@@ -600,12 +592,14 @@ mod tests {
         let report = paint_stroke(
             &mesh,
             &mut rows,
-            &locked,
-            1,
+            &PaintTarget {
+                column: 1,
+                locked: &locked,
+                max_influences: None,
+            },
             BrushMode::Add,
             &stroke,
             &options,
-            None,
         )
         .unwrap();
         assert!(report.dabs > 5 && report.vertex_changes > 0, "{report:?}");
@@ -641,12 +635,14 @@ mod tests {
         paint_stroke(
             &mesh,
             &mut full,
-            &locked,
-            1,
+            &PaintTarget {
+                column: 1,
+                locked: &locked,
+                max_influences: None,
+            },
             BrushMode::Add,
             &stroke,
             &strong,
-            None,
         )
         .unwrap();
         check_rows(&full);
@@ -659,12 +655,14 @@ mod tests {
         paint_stroke(
             &mesh,
             &mut less,
-            &locked,
-            0,
+            &PaintTarget {
+                column: 0,
+                locked: &locked,
+                max_influences: None,
+            },
             BrushMode::Subtract,
             &stroke,
             &strong,
-            None,
         )
         .unwrap();
         check_rows(&less);
@@ -702,12 +700,14 @@ mod tests {
         paint_stroke(
             &mesh,
             &mut rows,
-            &[false, false],
-            0,
+            &PaintTarget {
+                column: 0,
+                locked: &[false, false],
+                max_influences: None,
+            },
             BrushMode::Smooth,
             &stroke,
             &options,
-            None,
         )
         .unwrap();
         check_rows(&rows);
@@ -744,12 +744,14 @@ mod tests {
         let report = paint_stroke(
             &mesh,
             &mut same,
-            &[false, true, true],
-            0,
+            &PaintTarget {
+                column: 0,
+                locked: &[false, true, true],
+                max_influences: None,
+            },
             BrushMode::Add,
             &[[20.0, 20.0]],
             &options,
-            None,
         )
         .unwrap();
         assert_eq!(report.vertex_changes, 0);
@@ -760,12 +762,14 @@ mod tests {
             paint_stroke(
                 &mesh,
                 &mut copy,
-                locked,
-                column,
+                &PaintTarget {
+                    column,
+                    locked,
+                    max_influences: None,
+                },
                 BrushMode::Add,
                 &[at],
                 options,
-                None,
             )
         };
         assert_eq!(
@@ -826,12 +830,14 @@ mod tests {
         paint_dab(
             &mesh,
             &mut rows,
-            &[false; 3],
-            0,
+            &PaintTarget {
+                column: 0,
+                locked: &[false; 3],
+                max_influences: None,
+            },
             BrushMode::Subtract,
             [0.0, 10.0],
             &options,
-            None,
         )
         .unwrap();
         assert_eq!(rows[3], vec![(0, 1.0)]);
@@ -839,12 +845,14 @@ mod tests {
         paint_dab(
             &mesh,
             &mut rows,
-            &[false; 3],
-            0,
+            &PaintTarget {
+                column: 0,
+                locked: &[false; 3],
+                max_influences: None,
+            },
             BrushMode::Subtract,
             [10.0, 0.0],
             &options,
-            None,
         )
         .unwrap();
         assert_eq!(rows[1], vec![(0, 0.5), (1, 0.5)]);
@@ -979,12 +987,14 @@ mod tests {
             paint_stroke(
                 &mesh,
                 rows,
-                &[false; 3],
-                2,
+                &PaintTarget {
+                    column: 2,
+                    locked: &[false; 3],
+                    max_influences: limit,
+                },
                 BrushMode::Add,
                 &stroke,
                 &options,
-                limit,
             )
         };
         let report = paint(&mut rows, Some(2)).unwrap();
