@@ -23,10 +23,15 @@ pub enum LockError {
     EmptyMesh,
 }
 
+/// How far a kept row's sum may stray from one by rounding.
+const ROW_SUM_TOLERANCE: f64 = 1e-9;
+
 /// Replaces the locked columns of `fresh` by those of `previous`, vertex by vertex, and
 /// rescales the fresh unlocked columns to fill the rest of one. Where the fresh unlocked
 /// columns are all zero, the previous unlocked ones are rescaled instead; where those are zero
-/// too, the vertex keeps its previous row. `locked` has one flag per column.
+/// too, the vertex keeps its previous row, or, when that row no longer sums to one (its weight
+/// went with a deleted handle), takes its fresh row: every row still sums to one. `locked` has
+/// one flag per column.
 ///
 /// With `max_influences` K, a row keeps only the largest unlocked weights that fit beside its
 /// non-zero locked ones (K minus their count), rescaled to fill the rest; where the locked
@@ -71,7 +76,11 @@ pub fn keep_locked(
         } else if sum(&old_free) > 0.0 {
             old_free
         } else {
-            *row = before.clone();
+            if (sum(before) - 1.0).abs() <= ROW_SUM_TOLERANCE {
+                *row = before.clone();
+            }
+            // Otherwise nothing unlocked can fill what a deleted handle took: the fresh row,
+            // which sums to one, is the only whole row there is.
             continue;
         };
         if let Some(k) = max_influences {
@@ -304,6 +313,22 @@ mod tests {
             three[0].iter().map(|e| e.0).collect::<Vec<_>>(),
             vec![0, 1, 2]
         );
+    }
+
+    #[test]
+    fn rows_that_lost_weight_with_a_deleted_handle_take_their_fresh_row() {
+        // Column 0 locked. The previous rows lost a deleted handle's weight (0.25, and all of
+        // it), and the fresh rows weigh only the locked column: nothing unlocked can fill them.
+        let previous = vec![vec![(0, 0.75)], vec![], vec![(0, 1.0)]];
+        let mut fresh = vec![vec![(0, 1.0)], vec![(0, 1.0)], vec![(0, 1.0)]];
+        keep_locked(&mut fresh, &previous, &[true, false], None).unwrap();
+        sums_to_one(&fresh);
+        assert_eq!(fresh, vec![vec![(0, 1.0)]; 3]);
+        // A whole previous row is kept as it was.
+        let previous = vec![vec![(0, 0.5), (1, 0.5)]];
+        let mut fresh = vec![vec![(0, 1.0)]];
+        keep_locked(&mut fresh, &previous, &[true, true], None).unwrap();
+        assert_eq!(fresh, previous);
     }
 
     #[test]
