@@ -467,17 +467,15 @@ fn resolved(path: &Path) -> PathBuf {
     }
 }
 
-/// Fails, before any work, when an output names an input (the input would be written over,
-/// say a sprite with rig JSON) or another output, or lies in a folder that does not exist
-/// (the outputs written before it would be left behind).
-/// Absent (`None`) outputs are skipped.
+/// Fails, before any work, when an output file names an input (the input would be written
+/// over, say a sprite with rig JSON) or another output, or lies in a folder that does not
+/// exist (the outputs written before it would be left behind). Absent (`None`) outputs are
+/// skipped; output folders, which the commands make where missing, are not passed here.
 fn check_outputs<'a>(
     inputs: impl IntoIterator<Item = &'a Path>,
-    outputs: impl IntoIterator<Item = Option<&'a Path>>,
+    outputs: impl IntoIterator<Item = Option<&'a Path>> + Clone,
 ) -> Result<()> {
-    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
-    let mut seen: Vec<PathBuf> = Vec::new();
-    for output in outputs.into_iter().flatten() {
+    for output in outputs.clone().into_iter().flatten() {
         let folder = parent_dir(output);
         if !folder.as_os_str().is_empty() && !folder.is_dir() {
             bail!(
@@ -486,6 +484,18 @@ fn check_outputs<'a>(
                 folder.display()
             );
         }
+    }
+    check_not_overwriting(inputs, outputs)
+}
+
+/// Fails when an output file names an input or another output.
+fn check_not_overwriting<'a>(
+    inputs: impl IntoIterator<Item = &'a Path>,
+    outputs: impl IntoIterator<Item = Option<&'a Path>>,
+) -> Result<()> {
+    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for output in outputs.into_iter().flatten() {
         let at = resolved(output);
         if inputs.contains(&at) {
             bail!("{}: the output would overwrite an input", output.display());
@@ -496,6 +506,14 @@ fn check_outputs<'a>(
         seen.push(at);
     }
     Ok(())
+}
+
+/// The image files of `doc`'s parts (`doc` read from `rig`).
+fn part_images(rig: &Path, doc: &RigDocument) -> Vec<PathBuf> {
+    doc.parts
+        .iter()
+        .map(|part| RigDocument::image_path(rig, part))
+        .collect()
 }
 
 /// Reads a JSON file into `T`, naming the file in every error.
@@ -615,13 +633,15 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
+    let scene = Scene::load(&args.rig)?;
+    let images = part_images(&args.rig, &scene.doc);
     check_outputs(
         [Some(args.rig.as_path()), args.pose.as_deref()]
             .into_iter()
-            .flatten(),
+            .flatten()
+            .chain(images.iter().map(PathBuf::as_path)),
         [args.output.as_deref(), args.vertices.as_deref()],
     )?;
-    let scene = Scene::load(&args.rig)?;
     let pose: Pose = match (&args.pose, &args.anim) {
         (Some(path), _) => read_json(path, "pose file")?,
         (None, Some(name)) => {
@@ -657,8 +677,20 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    check_outputs([args.rig.as_path()], [Some(args.output.as_path())])?;
     let scene = Scene::load(&args.rig)?;
+    // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
+    let files = match io::sequence::format_for_path(&args.output)? {
+        io::sequence::SequenceFormat::Folder => vec![],
+        io::sequence::SequenceFormat::Gif => vec![args.output.clone()],
+        io::sequence::SequenceFormat::Sheet => {
+            vec![args.output.clone(), args.output.with_extension("json")]
+        }
+    };
+    let images = part_images(&args.rig, &scene.doc);
+    check_outputs(
+        std::iter::once(args.rig.as_path()).chain(images.iter().map(PathBuf::as_path)),
+        files.iter().map(|f| Some(f.as_path())),
+    )?;
     let animation = animation(&scene.doc, &args.anim)?;
     let settings = playback::RenderSettings {
         fps: args.fps,
@@ -674,7 +706,6 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     };
     // Check the settings and the target before rendering: a bad one fails at once.
     settings.view(scene.doc.canvas)?;
-    io::sequence::format_for_path(&args.output)?;
     let bar = indicatif::ProgressBar::new(
         playback::frame_times(animation.duration_s(), args.fps)?.len() as u64,
     );
@@ -894,6 +925,18 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
             .unwrap_or_else(|| "skeleton".into()),
     };
     let export = spine::export_spine(&scene, &images, &name, &options)?;
+    // `-o .` beside the rig would write NAME.json over the rig and NAME.png over a sprite.
+    let targets: Vec<PathBuf> = export
+        .files()
+        .into_iter()
+        .map(|(file, _)| args.output.join(file))
+        .collect();
+    let sprites = part_images(&args.rig, &scene.doc);
+    // The export folder is made where missing: only the overwriting is checked.
+    check_not_overwriting(
+        std::iter::once(args.rig.as_path()).chain(sprites.iter().map(PathBuf::as_path)),
+        targets.iter().map(|t| Some(t.as_path())),
+    )?;
     let written = export.write(&args.output)?;
     report_spine_export(&export, &written);
     Ok(())

@@ -47,17 +47,35 @@ fn one_line(error: &anyhow::Error) -> String {
 }
 
 /// A command-line error on one line: clap's first paragraph (what is wrong, with the missing
-/// arguments or the possible values it lists under it), without its tips and usage block, and
-/// where to look for the rest.
+/// arguments or the possible values it lists under it) and its tips (a similar name, how to pass
+/// a negative number), without its usage block, and which help to read.
 fn clap_one_line(error: &clap::Error) -> String {
     let text = error.render().to_string();
-    let what: Vec<&str> = text
-        .lines()
-        .map(str::trim)
+    let lines: Vec<&str> = text.lines().map(str::trim).collect();
+    let what: Vec<&str> = lines
+        .iter()
+        .copied()
         .skip_while(|l| l.is_empty())
         .take_while(|l| !l.is_empty())
         .collect();
     let what = what.join(" ");
-    let what = what.strip_prefix("error: ").unwrap_or(&what);
-    format!("{what} (see sinew --help)")
+    let mut line = what.strip_prefix("error: ").unwrap_or(&what).to_string();
+    for tip in lines.iter().filter(|l| l.starts_with("tip:")) {
+        line.push_str("; ");
+        line.push_str(tip);
+    }
+    // "Usage: sinew rig [OPTIONS] ...": the words before the first placeholder name the command.
+    let command = lines
+        .iter()
+        .find_map(|l| l.strip_prefix("Usage: "))
+        .map(|usage| {
+            usage
+                .split_whitespace()
+                .take_while(|w| !w.starts_with(['[', '<', '-']))
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .filter(|c| !c.is_empty())
+        .unwrap_or_else(|| "sinew".into());
+    format!("{line} (see {command} --help)")
 }

@@ -271,6 +271,56 @@ fn a_failed_demo_leaves_no_empty_folder() {
 }
 
 #[test]
+fn outputs_never_write_over_inputs_and_output_folders_are_made() {
+    let dir = scratch("overwrite");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let sprite_bytes = std::fs::read(&sprite).unwrap();
+    let handles = dir.join("handles.json");
+    std::fs::write(
+        &handles,
+        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
+    )
+    .unwrap();
+    let rig = dir.join("critter.json");
+    assert!(
+        sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)])
+            .status
+            .success()
+    );
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
+        {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
+    ]}}}});
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    let rig_bytes = std::fs::read(&rig).unwrap();
+    // Exporting beside the rig would write critter.json over it and critter.png over the sprite.
+    assert_bad_input(
+        &["export", "spine", s(&rig), "-o", s(&dir)],
+        "would overwrite an input",
+    );
+    // A sprite sheet writes its JSON beside it: critter.png -> critter.json, the rig.
+    assert_bad_input(
+        &["render", s(&rig), "--anim", "go", "-o", s(&sprite)],
+        "would overwrite an input",
+    );
+    assert_eq!(std::fs::read(&rig).unwrap(), rig_bytes);
+    assert_eq!(std::fs::read(&sprite).unwrap(), sprite_bytes);
+    // Output folders are made where missing.
+    let frames = dir.join("new/nested/frames");
+    let out = sinew(&["render", s(&rig), "--anim", "go", "-o", s(&frames)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(frames.join("frame_0000.png").is_file());
+    // A misspelt option keeps clap's tip on the one line.
+    assert_bad_input(&["rig", s(&sprite), "--handle", s(&handles)], "'--handles'");
+}
+
+#[test]
 fn bad_handles_fail_cleanly_without_output() {
     let dir = scratch("bad-handles");
     let sprite = dir.join("critter.png");

@@ -42,7 +42,8 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
     let start = Instant::now();
     super::check_outputs(
         [args.lineart.as_path(), args.scribbles.as_path()],
-        [Some(args.output.as_path()), args.layers.as_deref()],
+        // --layers is a folder, made where missing.
+        [Some(args.output.as_path())],
     )?;
     let options = ColorizeOptions {
         scale: args.scale,
