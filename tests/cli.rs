@@ -149,6 +149,27 @@ fn bad_rig_documents_fail_cleanly_without_output() {
     assert!(!out.exists());
 }
 
+/// Rigs `sprite` with one bone into `rig` and returns the rig document's JSON.
+fn one_bone_rig(
+    dir: &std::path::Path,
+    sprite: &std::path::Path,
+    rig: &std::path::Path,
+) -> serde_json::Value {
+    let handles = dir.join("handles.json");
+    std::fs::write(
+        &handles,
+        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
+    )
+    .unwrap();
+    let out = sinew(&["rig", s(sprite), "--handles", s(&handles), "-o", s(rig)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(rig).unwrap()).unwrap()
+}
+
 #[test]
 fn absurd_sizes_and_durations_fail_cleanly_without_output() {
     let dir = scratch("absurd");
@@ -168,20 +189,8 @@ fn absurd_sizes_and_durations_fail_cleanly_without_output() {
     );
     assert!(!rig.exists());
 
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
-        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
-    )
-    .unwrap();
-    assert!(
-        sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)])
-            .status
-            .success()
-    );
+    let mut doc = one_bone_rig(&dir, &sprite, &rig);
     // One key at a typo'd time: 1e6 s of animation.
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 1e6, "value": 30}
     ]}}}});
@@ -276,20 +285,9 @@ fn outputs_never_write_over_inputs_and_output_folders_are_made() {
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let sprite_bytes = std::fs::read(&sprite).unwrap();
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
-        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
-    )
-    .unwrap();
     let rig = dir.join("critter.json");
-    assert!(
-        sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)])
-            .status
-            .success()
-    );
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    let mut doc = one_bone_rig(&dir, &sprite, &rig);
+    let handles = dir.join("handles.json");
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
     ]}}}});
