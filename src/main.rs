@@ -1,5 +1,4 @@
 use clap::Parser;
-
 use std::process::ExitCode;
 
 /// Exit code for bad input (files, arguments, options): the message says which and why.
