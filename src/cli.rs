@@ -927,9 +927,9 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
     let export = spine::export_spine(&scene, &images, &name, &options)?;
     // `-o .` beside the rig would write NAME.json over the rig and NAME.png over a sprite.
     let targets: Vec<PathBuf> = export
-        .files()
+        .file_names()
         .into_iter()
-        .map(|(file, _)| args.output.join(file))
+        .map(|file| args.output.join(file))
         .collect();
     let sprites = part_images(&args.rig, &scene.doc);
     // The export folder is made where missing: only the overwriting is checked.

@@ -612,20 +612,26 @@ fn content_hash(
 }
 
 impl SpineExport {
+    /// The names of the export's files, in [`SpineExport::files`]' order.
+    pub fn file_names(&self) -> Vec<String> {
+        let mut names = vec![
+            format!("{}.json", self.name),
+            format!("{}.atlas", self.name),
+        ];
+        names.extend(self.pages.iter().map(|(name, _)| name.clone()));
+        names
+    }
+
     /// The files of the export: name and bytes.
     pub fn files(&self) -> Vec<(String, Vec<u8>)> {
-        let mut files = vec![
-            (
-                format!("{}.json", self.name),
-                self.json.clone().into_bytes(),
-            ),
-            (
-                format!("{}.atlas", self.name),
-                self.atlas.clone().into_bytes(),
-            ),
-        ];
-        files.extend(self.pages.iter().cloned());
-        files
+        let bytes = [self.json.as_bytes(), self.atlas.as_bytes()]
+            .into_iter()
+            .chain(self.pages.iter().map(|(_, png)| png.as_slice()));
+        self.file_names()
+            .into_iter()
+            .zip(bytes)
+            .map(|(name, bytes)| (name, bytes.to_vec()))
+            .collect()
     }
 
     /// Writes every file into `dir` (created if missing): each goes to a hidden temporary file
