@@ -207,19 +207,13 @@ pub const MAX_POSED_PX: f64 = 1e6;
 /// How much a posed handle may scale anything.
 pub const MAX_POSED_SCALE: f64 = 1e4;
 
-/// Fails when `transform`, handle `name`'s, reaches beyond [`MAX_POSED_PX`] or
-/// [`MAX_POSED_SCALE`].
-fn check_reach(transform: &Affine, name: &str) -> Result<(), PoseError> {
-    let moves = transform
+/// Whether `transform` stays within [`MAX_POSED_PX`] and [`MAX_POSED_SCALE`].
+fn within_reach(transform: &Affine) -> bool {
+    transform
         .translation
         .iter()
-        .all(|v| v.abs() <= MAX_POSED_PX);
-    let scales = transform.linear.iter().all(|v| v.abs() <= MAX_POSED_SCALE);
-    if moves && scales {
-        Ok(())
-    } else {
-        Err(PoseError::OutOfRange(name.to_string()))
-    }
+        .all(|v| v.abs() <= MAX_POSED_PX)
+        && transform.linear.iter().all(|v| v.abs() <= MAX_POSED_SCALE)
 }
 
 /// A bone's rest frame: origin at the head, x axis along head → tail.
@@ -510,8 +504,10 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         }
     }
     out.extend(handles.regions.iter().map(|_| Affine::identity()));
-    for (transform, name) in out.iter().zip(handle_columns(handles)) {
-        check_reach(transform, &name)?;
+    // Names are built only for a failure: this runs every frame and every drag.
+    if let Some(column) = out.iter().position(|t| !within_reach(t)) {
+        let name = handle_columns(handles).swap_remove(column);
+        return Err(PoseError::OutOfRange(name));
     }
     Ok(out)
 }
