@@ -22,8 +22,9 @@ use rayon::prelude::*;
 /// Frame rates above this are refused: nothing plays them, and a typo (`--fps 2400`) would
 /// otherwise render for minutes.
 pub const MAX_FPS: f64 = 240.0;
-/// Lowest frame rate, frames per second (a frame every 10 s): below, GIF frame delays and
-/// sprite-sheet durations overflow their fields.
+/// Lowest frame rate, frames per second (a frame every 10 s). A choice well above where GIF
+/// frame delays overflow (at most 655.35 s, below ~0.0015 fps; at 1e-300 the sweep saw the
+/// sheet's duration field overflow too).
 pub const MIN_FPS: f64 = 0.1;
 /// Most frames one animation may play as (duration × fps): beyond, a typo'd key time (1e6 s)
 /// would allocate and render for ever.

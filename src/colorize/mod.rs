@@ -229,8 +229,9 @@ pub struct PreparedLineArt {
     pub options: ColorizeOptions,
 }
 
-/// Largest lift scale, px per full color change: far beyond any image's size, where the
-/// lifted Laplacian loses its positive definiteness to rounding.
+/// Largest lift scale, px per full color change: far beyond any image's size (the bad-input
+/// sweep saw 1e300 fail as "not positive definite"; where between the two the solve breaks
+/// down was not measured).
 pub const MAX_LIFT_SCALE_PX: f64 = 1e5;
 
 impl PreparedLineArt {
