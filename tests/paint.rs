@@ -75,6 +75,14 @@ fn check_rows(rows: &[Vec<(u32, f64)>]) {
     }
 }
 
+/// Sets the document's influence limit to `k` and recomputes the weights.
+fn limit_and_compute(doc: &mut Document, k: usize) {
+    let mut options = doc.state().options.clone();
+    options.weights.max_influences = Some(k);
+    doc.apply(Command::SetOptions(options)).unwrap();
+    compute(doc);
+}
+
 /// A stroke adding handle b's weight at full strength over discs of `radius_px` along
 /// `samples_px`.
 fn fill_b(samples_px: Vec<[f64; 2]>, radius_px: f64) -> Command {
@@ -211,10 +219,7 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
         at: [250.0, 40.0],
     }))
     .unwrap();
-    let mut options = doc.state().options.clone();
-    options.weights.max_influences = Some(2);
-    doc.apply(Command::SetOptions(options)).unwrap();
-    compute(&mut doc);
+    limit_and_compute(&mut doc, 2);
     let kept = rows(&doc);
     check_rows(&kept);
     let widest = kept.iter().map(Vec::len).max().unwrap_or(0);
@@ -233,12 +238,6 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
 fn painting_keeps_the_influence_limit() {
     let dir = scratch("paint-limit");
     let mut doc = arm(&dir);
-    let limit_and_compute = |doc: &mut Document, k: usize| {
-        let mut options = doc.state().options.clone();
-        options.weights.max_influences = Some(k);
-        doc.apply(Command::SetOptions(options)).unwrap();
-        compute(doc);
-    };
     // c painted over a's end of the bar, where a and b already weigh every vertex.
     let paint_c = |strength: f64| Command::PaintWeights {
         part: "bar".into(),
