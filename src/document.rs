@@ -69,14 +69,6 @@ pub enum DocumentError {
     Cancelled,
     #[error(transparent)]
     Animation(#[from] crate::anim::AnimError),
-    #[error(transparent)]
-    Spine(#[from] crate::export::spine::SpineError),
-    #[error(transparent)]
-    Playback(#[from] crate::playback::PlaybackError),
-    #[error(transparent)]
-    Render(#[from] crate::playback::RenderAnimationError),
-    #[error(transparent)]
-    Sequence(#[from] crate::io::sequence::SequenceError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
     #[error("'{name}' has {expected} vertices, not {got}")]
@@ -85,8 +77,6 @@ pub enum DocumentError {
         got: usize,
         expected: usize,
     },
-    #[error(transparent)]
-    Autorig(#[from] crate::autorig::AutorigError),
     #[error("handle '{0}' is locked: unlock it to paint its weights")]
     LockedHandle(String),
     #[error("painting weights: {0}")]
@@ -465,26 +455,8 @@ impl Document {
         }
     }
 
-    /// Exports the current state for Spine's runtimes into `dir` (see [`crate::export::spine`]):
-    /// `NAME.json`, `NAME.atlas` and the atlas pages, with the document's current animations.
-    /// Needs current weights.
-    pub fn export_spine(
-        &self,
-        dir: &Path,
-        name: &str,
-        options: &crate::export::spine::SpineOptions,
-    ) -> Result<Vec<PathBuf>, DocumentError> {
-        if self.posable().is_none() {
-            return Err(DocumentError::NoWeights);
-        }
-        let doc = self.to_rig_document(&dir.join(format!("{name}.sinew.json")))?;
-        let images: Vec<_> = self.state.layers.iter().map(|l| l.image.clone()).collect();
-        let scene = Scene::new(doc, &images)?;
-        let export = crate::export::spine::export_spine(&scene, &images, name, options)?;
-        Ok(export.write(dir)?)
-    }
-
-    /// What [`render_animation`] needs, copied out of the current state (for another thread).
+    /// What [`crate::jobs::render_animation`] needs, copied out of the current state (for
+    /// another thread).
     pub fn render_job(&self) -> Result<(RigDocument, Vec<image::RgbaImage>), DocumentError> {
         if self.posable().is_none() {
             return Err(DocumentError::NoWeights);
@@ -576,48 +548,6 @@ impl SaveJob {
         rig_document(&self.state, &self.target)?.save(&self.target)?;
         Ok(self.target.clone())
     }
-}
-
-/// Renders animation `name` of `doc` as `settings` say to `output`, which is a folder of
-/// numbered PNGs, a `.gif` or a `.png` sprite sheet, as `sinew render` does.
-pub fn render_animation(
-    doc: RigDocument,
-    images: &[image::RgbaImage],
-    name: &str,
-    settings: &crate::playback::RenderSettings,
-    output: &Path,
-) -> Result<crate::io::sequence::SequenceReport, DocumentError> {
-    let animation = crate::anim::load_animations(&doc)?
-        .remove(name)
-        .ok_or_else(|| {
-            DocumentError::Animation(crate::anim::AnimError::Malformed {
-                animation: name.to_string(),
-                reason: "the document has no animation of that name".into(),
-            })
-        })?;
-    crate::io::sequence::format_for_path(output)?;
-    // Settings are checked before the scene is built: a bad scale fails at once.
-    settings.view(doc.canvas)?;
-    let scene = Scene::new(doc, images)?;
-    let frames = crate::playback::render_animation(&scene, &animation, settings, &|| {})?;
-    crate::io::sequence::write_sequence(&frames, settings.fps, output, &Default::default())
-        .map_err(DocumentError::from)
-}
-
-/// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with
-/// [`Command::SetHandles`] and edit like hand-placed ones.
-pub fn propose_handles(
-    layers: &[Arc<Layer>],
-    options: &crate::autorig::AutorigOptions,
-) -> Result<crate::autorig::Proposal, DocumentError> {
-    let refs: Vec<crate::autorig::LayerRef> = layers
-        .iter()
-        .map(|l| crate::autorig::LayerRef {
-            name: &l.name,
-            image: &l.image,
-        })
-        .collect();
-    Ok(crate::autorig::autorig(&refs, options)?)
 }
 
 /// Makes the last state of `from` current, pushing the current one onto `to`.

@@ -16,6 +16,7 @@ pub mod export;
 pub mod geom;
 pub mod ik;
 pub mod io;
+pub mod jobs;
 pub mod mesh;
 pub mod pipeline;
 pub mod playback;

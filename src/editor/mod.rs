@@ -537,8 +537,7 @@ impl EditorApp {
         match std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))
             .and_then(|()| {
-                self.doc
-                    .export_spine(dir, &name, &options)
+                crate::jobs::export_spine(&self.doc, dir, &name, &options)
                     .map_err(|e| e.to_string())
             }) {
             Ok(written) => format!("exported {} files to {}", written.len(), dir.display()),
@@ -566,7 +565,7 @@ impl EditorApp {
         std::thread::spawn(move || {
             let (doc, images) = job;
             let message =
-                match crate::document::render_animation(doc, &images, &name, &settings, &output) {
+                match crate::jobs::render_animation(doc, &images, &name, &settings, &output) {
                     Ok(report) => format!(
                         "rendered {} frames to {}",
                         report.frame_count,

@@ -302,7 +302,7 @@ impl EditorApp {
         let ctx = ctx.clone();
         std::thread::spawn(move || {
             let result =
-                crate::document::propose_handles(&layers, &options).map_err(|e| e.to_string());
+                crate::jobs::propose_handles(&layers, &options).map_err(|e| e.to_string());
             let _ = send.send(result);
             ctx.request_repaint();
         });

@@ -1,0 +1,104 @@
+//! The long-running work the shells start on a document: exporting, rendering an animation,
+//! proposing handles.
+//!
+//! In: a [`Document`] (or what [`Document::render_job`] copies out of it, or its layers) and the
+//! job's options. Out: the files written, or the proposal. Each runs to completion on the
+//! calling thread; the editor calls them from a background thread, the command line has its
+//! own glue for the same library calls. [`crate::document`] stays about the editable document:
+//! it does not reach into export, playback or the automatic rig.
+
+use crate::anim::{self, AnimError};
+use crate::autorig::{self, AutorigError, AutorigOptions, LayerRef, Proposal};
+use crate::document::{Document, DocumentError};
+use crate::export::spine::{self, SpineError, SpineOptions};
+use crate::io::sequence::{self, SequenceError, SequenceReport};
+use crate::io::RigDocument;
+use crate::pipeline::{Layer, PipelineError, Scene};
+use crate::playback::{self, PlaybackError, RenderAnimationError, RenderSettings};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Why a job failed. Each variant is the failing stage's own error, shown as it is.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    #[error(transparent)]
+    Document(#[from] DocumentError),
+    #[error(transparent)]
+    Pipeline(#[from] PipelineError),
+    #[error(transparent)]
+    Animation(#[from] AnimError),
+    #[error(transparent)]
+    Spine(#[from] SpineError),
+    #[error(transparent)]
+    Playback(#[from] PlaybackError),
+    #[error(transparent)]
+    Render(#[from] RenderAnimationError),
+    #[error(transparent)]
+    Sequence(#[from] SequenceError),
+    #[error(transparent)]
+    Autorig(#[from] AutorigError),
+}
+
+/// Exports the document's current state for Spine's runtimes into `dir` (see
+/// [`crate::export::spine`]): `NAME.json`, `NAME.atlas` and the atlas pages, with the document's
+/// current animations. Needs current weights ([`DocumentError::NoWeights`] otherwise).
+pub fn export_spine(
+    doc: &Document,
+    dir: &Path,
+    name: &str,
+    options: &SpineOptions,
+) -> Result<Vec<PathBuf>, JobError> {
+    if doc.posable().is_none() {
+        return Err(DocumentError::NoWeights.into());
+    }
+    let rig = doc.to_rig_document(&dir.join(format!("{name}.sinew.json")))?;
+    let images: Vec<_> = doc.state().layers.iter().map(|l| l.image.clone()).collect();
+    let scene = Scene::new(rig, &images)?;
+    let export = spine::export_spine(&scene, &images, name, options)?;
+    Ok(export.write(dir)?)
+}
+
+/// Renders animation `name` of `doc` as `settings` say to `output`, which is a folder of
+/// numbered PNGs, a `.gif` or a `.png` sprite sheet, as `sinew render` does. `doc` and `images`
+/// are what [`Document::render_job`] copies out of a document.
+pub fn render_animation(
+    doc: RigDocument,
+    images: &[image::RgbaImage],
+    name: &str,
+    settings: &RenderSettings,
+    output: &Path,
+) -> Result<SequenceReport, JobError> {
+    let animation = anim::load_animations(&doc)?
+        .remove(name)
+        .ok_or_else(|| AnimError::Malformed {
+            animation: name.to_string(),
+            reason: "the document has no animation of that name".into(),
+        })?;
+    sequence::format_for_path(output)?;
+    // Settings are checked before the scene is built: a bad scale fails at once.
+    settings.view(doc.canvas)?;
+    let scene = Scene::new(doc, images)?;
+    let frames = playback::render_animation(&scene, &animation, settings, &|| {})?;
+    Ok(sequence::write_sequence(
+        &frames,
+        settings.fps,
+        output,
+        &Default::default(),
+    )?)
+}
+
+/// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with
+/// [`crate::document::Command::SetHandles`] and edit like hand-placed ones.
+pub fn propose_handles(
+    layers: &[Arc<Layer>],
+    options: &AutorigOptions,
+) -> Result<Proposal, JobError> {
+    let refs: Vec<LayerRef> = layers
+        .iter()
+        .map(|l| LayerRef {
+            name: &l.name,
+            image: &l.image,
+        })
+        .collect();
+    Ok(autorig::autorig(&refs, options)?)
+}
