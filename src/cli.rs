@@ -3,22 +3,25 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+mod choices;
 mod colorize;
 
-use crate::anim::{self, CurveEvaluation, SampleOptions};
-use crate::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
-use crate::io::{self, BuildOptions, RigDocument};
-use crate::mesh::MeshOptions;
-use crate::pipeline::{self, PartReport, Scene};
-use crate::playback::{self, FrameView};
-use crate::render;
-use crate::rig::{Handles, Pose};
-use crate::skin::Blend;
-use crate::trace::TraceOptions;
-use crate::weights::{WeightMethod, WeightOptions};
 use anyhow::{anyhow, bail, Context, Result};
+use choices::{BakeModeArg, BlendArg, TemplateArg, WeightMethodArg};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
+use sinew::anim::{self, CurveEvaluation, SampleOptions};
+use sinew::autorig::Template;
+use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
+use sinew::io::{self, BuildOptions, RigDocument};
+use sinew::mesh::MeshOptions;
+use sinew::pipeline::{self, PartReport, Scene};
+use sinew::playback::{self, FrameView};
+use sinew::render;
+use sinew::rig::{Handles, Pose};
+use sinew::skin::Blend;
+use sinew::trace::TraceOptions;
+use sinew::weights::{WeightMethod, WeightOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -121,7 +124,7 @@ pub struct SpineArgs {
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
     /// auto: bake only what native timelines cannot express; all: bake every bone.
-    #[arg(long, value_enum, default_value_t = BakeMode::Auto)]
+    #[arg(long, value_parser = choices::parser::<BakeModeArg, BakeMode>(), default_value = "auto")]
     pub bake: BakeMode,
     /// Base name of the files (default: the rig file's name).
     #[arg(long)]
@@ -162,8 +165,8 @@ pub struct AutorigArgs {
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub points: usize,
     /// Fit a known skeleton, naming and parenting its limbs.
-    #[arg(long, value_enum)]
-    pub template: Option<crate::autorig::Template>,
+    #[arg(long, value_parser = choices::parser::<TemplateArg, Template>())]
+    pub template: Option<Template>,
     /// Also draw the proposed rig over the images as a PNG.
     #[arg(long)]
     pub preview: Option<PathBuf>,
@@ -189,7 +192,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub background: Option<String>,
     /// How handle transformations blend.
-    #[arg(long, value_enum, default_value_t = Blend::Linear)]
+    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = "linear")]
     pub blend: Blend,
     /// Play curves as this runtime does instead of exactly (see README, "Spine export").
     #[arg(long, value_enum)]
@@ -255,7 +258,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub max_area_fraction: Option<f64>,
     /// The weights' energy.
-    #[arg(long = "weights", value_enum, default_value_t = WeightMethod::Bbw)]
+    #[arg(long = "weights", value_parser = choices::parser::<WeightMethodArg, WeightMethod>(), default_value = "bbw")]
     pub weight_method: WeightMethod,
     /// Content-aware weights: measure color changes as this many px.
     #[arg(long, value_name = "S")]
@@ -311,7 +314,7 @@ impl BuildArgs {
             trace,
             mesh,
             weights,
-            ik: crate::ik::IkOptions::default(),
+            ik: sinew::ik::IkOptions::default(),
         }
     }
 }
@@ -337,7 +340,7 @@ pub struct PoseArgs {
     pub time: Option<f64>,
     /// How handle transformations blend: linear (LBS), dqs (dual quaternions) or stretch
     /// (LBS with stretchable bones).
-    #[arg(long, value_enum, default_value_t = Blend::Linear)]
+    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = "linear")]
     pub blend: Blend,
     /// With --anim: sample curves as this runtime plays them instead of exactly.
     #[arg(long, value_enum, requires = "anim")]
@@ -373,9 +376,9 @@ pub fn run(cli: Cli) -> Result<()> {
 
 #[cfg(feature = "editor")]
 fn edit(args: &EditArgs) -> Result<()> {
-    use crate::editor::Mode;
+    use sinew::editor::Mode;
     let pose = match &args.pose {
-        Some(path) => Some(read_json::<crate::rig::Pose>(path, "pose file")?),
+        Some(path) => Some(read_json::<sinew::rig::Pose>(path, "pose file")?),
         None => None,
     };
     let mode = args.mode.map(|m| match m {
@@ -384,7 +387,7 @@ fn edit(args: &EditArgs) -> Result<()> {
         EditMode::Animate => Mode::Animate,
         EditMode::Colorize => Mode::Colorize,
     });
-    crate::editor::run(crate::editor::Start {
+    sinew::editor::run(sinew::editor::Start {
         rig: args.rig.clone(),
         mode,
         pose,
@@ -396,7 +399,7 @@ fn edit(args: &EditArgs) -> Result<()> {
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
-    use crate::autorig::{self as ar, AutorigOptions, LayerRef};
+    use sinew::autorig::{self as ar, AutorigOptions, LayerRef};
     check_outputs(
         args.images.iter().map(PathBuf::as_path),
         [Some(args.output.as_path()), args.preview.as_deref()],
@@ -746,7 +749,7 @@ fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
 }
 
 /// The `--vertices` file of DESIGN.md.
-fn vertices_json(doc: &RigDocument, positions: &[Vec<crate::geom::Point>]) -> Result<String> {
+fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Result<String> {
     #[derive(Serialize)]
     struct Part<'a> {
         name: &'a str,

@@ -3,11 +3,11 @@
 //! The pipeline, stage by stage (see `ARCHITECTURE.md`):
 //! RGBA image → [`trace`] → outlines → [`mesh`] → triangle mesh → weights → skin → [`render`].
 //! [`io`] reads and writes the native rig document and images; [`pipeline`] wires the stages
-//! together; [`cli`] is the `sinew` command.
+//! together. The `sinew` command and its argument parsing live in the binary (feature `cli`);
+//! the library knows no shell.
 
 pub mod anim;
 pub mod autorig;
-pub mod cli;
 pub mod colorize;
 pub mod document;
 #[cfg(feature = "editor")]

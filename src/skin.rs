@@ -126,17 +126,7 @@ pub fn stretchable_blend(
 }
 
 /// How handle transformations blend.
-#[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Blend {
     /// Linear blend skinning: fast, exact for affine handles; joints thin when twisted far.

@@ -5,9 +5,11 @@
 //! `sinew autorig` → `sinew rig --handles` → `sinew pose` with no manual step, and a golden
 //! image of the proposed rig over the character.
 
+#[cfg(feature = "cli")]
 mod command;
 mod common;
 
+#[cfg(feature = "cli")]
 use command::{scratch, sinew};
 use image::RgbaImage;
 use sinew::autorig::shape::{segments_touch, Shape};
@@ -719,6 +721,7 @@ fn proposals_are_deterministic() {
 
 // ---------------------------------------------------------------- end to end and golden
 
+#[cfg(feature = "cli")]
 fn ok(out: &std::process::Output, what: &str) {
     assert!(
         out.status.success(),
@@ -727,6 +730,7 @@ fn ok(out: &std::process::Output, what: &str) {
     );
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn autorig_then_rig_then_pose_works_with_no_manual_step() {
     let dir = scratch("e2e");
@@ -821,6 +825,7 @@ fn autorig_then_rig_then_pose_works_with_no_manual_step() {
     }
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
     let dir = scratch("layers");
@@ -874,6 +879,7 @@ fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
     assert!(posed.get_pixel(156, 340)[3] > 200, "the right hand moved");
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn autorig_bad_input_is_one_line_and_exit_2() {
     let dir = scratch("bad");

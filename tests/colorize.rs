@@ -11,9 +11,11 @@
 //! `SINEW_BLESS=1 cargo test --test colorize` rewrites them (look at every one before
 //! committing).
 
+#[cfg(feature = "cli")]
 mod command;
 mod common;
 
+#[cfg(feature = "cli")]
 use command::{s, scratch, sinew};
 use image::{Rgba, RgbaImage};
 use sinew::colorize::flood::flood_fill;
@@ -355,6 +357,7 @@ fn results_are_deterministic() {
 // ---- the command -------------------------------------------------------------------------
 
 /// The scene's scribbles as an RGBA layer (colored strokes on transparency).
+#[cfg(feature = "cli")]
 fn scribble_layer(sc: &Scribbles) -> RgbaImage {
     RgbaImage::from_fn(sc.width, sc.height, |x, y| {
         match sc.labels[(y * sc.width + x) as usize] {
@@ -367,6 +370,7 @@ fn scribble_layer(sc: &Scribbles) -> RgbaImage {
     })
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn the_command_colors_from_a_layer_or_json_and_writes_layers() {
     let dir = scratch("ok");
@@ -426,11 +430,13 @@ fn the_command_colors_from_a_layer_or_json_and_writes_layers() {
 }
 
 /// Runs a command that must fail on bad input: one line, exit 2, no output file.
+#[cfg(feature = "cli")]
 fn assert_bad_input(args: &[&str], output: &Path, expect_in_message: &str) {
     command::assert_bad_input(args, expect_in_message);
     assert!(!output.exists(), "{args:?} wrote {}", output.display());
 }
 
+#[cfg(feature = "cli")]
 #[test]
 fn the_command_rejects_bad_input() {
     let dir = scratch("bad");

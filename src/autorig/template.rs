@@ -25,7 +25,7 @@ use crate::geom::Point;
 use serde::{Deserialize, Serialize};
 
 /// A known skeleton topology.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Template {
     /// Spine (hip, chest), head, two arms and two legs of two bones each.

@@ -1,9 +1,10 @@
 //! `sinew colorize LINEART.png --scribbles S.png|S.json -o OUT.png`: argument parsing and glue.
 
-use crate::colorize::{self, ColorWeights, ColorizeOptions, FillMode, Scribbles};
-use crate::io;
+use super::choices::{self, ColorWeightsArg, FillModeArg};
 use anyhow::{Context, Result};
 use clap::Args;
+use sinew::colorize::{self, ColorWeights, ColorizeOptions, FillMode, Scribbles};
+use sinew::io;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -19,13 +20,13 @@ pub struct ColorizeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// flat: each pixel takes its largest weight's color; soft: colors blended by weight.
-    #[arg(long, value_enum, default_value_t = FillMode::Flat)]
+    #[arg(long, value_parser = choices::parser::<FillModeArg, FillMode>(), default_value = "flat")]
     pub fill: FillMode,
     /// Also write one mask PNG per scribble color into this folder (NN-rrggbb.png).
     #[arg(long, value_name = "DIR")]
     pub layers: Option<PathBuf>,
     /// The weights' energy.
-    #[arg(long, value_enum, default_value_t = ColorWeights::Harmonic)]
+    #[arg(long, value_parser = choices::parser::<ColorWeightsArg, ColorWeights>(), default_value = "harmonic")]
     pub weights: ColorWeights,
     /// Lift scale: a full color change counts as S px.
     #[arg(long, value_name = "S", default_value_t = colorize::DEFAULT_LIFT_SCALE)]

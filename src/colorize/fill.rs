@@ -17,7 +17,7 @@ use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 
 /// How weights become colors.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FillMode {
     /// Each pixel takes the color of its largest weight: crisp cartoon fills.

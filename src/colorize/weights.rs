@@ -19,7 +19,7 @@ use crate::weights::{
 use serde::{Deserialize, Serialize};
 
 /// Which energy the color weights minimize.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ColorWeights {
     /// Harmonic weights: one Laplace solve per color over one factorization. Fast.
@@ -30,7 +30,7 @@ pub enum ColorWeights {
 }
 
 /// How the lifted mesh is measured.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LiftedStiffness {
     /// The cotangent Laplacian of the mesh lifted to 5D (`Domain::new::<5>`), as `sinew rig

@@ -22,7 +22,7 @@ use crate::rig::{handle_columns, Handles};
 use serde::{Deserialize, Serialize};
 
 /// Which energy the weights minimize.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum WeightMethod {
     /// Bounded biharmonic weights (Jacobson et al. 2011): smooth, local, in [0, 1].

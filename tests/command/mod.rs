@@ -2,7 +2,8 @@
 //! bad-input contract (exit code 2, one line on stderr, no panic).
 //!
 //! Kept apart from `tests/common`, which benchmarks include too: `CARGO_BIN_EXE_sinew` exists
-//! only when integration tests are compiled.
+//! only when integration tests are compiled, and only with the `cli` feature (the binary's):
+//! without it only the scratch folders are here.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -12,6 +13,7 @@ use std::process::{Command, Output};
 pub const EXIT_BAD_INPUT: i32 = 2;
 
 /// Runs the binary with `args`.
+#[cfg(feature = "cli")]
 pub fn sinew(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sinew"))
         .args(args)
@@ -38,6 +40,7 @@ pub fn s(p: &Path) -> &str {
 
 /// Runs a command that must fail on bad input, checks the contract and that the message
 /// mentions `expect_in_message`; returns stderr.
+#[cfg(feature = "cli")]
 pub fn assert_bad_input(args: &[&str], expect_in_message: &str) -> String {
     let out = sinew(args);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();

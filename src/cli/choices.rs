@@ -1,0 +1,134 @@
+//! Command-line mirrors of the library's enums that flags take (`--blend`, `--weights`, …).
+//!
+//! The library derives no clap trait: each mirror here derives [`clap::ValueEnum`] with the
+//! library variant's name and doc comment (which clap shows as the value's help), and converts
+//! both ways with exhaustive matches, so a variant added to the library and not here does not
+//! compile. Flags keep the library type as their value through [`parser`].
+
+use clap::builder::{EnumValueParser, TypedValueParser};
+use clap::ValueEnum;
+use sinew::autorig::Template;
+use sinew::colorize::{ColorWeights, FillMode};
+use sinew::export::spine::BakeMode;
+use sinew::skin::Blend;
+use sinew::weights::WeightMethod;
+
+/// A value parser for library enum `L` through its mirror `A`: `A`'s names and help, `L`'s
+/// value.
+pub fn parser<A, L>() -> impl TypedValueParser<Value = L>
+where
+    A: ValueEnum + Clone + Send + Sync + 'static,
+    L: From<A> + Clone + Send + Sync + 'static,
+{
+    EnumValueParser::<A>::new().map(L::from)
+}
+
+macro_rules! mirror {
+    ($mirror:ident => $library:ident { $($(#[$doc:meta])* $variant:ident,)* }) => {
+        #[doc = concat!("[`", stringify!($library), "`] on the command line.")]
+        #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum $mirror {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl From<$mirror> for $library {
+            fn from(value: $mirror) -> $library {
+                match value {
+                    $($mirror::$variant => $library::$variant,)*
+                }
+            }
+        }
+
+        impl From<$library> for $mirror {
+            fn from(value: $library) -> $mirror {
+                match value {
+                    $($library::$variant => $mirror::$variant,)*
+                }
+            }
+        }
+    };
+}
+
+mirror!(BlendArg => Blend {
+    /// Linear blend skinning: fast, exact for affine handles; joints thin when twisted far.
+    Linear,
+    /// Dual-quaternion skinning: keeps limbs' thickness at strongly rotated joints.
+    Dqs,
+    /// Linear blending with stretchable bones: a bone scaled along its length stretches its
+    /// limb and carries what lies past its tail ([`stretchable_blend`]).
+    Stretch,
+});
+
+mirror!(WeightMethodArg => WeightMethod {
+    /// Bounded biharmonic weights (Jacobson et al. 2011): smooth, local, in [0, 1].
+    Bbw,
+    /// Harmonic weights: fast, in [0, 1], but with a kink at point handles.
+    Harmonic,
+    /// Unconstrained biharmonic weights: smooth but not bounded nor local (for comparison).
+    Biharmonic,
+    /// Rigid cutout weights: the nearest handle inside the shape, blended over
+    /// `rigid_blend_px` around joints (see [`super::rigid`]).
+    Rigid,
+});
+
+mirror!(BakeModeArg => BakeMode {
+    /// Only what native timelines cannot express (default).
+    Auto,
+    /// Every bone, at the bake rate (for engines that resample anyway, and to test baking).
+    All,
+});
+
+mirror!(TemplateArg => Template {
+    /// Spine (hip, chest), head, two arms and two legs of two bones each.
+    Humanoid,
+    /// Spine (hip, chest), head, a tail of two bones and four legs of two bones each.
+    Quadruped,
+});
+
+mirror!(FillModeArg => FillMode {
+    /// Each pixel takes the color of its largest weight: crisp cartoon fills.
+    Flat,
+    /// Colors blended by weight.
+    Soft,
+});
+
+mirror!(ColorWeightsArg => ColorWeights {
+    /// Harmonic weights: one Laplace solve per color over one factorization. Fast.
+    Harmonic,
+    /// Bounded biharmonic weights (Jacobson et al. 2011): smoother blends, far slower.
+    Bbw,
+});
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Serialize;
+
+    /// Every mirror value converts to the library value whose file name (serde) is the flag
+    /// value's name, and back to itself.
+    fn check<A, L>()
+    where
+        A: ValueEnum + Copy + PartialEq + std::fmt::Debug + From<L>,
+        L: From<A> + Serialize + Copy,
+    {
+        for &value in A::value_variants() {
+            let name = value.to_possible_value().expect("no hidden values");
+            let library = L::from(value);
+            assert_eq!(
+                serde_json::to_value(library).expect("serializes"),
+                serde_json::Value::String(name.get_name().to_string())
+            );
+            assert_eq!(A::from(library), value);
+        }
+    }
+
+    #[test]
+    fn mirrors_name_the_library_values_as_files_do() {
+        check::<BlendArg, Blend>();
+        check::<WeightMethodArg, WeightMethod>();
+        check::<BakeModeArg, BakeMode>();
+        check::<TemplateArg, Template>();
+        check::<FillModeArg, FillMode>();
+        check::<ColorWeightsArg, ColorWeights>();
+    }
+}
