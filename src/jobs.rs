@@ -68,12 +68,13 @@ pub fn render_animation(
     settings: &RenderSettings,
     output: &Path,
 ) -> Result<SequenceReport, JobError> {
-    let animation = anim::load_animations(&doc)?
-        .remove(name)
-        .ok_or_else(|| AnimError::Malformed {
-            animation: name.to_string(),
-            reason: "the document has no animation of that name".into(),
-        })?;
+    let animation =
+        anim::load_animations(&doc)?
+            .remove(name)
+            .ok_or_else(|| AnimError::Malformed {
+                animation: name.to_string(),
+                reason: "the document has no animation of that name".into(),
+            })?;
     sequence::format_for_path(output)?;
     // Settings are checked before the scene is built: a bad scale fails at once.
     settings.view(doc.canvas)?;
