@@ -7,7 +7,7 @@ mod choices;
 mod colorize;
 
 use anyhow::{anyhow, bail, Context, Result};
-use choices::{BakeModeArg, BlendArg, TemplateArg, WeightMethodArg};
+use choices::{BakeModeArg, BlendArg, SchemaKindArg, TemplateArg, WeightMethodArg};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
@@ -19,6 +19,7 @@ use sinew::pipeline::{self, PartReport, Scene};
 use sinew::playback::{self, FrameView};
 use sinew::render;
 use sinew::rig::{Handles, Pose};
+use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
 use sinew::trace::TraceOptions;
 use sinew::weights::{WeightMethod, WeightOptions};
@@ -52,6 +53,8 @@ pub enum Command {
     Autorig(AutorigArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
+    /// Print the JSON Schema of a file sinew reads (see docs/formats.md).
+    Schema(SchemaArgs),
     /// Open the editor window (rig, weigh and pose by hand).
     #[cfg(feature = "editor")]
     Edit(EditArgs),
@@ -90,6 +93,14 @@ pub enum EditMode {
     Pose,
     Animate,
     Colorize,
+}
+
+/// `sinew schema KIND`.
+#[derive(Args, Debug)]
+pub struct SchemaArgs {
+    /// The file whose schema to print.
+    #[arg(value_parser = choices::parser::<SchemaKindArg, SchemaKind>())]
+    pub kind: SchemaKind,
 }
 
 #[derive(Args, Debug)]
@@ -369,6 +380,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Colorize(args) => colorize::run(&args),
+        Command::Schema(args) => print_schema(&args),
         #[cfg(feature = "editor")]
         Command::Edit(args) => edit(&args),
     }
@@ -396,6 +408,19 @@ fn edit(args: &EditArgs) -> Result<()> {
         line_art: args.line_art.clone(),
         scribbles: args.scribbles.clone(),
     })
+}
+
+/// Prints the JSON Schema of a file kind on stdout (a reader that stops early, `| head`, is no
+/// error).
+fn print_schema(args: &SchemaArgs) -> Result<()> {
+    use std::io::Write;
+    let text = serde_json::to_string_pretty(&sinew::schema::schema(args.kind))? + "\n";
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("cannot write the schema to stdout")
+        }
+        _ => Ok(()),
+    }
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
@@ -748,7 +773,7 @@ fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
     })
 }
 
-/// The `--vertices` file of DESIGN.md.
+/// The `--vertices` file of docs/formats.md.
 fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Result<String> {
     #[derive(Serialize)]
     struct Part<'a> {

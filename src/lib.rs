@@ -4,7 +4,7 @@
 //! RGBA image → [`trace`] → outlines → [`mesh`] → triangle mesh → weights → skin → [`render`].
 //! [`io`] reads and writes the native rig document and images; [`pipeline`] wires the stages
 //! together. The `sinew` command and its argument parsing live in the binary (feature `cli`);
-//! the library knows no shell.
+//! the library knows no shell. The files sinew reads and writes: `docs/formats.md`.
 
 pub mod anim;
 pub mod autorig;
@@ -22,6 +22,7 @@ pub mod pipeline;
 pub mod playback;
 pub mod render;
 pub mod rig;
+pub mod schema;
 pub mod skin;
 pub mod trace;
 pub mod weights;

@@ -19,7 +19,7 @@ use spade::{
 use std::collections::{HashMap, HashSet};
 
 /// How outlines become triangles.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct MeshOptions {
     /// Whether to add interior (Steiner) points for quality. Default true.

@@ -30,7 +30,7 @@ mod simplify;
 pub const MAX_PADDING_PX: f64 = 256.0;
 
 /// How alpha becomes outlines. Defaults work on ordinary antialiased sprites.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct TraceOptions {
     /// A pixel is opaque when its alpha is at least this (1–255; 0 would make every pixel

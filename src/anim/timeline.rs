@@ -13,7 +13,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::BTreeMap;
 
 /// A key: a value at a time, and how it travels to the next key.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Key<V> {
     /// Seconds from the start of the animation.
@@ -25,7 +25,7 @@ pub struct Key<V> {
 }
 
 /// A key of a timeline that only ever steps (visibility, draw order): no curve.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StepKey<V> {
     pub time: f64,
@@ -123,7 +123,7 @@ impl Channels for Vec<[f64; 2]> {
 }
 
 /// A bone's timelines; each value replaces the bone's [`crate::rig::pose::BonePose`] field.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct BoneTimelines {
     /// Degrees, counter-clockwise on screen; interpolated as authored (0 → 360 is a full turn).
@@ -141,7 +141,7 @@ pub struct BoneTimelines {
 }
 
 /// A point handle's timelines, as [`crate::rig::pose::PointPose`].
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PointTimelines {
     /// px, canvas axes.
@@ -158,7 +158,7 @@ pub struct PointTimelines {
 }
 
 /// A part's timelines, as [`crate::rig::pose::PartPose`].
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PartTimelines {
     /// RGBA multiplier; a Bézier has 4 channels whose `cy` are channel values in [0, 1].
@@ -170,7 +170,7 @@ pub struct PartTimelines {
 
 /// A keyed skinning-IK drag: the material point at rest position `at` (canvas px) goes to the
 /// keyed position.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IkTimeline {
     pub at: [f64; 2],
@@ -181,7 +181,7 @@ pub struct IkTimeline {
 }
 
 /// One animation: timelines by what they move. Anything without a timeline stays at rest.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Animation {
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]

@@ -1,8 +1,8 @@
 //! Automatic rigging: skeletons, cages and point handles proposed from the drawing.
 //!
 //! In: one or more straight-alpha RGBA layers on one canvas (with their part names) and
-//! [`AutorigOptions`]. Out: a [`Proposal`]: a [`Handles`] value (the handles file of DESIGN.md,
-//! canvas px, validated) that a person can edit and pass to `sinew rig --handles`, plus notes
+//! [`AutorigOptions`]. Out: a [`Proposal`]: a [`Handles`] value (the handles file of
+//! `docs/formats.md`, canvas px, validated) that a person can edit and pass to `sinew rig --handles`, plus notes
 //! for the person.
 //!
 //! - One image, or any images with a template: the union silhouette is traced as `sinew rig`

@@ -10,6 +10,7 @@ use clap::ValueEnum;
 use sinew::autorig::Template;
 use sinew::colorize::{ColorWeights, FillMode};
 use sinew::export::spine::BakeMode;
+use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
 use sinew::weights::WeightMethod;
 
@@ -92,6 +93,19 @@ mirror!(FillModeArg => FillMode {
     Soft,
 });
 
+mirror!(SchemaKindArg => SchemaKind {
+    /// The handles file (`sinew rig --handles`, `sinew autorig -o`).
+    Handles,
+    /// The rig document (`sinew rig -o`, the editor's documents).
+    Rig,
+    /// The pose file (`sinew pose --pose`).
+    Pose,
+    /// An animations file: animation name → animation, as the rig document's `animations`.
+    Animations,
+    /// The scribbles JSON of `sinew colorize --scribbles`.
+    Scribbles,
+});
+
 mirror!(ColorWeightsArg => ColorWeights {
     /// Harmonic weights: one Laplace solve per color over one factorization. Fast.
     Harmonic,
@@ -130,5 +144,10 @@ mod tests {
         check::<TemplateArg, Template>();
         check::<FillModeArg, FillMode>();
         check::<ColorWeightsArg, ColorWeights>();
+        for &kind in SchemaKindArg::value_variants() {
+            let name = kind.to_possible_value().expect("no hidden values");
+            assert_eq!(SchemaKind::from(kind).name(), name.get_name());
+            assert_eq!(SchemaKindArg::from(SchemaKind::from(kind)), kind);
+        }
     }
 }

@@ -78,21 +78,23 @@ pub enum ScribbleError {
 }
 
 /// The JSON scribble file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct StrokeFile {
     pub strokes: Vec<Stroke>,
 }
 
 /// One polyline scribble.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Stroke {
     /// `#rrggbb`.
+    #[schemars(regex(pattern = r"^#[0-9a-fA-F]{6}$"))]
     pub color: String,
     /// Stroke width, px.
     pub width: f64,
     /// Polyline points, canvas px.
+    #[schemars(length(min = 1))]
     pub points: Vec<[f64; 2]>,
 }
 

@@ -1,8 +1,8 @@
 //! The native rig document (`sinew-rig`, version 1).
 //!
-//! In: a JSON file as in DESIGN.md. Out: a [`RigDocument`] that has been checked: format name and
-//! version known, triangle indices in range, coordinates finite, weight rows matching vertices
-//! and handles, part names unique. Image paths are stored relative to the document's folder.
+//! In: a JSON file as in `docs/formats.md`. Out: a [`RigDocument`] that has been checked: format
+//! name and version known, triangle indices in range, coordinates finite, weight rows matching
+//! vertices and handles, part names unique. Image paths are stored relative to the document's folder.
 //! Saving writes atomically.
 
 use super::atomic::write_atomic;
@@ -21,10 +21,12 @@ pub const RIG_FORMAT: &str = "sinew-rig";
 pub const RIG_VERSION: u32 = 1;
 
 /// A whole rig: parts on one canvas, their meshes and weights, the handles and animations.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RigDocument {
+    #[schemars(extend("const" = RIG_FORMAT))]
     pub format: String,
+    #[schemars(extend("const" = RIG_VERSION))]
     pub version: u32,
     /// Canvas size in px, shared by every part's image.
     pub canvas: [u32; 2],
@@ -32,8 +34,10 @@ pub struct RigDocument {
     pub parts: Vec<PartDoc>,
     #[serde(default)]
     pub handles: Handles,
-    /// Animations by name. Kept verbatim: the timeline model reads them.
+    /// Animations by name. Kept verbatim: the timeline model reads them (the schema describes
+    /// each as the animation it is parsed into, `crate::anim::Animation`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[schemars(with = "crate::schema::Animations")]
     pub animations: BTreeMap<String, serde_json::Value>,
     /// The options the meshes were built with, so a re-trace reproduces them.
     #[serde(default)]
@@ -45,7 +49,7 @@ pub struct RigDocument {
 }
 
 /// How the document's meshes were built.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct BuildOptions {
     pub trace: TraceOptions,
@@ -56,7 +60,7 @@ pub struct BuildOptions {
 }
 
 /// One image of the rig with its mesh.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PartDoc {
     pub name: String,
@@ -73,7 +77,7 @@ pub struct PartDoc {
 }
 
 /// A mesh as stored: vertices in canvas px, triangles as vertex indices.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeshDoc {
     pub vertices: Vec<[f64; 2]>,
@@ -82,7 +86,7 @@ pub struct MeshDoc {
 
 /// Sparse skinning weights: `rows[i]` lists vertex `i`'s non-zero weights as
 /// `(index into handles, weight)`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WeightsDoc {
     pub handles: Vec<String>,

@@ -37,7 +37,7 @@ use crate::geom::{Point, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// An IK constraint of the handles file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoneIk {
     pub name: String,

@@ -1,6 +1,7 @@
 //! The handles file: what the animator placed on the canvas.
 //!
-//! In: JSON as in DESIGN.md (`bones`, `points`, `cages`, `regions`; positions in canvas px).
+//! In: JSON as in `docs/formats.md` (`bones`, `points`, `cages`, `regions`, `bind`, `ik`;
+//! positions in canvas px).
 //! Out: [`Handles`], checked by [`Handles::validate`]: names unique across all handles, parents
 //! known and acyclic, bones of non-zero length, polygons of at least three points, every
 //! coordinate finite.
@@ -10,7 +11,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// A bone: rest geometry `head` → `tail` in canvas px; it rotates about its head in its
 /// parent's frame. A bone without a parent starts its own skeleton.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bone {
     pub name: String,
@@ -21,7 +22,7 @@ pub struct Bone {
 }
 
 /// A loose point handle at `at` (canvas px).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointHandle {
     pub name: String,
@@ -29,7 +30,7 @@ pub struct PointHandle {
 }
 
 /// A cage: a closed polygon (canvas px) whose vertices are handles.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Cage {
     pub name: String,
@@ -37,7 +38,7 @@ pub struct Cage {
 }
 
 /// A region: a closed polygon (canvas px) whose inside moves rigidly together.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
     pub name: String,
@@ -45,7 +46,7 @@ pub struct Region {
 }
 
 /// Every handle of a rig, in file order.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Handles {
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -1,6 +1,6 @@
 //! Poses and forward kinematics over the bone forest.
 //!
-//! In: validated [`Handles`] and a [`Pose`] (the pose file of DESIGN.md). Out: one affine
+//! In: validated [`Handles`] and a [`Pose`] (the pose file of `docs/formats.md`). Out: one affine
 //! [`Affine`] per handle that maps rest canvas positions to posed canvas positions — the
 //! transformations skinning blends.
 //!
@@ -74,7 +74,7 @@ pub fn screen_angle_deg(v: Vec2) -> f64 {
 }
 
 /// A bone's local pose, in its parent's frame.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct BonePose {
     /// Degrees, counter-clockwise on screen, about the head.
@@ -99,7 +99,7 @@ impl Default for BonePose {
 }
 
 /// A point handle's pose: about its rest position, in canvas axes.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PointPose {
     pub translate: [f64; 2],
@@ -127,7 +127,7 @@ impl Default for PointPose {
 }
 
 /// A cage's posed polygon (same vertex count as at rest), canvas px.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CagePose {
     pub polygon: Vec<[f64; 2]>,
@@ -136,7 +136,7 @@ pub struct CagePose {
 /// A drag for skinning IK: the material point at rest position `at` goes to `to` (canvas px).
 /// Without a `weight` the drag is a hard constraint (met exactly when feasible); with one it is
 /// a soft pull of that strength (1 ≈ the stiffness of moving one handle).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IkDrag {
     pub at: [f64; 2],
@@ -146,7 +146,7 @@ pub struct IkDrag {
 }
 
 /// A part's look: a tint multiplying its texture, and whether it is drawn.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PartPose {
     /// RGBA multiplier, each channel in [0, 1].
@@ -164,7 +164,7 @@ impl Default for PartPose {
 }
 
 /// The pose file: anything not named stays at rest.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Pose {
     pub bones: BTreeMap<String, BonePose>,

@@ -22,7 +22,9 @@ use crate::rig::{handle_columns, Handles};
 use serde::{Deserialize, Serialize};
 
 /// Which energy the weights minimize.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum WeightMethod {
     /// Bounded biharmonic weights (Jacobson et al. 2011): smooth, local, in [0, 1].
@@ -38,7 +40,7 @@ pub enum WeightMethod {
 }
 
 /// How weights are computed. Shared by the command line, the editor and the rig document.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct WeightOptions {
     /// Default: bounded biharmonic.

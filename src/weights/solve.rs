@@ -150,7 +150,7 @@ impl WeightMatrix {
 pub const EMPTY_ROW_SUM: f64 = 1e-9;
 
 /// Parameters of the bounded biharmonic solve (a primal–dual interior-point method).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct BbwOptions {
     /// Interior-point iterations per handle before giving up (the iterate is then clamped to

@@ -16,7 +16,8 @@
 //! - [`constraints`]: one- and two-bone IK constraints as Spine IK constraints;
 //! - [`bake`]: what Spine cannot express, sampled at `bake_fps` through the one pose path.
 //!
-//! Spine facts relied on are in `/work/shared/spine-format.md` (section numbers cited there);
+//! Spine facts relied on are in `docs/spine-format.md` (the "spine-format.md §N" cited in these
+//! modules); what sinew writes is summed up in `docs/formats.md`;
 //! `tests/spine_runtime.rs` checks the result against the official `spine-core` runtime.
 
 pub mod atlas;
