@@ -25,7 +25,9 @@ use sinew::colorize::{
     self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
     ScribbleOptions, Scribbles,
 };
+#[cfg(feature = "cli")]
 use sinew::io::{load_png, save_png};
+#[cfg(feature = "cli")]
 use std::path::Path;
 
 fn scribbles(s: &Scene) -> Scribbles {
