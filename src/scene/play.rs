@@ -173,6 +173,11 @@ pub fn frames(
         }
         return Ok(out.into_iter().flatten().collect());
     }
+    if !animation.ik.is_empty() {
+        // Made here, outside the thread pool: the precomputation runs rayon work of its own, and
+        // a worker that steals a frame while initializing the shared cell would wait on itself.
+        scene.rig_ik()?;
+    }
     times_s
         .par_iter()
         .map_init(
