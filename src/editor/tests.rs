@@ -1,9 +1,14 @@
 //! The editor driven through egui_kittest: real frames, simulated pointer and keys, checked
 //! against the document.
 
+use super::rig_mode::distance;
 use super::*;
+use crate::rig::PointHandle;
+use eframe::egui::Pos2;
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
+use std::path::Path;
+use std::sync::Arc;
 
 /// Frames a background weight build may take before a test gives up (50 ms apart).
 const BUILD_FRAMES: usize = 1200;
@@ -165,7 +170,7 @@ fn rig_weigh_pose_undo_through_the_ui() {
     assert_eq!(pose.ik.len(), 1, "{:?}", h.state().message);
     assert!(distance(pose.ik[0].at, grip) < 1.0);
     assert!(distance(pose.ik[0].to, [grip[0] + 25.0, grip[1] - 15.0]) < 1.0);
-    let posed = h.state().posed.as_ref().expect("posed");
+    let posed = h.state().pose_mode.posed.as_ref().expect("posed");
     let moved = posed
         .positions
         .iter()
@@ -465,9 +470,9 @@ fn set_two_keys_and_scrub_the_timeline() {
         h.run();
     }
     assert!(
-        (h.state().time_s - 1.0).abs() < 1e-9,
+        (h.state().animate.time_s - 1.0).abs() < 1e-9,
         "{}",
-        h.state().time_s
+        h.state().animate.time_s
     );
     // Grab the pin where the first key left it and move it to the other side.
     let second = [grip[0] - 20.0, grip[1] - 10.0];
@@ -488,7 +493,10 @@ fn set_two_keys_and_scrub_the_timeline() {
         halfway.ik[0].to
     );
     // The canvas shows that pose: the posed mesh was solved for it.
-    assert_eq!(h.state().posed.as_ref().expect("posed").pose, halfway);
+    assert_eq!(
+        h.state().pose_mode.posed.as_ref().expect("posed").pose,
+        halfway
+    );
     // Setting keys is undoable like any edit.
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
@@ -506,7 +514,7 @@ fn reopening_restores_the_view() {
         pan: egui::vec2(-40.0, 12.0),
     });
     app.selected = Some("head".into());
-    app.time_s = 0.75;
+    app.animate.time_s = 0.75;
     app.timeline.looping = false;
     app.timeline.onion.enabled = true;
     app.timeline.onion.frames = 3;
@@ -523,7 +531,7 @@ fn reopening_restores_the_view() {
         "animation": "animation", "time_s": 0.0}"#;
     let state: ViewState = serde_json::from_str(old).expect("an older view file");
     assert!(state.looping);
-    assert_eq!(state.onion, timeline::OnionOptions::default());
+    assert_eq!(state.onion, animate_mode::OnionOptions::default());
     assert_eq!(state.render, crate::playback::RenderSettings::default());
     // Hand-edited values come back inside the ranges the UI edits.
     let mut wild = state;
@@ -535,7 +543,7 @@ fn reopening_restores_the_view() {
     let restored = reopened.view_state();
     assert_eq!(restored.render.fps, crate::playback::MAX_FPS);
     assert_eq!(restored.render.scale, 1.0);
-    assert_eq!(restored.onion.frames, timeline::MAX_ONION_FRAMES);
+    assert_eq!(restored.onion.frames, animate_mode::MAX_ONION_FRAMES);
     assert_eq!(restored.onion.opacity, 0.05);
 }
 
@@ -576,7 +584,7 @@ fn renders_the_current_animation_in_the_background() {
     {
         let app = h.state_mut();
         key_nod(app, &[(0.0, 0.0), (0.5, 20.0)]);
-        app.animation = "nod".into();
+        app.animate.animation = "nod".into();
         app.render_settings.fps = 8.0;
         app.render_settings.scale = 0.5;
         app.render_path = gif.display().to_string();
@@ -600,7 +608,7 @@ fn renders_the_current_animation_in_the_background() {
     let width = u16::from_le_bytes([bytes[6], bytes[7]]);
     assert_eq!(u32::from(width), canvas_width.div_ceil(2));
     // An animation the document does not have: a message, no file.
-    h.state_mut().animation = "nope".into();
+    h.state_mut().animate.animation = "nope".into();
     h.state_mut().render_path = path.with_file_name("nope.gif").display().to_string();
     h.state_mut().start_render(&ctx);
     for _ in 0..BUILD_FRAMES {
@@ -1235,14 +1243,14 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let mut h = open_character("dopesheet");
     h.key_press(Key::Num3);
     h.run();
-    h.state_mut().animation = "nod".into();
+    h.state_mut().animate.animation = "nod".into();
     // Two keys from the pose: the head at 0° at 0 s and at 20° at 0.5 s.
     for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
         for _ in 0..frames {
             h.get_by_label("Next frame").click();
             h.run();
         }
-        h.state_mut().shown = Some(head_turned(degrees));
+        h.state_mut().animate.shown = Some(head_turned(degrees));
         h.get_by_label("Set key").click();
         h.run();
     }
@@ -1265,7 +1273,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
         time_s: 0.5,
     };
     assert_eq!(h.state().timeline.selection, vec![selected.clone()]);
-    assert!((h.state().time_s - 0.5).abs() < 1e-9);
+    assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
 
     // Drag it to 0.75 s (a little off: it snaps to the frame); only that channel moves.
     let sheet = h.state().timeline.sheet.clone().expect("sheet");
@@ -1288,9 +1296,9 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let ruler_y = sheet.ruler.center().y;
     click_screen(&mut h, Pos2::new(sheet.x_of(1.0), ruler_y));
     assert!(
-        (h.state().time_s - 1.0).abs() < 1e-9,
+        (h.state().animate.time_s - 1.0).abs() < 1e-9,
         "{}",
-        h.state().time_s
+        h.state().animate.time_s
     );
     h.get_by_label("Paste keys").click();
     h.run();
@@ -1378,41 +1386,41 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     {
         let app = h.state_mut();
         key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);
-        app.animation = "nod".into();
+        app.animate.animation = "nod".into();
         app.render_settings.fps = 12.0;
-        app.playing = true;
+        app.animate.playing = true;
     }
     let on_frame = |t: f64| ((t * 12.0) - (t * 12.0).round()).abs() < 1e-6;
     let mut wrapped = false;
     let mut last = 0.0;
     for _ in 0..240 {
         h.step();
-        let t = h.state().time_s;
+        let t = h.state().animate.time_s;
         assert!(on_frame(t) && t < 0.5 - 1e-9, "{t}");
         wrapped |= t < last;
         last = t;
     }
     assert!(wrapped, "playback never looped");
     // Without looping it stops on the last key.
-    h.state_mut().playing = false;
+    h.state_mut().animate.playing = false;
     h.get_by_label("Loop").click();
     h.run();
-    h.state_mut().playing = true;
+    h.state_mut().animate.playing = true;
     for _ in 0..240 {
         h.step();
-        if !h.state().playing {
+        if !h.state().animate.playing {
             break;
         }
     }
-    assert!(!h.state().playing);
-    assert!((h.state().time_s - 0.5).abs() < 1e-9);
+    assert!(!h.state().animate.playing);
+    assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
     // Playing again from the end starts over.
-    h.state_mut().playing = true;
+    h.state_mut().animate.playing = true;
     h.step();
-    assert_eq!(h.state().time_s, 0.0);
+    assert_eq!(h.state().animate.time_s, 0.0);
     h.step();
-    assert!(h.state().time_s > 0.0);
-    h.state_mut().playing = false;
+    assert!(h.state().animate.time_s > 0.0);
+    h.state_mut().animate.playing = false;
     h.state_mut().set_time(0.5);
 
     // Onion skins: at the end only earlier frames exist; in the middle both sides.
@@ -1440,7 +1448,7 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     {
         let app = h.state_mut();
         key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);
-        app.animation = "nod".into();
+        app.animate.animation = "nod".into();
     }
     h.key_press(Key::Num3);
     h.run();
@@ -1468,7 +1476,7 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
         time_s: 0.5
     }));
     assert!(
-        (h.state().time_s - 0.5).abs() < 1e-9,
+        (h.state().animate.time_s - 0.5).abs() < 1e-9,
         "a plain click moves the playhead to its key"
     );
     // Ctrl+C, playhead to 1 s, Ctrl+V: both keys pasted at 1 s.
