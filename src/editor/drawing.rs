@@ -112,7 +112,9 @@ impl EditorApp {
         rect: Rect,
         placed: &Placed,
     ) -> Result<(), String> {
-        let Some(posed) = &self.pose_mode.posed else {
+        let Some(posed) = self.pose_mode.posed.as_ref().filter(|p| p.scene.is(scene)) else {
+            // Nothing of this rig was posed yet (its first pose failed): nothing to show.
+            self.drawing.picture = None;
             return Ok(());
         };
         let pixels_per_point = ctx.pixels_per_point();

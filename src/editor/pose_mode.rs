@@ -22,7 +22,7 @@ use std::sync::Arc;
 
 /// Posed vertex positions of a built rig, for one pose.
 pub struct Posed {
-    scene: Identity<Scene>,
+    pub(super) scene: Identity<Scene>,
     /// How the positions were blended.
     blend: Blend,
     pub pose: Pose,
@@ -161,7 +161,7 @@ impl EditorApp {
         let shift = ctx.input(|i| i.modifiers.shift);
         // The rest point of the drawing under the pointer and where it is shown now.
         let grab = |app: &mut EditorApp, at: Pos2| -> Option<([f64; 2], [f64; 2])> {
-            let posed = app.pose_mode.posed.as_ref()?;
+            let posed = app.pose_mode.posed.as_ref().filter(|p| p.scene.is(scene))?;
             let rest = rest_point_under(
                 scene,
                 &posed.positions,
@@ -406,6 +406,13 @@ pub fn shown_position(
             weight: None,
         })
         .map_err(|e| e.to_string())?;
+    if grip.row.len() != 3 * transforms.len() {
+        return Err(format!(
+            "{} transforms for a rig of {} handle columns",
+            transforms.len(),
+            grip.row.len() / 3
+        ));
+    }
     let p = crate::ik::rig::skinned_position(&grip.row, transforms);
     Ok([p.x, p.y])
 }
