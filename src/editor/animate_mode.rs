@@ -15,7 +15,6 @@ use crate::pipeline::Scene;
 use crate::rig::Pose;
 use crate::skin::Blend;
 use eframe::egui::{self, Color32, Shape, Stroke};
-use std::collections::btree_map::Entry;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -207,6 +206,7 @@ impl EditorApp {
         placed: &canvas::Placed,
     ) -> Vec<Shape> {
         let options = self.timeline.onion;
+        let opacity = options.opacity;
         if !options.enabled || self.mode != Mode::Animate {
             return Vec::new();
         }
@@ -241,45 +241,56 @@ impl EditorApp {
         if frames == 0 {
             return Vec::new();
         }
-        let mut shapes = Vec::new();
-        for k in (1..=frames).rev() {
-            let fade = options.opacity * (frames + 1 - k) as f32 / frames as f32;
-            for (sign, rgb) in [(-1.0, [255, 90, 90]), (1.0, [90, 230, 120])] {
-                let t = now + sign * k as f64 * frame_s;
-                if t < -KEY_TIME_TOLERANCE_S || t > end + KEY_TIME_TOLERANCE_S {
-                    continue;
+        // The frames around the playhead, as the library plays them (momentum included).
+        let times: Vec<(usize, f64, [u8; 3])> = (1..=frames)
+            .rev()
+            .flat_map(|k| {
+                [(-1.0, [255, 90, 90]), (1.0, [90, 230, 120])]
+                    .map(|(sign, rgb)| (k, now + sign * k as f64 * frame_s, rgb))
+            })
+            .filter(|(_, t, _)| *t >= -KEY_TIME_TOLERANCE_S && *t <= end + KEY_TIME_TOLERANCE_S)
+            .collect();
+        let micros = |t: f64| (t * 1e6).round() as i64;
+        let missing: Vec<f64> = times
+            .iter()
+            .map(|(_, t, _)| t.max(0.0))
+            .filter(|&t| !cache.frames.contains_key(&micros(t)))
+            .collect();
+        let options = crate::scene::PlayOptions {
+            sampling,
+            looping: false,
+        };
+        // Frames that cannot be posed are left out; the canvas reports the error.
+        if let Ok(played) = crate::scene::frames(scene, &animation, &missing, options) {
+            for frame in played {
+                if let Ok(positions) =
+                    scene.positions_from_transforms(&frame.transforms, &frame.pose, blend)
+                {
+                    cache.frames.insert(micros(frame.time_s), positions);
                 }
-                let micros = (t * 1e6).round() as i64;
-                let positions = match cache.frames.entry(micros) {
-                    Entry::Occupied(kept) => kept.into_mut(),
-                    Entry::Vacant(slot) => {
-                        let pose = animation.sample_with(t.max(0.0), false, &sampling);
-                        // A frame that cannot be posed is left out; the canvas reports the
-                        // error.
-                        let Ok((_, positions)) = super::pose_mode::pose_frame(scene, &pose, blend)
-                        else {
-                            continue;
-                        };
-                        slot.insert(positions)
-                    }
-                };
-                let color =
-                    Color32::from_rgba_unmultiplied(rgb[0], rgb[1], rgb[2], (fade * 255.0) as u8);
-                let stroke = Stroke::new(1.2, color);
-                for (edges, part) in cache.outlines.iter().zip(positions) {
-                    for [a, b] in edges {
-                        let (Some(p), Some(q)) = (part.get(*a as usize), part.get(*b as usize))
-                        else {
-                            continue;
-                        };
-                        shapes.push(Shape::line_segment(
-                            [
-                                placed.screen_from_canvas([p.x, p.y]),
-                                placed.screen_from_canvas([q.x, q.y]),
-                            ],
-                            stroke,
-                        ));
-                    }
+            }
+        }
+        let mut shapes = Vec::new();
+        for (k, t, rgb) in times {
+            let fade = opacity * (frames + 1 - k) as f32 / frames as f32;
+            let Some(positions) = cache.frames.get(&micros(t.max(0.0))) else {
+                continue;
+            };
+            let color =
+                Color32::from_rgba_unmultiplied(rgb[0], rgb[1], rgb[2], (fade * 255.0) as u8);
+            let stroke = Stroke::new(1.2, color);
+            for (edges, part) in cache.outlines.iter().zip(positions) {
+                for [a, b] in edges {
+                    let (Some(p), Some(q)) = (part.get(*a as usize), part.get(*b as usize)) else {
+                        continue;
+                    };
+                    shapes.push(Shape::line_segment(
+                        [
+                            placed.screen_from_canvas([p.x, p.y]),
+                            placed.screen_from_canvas([q.x, q.y]),
+                        ],
+                        stroke,
+                    ));
                 }
             }
         }

@@ -209,11 +209,19 @@ impl EditorApp {
         let mut posed_handles = None;
         match (self.mode, &posable) {
             (Mode::Pose | Mode::Animate, Some(scene)) => {
-                let pose = live_pose.unwrap_or_else(|| self.edited_pose());
                 shapes.extend(self.onion_shapes(scene, &placed));
-                let drawn = self
-                    .update_posed(scene, &pose)
-                    .and_then(|()| self.picture(&ctx, scene, rect, &placed));
+                // The playhead's frame when animate mode shows the animation as it plays, else
+                // the pose edited.
+                let playhead = self.mode == Mode::Animate
+                    && live_pose.is_none()
+                    && self.animate.shown.is_none();
+                let pose = live_pose.unwrap_or_else(|| self.edited_pose());
+                let posed = if playhead {
+                    self.update_posed_at_playhead(scene)
+                } else {
+                    self.update_posed(scene, &pose)
+                };
+                let drawn = posed.and_then(|()| self.picture(&ctx, scene, rect, &placed));
                 if let Err(e) = drawn {
                     self.message = Some(e);
                 }

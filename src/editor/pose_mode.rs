@@ -25,12 +25,67 @@ pub struct Posed {
     pub(super) scene: Identity<Scene>,
     /// How the positions were blended.
     blend: Blend,
+    /// The animation and time played, when the pose is a playhead's frame (its transforms may
+    /// carry momentum, so the pose alone does not decide them).
+    played: Option<Played>,
     pub pose: Pose,
     pub positions: Vec<Vec<Point>>,
     /// Per handle column, the transform shown ([`Scene::handle_transforms`]'s).
     pub transforms: Vec<crate::rig::Affine>,
     /// The handles where the pose puts them (bones' heads and tails, points), for drawing.
     pub handles: crate::rig::Handles,
+}
+
+/// An animation played at a time, as [`Posed`] remembers it.
+#[derive(Clone, Debug, PartialEq)]
+struct Played {
+    animation: serde_json::Value,
+    time_s: f64,
+    options: crate::scene::PlayOptions,
+}
+
+impl Posed {
+    fn new(
+        scene: &Arc<Scene>,
+        blend: Blend,
+        played: Option<Played>,
+        pose: Pose,
+        positions: Vec<Vec<Point>>,
+        transforms: Vec<crate::rig::Affine>,
+    ) -> Self {
+        let map = |t: &crate::rig::Affine, p: [f64; 2]| {
+            let q = t.apply(Point::new(p[0], p[1]));
+            [q.x, q.y]
+        };
+        let mut handles = scene.doc.handles.clone();
+        let bone_count = handles.bones.len();
+        for (b, t) in handles.bones.iter_mut().zip(&transforms) {
+            (b.head, b.tail) = (map(t, b.head), map(t, b.tail));
+        }
+        for (p, t) in handles
+            .points
+            .iter_mut()
+            .zip(transforms.iter().skip(bone_count))
+        {
+            p.at = map(t, p.at);
+        }
+        // Cage vertices follow the points in column order, one column each.
+        let mut cage_columns = transforms.iter().skip(bone_count + handles.points.len());
+        for cage in &mut handles.cages {
+            for (v, t) in cage.polygon.iter_mut().zip(cage_columns.by_ref()) {
+                *v = map(t, *v);
+            }
+        }
+        Posed {
+            scene: Identity::of(scene),
+            blend,
+            played,
+            pose,
+            positions,
+            transforms,
+            handles,
+        }
+    }
 }
 
 /// Pose mode's own state: the pose shown, posed.
@@ -100,50 +155,66 @@ impl EditorApp {
         }
     }
 
-    /// Poses `scene` for `pose` through [`pose_frame`] into [`PoseMode::posed`] (kept while
-    /// the rig, the pose and the blend stay the same).
+    /// Poses `scene` for the static `pose` through [`pose_frame`] into [`PoseMode::posed`]
+    /// (kept while the rig, the pose and the blend stay the same).
     pub(super) fn update_posed(&mut self, scene: &Arc<Scene>, pose: &Pose) -> Result<(), String> {
         let blend = self.render_settings.blend;
-        if self
-            .pose_mode
-            .posed
-            .as_ref()
-            .is_some_and(|p| p.scene.is(scene) && p.blend == blend && p.pose == *pose)
-        {
+        if self.pose_mode.posed.as_ref().is_some_and(|p| {
+            p.scene.is(scene) && p.blend == blend && p.played.is_none() && p.pose == *pose
+        }) {
             return Ok(());
         }
         let (transforms, positions) = pose_frame(scene, pose, blend)?;
-        let map = |t: &crate::rig::pose::Affine, p: [f64; 2]| {
-            let q = t.apply(Point::new(p[0], p[1]));
-            [q.x, q.y]
-        };
-        let mut handles = scene.doc.handles.clone();
-        let bone_count = handles.bones.len();
-        for (b, t) in handles.bones.iter_mut().zip(&transforms) {
-            (b.head, b.tail) = (map(t, b.head), map(t, b.tail));
-        }
-        for (p, t) in handles
-            .points
-            .iter_mut()
-            .zip(transforms.iter().skip(bone_count))
-        {
-            p.at = map(t, p.at);
-        }
-        // Cage vertices follow the points in column order, one column each.
-        let mut cage_columns = transforms.iter().skip(bone_count + handles.points.len());
-        for cage in &mut handles.cages {
-            for (v, t) in cage.polygon.iter_mut().zip(cage_columns.by_ref()) {
-                *v = map(t, *v);
-            }
-        }
-        self.pose_mode.posed = Some(Posed {
-            scene: Identity::of(scene),
+        self.pose_mode.posed = Some(Posed::new(
+            scene,
             blend,
-            pose: pose.clone(),
+            None,
+            pose.clone(),
             positions,
             transforms,
-            handles,
-        });
+        ));
+        Ok(())
+    }
+
+    /// Poses `scene` as the animation edited plays at the playhead, through the library's
+    /// [`crate::scene::Playhead`] (pure in the time; momentum simulated from the start), sampled
+    /// and blended as File → Render's settings say.
+    pub(super) fn update_posed_at_playhead(&mut self, scene: &Arc<Scene>) -> Result<(), String> {
+        let name = self.animate.animation.clone();
+        let json = crate::document::animation_json(self.doc.state(), &name);
+        let Ok(animation) = crate::anim::Animation::from_json(&name, &json) else {
+            // No such animation (yet): the rest pose, as sampling it gives.
+            return self.update_posed(scene, &self.sampled_pose());
+        };
+        let (blend, time_s) = (self.render_settings.blend, self.animate.time_s);
+        let options = crate::scene::PlayOptions {
+            sampling: self.render_settings.sampling,
+            looping: false,
+        };
+        let played = Played {
+            animation: json,
+            time_s,
+            options,
+        };
+        if self.pose_mode.posed.as_ref().is_some_and(|p| {
+            p.scene.is(scene) && p.blend == blend && p.played.as_ref() == Some(&played)
+        }) {
+            return Ok(());
+        }
+        let frame = crate::scene::Playhead::new(scene, &animation, options)
+            .frame(time_s)
+            .map_err(|e| e.to_string())?;
+        let positions = scene
+            .positions_from_transforms(&frame.transforms, &frame.pose, blend)
+            .map_err(|e| e.to_string())?;
+        self.pose_mode.posed = Some(Posed::new(
+            scene,
+            blend,
+            Some(played),
+            frame.pose,
+            positions,
+            frame.transforms,
+        ));
         Ok(())
     }
 
