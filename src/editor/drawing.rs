@@ -4,7 +4,8 @@
 //! rig mode the layers at rest (with the selected handle's weights); in pose and animate mode
 //! the posed drawing as `sinew render` draws it — and the pointer handed to the mode.
 //!
-//! A pose is drawn one way: posed by [`super::pose_mode::pose_frame`], listed back to front with
+//! A pose is drawn one way: posed by [`super::pose_mode::pose_frame`] (a static pose) or by the
+//! library's [`crate::scene::Playhead`] (animate mode's playhead), listed back to front with
 //! each part's tint and visibility by [`crate::playback::pose_draws`] (the list `sinew render`
 //! draws), drawn by the library's renderer ([`Scene::draw_parts`]) into a pixmap of the canvas's
 //! on-screen size in physical pixels, shown as one texture. The picture is kept while the rig,

@@ -9,7 +9,8 @@
 //! [`paint`]), **Pose** ([`pose_mode`], with the FK [`gizmo`]), **Animate** ([`animate_mode`]:
 //! playhead, playback, onion skins; [`timeline`]: dopesheet and curves) and **Colorize**
 //! ([`colorize`]). The canvas ([`drawing`], helpers in [`canvas`]) draws a pose as `sinew
-//! render` does: posed through [`pose_mode::pose_frame`], drawn from the library's draw list
+//! render` does: posed through [`pose_mode::pose_frame`] (or [`crate::scene::Playhead`] at the
+//! playhead), drawn from the library's draw list
 //! ([`crate::playback::pose_draws`]) by its renderer. Files and the File menu are [`file`]'s.
 
 pub mod animate_mode;

@@ -6,7 +6,8 @@
 //! Out: `SetPose` commands (or animate mode's unkeyed pose), and the posed vertices the canvas
 //! draws. Every pose goes to vertices one way, [`pose_frame`]: the library's
 //! [`Scene::handle_transforms`] (no warm start: the result depends on the pose only, not on the
-//! editing that led to it) and [`Scene::positions_from_transforms`].
+//! editing that led to it) and [`Scene::positions_from_transforms`]; animate mode's playhead
+//! frame comes from [`crate::scene::Playhead`], then the same skinning.
 
 use super::canvas::{self, Placed};
 use super::identity::Identity;
