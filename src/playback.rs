@@ -303,7 +303,7 @@ fn render_positions(
 }
 
 /// Draws the parts at `positions` as `pose` shows them: its draw order (the document's
-/// otherwise), each part's tint and visibility.
+/// otherwise), each part's tint and visibility ([`pose_draws`]).
 pub fn draw_pose(
     scene: &Scene,
     canvas: &mut tiny_skia::Pixmap,
@@ -311,6 +311,18 @@ pub fn draw_pose(
     pose: &Pose,
     output_from_canvas: tiny_skia::Transform,
 ) -> Result<(), PipelineError> {
+    let draws = pose_draws(scene, positions, pose);
+    scene.draw_parts(canvas, &draws, output_from_canvas)
+}
+
+/// The parts at `positions` (one list per part, canvas px) as `pose` shows them, back to
+/// front: its draw order (the document's otherwise), each part's tint and visibility. What
+/// [`draw_pose`] draws, for every consumer that draws a pose (the editor's canvas too).
+pub fn pose_draws<'a>(
+    scene: &Scene,
+    positions: &'a [Vec<crate::geom::Point>],
+    pose: &Pose,
+) -> Vec<render::PartDraw<'a>> {
     let parts = &scene.doc.parts;
     let order: Vec<usize> = match &pose.draw_order {
         Some(names) => names
@@ -319,7 +331,7 @@ pub fn draw_pose(
             .collect(),
         None => (0..parts.len()).collect(),
     };
-    let draws: Vec<render::PartDraw> = order
+    order
         .into_iter()
         .map(|i| {
             let mut draw =
@@ -331,8 +343,7 @@ pub fn draw_pose(
             }
             draw
         })
-        .collect();
-    scene.draw_parts(canvas, &draws, output_from_canvas)
+        .collect()
 }
 
 /// Draws every frame through `view`, in parallel; `on_frame` is called once per finished frame
