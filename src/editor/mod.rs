@@ -1573,9 +1573,7 @@ impl EditorApp {
 
     /// The current animation at the current time (clamped to its keys).
     pub fn sampled_pose(&self) -> Pose {
-        crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.sample(self.time_s, false))
-            .unwrap_or_default()
+        crate::document::animation_named(self.doc.state(), &self.animation).sample(self.time_s, false)
     }
 
     fn commit_pose(&mut self, pose: Pose) {

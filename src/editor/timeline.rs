@@ -168,7 +168,7 @@ enum SheetGesture {
 #[derive(Default)]
 struct OnionCache {
     scene: Option<Identity<Scene>>,
-    animation: Option<(String, serde_json::Value)>,
+    animation: Option<(String, Animation)>,
     /// Boundary edges (vertex pairs) of each part's mesh.
     outlines: Vec<Vec<[u32; 2]>>,
     /// Posed vertex positions by frame time (µs).
@@ -294,8 +294,7 @@ impl EditorApp {
     /// The current animation's length: its last key, at least [`super::MIN_TIMELINE_S`].
     pub fn timeline_length_s(&self) -> f64 {
         crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0)
+            .duration_s()
             .max(super::MIN_TIMELINE_S)
     }
 
@@ -316,9 +315,7 @@ impl EditorApp {
     /// Where playback ends (and loops): the last key, or the timeline's length when every key
     /// is at 0.
     fn play_end_s(&self) -> f64 {
-        let end = crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0);
+        let end = crate::document::animation_named(self.doc.state(), &self.animation).duration_s();
         if end > KEY_TIME_TOLERANCE_S {
             end
         } else {
@@ -414,8 +411,8 @@ impl EditorApp {
 
     /// Copies the selected keys to the editor's clipboard.
     pub fn copy_keys(&mut self) {
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        match edit::copy_keys(&json, &self.timeline.selection) {
+        let animation = crate::document::animation_named(self.doc.state(), &self.animation);
+        match edit::copy_keys(&animation, &self.timeline.selection) {
             Ok(keys) => self.timeline.clipboard = keys,
             Err(e) => self.message = Some(e.to_string()),
         }
@@ -539,8 +536,8 @@ impl EditorApp {
             );
             ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
         });
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        let timelines = edit::timelines(&json);
+        let animation = crate::document::animation_named(self.doc.state(), &self.animation);
+        let timelines = edit::timelines(&animation);
         // Another animation, undo, redo and other edits can take selected keys away.
         if self.timeline.selection_of != self.animation {
             self.timeline.selection_of = self.animation.clone();
@@ -562,7 +559,7 @@ impl EditorApp {
                 .max_width(width)
                 .show(ui, |ui| self.dopesheet(ui, width, &timelines));
             ui.separator();
-            ui.vertical(|ui| self.curve_editor(ui, &json));
+            ui.vertical(|ui| self.curve_editor(ui, &animation));
         });
     }
 
@@ -925,14 +922,14 @@ impl EditorApp {
 
     /// The curve of the one selected key's outgoing segment: its kind, and for a Bézier the
     /// graph of one channel with its two handles to drag.
-    fn curve_editor(&mut self, ui: &mut egui::Ui, json: &serde_json::Value) {
+    fn curve_editor(&mut self, ui: &mut egui::Ui, animation: &Animation) {
         self.timeline.curve = None;
         let [key] = self.timeline.selection.as_slice() else {
             ui.label("Select one key to edit the curve to the next key.");
             return;
         };
         let key = key.clone();
-        let segment = match edit::segment(json, &key) {
+        let segment = match edit::segment(animation, &key) {
             Ok(s) => s,
             Err(e) => {
                 ui.label(e.to_string());
@@ -1152,10 +1149,7 @@ impl EditorApp {
         if !options.enabled || self.mode != Mode::Animate {
             return Vec::new();
         }
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        let Ok(animation) = Animation::from_json(&self.animation, &json) else {
-            return Vec::new();
-        };
+        let animation = crate::document::animation_named(self.doc.state(), &self.animation);
         let frame_s = self.frame_s();
         let cache = &mut self.timeline.onion_cache;
         if cache.scene.as_ref().is_none_or(|k| !k.is(scene)) {
@@ -1168,7 +1162,7 @@ impl EditorApp {
                 .collect();
             cache.frames.clear();
         }
-        let version = (self.animation.clone(), json);
+        let version = (self.animation.clone(), animation.clone());
         if cache.animation.as_ref() != Some(&version) {
             cache.animation = Some(version);
             cache.frames.clear();

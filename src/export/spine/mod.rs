@@ -32,7 +32,7 @@ pub use atlas::AtlasOptions;
 pub use bake::BakeMode;
 pub use frame::SpineFrame;
 
-use crate::anim::{self, AnimError};
+use crate::anim::AnimError;
 use crate::geom::Point;
 use crate::io::{self, RigDocument};
 use crate::pipeline::{PipelineError, Scene};
@@ -361,14 +361,15 @@ pub fn export_spine(
     let atlas = atlas::pack_atlas(name, &regions, &options.atlas)?;
 
     // Animations: native timelines, and baked keys for what they cannot express.
-    let animations = anim::load_animations(doc)?;
+    doc.check_animations()?;
+    let animations = &doc.animations;
     let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
     // Where a handle's transformation is compared when deciding what to bake.
     let corners = crate::playback::rest_corners(doc);
     let path = |pose: &Pose| scene.handle_transforms(pose);
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
-    for (anim_name, animation) in &animations {
+    for (anim_name, animation) in animations {
         let samples = animation.duration_s() * options.bake_fps;
         if samples.is_nan() || samples > MAX_BAKE_SAMPLES {
             return Err(SpineError::TooLong {
