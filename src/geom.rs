@@ -60,6 +60,24 @@ pub fn barycentric(p: Point, a: Point, b: Point, c: Point) -> Option<[f64; 3]> {
 /// Twice a triangle's area (px²) below which [`barycentric`] calls it degenerate.
 pub const DEGENERATE_DET: f64 = 1e-12;
 
+/// Distance (px) from `p` to the closed segment a–b, and the parameter of the closest point on
+/// it (0 at a, 1 at b; 0 for a segment of zero length, whose distance is to a).
+pub fn segment_distance(p: Point, a: Point, b: Point) -> (f64, f64) {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((p - (a + ab * t)).norm(), t)
+}
+
+/// Distance (px) from `p` to the closed segment a–b (see [`segment_distance`]).
+pub fn point_segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    segment_distance(p, a, b).0
+}
+
 /// Twice the signed area of triangle (a, b, c), in px²; positive when a → b → c turns clockwise
 /// on screen (y down).
 pub fn triangle_area2(a: Point, b: Point, c: Point) -> f64 {

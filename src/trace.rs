@@ -196,6 +196,7 @@ fn assemble(rings: Vec<Vec<Point>>, owners: &[Owner]) -> Vec<Outline> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::point_segment_distance;
 
     /// The defaults with the threshold at mid alpha, which the exact geometric expectations
     /// below are computed for.
@@ -269,12 +270,6 @@ mod tests {
             .count()
             % 2
             == 1
-    }
-
-    fn point_segment_distance(p: Point, a: Point, b: Point) -> f64 {
-        let ab = b - a;
-        let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
-        (p - (a + ab * t)).norm()
     }
 
     fn distance_to_rings(p: Point, outlines: &[Outline]) -> f64 {

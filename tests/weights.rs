@@ -8,7 +8,7 @@ use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer, Scene};
 use sinew::rig::pose::{rotation, BonePose, PointPose};
 use sinew::rig::{handle_columns, Bone, Handles, PointHandle, Pose};
-use sinew::weights::boundary::segment_distance;
+use sinew::geom::segment_distance;
 use sinew::weights::WeightOptions;
 use std::path::Path;
 

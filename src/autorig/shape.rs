@@ -251,16 +251,7 @@ impl EdgeGrid {
 /// The distance between segments `a`–`b` and `c`–`d` when they do not cross (the smallest
 /// distance from an endpoint of one to the other).
 fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
-    let to = |p: Point, s: Point, t: Point| {
-        let st = t - s;
-        let len2 = st.norm_squared();
-        let u = if len2 > 0.0 {
-            ((p - s).dot(&st) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s + st * u)).norm()
-    };
+    let to = crate::geom::point_segment_distance;
     to(a, c, d)
         .min(to(b, c, d))
         .min(to(c, a, b))
