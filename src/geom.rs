@@ -3,6 +3,8 @@
 //! Coordinates are canvas pixels: x to the right, y down, origin at the top-left corner of the
 //! canvas. Pixel (i, j) covers [i, i+1) × [j, j+1), so its center is (i + 0.5, j + 0.5).
 
+pub mod pack;
+
 /// A position on the canvas, in pixels.
 pub type Point = nalgebra::Point2<f64>;
 /// A displacement on the canvas, in pixels.
