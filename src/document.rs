@@ -590,11 +590,11 @@ pub fn render_animation(
 ) -> Result<crate::io::sequence::SequenceReport, DocumentError> {
     doc.check_animations()?;
     let animation = doc.animations.get(name).cloned().ok_or_else(|| {
-            DocumentError::Animation(crate::anim::AnimError::Malformed {
-                animation: name.to_string(),
-                reason: "the document has no animation of that name".into(),
-            })
-        })?;
+        DocumentError::Animation(crate::anim::AnimError::Malformed {
+            animation: name.to_string(),
+            reason: "the document has no animation of that name".into(),
+        })
+    })?;
     crate::io::sequence::format_for_path(output)?;
     // Settings are checked before the scene is built: a bad scale fails at once.
     settings.view(doc.canvas)?;

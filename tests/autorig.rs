@@ -357,9 +357,10 @@ fn letter_with_a_hole_keeps_bones_off_the_hole() {
     let sides = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
     for (dx, dy) in sides {
         let probe = Point::new(120.0 + 43.0 * dx, 95.0 + 43.0 * dy);
-        let near = h.bones.iter().any(|b| {
-            sinew::geom::segment_distance(probe, pt(b.head), pt(b.tail)).0 < 12.0
-        });
+        let near = h
+            .bones
+            .iter()
+            .any(|b| sinew::geom::segment_distance(probe, pt(b.head), pt(b.tail)).0 < 12.0);
         assert!(near, "no bone in the bowl near {probe:?}");
     }
 }

@@ -26,7 +26,7 @@
 mod keys;
 
 use super::curve::{Curve, BEZIER_NUMBERS_PER_CHANNEL};
-use super::{AnimError, Animation};
+use super::{AnimError, Animation, Key};
 use keys::{entries_of, find, write_keys, EditKey, Entry, TimelineEdit};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -234,36 +234,17 @@ impl Segment {
 /// IK drags, part colors and visibility, draw order (names alphabetical, channels as
 /// [`TransformChannel::ALL`]).
 pub fn timelines(animation: &Animation) -> Vec<(TimelineId, Vec<f64>)> {
-    fn times<K: EditKey>(keys: &[K]) -> Vec<f64> {
-        keys.iter().map(EditKey::time).collect()
-    }
     let mut out = Vec::new();
     for (bone, t) in &animation.bones {
-        let channels = [
-            t.rotate.as_deref().map(times),
-            t.translate.as_deref().map(times),
-            t.scale.as_deref().map(times),
-            t.shear.as_deref().map(times),
-        ];
-        for (channel, times) in TransformChannel::ALL.into_iter().zip(channels) {
-            if let Some(times) = times {
-                let bone = bone.clone();
-                out.push((TimelineId::Bone { bone, channel }, times));
-            }
+        for (channel, times) in transform_times(&t.rotate, [&t.translate, &t.scale, &t.shear]) {
+            let bone = bone.clone();
+            out.push((TimelineId::Bone { bone, channel }, times));
         }
     }
     for (point, t) in &animation.points {
-        let channels = [
-            t.rotate.as_deref().map(times),
-            t.translate.as_deref().map(times),
-            t.scale.as_deref().map(times),
-            t.shear.as_deref().map(times),
-        ];
-        for (channel, times) in TransformChannel::ALL.into_iter().zip(channels) {
-            if let Some(times) = times {
-                let point = point.clone();
-                out.push((TimelineId::Point { point, channel }, times));
-            }
+        for (channel, times) in transform_times(&t.rotate, [&t.translate, &t.scale, &t.shear]) {
+            let point = point.clone();
+            out.push((TimelineId::Point { point, channel }, times));
         }
     }
     for (cage, keys) in &animation.cages {
@@ -286,6 +267,29 @@ pub fn timelines(animation: &Animation) -> Vec<(TimelineId, Vec<f64>)> {
     out
 }
 
+fn times<K: EditKey>(keys: &[K]) -> Vec<f64> {
+    keys.iter().map(EditKey::time).collect()
+}
+
+/// The key times of a bone's or point's transform timelines that exist, by channel in
+/// [`TransformChannel::ALL`]'s order.
+fn transform_times(
+    rotate: &Option<Vec<Key<f64>>>,
+    [translate, scale, shear]: [&Option<Vec<Key<[f64; 2]>>>; 3],
+) -> Vec<(TransformChannel, Vec<f64>)> {
+    let channels = [
+        rotate.as_deref().map(times),
+        translate.as_deref().map(times),
+        scale.as_deref().map(times),
+        shear.as_deref().map(times),
+    ];
+    TransformChannel::ALL
+        .into_iter()
+        .zip(channels)
+        .filter_map(|(channel, times)| Some((channel, times?)))
+        .collect()
+}
+
 /// Moves `keys` by `delta_s` seconds (one step: all of them or none).
 pub fn move_keys(
     name: &str,
@@ -298,7 +302,11 @@ pub fn move_keys(
         delta_s: f64,
     }
     impl TimelineEdit for Move {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             for &time_s in &self.times {
                 let entry = find(&mut entries, timeline, time_s)?;
@@ -324,7 +332,11 @@ pub fn delete_keys(
         times: Vec<f64>,
     }
     impl TimelineEdit for Delete {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             for &time_s in &self.times {
                 find(&mut entries, timeline, time_s)?;
@@ -350,7 +362,11 @@ pub fn copy_keys(animation: &Animation, keys: &[KeyRef]) -> Result<Vec<CopiedKey
         out: Vec<CopiedKey>,
     }
     impl TimelineEdit for Copy {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             for (i, &time_s) in self.times.iter().enumerate() {
                 let entry = find(&mut entries, timeline, time_s)?;
@@ -395,13 +411,17 @@ pub fn paste_keys(
         keys: &'a [CopiedKey],
     }
     impl TimelineEdit for Paste<'_> {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             let pasted = self.keys.iter().enumerate();
             for (i, copied) in pasted.filter(|(_, k)| k.timeline == *timeline) {
                 let time_s = checked_time(self.at_s + copied.offset_s)?;
-                let key = K::deserialize(&copied.key)
-                    .map_err(|e| malformed(&timeline.label(), i, e))?;
+                let key =
+                    K::deserialize(&copied.key).map_err(|e| malformed(&timeline.label(), i, e))?;
                 let old_time = key.time();
                 entries.retain(|e| (e.time_s - time_s).abs() > KEY_TIME_TOLERANCE_S);
                 entries.push(Entry {
@@ -440,7 +460,11 @@ pub fn set_curve(
         curve: &'a Curve,
     }
     impl TimelineEdit for SetCurve<'_> {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             let entry = find(&mut entries, timeline, self.time_s)?;
             if matches!(self.curve, Curve::Bezier(_)) && entry.old_segment.is_none() {
@@ -477,7 +501,11 @@ pub fn segment(animation: &Animation, key: &KeyRef) -> Result<Segment, EditError
         out: Option<Segment>,
     }
     impl TimelineEdit for Read {
-        fn edit<K: EditKey>(&mut self, timeline: &TimelineId, keys: &mut Vec<K>) -> Result<(), EditError> {
+        fn edit<K: EditKey>(
+            &mut self,
+            timeline: &TimelineId,
+            keys: &mut Vec<K>,
+        ) -> Result<(), EditError> {
             let index = keys
                 .iter()
                 .position(|k| (k.time() - self.time_s).abs() <= KEY_TIME_TOLERANCE_S)

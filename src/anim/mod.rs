@@ -27,8 +27,8 @@ pub use curve::CurveEvaluation;
 pub use mix::{mix_poses, sample_mix, Playhead, STEPPED_MIX_THRESHOLD};
 pub use sample::SampleOptions;
 pub use timeline::{
-    animations_from_json, parse_animations, Animation, BoneTimelines, IkTimeline, Key, PartTimelines, PointTimelines,
-    Rgba, StepKey, TimelineError,
+    animations_from_json, parse_animations, Animation, BoneTimelines, IkTimeline, Key,
+    PartTimelines, PointTimelines, Rgba, StepKey, TimelineError,
 };
 
 /// What is wrong with an animation, on its own or for a rig.

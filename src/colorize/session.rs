@@ -20,8 +20,8 @@
 
 use super::scribbles::{hex, ScribbleError, Stroke, StrokeFile, MAX_COORDINATE_PX};
 use super::{ColorizeError, ColorizeOptions, Colorized, PreparedLineArt, Scribbles};
-use crate::geom::Point;
 use crate::geom::segment_distance;
+use crate::geom::Point;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

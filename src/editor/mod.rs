@@ -1573,7 +1573,8 @@ impl EditorApp {
 
     /// The current animation at the current time (clamped to its keys).
     pub fn sampled_pose(&self) -> Pose {
-        crate::document::animation_named(self.doc.state(), &self.animation).sample(self.time_s, false)
+        crate::document::animation_named(self.doc.state(), &self.animation)
+            .sample(self.time_s, false)
     }
 
     fn commit_pose(&mut self, pose: Pose) {

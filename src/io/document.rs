@@ -203,12 +203,14 @@ impl RigDocument {
         }
         // The animations on their own, for an error that keeps its place in them.
         let animations = match value.as_object_mut().and_then(|o| o.remove("animations")) {
-            Some(animations) => crate::anim::animations_from_json(&animations).map_err(|source| {
-                DocumentError::Animation {
-                    path: path.into(),
-                    source,
-                }
-            })?,
+            Some(animations) => {
+                crate::anim::animations_from_json(&animations).map_err(|source| {
+                    DocumentError::Animation {
+                        path: path.into(),
+                        source,
+                    }
+                })?
+            }
             None => BTreeMap::new(),
         };
         // Valid JSON by now: what is left is a field of the wrong shape.
@@ -438,7 +440,10 @@ mod tests {
         // The comparison sees a changed number.
         let mut changed = bundled;
         changed["walk"]["bones"]["hip"]["translate"][0]["time"] = 0.5.into();
-        assert!(!same_json(&serde_json::to_value(&parsed).unwrap(), &changed));
+        assert!(!same_json(
+            &serde_json::to_value(&parsed).unwrap(),
+            &changed
+        ));
     }
 
     #[test]
@@ -464,7 +469,9 @@ mod tests {
             "r.json: animations: expected an object: name → animation"
         );
         // Serde alone gives the same reason.
-        let e = serde_json::from_value::<RigDocument>(v).unwrap_err().to_string();
+        let e = serde_json::from_value::<RigDocument>(v)
+            .unwrap_err()
+            .to_string();
         assert_eq!(e, "animations: expected an object: name → animation");
         // Names the rig lacks do not stop it loading; posing checks them.
         v = serde_json::to_value(sample()).unwrap();

@@ -31,7 +31,9 @@
 //! The Spine port works in Spine's axes: world and bone frames with y flipped (sinew's y points
 //! down), so that spine-core's formulas, signs and special cases carry over unchanged.
 
-use super::frames::{bone_rest_frame, bone_world_frames, screen_angle_deg, Affine, Pose, PoseError};
+use super::frames::{
+    bone_rest_frame, bone_world_frames, screen_angle_deg, Affine, Pose, PoseError,
+};
 pub use super::handles::BoneIk;
 use super::handles::Handles;
 use crate::geom::{Point, Vec2};

@@ -6,11 +6,11 @@
 //! [`super::frames`] (re-exported here), below [`super::bone_ik`], which this module calls.
 //! Bone frames, local poses and angles follow Spine's conventions (see [`super::frames`]).
 
-use super::frames::{check_names, finite, local_linear, within_reach};
 pub use super::frames::{
     bone_rest_frame, bone_world_frames, rotation, screen_angle_deg, Affine, BonePose, CagePose,
     IkDrag, PartPose, PointPose, Pose, PoseError, MAX_POSED_PX, MAX_POSED_SCALE,
 };
+use super::frames::{check_names, finite, local_linear, within_reach};
 use super::handles::Handles;
 use crate::geom::{Point, Vec2};
 use nalgebra::Matrix2;

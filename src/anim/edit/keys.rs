@@ -133,7 +133,8 @@ pub(super) fn write_keys<K: EditKey>(
         .enumerate()
         .map(|(i, mut e)| {
             e.key.set_time(e.time_s);
-            if let (Some(Curve::Bezier(numbers)), Some(&end)) = (e.key.curve_mut(), times.get(i + 1))
+            if let (Some(Curve::Bezier(numbers)), Some(&end)) =
+                (e.key.curve_mut(), times.get(i + 1))
             {
                 // An untouched segment keeps its handles exactly as given (a curve being set is
                 // checked, not bent into shape).
@@ -175,13 +176,19 @@ pub(super) fn edit_timeline(
     match timeline {
         TimelineId::Bone { bone, channel } => {
             let t = owner(&mut animation.bones, bone, create).ok_or_else(missing)?;
-            let (rotate, pairs) = (&mut t.rotate, [&mut t.translate, &mut t.scale, &mut t.shear]);
+            let (rotate, pairs) = (
+                &mut t.rotate,
+                [&mut t.translate, &mut t.scale, &mut t.shear],
+            );
             in_channel(rotate, pairs, *channel, create, timeline, edit)?;
             drop_if_empty(&mut animation.bones, bone);
         }
         TimelineId::Point { point, channel } => {
             let t = owner(&mut animation.points, point, create).ok_or_else(missing)?;
-            let (rotate, pairs) = (&mut t.rotate, [&mut t.translate, &mut t.scale, &mut t.shear]);
+            let (rotate, pairs) = (
+                &mut t.rotate,
+                [&mut t.translate, &mut t.scale, &mut t.shear],
+            );
             in_channel(rotate, pairs, *channel, create, timeline, edit)?;
             drop_if_empty(&mut animation.points, point);
         }

@@ -23,14 +23,17 @@ fn key(timeline: &TimelineId, time_s: f64) -> KeyRef {
 
 /// `arm` rotates 0 → 90 → 0 over keys at 0, 1, 2; its translate has one key; one IK drag.
 fn walk() -> Animation {
-    parsed("walk", json!({
-        "bones": {"arm": {
-            "rotate": [{"time": 0, "value": 0}, {"time": 1, "value": 90},
-                       {"time": 2, "value": 0}],
-            "translate": [{"time": 1, "value": [3, 4]}]}},
-        "ik": [{"at": [1, 2], "to": [{"time": 0, "value": [5, 6]}]}],
-        "parts": {"head": {"visible": [{"time": 0, "value": true}]}}
-    }))
+    parsed(
+        "walk",
+        json!({
+            "bones": {"arm": {
+                "rotate": [{"time": 0, "value": 0}, {"time": 1, "value": 90},
+                           {"time": 2, "value": 0}],
+                "translate": [{"time": 1, "value": [3, 4]}]}},
+            "ik": [{"at": [1, 2], "to": [{"time": 0, "value": [5, 6]}]}],
+            "parts": {"head": {"visible": [{"time": 0, "value": true}]}}
+        }),
+    )
 }
 
 fn times(animation: &Animation, timeline: &TimelineId) -> Vec<f64> {
@@ -136,13 +139,22 @@ fn bezier_handles_keep_their_fraction_of_the_segment() {
     let curved = curved_walk();
     // Stretching the segment to 0 → 2 doubles the handle times; values stay.
     let stretched = move_keys("walk", &curved, &[key(&arm, 1.0), key(&arm, 2.0)], 1.0).unwrap();
-    assert_eq!(arm_rotate(&stretched)[0].curve, bezier(&[0.5, 10.0, 1.5, 80.0]));
+    assert_eq!(
+        arm_rotate(&stretched)[0].curve,
+        bezier(&[0.5, 10.0, 1.5, 80.0])
+    );
     // Deleting the key that ended the segment stretches it to the next one.
     let deleted = delete_keys("walk", &curved, &[key(&arm, 1.0)]).unwrap();
-    assert_eq!(arm_rotate(&deleted)[0].curve, bezier(&[0.5, 10.0, 1.5, 80.0]));
+    assert_eq!(
+        arm_rotate(&deleted)[0].curve,
+        bezier(&[0.5, 10.0, 1.5, 80.0])
+    );
     // Moving the curved key itself shifts and squeezes its handles with it.
     let shifted = move_keys("walk", &curved, &[key(&arm, 0.0)], 0.5).unwrap();
-    assert_eq!(arm_rotate(&shifted)[0].curve, bezier(&[0.625, 10.0, 0.875, 80.0]));
+    assert_eq!(
+        arm_rotate(&shifted)[0].curve,
+        bezier(&[0.625, 10.0, 0.875, 80.0])
+    );
 }
 
 #[test]
@@ -207,7 +219,10 @@ fn pasted_bezier_handles_fit_their_new_segment() {
     let copied = copy_keys(&curved, &[key(&arm, 0.0)]).unwrap();
     let pasted = paste_keys("walk", &curved, 1.5, &copied).unwrap();
     // The segment 1.5 → 2 is half as long as the copied 0 → 1.
-    assert_eq!(arm_rotate(&pasted)[2].curve, bezier(&[1.625, 10.0, 1.875, 80.0]));
+    assert_eq!(
+        arm_rotate(&pasted)[2].curve,
+        bezier(&[1.625, 10.0, 1.875, 80.0])
+    );
     pasted.validate("walk").unwrap();
 }
 

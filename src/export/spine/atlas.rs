@@ -112,7 +112,12 @@ pub fn pack_atlas(
     });
     let sizes: Vec<(u64, u64)> = order
         .iter()
-        .map(|&i| (u64::from(regions[i].2.width), u64::from(regions[i].2.height)))
+        .map(|&i| {
+            (
+                u64::from(regions[i].2.width),
+                u64::from(regions[i].2.height),
+            )
+        })
         .collect();
     let layout = ShelfLayout {
         width: u64::from(page_width),
