@@ -181,6 +181,42 @@ fn deleting_the_last_keys_removes_the_timeline_and_its_owner() {
 }
 
 #[test]
+fn emptying_several_ik_drags_in_one_edit_removes_each() {
+    let drag =
+        |at: f64, time: f64| json!({"at": [at, at], "to": [{"time": time, "value": [at, 0]}]});
+    let three = parsed(
+        "walk",
+        json!({"ik": [drag(0.0, 0.0), drag(5.0, 0.0), drag(9.0, 1.0)]}),
+    );
+    let keys = [
+        key(&TimelineId::Ik { index: 0 }, 0.0),
+        key(&TimelineId::Ik { index: 1 }, 0.0),
+    ];
+    // Drag 1 is still drag 1 after drag 0 lost its last key.
+    let left = delete_keys("walk", &three, &keys).unwrap();
+    assert_eq!(left.ik.len(), 1);
+    assert_eq!(left.ik[0].at, [9.0, 9.0]);
+}
+
+#[test]
+fn a_copied_key_of_another_kind_is_refused() {
+    let copied = CopiedKey {
+        timeline: rotate("arm"),
+        offset_s: 0.0,
+        key: json!({"time": 0, "value": [1, 2]}),
+        next_time_s: None,
+    };
+    let refused = paste_keys("walk", &walk(), 0.5, &[copied]).unwrap_err();
+    assert!(
+        matches!(&refused, EditError::MalformedKey { key: 0, .. }),
+        "{refused}"
+    );
+    assert!(refused
+        .to_string()
+        .starts_with("arm rotate: copied key 0 is malformed"));
+}
+
+#[test]
 fn copy_and_paste_at_a_time() {
     let arm = rotate("arm");
     let ik = TimelineId::Ik { index: 0 };
