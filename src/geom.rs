@@ -86,6 +86,25 @@ pub fn triangle_area2(a: Point, b: Point, c: Point) -> f64 {
     (b - a).perp(&(c - a))
 }
 
+/// Whether closed segments `a`–`b` and `c`–`d` share a point.
+pub fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
+    let orient = triangle_area2;
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let on = |p: Point, q: Point, r: Point| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    (d1 == 0.0 && on(c, d, a))
+        || (d2 == 0.0 && on(c, d, b))
+        || (d3 == 0.0 && on(a, b, c))
+        || (d4 == 0.0 && on(a, b, d))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -10,8 +10,9 @@ mod common;
 
 use command::{scratch, sinew};
 use image::RgbaImage;
-use sinew::autorig::shape::{segments_touch, Shape};
+use sinew::autorig::shape::Shape;
 use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
+use sinew::geom::segments_touch;
 use sinew::geom::{point_in_ring, Point};
 use sinew::rig::Handles;
 use sinew::trace::TraceOptions;
