@@ -599,7 +599,7 @@ pub fn render_animation(
     // Settings are checked before the scene is built: a bad scale fails at once.
     settings.view(doc.canvas)?;
     let scene = Scene::new(doc, images)?;
-    let frames = crate::playback::render_animation(&scene, &animation, settings, &|| {})?;
+    let frames = crate::playback::render_animation(&scene, name, &animation, settings, &|| {})?;
     crate::io::sequence::write_sequence(&frames, settings.fps, output, &Default::default())
         .map_err(DocumentError::from)
 }

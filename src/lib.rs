@@ -21,6 +21,7 @@ pub mod pipeline;
 pub mod playback;
 pub mod render;
 pub mod rig;
+pub mod scene;
 pub mod skin;
 pub mod trace;
 pub mod weights;
