@@ -737,8 +737,8 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
 
 /// The document's animation `name`, checked against its rig.
 fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
-    let mut animations = anim::load_animations(doc)?;
-    animations.remove(name).ok_or_else(|| {
+    doc.check_animations()?;
+    doc.animations.get(name).cloned().ok_or_else(|| {
         let known: Vec<&str> = doc.animations.keys().map(String::as_str).collect();
         anyhow!(
             "the rig has no animation '{name}' (it has: {})",
@@ -820,9 +820,11 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 
     let mut doc = doc;
     let animations_path = args.assets.join("animations.json");
-    doc.animations = read_json(&animations_path, "animations file")?;
-    let animations = anim::load_animations(&doc)
-        .with_context(|| format!("{}: bad animation", animations_path.display()))?;
+    let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
+    let bad = || format!("{}: bad animation", animations_path.display());
+    doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
+    doc.check_animations().with_context(bad)?;
+    let animations = doc.animations.clone();
     let rig_path = args.output.join("character.json");
     doc.save(&rig_path)?;
     let mut written = vec![rig_path];

@@ -17,7 +17,6 @@ mod command;
 
 use command::{s, scratch};
 use serde::Deserialize;
-use sinew::anim;
 use sinew::export::spine::bake::bake_times;
 use sinew::export::spine::played::as_played;
 use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
@@ -149,7 +148,8 @@ fn times_for(doc: &RigDocument, name: &str, duration: f64) -> Vec<f64> {
             _ => {}
         }
     }
-    keys(&doc.animations[name], &mut times);
+    let json = serde_json::to_value(&doc.animations[name]).expect("an animation writes as JSON");
+    keys(&json, &mut times);
     times.retain(|&t| t < duration);
     times.sort_by(f64::total_cmp);
     times.dedup();
@@ -217,7 +217,8 @@ fn check_rig(
             );
         }
     }
-    let animations = anim::load_animations(&doc).unwrap();
+    doc.check_animations().unwrap();
+    let animations = doc.animations.clone();
     let baked: BTreeMap<&str, &[String]> = export
         .baked
         .iter()
@@ -732,7 +733,8 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
     // baked animation shows what the original does at the bake times (mix < 1 is not blended a
     // second time; the FABRIK tail solves again from the same keys).
     let scene = Scene::load(&rig).unwrap();
-    for (name, animation) in anim::load_animations(&scene.doc).unwrap() {
+    scene.doc.check_animations().unwrap();
+    for (name, animation) in scene.doc.animations.clone() {
         let times = bake_times(animation.duration_s(), 10.0);
         let baked = sinew::playback::bake(&scene, &animation, &times).unwrap();
         for &t in &times {

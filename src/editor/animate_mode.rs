@@ -52,7 +52,7 @@ impl Default for OnionOptions {
 struct OnionCache {
     scene: Option<Identity<Scene>>,
     /// The animation's name and JSON, and how its frames are sampled and skinned.
-    animation: Option<(String, serde_json::Value, SampleOptions, Blend)>,
+    animation: Option<(String, Animation, SampleOptions, Blend)>,
     /// Boundary edges (vertex pairs) of each part's mesh.
     outlines: Vec<Vec<[u32; 2]>>,
     /// Posed vertex positions by frame time (µs).
@@ -109,9 +109,11 @@ impl EditorApp {
     /// The current animation at the current time (clamped to its keys), sampled as File →
     /// Render's settings sample it.
     pub fn sampled_pose(&self) -> Pose {
-        crate::document::animation_named(self.doc.state(), &self.animate.animation)
-            .map(|a| a.sample_with(self.animate.time_s, false, &self.render_settings.sampling))
-            .unwrap_or_default()
+        crate::document::animation_named(self.doc.state(), &self.animate.animation).sample_with(
+            self.animate.time_s,
+            false,
+            &self.render_settings.sampling,
+        )
     }
 
     /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
@@ -123,8 +125,7 @@ impl EditorApp {
     /// The current animation's length: its last key, at least [`super::MIN_TIMELINE_S`].
     pub fn timeline_length_s(&self) -> f64 {
         crate::document::animation_named(self.doc.state(), &self.animate.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0)
+            .duration_s()
             .max(super::MIN_TIMELINE_S)
     }
 
@@ -146,8 +147,7 @@ impl EditorApp {
     /// is at 0.
     pub(super) fn play_end_s(&self) -> f64 {
         let end = crate::document::animation_named(self.doc.state(), &self.animate.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0);
+            .duration_s();
         if end > KEY_TIME_TOLERANCE_S {
             end
         } else {
@@ -210,10 +210,7 @@ impl EditorApp {
         if !options.enabled || self.mode != Mode::Animate {
             return Vec::new();
         }
-        let json = crate::document::animation_json(self.doc.state(), &self.animate.animation);
-        let Ok(animation) = Animation::from_json(&self.animate.animation, &json) else {
-            return Vec::new();
-        };
+        let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
         let frame_s = self.frame_s();
         let (sampling, blend) = (self.render_settings.sampling, self.render_settings.blend);
         let cache = &mut self.animate.onion_cache;
@@ -227,7 +224,7 @@ impl EditorApp {
                 .collect();
             cache.frames.clear();
         }
-        let version = (self.animate.animation.clone(), json, sampling, blend);
+        let version = (self.animate.animation.clone(), animation.clone(), sampling, blend);
         if cache.animation.as_ref() != Some(&version) {
             cache.animation = Some(version);
             cache.frames.clear();

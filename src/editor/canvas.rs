@@ -190,7 +190,7 @@ pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Ve
 
 /// The handle nearest to `at` (screen points) within [`PICK_RADIUS_PT`], by name.
 pub fn pick(placed: &Placed, handles: &Handles, at: Pos2) -> Option<String> {
-    use crate::weights::boundary::segment_distance;
+    use crate::geom::segment_distance;
     // Measured in canvas px, then compared in screen points: the view only scales.
     let c = placed.canvas_from_screen(at);
     let c = Point::new(c[0], c[1]);

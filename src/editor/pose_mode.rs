@@ -40,7 +40,7 @@ pub struct Posed {
 /// An animation played at a time, as [`Posed`] remembers it.
 #[derive(Clone, Debug, PartialEq)]
 struct Played {
-    animation: serde_json::Value,
+    animation: crate::anim::Animation,
     time_s: f64,
     options: crate::scene::PlayOptions,
 }
@@ -182,8 +182,7 @@ impl EditorApp {
     /// and blended as File → Render's settings say.
     pub(super) fn update_posed_at_playhead(&mut self, scene: &Arc<Scene>) -> Result<(), String> {
         let name = self.animate.animation.clone();
-        let json = crate::document::animation_json(self.doc.state(), &name);
-        let Ok(animation) = crate::anim::Animation::from_json(&name, &json) else {
+        let Some(animation) = self.doc.state().animations.get(&name).cloned() else {
             // No such animation (yet): the rest pose, as sampling it gives.
             return self.update_posed(scene, &self.sampled_pose());
         };
@@ -193,7 +192,7 @@ impl EditorApp {
             looping: false,
         };
         let played = Played {
-            animation: json,
+            animation: animation.clone(),
             time_s,
             options,
         };

@@ -479,7 +479,7 @@ fn set_two_keys_and_scrub_the_timeline() {
     drag(&mut h, first, second);
     h.get_by_label("Set key").click();
     h.run();
-    let anim = crate::document::animation_named(h.state().doc.state(), "animation").expect("keys");
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation");
     assert_eq!(crate::document::key_times(&anim), vec![0.0, 1.0]);
     for _ in 0..12 {
         h.get_by_label("Previous frame").click();
@@ -500,7 +500,7 @@ fn set_two_keys_and_scrub_the_timeline() {
     // Setting keys is undoable like any edit.
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
-    let anim = crate::document::animation_named(h.state().doc.state(), "animation").expect("keys");
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation");
     assert_eq!(crate::document::key_times(&anim), vec![0.0]);
 }
 
@@ -1195,9 +1195,10 @@ fn head(channel: crate::anim::edit::TransformChannel) -> crate::anim::edit::Time
     }
 }
 
-/// (time, value, curve) of the head's rotate keys in the document.
+/// (time, value, curve) of the head's rotate keys in the document, as the file writes them.
 fn head_rotate_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, f64, serde_json::Value)> {
-    let json = crate::document::animation_json(h.state().doc.state(), "nod");
+    let anim = crate::document::animation_named(h.state().doc.state(), "nod");
+    let json = serde_json::to_value(anim).expect("an animation writes as JSON");
     json["bones"]["head"]["rotate"]
         .as_array()
         .map(|keys| {
@@ -1215,8 +1216,8 @@ fn head_rotate_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, f64, serde_json::Va
 }
 
 fn times_of(h: &Harness<'_, EditorApp>, channel: crate::anim::edit::TransformChannel) -> Vec<f64> {
-    let json = crate::document::animation_json(h.state().doc.state(), "nod");
-    crate::anim::edit::timelines(&json)
+    let anim = crate::document::animation_named(h.state().doc.state(), "nod");
+    crate::anim::edit::timelines(&anim)
         .into_iter()
         .find(|(t, _)| *t == head(channel))
         .map(|(_, times)| times)

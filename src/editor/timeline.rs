@@ -231,8 +231,8 @@ impl EditorApp {
 
     /// Copies the selected keys to the editor's clipboard.
     pub fn copy_keys(&mut self) {
-        let json = crate::document::animation_json(self.doc.state(), &self.animate.animation);
-        match edit::copy_keys(&json, &self.timeline.selection) {
+        let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
+        match edit::copy_keys(&animation, &self.timeline.selection) {
             Ok(keys) => self.timeline.clipboard = keys,
             Err(e) => self.message = Some(e.to_string()),
         }
@@ -360,8 +360,8 @@ impl EditorApp {
             );
             ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
         });
-        let json = crate::document::animation_json(self.doc.state(), &self.animate.animation);
-        let timelines = edit::timelines(&json);
+        let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
+        let timelines = edit::timelines(&animation);
         // Another animation, undo, redo and other edits can take selected keys away.
         if self.timeline.selection_of != self.animate.animation {
             self.timeline.selection_of = self.animate.animation.clone();
@@ -383,7 +383,7 @@ impl EditorApp {
                 .max_width(width)
                 .show(ui, |ui| self.dopesheet(ui, width, &timelines));
             ui.separator();
-            ui.vertical(|ui| self.curve_editor(ui, &json));
+            ui.vertical(|ui| self.curve_editor(ui, &animation));
         });
     }
 
@@ -746,14 +746,14 @@ impl EditorApp {
 
     /// The curve of the one selected key's outgoing segment: its kind, and for a Bézier the
     /// graph of one channel with its two handles to drag.
-    fn curve_editor(&mut self, ui: &mut egui::Ui, json: &serde_json::Value) {
+    fn curve_editor(&mut self, ui: &mut egui::Ui, animation: &Animation) {
         self.timeline.curve = None;
         let [key] = self.timeline.selection.as_slice() else {
             ui.label("Select one key to edit the curve to the next key.");
             return;
         };
         let key = key.clone();
-        let segment = match edit::segment(json, &key) {
+        let segment = match edit::segment(animation, &key) {
             Ok(s) => s,
             Err(e) => {
                 ui.label(e.to_string());

@@ -411,11 +411,12 @@ pub fn export_spine(
     let atlas = atlas::pack_atlas(name, &regions, &options.atlas)?;
 
     // Animations: native timelines, and baked keys for what they cannot express.
-    let animations = anim::load_animations(doc)?;
+    doc.check_animations()?;
+    let animations = &doc.animations;
     let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
-    for (anim_name, animation) in &animations {
+    for (anim_name, animation) in animations {
         let BakePlan {
             times,
             samples,
