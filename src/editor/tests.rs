@@ -1650,13 +1650,17 @@ fn the_canvas_draws_the_poses_draw_order_tint_and_visibility() {
     order.push("torso".into());
     doc.animations.insert(
         "show".into(),
-        serde_json::json!({
-            "parts": {
-                "head": {"visible": [{"time": 0, "value": false}]},
-                "bag": {"color": [{"time": 0, "value": "ff000080"}]}
-            },
-            "draw_order": [{"time": 0, "value": order}]
-        }),
+        crate::anim::Animation::from_json(
+            "show",
+            &serde_json::json!({
+                "parts": {
+                    "head": {"visible": [{"time": 0, "value": false}]},
+                    "bag": {"color": [{"time": 0, "value": "ff000080"}]}
+                },
+                "draw_order": [{"time": 0, "value": order}]
+            }),
+        )
+        .expect("an animation"),
     );
     doc.save(&path).expect("saved");
     let mut h = harness(EditorApp::new(Document::new()));

@@ -13,7 +13,7 @@
 use super::animate_mode::{OnionOptions, MAX_ONION_FRAMES};
 use super::{EditorApp, Mode};
 use crate::anim::edit::{self, CopiedKey, KeyRef, Segment, TimelineId, KEY_TIME_TOLERANCE_S};
-use crate::anim::Curve;
+use crate::anim::{Animation, Curve};
 use crate::document::Command;
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Rect, Sense, Shape, Stroke};
 
