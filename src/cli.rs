@@ -670,24 +670,29 @@ fn pose(args: &PoseArgs) -> Result<()> {
             .chain(images.iter().map(PathBuf::as_path)),
         [args.output.as_deref(), args.vertices.as_deref()],
     )?;
-    let pose: Pose = match (&args.pose, &args.anim) {
-        (Some(path), _) => read_json(path, "pose file")?,
+    let (pose, transforms) = match (&args.pose, &args.anim) {
+        (Some(path), _) => {
+            let pose: Pose = read_json(path, "pose file")?;
+            let transforms = scene.handle_transforms(&pose)?;
+            (pose, transforms)
+        }
         (None, Some(name)) => {
             let time_s = args.time.unwrap_or(0.0);
             if !time_s.is_finite() {
                 bail!("--time must be a finite number of seconds");
             }
-            animation(&scene.doc, name)?.sample_with(
-                time_s,
-                true,
-                &sample_options(args.match_runtime),
-            )
+            let animation = animation(&scene.doc, name)?;
+            let sampling = sample_options(args.match_runtime);
+            let frame = playback::play(&scene, name, &animation, &[time_s], true, &sampling)?
+                .pop()
+                .context("no frame")?;
+            (frame.pose, frame.transforms)
         }
-        (None, None) => Pose::default(),
+        (None, None) => (Pose::default(), scene.handle_transforms(&Pose::default())?),
     };
-    let positions = scene.pose_positions_with(&pose, args.blend)?;
+    let positions = scene.positions_from_transforms(&transforms, &pose, args.blend)?;
     let image = match &args.output {
-        Some(_) => Some(render::rgba_from_pixmap(&scene.render(&positions)?)),
+        Some(_) => Some(playback::render_posed(&scene, &positions, &pose)?),
         None => None,
     };
     let vertices = match &args.vertices {
@@ -742,7 +747,8 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     {
         bar.set_style(style);
     }
-    let frames = playback::render_animation(&scene, &animation, &settings, &|| bar.inc(1));
+    let frames =
+        playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
     let report =
         io::sequence::write_sequence(&frames?, args.fps, &args.output, &Default::default())?;
@@ -759,8 +765,8 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
 
 /// The document's animation `name`, checked against its rig.
 fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
-    let mut animations = anim::load_animations(doc)?;
-    animations.remove(name).ok_or_else(|| {
+    doc.check_animations()?;
+    doc.animations.get(name).cloned().ok_or_else(|| {
         let known: Vec<&str> = doc.animations.keys().map(String::as_str).collect();
         anyhow!(
             "the rig has no animation '{name}' (it has: {})",
@@ -842,9 +848,11 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 
     let mut doc = doc;
     let animations_path = args.assets.join("animations.json");
-    doc.animations = read_json(&animations_path, "animations file")?;
-    let animations = anim::load_animations(&doc)
-        .with_context(|| format!("{}: bad animation", animations_path.display()))?;
+    let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
+    let bad = || format!("{}: bad animation", animations_path.display());
+    doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
+    doc.check_animations().with_context(bad)?;
+    let animations = doc.animations.clone();
     let rig_path = args.output.join("character.json");
     doc.save(&rig_path)?;
     let mut written = vec![rig_path];
@@ -865,15 +873,16 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     written.extend(export.write(&args.output.join("spine"))?);
     let spine_s = t.elapsed().as_secs_f64();
 
-    let view = FrameView::new(doc.canvas, 1.0, None, None)?;
     let mut render_s = 0.0;
     let mut write_s = 0.0;
     let mut frame_count = 0;
     for (name, animation) in &animations {
         let t = Instant::now();
-        let times = playback::frame_times(animation.duration_s(), DEMO_FPS)?;
-        let poses = playback::poses_at(animation, &times);
-        let frames = playback::render_poses(&scene, &poses, &times, Blend::Linear, &view, &|| {})?;
+        let settings = playback::RenderSettings {
+            fps: DEMO_FPS,
+            ..Default::default()
+        };
+        let frames = playback::render_animation(&scene, name, animation, &settings, &|| {})?;
         render_s += t.elapsed().as_secs_f64();
         frame_count += frames.len();
         let t = Instant::now();

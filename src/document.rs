@@ -108,8 +108,9 @@ pub struct State {
     pub layers: Vec<Arc<Layer>>,
     pub handles: Handles,
     pub options: BuildOptions,
-    /// Animations by name, as stored in the rig file.
-    pub animations: BTreeMap<String, serde_json::Value>,
+    /// Animations by name, each checked on its own (names the rig lacks are checked where an
+    /// animation is rendered or exported).
+    pub animations: BTreeMap<String, Animation>,
     /// The rig last built from layers, handles and options (meshes, weights, textures).
     pub rig: Option<Arc<Scene>>,
     /// Whether `rig` was built from exactly the current layers, handles and options.
@@ -611,13 +612,14 @@ pub fn compute_rig(
     Ok(Scene::new(doc, &images)?)
 }
 
-/// Replaces animation `name` of `state` by `apply(name, its JSON)` (a key edit: `anim::edit`).
+/// Replaces animation `name` of `state` (an empty one when there is none) by `apply(name, it)`
+/// (a key edit: `anim::edit`, which checks what it returns).
 fn edit_animation(
     state: &mut State,
     name: String,
-    apply: impl FnOnce(&str, &serde_json::Value) -> Result<serde_json::Value, edit::EditError>,
+    apply: impl FnOnce(&str, &Animation) -> Result<Animation, edit::EditError>,
 ) -> Result<(), DocumentError> {
-    let edited = apply(&name, &animation_json(state, &name))?;
+    let edited = apply(&name, &animation_named(state, &name))?;
     state.animations.insert(name, edited);
     Ok(())
 }
@@ -730,16 +732,16 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             pose,
         } => {
             check_key_time(time_s)?;
-            let mut anim = animation_named(state, &animation)?;
+            let mut anim = animation_named(state, &animation);
             key_pose(&mut anim, time_s, &pose);
-            store_animation(&mut next, &animation, &anim)?;
+            store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }
         Command::DeleteKeys { animation, time_s } => {
             check_key_time(time_s)?;
-            let mut anim = animation_named(state, &animation)?;
+            let mut anim = animation_named(state, &animation);
             delete_keys(&mut anim, time_s);
-            store_animation(&mut next, &animation, &anim)?;
+            store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }
         Command::SetPose(pose) => {
@@ -965,31 +967,13 @@ fn check_key_time(time_s: f64) -> Result<(), DocumentError> {
 }
 
 /// The animation stored under `name`, or a new empty one.
-pub fn animation_named(state: &State, name: &str) -> Result<Animation, DocumentError> {
-    match state.animations.get(name) {
-        Some(value) => Ok(Animation::from_json(name, value)?),
-        None => Ok(Animation::default()),
-    }
+pub fn animation_named(state: &State, name: &str) -> Animation {
+    state.animations.get(name).cloned().unwrap_or_default()
 }
 
-/// The animation stored under `name` as JSON, or an empty one.
-pub fn animation_json(state: &State, name: &str) -> serde_json::Value {
-    state
-        .animations
-        .get(name)
-        .cloned()
-        .unwrap_or_else(|| serde_json::json!({}))
-}
-
-fn store_animation(next: &mut State, name: &str, anim: &Animation) -> Result<(), DocumentError> {
+fn store_animation(next: &mut State, name: &str, anim: Animation) -> Result<(), DocumentError> {
     anim.validate(name)?;
-    let value = serde_json::to_value(anim).map_err(|e| {
-        DocumentError::Animation(crate::anim::AnimError::Malformed {
-            animation: name.to_string(),
-            reason: e.to_string(),
-        })
-    })?;
-    next.animations.insert(name.to_string(), value);
+    next.animations.insert(name.to_string(), anim);
     Ok(())
 }
 

@@ -42,7 +42,7 @@ fn keyed() -> Document {
 }
 
 fn times(doc: &Document, timeline: &TimelineId) -> Vec<f64> {
-    edit::timelines(&animation_json(doc.state(), "wave"))
+    edit::timelines(&animation_named(doc.state(), "wave"))
         .into_iter()
         .find(|(t, _)| t == timeline)
         .map(|(_, times)| times)
@@ -50,7 +50,7 @@ fn times(doc: &Document, timeline: &TimelineId) -> Vec<f64> {
 }
 
 fn rotate_at(doc: &Document, time_s: f64) -> f64 {
-    let anim = animation_named(doc.state(), "wave").expect("parses");
+    let anim = animation_named(doc.state(), "wave");
     anim.sample(time_s, false).bones["arm"].rotate
 }
 
@@ -127,7 +127,7 @@ fn paste_delete_and_curves_undo_in_order() {
     let rotate = arm(TransformChannel::Rotate);
     let translate = arm(TransformChannel::Translate);
     let copied = edit::copy_keys(
-        &animation_json(doc.state(), "wave"),
+        &animation_named(doc.state(), "wave"),
         &[key(&rotate, 0.0), key(&rotate, 1.0)],
     )
     .expect("copied");

@@ -3,6 +3,8 @@
 //! Coordinates are canvas pixels: x to the right, y down, origin at the top-left corner of the
 //! canvas. Pixel (i, j) covers [i, i+1) × [j, j+1), so its center is (i + 0.5, j + 0.5).
 
+pub mod pack;
+
 /// A position on the canvas, in pixels.
 pub type Point = nalgebra::Point2<f64>;
 /// A displacement on the canvas, in pixels.
@@ -60,10 +62,47 @@ pub fn barycentric(p: Point, a: Point, b: Point, c: Point) -> Option<[f64; 3]> {
 /// Twice a triangle's area (px²) below which [`barycentric`] calls it degenerate.
 pub const DEGENERATE_DET: f64 = 1e-12;
 
+/// Distance (px) from `p` to the closed segment a–b, and the parameter of the closest point on
+/// it (0 at a, 1 at b; 0 for a segment of zero length, whose distance is to a).
+pub fn segment_distance(p: Point, a: Point, b: Point) -> (f64, f64) {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    ((p - (a + ab * t)).norm(), t)
+}
+
+/// Distance (px) from `p` to the closed segment a–b (see [`segment_distance`]).
+pub fn point_segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    segment_distance(p, a, b).0
+}
+
 /// Twice the signed area of triangle (a, b, c), in px²; positive when a → b → c turns clockwise
 /// on screen (y down).
 pub fn triangle_area2(a: Point, b: Point, c: Point) -> f64 {
     (b - a).perp(&(c - a))
+}
+
+/// Whether closed segments `a`–`b` and `c`–`d` share a point.
+pub fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
+    let orient = triangle_area2;
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let on = |p: Point, q: Point, r: Point| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    (d1 == 0.0 && on(c, d, a))
+        || (d2 == 0.0 && on(c, d, b))
+        || (d3 == 0.0 && on(a, b, c))
+        || (d4 == 0.0 && on(a, b, d))
 }
 
 #[cfg(test)]

@@ -68,18 +68,20 @@ pub fn render_animation(
     settings: &RenderSettings,
     output: &Path,
 ) -> Result<SequenceReport, JobError> {
-    let animation =
-        anim::load_animations(&doc)?
-            .remove(name)
-            .ok_or_else(|| AnimError::Malformed {
-                animation: name.to_string(),
-                reason: "the document has no animation of that name".into(),
-            })?;
+    doc.check_animations()?;
+    let animation = doc
+        .animations
+        .get(name)
+        .cloned()
+        .ok_or_else(|| AnimError::Malformed {
+            animation: name.to_string(),
+            reason: "the document has no animation of that name".into(),
+        })?;
     sequence::format_for_path(output)?;
     // Settings are checked before the scene is built: a bad scale fails at once.
     settings.view(doc.canvas)?;
     let scene = Scene::new(doc, images)?;
-    let frames = playback::render_animation(&scene, &animation, settings, &|| {})?;
+    let frames = playback::render_animation(&scene, name, &animation, settings, &|| {})?;
     Ok(sequence::write_sequence(
         &frames,
         settings.fps,

@@ -23,6 +23,7 @@ pub mod playback;
 pub mod render;
 pub mod rig;
 pub mod schema;
+pub mod scene;
 pub mod skin;
 pub mod trace;
 pub mod weights;

@@ -44,6 +44,8 @@ pub enum PipelineError {
     NoImages,
     #[error("cancelled")]
     Cancelled,
+    #[error("momentum is simulated from the animation's start: time {0:e} s lies outside [0, {max}] s", max = crate::scene::MAX_SIMULATED_S)]
+    SimulatedTime(f64),
     #[error("{path}: image is {got:?} px but the canvas (from the first image) is {canvas:?} px; all layers must share one canvas")]
     SizeMismatch {
         path: PathBuf,
@@ -523,41 +525,6 @@ impl Scene {
     ) -> Result<Vec<Vec<Point>>, PipelineError> {
         let transforms = self.handle_transforms(pose)?;
         self.positions_from_transforms(&transforms, pose, blend)
-    }
-
-    /// The skinning transformations of a sequence of poses (an animation's frames at
-    /// `times_s`), solved in order: each IK solve starts from the previous frame's result, and
-    /// handles with momentum ([`crate::ik::IkOptions::momentum`]) carry their motion from frame
-    /// to frame.
-    pub fn sequence_transforms(
-        &self,
-        poses: &[Pose],
-        times_s: &[f64],
-    ) -> Result<Vec<Vec<Affine>>, PipelineError> {
-        let dynamic = !self.doc.options.ik.momentum.is_empty();
-        let mut ik: Option<RigIk> = None;
-        let mut out = Vec::with_capacity(poses.len());
-        for (k, pose) in poses.iter().enumerate() {
-            if pose.ik.is_empty() && !dynamic {
-                out.push(handle_transforms(&self.doc.handles, pose)?);
-                continue;
-            }
-            if ik.is_none() {
-                ik = Some(self.rig_ik()?);
-            }
-            let frame_time_s = match (
-                k.checked_sub(1).and_then(|p| times_s.get(p)),
-                times_s.get(k),
-            ) {
-                (Some(before), Some(now)) => now - before,
-                _ => 0.0,
-            };
-            let solver = ik
-                .as_mut()
-                .ok_or(PipelineError::Ik(crate::ik::IkError::Singular))?;
-            out.push(solver.step(pose, frame_time_s)?.transforms);
-        }
-        Ok(out)
     }
 
     /// The rig's meshes as the skinning IK sees them: parts with weights, back to front, their

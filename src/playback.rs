@@ -5,16 +5,18 @@
 //! image per frame, at times 0, 1/fps, 2/fps, … up to but not including the animation's
 //! duration (the loop's end is its start), ready for [`crate::io::sequence`].
 //!
-//! Skinning IK (poses with drags) is solved frame after frame, each warm-started from the one
-//! before; drawing then runs in parallel, so the output does not depend on the thread count.
+//! Frames are posed through [`crate::scene::frames`] (a frame is a function of its time, not of
+//! the frame rate or of the frames before it) and drawn in parallel, so the output depends on
+//! neither the frame rate's other frames nor the thread count.
 //!
 //! [`bake`] turns an animation into plain keys (bones, points, cages at every frame time) from
 //! the transformations playback solves: what a runtime that knows no skinning IK can play.
 
-use crate::anim::{Animation, SampleOptions};
+use crate::anim::{Animation, CurveEvaluation, SampleOptions};
 use crate::pipeline::{PipelineError, Scene};
 use crate::render;
-use crate::rig::Pose;
+use crate::rig::{Handles, Pose};
+use crate::scene::{Frame, PlayOptions};
 use crate::skin::Blend;
 use image::RgbaImage;
 use rayon::prelude::*;
@@ -86,10 +88,12 @@ impl RenderSettings {
     }
 }
 
-/// Plays `animation` on `scene` as `settings` say: the frames at
-/// [`frame_times`]`(duration, fps)`. `on_frame` is called once per frame drawn (progress).
+/// Plays `animation` (named `name`) on `scene` as `settings` say: the frames at
+/// [`frame_times`]`(duration, fps)`, posed by [`play`] (so a frame is the same at any frame
+/// rate) and drawn by [`draw_pose`]. `on_frame` is called once per frame drawn (progress).
 pub fn render_animation(
     scene: &Scene,
+    name: &str,
     animation: &Animation,
     settings: &RenderSettings,
     on_frame: &(dyn Fn() + Sync),
@@ -97,15 +101,45 @@ pub fn render_animation(
     let view = settings.view(scene.doc.canvas)?;
     let times = frame_times(animation.duration_s(), settings.fps)?;
     check_render_memory(times.len(), &view)?;
-    let poses = poses_at_with(animation, &times, &settings.sampling);
-    Ok(render_poses(
+    let frames = play(scene, name, animation, &times, true, &settings.sampling)?;
+    Ok(render_frames(
         scene,
-        &poses,
-        &times,
+        &frames,
         settings.blend,
         &view,
         on_frame,
     )?)
+}
+
+/// The frames of `animation` (named `name`) at `times_s`: with exact curves, through the one
+/// pose path ([`crate::scene::frames`]); with [`CurveEvaluation::SpineRuntime`], as Spine's
+/// runtime plays the default Spine export ([`crate::export::spine::played`]: its curve
+/// evaluation, and the baked keys interpolated as it does).
+pub fn play(
+    scene: &Scene,
+    name: &str,
+    animation: &Animation,
+    times_s: &[f64],
+    looping: bool,
+    sampling: &SampleOptions,
+) -> Result<Vec<Frame>, RenderAnimationError> {
+    match sampling.curves {
+        CurveEvaluation::Exact => {
+            let options = PlayOptions {
+                sampling: *sampling,
+                looping,
+            };
+            Ok(crate::scene::frames(scene, animation, times_s, options)?)
+        }
+        CurveEvaluation::SpineRuntime => {
+            let options = crate::export::spine::SpineOptions::default();
+            let played = crate::export::spine::played::as_played(scene, name, animation, &options)?;
+            Ok(times_s
+                .iter()
+                .map(|&t| played.frame(t, looping))
+                .collect::<Result<_, _>>()?)
+        }
+    }
 }
 
 /// Why [`render_animation`] failed: its settings, or posing and drawing the rig.
@@ -115,6 +149,8 @@ pub enum RenderAnimationError {
     Settings(#[from] PlaybackError),
     #[error(transparent)]
     Pipeline(#[from] PipelineError),
+    #[error(transparent)]
+    Runtime(#[from] crate::export::spine::SpineError),
 }
 
 /// What is wrong with a playback request.
@@ -221,19 +257,6 @@ pub fn check_render_memory(frames: usize, view: &FrameView) -> Result<(), Playba
 /// How far below a whole frame count `duration · fps` may fall and still count as it.
 const FRAME_TIME_SLACK: f64 = 1e-9;
 
-/// The poses of `animation` at `times_s`, looping.
-pub fn poses_at(animation: &Animation, times_s: &[f64]) -> Vec<Pose> {
-    poses_at_with(animation, times_s, &SampleOptions::default())
-}
-
-/// [`poses_at`] with a choice of curve evaluation (e.g. as Spine's runtimes play it).
-pub fn poses_at_with(animation: &Animation, times_s: &[f64], options: &SampleOptions) -> Vec<Pose> {
-    times_s
-        .iter()
-        .map(|&t| animation.sample_with(t, true, options))
-        .collect()
-}
-
 /// Renders one pose through `view`.
 pub fn render_pose(
     scene: &Scene,
@@ -243,6 +266,18 @@ pub fn render_pose(
 ) -> Result<RgbaImage, PipelineError> {
     let positions = scene.pose_positions_with(pose, blend)?;
     render_positions(scene, &positions, pose, view)
+}
+
+/// Draws the parts at `positions` as `pose` shows them on a transparent canvas of the rig's size
+/// (what `sinew pose -o` writes).
+pub fn render_posed(
+    scene: &Scene,
+    positions: &[Vec<crate::geom::Point>],
+    pose: &Pose,
+) -> Result<RgbaImage, PipelineError> {
+    let view = FrameView::new(scene.doc.canvas, 1.0, None, None)
+        .map_err(|_| PipelineError::Canvas(scene.doc.canvas))?;
+    render_positions(scene, positions, pose, &view)
 }
 
 /// Renders parts at `positions` (one list per part, canvas px) as `pose` shows them.
@@ -268,7 +303,7 @@ fn render_positions(
 }
 
 /// Draws the parts at `positions` as `pose` shows them: its draw order (the document's
-/// otherwise), each part's tint and visibility.
+/// otherwise), each part's tint and visibility ([`pose_draws`]).
 pub fn draw_pose(
     scene: &Scene,
     canvas: &mut tiny_skia::Pixmap,
@@ -276,6 +311,18 @@ pub fn draw_pose(
     pose: &Pose,
     output_from_canvas: tiny_skia::Transform,
 ) -> Result<(), PipelineError> {
+    let draws = pose_draws(scene, positions, pose);
+    scene.draw_parts(canvas, &draws, output_from_canvas)
+}
+
+/// The parts at `positions` (one list per part, canvas px) as `pose` shows them, back to
+/// front: its draw order (the document's otherwise), each part's tint and visibility. What
+/// [`draw_pose`] draws, for every consumer that draws a pose (the editor's canvas too).
+pub fn pose_draws<'a>(
+    scene: &Scene,
+    positions: &'a [Vec<crate::geom::Point>],
+    pose: &Pose,
+) -> Vec<render::PartDraw<'a>> {
     let parts = &scene.doc.parts;
     let order: Vec<usize> = match &pose.draw_order {
         Some(names) => names
@@ -284,7 +331,7 @@ pub fn draw_pose(
             .collect(),
         None => (0..parts.len()).collect(),
     };
-    let draws: Vec<render::PartDraw> = order
+    order
         .into_iter()
         .map(|i| {
             let mut draw =
@@ -296,31 +343,26 @@ pub fn draw_pose(
             }
             draw
         })
-        .collect();
-    scene.draw_parts(canvas, &draws, output_from_canvas)
+        .collect()
 }
 
-/// Renders every pose (shown at `times_s`) through `view`; `on_frame` is called once per finished frame (for a
-/// progress bar). Skinning IK solves the poses in order first, each frame warm-started from the
-/// one before (so a sequence is deterministic and smooth); drawing then runs in parallel.
-pub fn render_poses(
+/// Draws every frame through `view`, in parallel; `on_frame` is called once per finished frame
+/// (for a progress bar).
+pub fn render_frames(
     scene: &Scene,
-    poses: &[Pose],
-    times_s: &[f64],
+    frames: &[Frame],
     blend: Blend,
     view: &FrameView,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<Vec<RgbaImage>, PipelineError> {
-    let transforms = scene.sequence_transforms(poses, times_s)?;
-    poses
+    frames
         .par_iter()
-        .zip(transforms.par_iter())
-        .map(|(pose, transforms)| {
-            let frame = scene
-                .positions_from_transforms(transforms, pose, blend)
-                .and_then(|positions| render_positions(scene, &positions, pose, view));
+        .map(|frame| {
+            let image = scene
+                .positions_from_transforms(&frame.transforms, &frame.pose, blend)
+                .and_then(|positions| render_positions(scene, &positions, &frame.pose, view));
             on_frame();
-            frame
+            image
         })
         .collect()
 }
@@ -346,13 +388,12 @@ pub fn bake(
     animation: &Animation,
     times_s: &[f64],
 ) -> Result<Animation, PipelineError> {
-    use crate::anim::timeline::{BoneTimelines, Key, PointTimelines};
     let handles = &scene.doc.handles;
-    let poses: Vec<Pose> = times_s
-        .iter()
-        .map(|&t| animation.sample(t, false))
-        .collect();
-    let transforms = scene.sequence_transforms(&poses, times_s)?;
+    let frames = crate::scene::frames(scene, animation, times_s, PlayOptions::default())?;
+    let (poses, transforms): (Vec<Pose>, Vec<Vec<crate::rig::Affine>>) = frames
+        .into_iter()
+        .map(|frame| (frame.pose, frame.transforms))
+        .unzip();
     let mut baked: Vec<Pose> = transforms
         .iter()
         .map(|t| crate::rig::pose::pose_from_transforms(handles, t))
@@ -384,6 +425,19 @@ pub fn bake(
             }
         }
     }
+    let mut out = keyed_animation(handles, times_s, &baked);
+    out.parts = animation.parts.clone();
+    out.draw_order = animation.draw_order.clone();
+    Ok(out)
+}
+
+/// An animation with one linear key per time in `times_s` for every bone, point and cage of
+/// `handles`, from `poses` (one per time; every handle posed, as
+/// [`crate::rig::pose::pose_from_transforms`] gives them). Rotations are unwrapped (each key
+/// within 180° of the one before), since runtimes interpolate plain numbers.
+pub fn keyed_animation(handles: &Handles, times_s: &[f64], poses: &[Pose]) -> Animation {
+    use crate::anim::timeline::{BoneTimelines, Key, PointTimelines};
+    let baked = poses;
     // One linear key per frame time.
     let keys = |values: &mut dyn Iterator<Item = [f64; 2]>| -> Option<Vec<Key<[f64; 2]>>> {
         Some(
@@ -412,11 +466,7 @@ pub fn bake(
                 .collect(),
         )
     };
-    let mut out = Animation {
-        parts: animation.parts.clone(),
-        draw_order: animation.draw_order.clone(),
-        ..Animation::default()
-    };
+    let mut out = Animation::default();
     for bone in &handles.bones {
         let pose = |k: usize| &baked[k].bones[&bone.name];
         let frames = 0..baked.len();
@@ -448,12 +498,12 @@ pub fn bake(
             cage.name.clone(),
             times_s
                 .iter()
-                .zip(&baked)
+                .zip(baked)
                 .map(|(&t, pose)| linear_key(t, pose.cages[&cage.name].polygon.clone()))
                 .collect(),
         );
     }
-    Ok(out)
+    out
 }
 
 /// The corners of the box around every part's rest mesh (canvas px); the origin alone for a

@@ -196,6 +196,7 @@ fn assemble(rings: Vec<Vec<Point>>, owners: &[Owner]) -> Vec<Outline> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::{point_segment_distance, segments_touch, triangle_area2 as orient};
 
     /// The defaults with the threshold at mid alpha, which the exact geometric expectations
     /// below are computed for.
@@ -271,40 +272,12 @@ mod tests {
             == 1
     }
 
-    fn point_segment_distance(p: Point, a: Point, b: Point) -> f64 {
-        let ab = b - a;
-        let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
-        (p - (a + ab * t)).norm()
-    }
-
     fn distance_to_rings(p: Point, outlines: &[Outline]) -> f64 {
         rings(outlines)
             .iter()
             .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
             .map(|(a, b)| point_segment_distance(p, a, b))
             .fold(f64::INFINITY, f64::min)
-    }
-
-    fn orient(a: Point, b: Point, c: Point) -> f64 {
-        (b - a).perp(&(c - a))
-    }
-
-    /// Whether c, known collinear with a–b, lies on segment a–b.
-    fn on_segment(a: Point, b: Point, c: Point) -> bool {
-        c.x >= a.x.min(b.x) && c.x <= a.x.max(b.x) && c.y >= a.y.min(b.y) && c.y <= a.y.max(b.y)
-    }
-
-    /// Exact-predicate style test: do closed segments a–b and c–d share a point?
-    fn segments_meet(a: Point, b: Point, c: Point, d: Point) -> bool {
-        let (o1, o2) = (orient(a, b, c), orient(a, b, d));
-        let (o3, o4) = (orient(c, d, a), orient(c, d, b));
-        if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-            return true;
-        }
-        (o1 == 0.0 && on_segment(a, b, c))
-            || (o2 == 0.0 && on_segment(a, b, d))
-            || (o3 == 0.0 && on_segment(c, d, a))
-            || (o4 == 0.0 && on_segment(c, d, b))
     }
 
     /// Rings simple and mutually disjoint (brute force), ≥ 3 distinct consecutive points,
@@ -346,7 +319,7 @@ mod tests {
                     );
                 } else {
                     assert!(
-                        !segments_meet(a, b, c, d),
+                        !segments_touch(a, b, c, d),
                         "ring {r} segment {i} meets ring {s} segment {j}"
                     );
                 }

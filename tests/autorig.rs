@@ -12,8 +12,9 @@ mod common;
 #[cfg(feature = "cli")]
 use command::{scratch, sinew};
 use image::RgbaImage;
-use sinew::autorig::shape::{segments_touch, Shape};
+use sinew::autorig::shape::Shape;
 use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
+use sinew::geom::segments_touch;
 use sinew::geom::{point_in_ring, Point};
 use sinew::rig::Handles;
 use sinew::trace::TraceOptions;
@@ -359,9 +360,10 @@ fn letter_with_a_hole_keeps_bones_off_the_hole() {
     let sides = [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)];
     for (dx, dy) in sides {
         let probe = Point::new(120.0 + 43.0 * dx, 95.0 + 43.0 * dy);
-        let near = h.bones.iter().any(|b| {
-            sinew::weights::boundary::segment_distance(probe, pt(b.head), pt(b.tail)).0 < 12.0
-        });
+        let near = h
+            .bones
+            .iter()
+            .any(|b| sinew::geom::segment_distance(probe, pt(b.head), pt(b.tail)).0 < 12.0);
         assert!(near, "no bone in the bowl near {probe:?}");
     }
 }

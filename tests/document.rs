@@ -277,7 +277,7 @@ fn keys_set_replace_sample_and_delete() {
     doc.apply(key(1.0, drag([260.0, 0.0]))).unwrap();
     // The same time again replaces the key instead of adding one.
     doc.apply(key(1.0, drag([280.0, 10.0]))).unwrap();
-    let anim = animation_named(doc.state(), "wave").unwrap();
+    let anim = animation_named(doc.state(), "wave");
     assert_eq!(key_times(&anim), vec![0.0, 1.0]);
     assert_eq!(anim.ik.len(), 1, "one timeline per rest point");
     let half = anim.sample(0.5, false);
@@ -286,14 +286,14 @@ fn keys_set_replace_sample_and_delete() {
     // Keys are undoable edits; weights stay current.
     assert!(doc.posable().is_some());
     doc.undo();
-    let anim = animation_named(doc.state(), "wave").unwrap();
+    let anim = animation_named(doc.state(), "wave");
     assert_eq!(anim.sample(1.0, false).ik[0].to, [260.0, 0.0]);
     doc.apply(Command::DeleteKeys {
         animation: "wave".into(),
         time_s: 0.0,
     })
     .unwrap();
-    let anim = animation_named(doc.state(), "wave").unwrap();
+    let anim = animation_named(doc.state(), "wave");
     assert_eq!(key_times(&anim), vec![1.0]);
     assert!(doc
         .apply(key(f64::NAN, Pose::default()))

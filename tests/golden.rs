@@ -19,7 +19,6 @@ mod common;
 use common::golden::{premultiplied_difference, premultiplied_tolerance};
 use image::RgbaImage;
 use sinew::pipeline::Scene;
-use sinew::render;
 use sinew::rig::Pose;
 use std::path::PathBuf;
 use std::sync::OnceLock;
@@ -47,9 +46,10 @@ fn render_pose(pose: &Pose) -> RgbaImage {
     render_pose_in(scene(), pose)
 }
 
+/// What `sinew pose --pose P -o OUT.png` draws: the one pose path, then the one draw.
 fn render_pose_in(scene: &Scene, pose: &Pose) -> RgbaImage {
     let positions = scene.pose_positions(pose).expect("the pose applies");
-    render::rgba_from_pixmap(&scene.render(&positions).expect("renders"))
+    sinew::playback::render_posed(scene, &positions, pose).expect("renders")
 }
 
 fn load_pose(name: &str) -> Pose {
@@ -83,10 +83,21 @@ fn bundled_animations_match_golden_at_fixed_times() {
     ] {
         let animation = &animations[name];
         for t in times_s {
-            let pose = animation.sample(t, true);
+            // What `sinew pose --anim NAME --time T` and every frame of `sinew render` show.
+            let frame =
+                sinew::playback::play(scene(), name, animation, &[t], true, &Default::default())
+                    .expect("plays")
+                    .remove(0);
+            let positions = scene()
+                .positions_from_transforms(
+                    &frame.transforms,
+                    &frame.pose,
+                    sinew::skin::Blend::Linear,
+                )
+                .expect("positions");
             check_golden(
                 &format!("{name}_{:04}ms", (t * 1000.0) as u32),
-                &render_pose(&pose),
+                &sinew::playback::render_posed(scene(), &positions, &frame.pose).expect("renders"),
             );
         }
     }

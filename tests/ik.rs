@@ -432,15 +432,12 @@ fn baking_reproduces_ik_driven_motion_with_plain_keys() {
     let times: Vec<f64> = (0..=20).map(|k| k as f64 / fps).collect();
     let baked = sinew::playback::bake(scene(), lift, &times).unwrap();
     assert!(baked.ik.is_empty());
-    let solved = scene()
-        .sequence_transforms(
-            &times
-                .iter()
-                .map(|&t| lift.sample(t, false))
-                .collect::<Vec<_>>(),
-            &times,
-        )
-        .unwrap();
+    let solved: Vec<Vec<Affine>> =
+        sinew::scene::frames(scene(), lift, &times, sinew::scene::PlayOptions::default())
+            .unwrap()
+            .into_iter()
+            .map(|frame| frame.transforms)
+            .collect();
     let mut worst: f64 = 0.0;
     for (k, &t) in times.iter().enumerate() {
         let pose = baked.sample(t, false);

@@ -17,12 +17,13 @@ mod command;
 
 use command::{s, scratch};
 use serde::Deserialize;
-use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::export::spine::bake::bake_times;
+use sinew::export::spine::played::as_played;
 use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
 use sinew::geom::Point;
 use sinew::io::{self, RigDocument};
 use sinew::pipeline::Scene;
+use sinew::skin::Blend;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -147,7 +148,8 @@ fn times_for(doc: &RigDocument, name: &str, duration: f64) -> Vec<f64> {
             _ => {}
         }
     }
-    keys(&doc.animations[name], &mut times);
+    let json = serde_json::to_value(&doc.animations[name]).expect("an animation writes as JSON");
+    keys(&json, &mut times);
     times.retain(|&t| t < duration);
     times.sort_by(f64::total_cmp);
     times.dedup();
@@ -165,22 +167,17 @@ enum Compare {
     ReportOnly,
 }
 
-/// How one animation is compared: skinning-IK drags and bone IK chains longer than two bones
-/// are baked into keys at the export's rate (Spine has no such constraints), so between keys the
-/// runtime interpolates the baked keys linearly while sinew solves exactly; such an animation
-/// is compared at its bake times.
-fn compare_for(
-    compare: Compare,
-    animation: &sinew::anim::Animation,
-    baked: &[String],
-    options: &SpineOptions,
-) -> Compare {
-    match compare {
-        Compare::RuntimeMode if !animation.ik.is_empty() || !baked.is_empty() => {
-            Compare::ExactAtBakeTimes(options.bake_fps)
-        }
-        other => other,
-    }
+/// How one animation is compared. Runtime mode holds for every animation, baked ones included:
+/// `--match-runtime spine` interpolates the export's baked keys as the runtime does.
+fn compare_for(compare: Compare) -> Compare {
+    compare
+}
+
+/// Times halfway between the bake times of an animation lasting `duration`: where the runtime
+/// interpolates baked keys.
+fn between_bake_times(duration: f64, fps: f64) -> Vec<f64> {
+    let times = bake_times(duration, fps);
+    times.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect()
 }
 
 /// Exports `rig` with the CLI (`flags`, which `options` must mirror) into `dir` and checks it
@@ -220,20 +217,14 @@ fn check_rig(
             );
         }
     }
-    let animations = anim::load_animations(&doc).unwrap();
+    doc.check_animations().unwrap();
+    let animations = doc.animations.clone();
     let baked: BTreeMap<&str, &[String]> = export
         .baked
         .iter()
         .map(|(name, bones)| (name.as_str(), bones.as_slice()))
         .collect();
-    let compare_of = |name: &str, a: &sinew::anim::Animation| {
-        compare_for(
-            compare,
-            a,
-            baked.get(name).copied().unwrap_or_default(),
-            options,
-        )
-    };
+    let compare_of = |_name: &str, _a: &sinew::anim::Animation| compare_for(compare);
     let times: BTreeMap<String, Vec<f64>> = animations
         .iter()
         .map(|(name, a)| {
@@ -243,7 +234,15 @@ fn check_rig(
                     t.retain(|&t| t < a.duration_s());
                     t
                 }
-                _ => times_for(&doc, name, a.duration_s()),
+                _ => {
+                    let mut t = times_for(&doc, name, a.duration_s());
+                    if baked.get(name.as_str()).is_some_and(|b| !b.is_empty()) {
+                        t.extend(between_bake_times(a.duration_s(), options.bake_fps));
+                        t.sort_by(f64::total_cmp);
+                        t.dedup();
+                    }
+                    t
+                }
             };
             (name.clone(), times)
         })
@@ -276,12 +275,17 @@ fn check_rig(
     println!("{}: setup pose deviation {setup:.2e} px", rig.display());
     assert!(setup <= SETUP_TOLERANCE_PX, "setup pose off by {setup} px");
 
-    let runtime = SampleOptions {
-        curves: CurveEvaluation::SpineRuntime,
-    };
+    // `--match-runtime spine` reproduces the default export; other options are reproduced
+    // in-process by the same function.
+    let defaults = SpineOptions::default();
+    let cli_matches = options.bake == defaults.bake
+        && options.bake_fps == defaults.bake_fps
+        && options.bake_tolerance_px == defaults.bake_tolerance_px
+        && options.root_bone == defaults.root_bone;
     let (mut worst_runtime, mut worst_exact) = (0.0_f64, 0.0_f64);
     for (name, animation) in &animations {
         let played = &oracle.animations[name];
+        let as_played = as_played(&scene, name, animation, options).unwrap();
         assert!(
             (played.duration - animation.duration_s()).abs() < 1e-6,
             "{name}: runtime duration {} vs {}",
@@ -291,8 +295,11 @@ fn check_rig(
         let cli_every = (played.frames.len() / CLI_TIMES_PER_ANIMATION).max(1);
         for (i, frame) in played.frames.iter().enumerate() {
             let t = frame.time;
-            let pose = animation.sample_with(t, true, &runtime);
-            let positions = scene.pose_positions(&pose).unwrap();
+            let runtime_frame = as_played.frame(t, true).unwrap();
+            let pose = &runtime_frame.pose;
+            let positions = scene
+                .positions_from_transforms(&runtime_frame.transforms, pose, Blend::Linear)
+                .unwrap();
             let d = deviation(&export, &doc, &frame.slots, &positions);
             worst_runtime = worst_runtime.max(d);
             let exact = scene.pose_positions(&animation.sample(t, true)).unwrap();
@@ -332,7 +339,10 @@ fn check_rig(
                 }
             }
             // Some times through the command line, as a user previews them.
-            if compare_of(name, animation) == Compare::RuntimeMode && i % cli_every == 0 {
+            if cli_matches
+                && compare_of(name, animation) == Compare::RuntimeMode
+                && i % cli_every == 0
+            {
                 let v = dir.join("v.json");
                 let time = format!("{t}");
                 sinew(&[
@@ -723,7 +733,8 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
     // baked animation shows what the original does at the bake times (mix < 1 is not blended a
     // second time; the FABRIK tail solves again from the same keys).
     let scene = Scene::load(&rig).unwrap();
-    for (name, animation) in anim::load_animations(&scene.doc).unwrap() {
+    scene.doc.check_animations().unwrap();
+    for (name, animation) in scene.doc.animations.clone() {
         let times = bake_times(animation.duration_s(), 10.0);
         let baked = sinew::playback::bake(&scene, &animation, &times).unwrap();
         for &t in &times {

@@ -3,12 +3,12 @@
 //! linear blend skinning (identity, whole-rig rigid motion, one bent joint).
 
 use image::{Rgba, RgbaImage};
+use sinew::geom::segment_distance;
 use sinew::geom::{triangle_area2, Point, Vec2};
 use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer, Scene};
 use sinew::rig::pose::{rotation, BonePose, PointPose};
 use sinew::rig::{handle_columns, Bone, Handles, PointHandle, Pose};
-use sinew::weights::boundary::segment_distance;
 use sinew::weights::WeightOptions;
 use std::path::Path;
 

@@ -6,7 +6,6 @@
 
 use super::timeline::Animation;
 use super::AnimError;
-use crate::io::RigDocument;
 use crate::rig::Handles;
 use std::collections::BTreeMap;
 
@@ -74,13 +73,14 @@ impl Animation {
     }
 }
 
-/// Every animation of a rig document, parsed, checked on its own and against the document's
-/// handles and parts.
-pub fn load_animations(doc: &RigDocument) -> Result<BTreeMap<String, Animation>, AnimError> {
-    let parts: Vec<&str> = doc.parts.iter().map(|p| p.name.as_str()).collect();
-    let animations = super::parse_animations(&doc.animations)?;
-    for (name, animation) in &animations {
-        animation.check_rig(name, &doc.handles, &parts)?;
-    }
-    Ok(animations)
+/// Checks each of `animations` against the rig's handles and part names (see
+/// [`Animation::check_rig`]); the first failure names its animation.
+pub fn check_animations(
+    animations: &BTreeMap<String, Animation>,
+    handles: &Handles,
+    parts: &[&str],
+) -> Result<(), AnimError> {
+    animations
+        .iter()
+        .try_for_each(|(name, animation)| animation.check_rig(name, handles, parts))
 }

@@ -1,7 +1,8 @@
 //! Keyframed animations: timelines of keys, curves, sampling into poses, crossfades.
 //!
 //! In: the rig document's `animations` map (name → animation JSON, see [`timeline`] for the
-//! model), the rig's handles and part names. Out: checked [`Animation`]s, and for any time the
+//! model; parsed once, where a document or an animations file is read, and held as
+//! [`Animation`]s from then on), the rig's handles and part names. Out: checked [`Animation`]s, and for any time the
 //! [`crate::rig::Pose`] they show — bone locals, point and cage poses, part tints, visibility and
 //! draw order, IK drags. Units: seconds, degrees (counter-clockwise on screen), canvas px, color
 //! multipliers in [0, 1].
@@ -11,7 +12,7 @@
 //! - [`check`]: names and sizes against a rig;
 //! - [`sample`]: an animation at a time, looping or clamped;
 //! - [`mix`]: the crossfade from one animation into another;
-//! - [`edit`]: keys edited per timeline (move, copy and paste, delete, curves) on the JSON.
+//! - [`edit`]: keys edited per timeline (move, copy and paste, delete, curves).
 
 pub mod check;
 pub mod curve;
@@ -20,19 +21,21 @@ pub mod mix;
 pub mod sample;
 pub mod timeline;
 
-pub use check::load_animations;
+pub use check::check_animations;
 pub use curve::Curve;
 pub use curve::CurveEvaluation;
 pub use mix::{mix_poses, sample_mix, Playhead, STEPPED_MIX_THRESHOLD};
 pub use sample::SampleOptions;
 pub use timeline::{
-    parse_animations, Animation, BoneTimelines, IkTimeline, Key, PartTimelines, PointTimelines,
-    Rgba, StepKey, TimelineError,
+    animations_from_json, parse_animations, Animation, BoneTimelines, IkTimeline, Key,
+    PartTimelines, PointTimelines, Rgba, StepKey, TimelineError,
 };
 
 /// What is wrong with an animation, on its own or for a rig.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum AnimError {
+    #[error("animations: expected an object: name → animation")]
+    NotAMap,
     #[error("animation '{animation}': {reason}")]
     Malformed { animation: String, reason: String },
     #[error("animation '{animation}', {timeline}: {problem}")]
@@ -308,6 +311,14 @@ mod tests {
         let raw: std::collections::BTreeMap<String, serde_json::Value> =
             serde_json::from_value(read("animations.json")).unwrap();
         let animations = parse_animations(&raw).unwrap();
+        assert_eq!(
+            animations_from_json(&read("animations.json")),
+            Ok(animations.clone())
+        );
+        assert_eq!(
+            animations_from_json(&serde_json::json!([])),
+            Err(AnimError::NotAMap)
+        );
         assert_eq!(
             animations.keys().collect::<Vec<_>>(),
             ["lift", "walk", "wave"].iter().collect::<Vec<_>>()

@@ -1,6 +1,7 @@
 //! The animation model: keys, timelines, and their checks.
 //!
-//! In: one animation as JSON (an entry of the rig document's `animations` map). Out: an
+//! In: one animation as JSON (an entry of the rig document's `animations` map, read once where
+//! a document or an animations file is loaded; see [`animations_from_json`]). Out: an
 //! [`Animation`] whose keys are checked: times finite, ≥ 0 and strictly increasing; values
 //! finite; Bézier curves of the right length with their control times inside their segment;
 //! colors in [0, 1]; cage keys of one vertex count; draw-order keys without repeated names.
@@ -474,8 +475,22 @@ impl Animation {
 pub fn parse_animations(
     animations: &BTreeMap<String, serde_json::Value>,
 ) -> Result<BTreeMap<String, Animation>, AnimError> {
+    parse_each(animations)
+}
+
+/// [`parse_animations`] for the map as JSON (a rig document's `animations`, or an animations
+/// file: name → animation), which must be an object.
+pub fn animations_from_json(
+    animations: &serde_json::Value,
+) -> Result<BTreeMap<String, Animation>, AnimError> {
+    parse_each(animations.as_object().ok_or(AnimError::NotAMap)?)
+}
+
+fn parse_each<'a>(
+    animations: impl IntoIterator<Item = (&'a String, &'a serde_json::Value)>,
+) -> Result<BTreeMap<String, Animation>, AnimError> {
     animations
-        .iter()
+        .into_iter()
         .map(|(name, value)| Ok((name.clone(), Animation::from_json(name, value)?)))
         .collect()
 }

@@ -274,7 +274,7 @@ fn crosses(ring: &[(usize, Point)], p: Point, q: Point, skip: &[usize], _pts: &[
         if skip.contains(&u) || skip.contains(&v) {
             return false;
         }
-        super::shape::segments_touch(p, q, a, b)
+        crate::geom::segments_touch(p, q, a, b)
     })
 }
 

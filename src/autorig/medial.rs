@@ -531,7 +531,7 @@ mod tests {
             let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
             let inside = segments.iter().any(|&(a, b, r)| {
                 let (a, b) = (Point::new(a.0, a.1), Point::new(b.0, b.1));
-                crate::autorig::skeleton::distance_to_segment(p, a, b) <= r
+                crate::geom::point_segment_distance(p, a, b) <= r
             });
             image::Rgba([0, 0, 0, if inside { 255 } else { 0 }])
         })

@@ -231,7 +231,7 @@ impl EdgeGrid {
                             continue;
                         }
                         let e = self.edges[k as usize];
-                        if segments_touch(a, b, e[0], e[1])
+                        if crate::geom::segments_touch(a, b, e[0], e[1])
                             || segment_gap(a, b, e[0], e[1]) < clearance
                         {
                             return true;
@@ -251,39 +251,11 @@ impl EdgeGrid {
 /// The distance between segments `a`–`b` and `c`–`d` when they do not cross (the smallest
 /// distance from an endpoint of one to the other).
 fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
-    let to = |p: Point, s: Point, t: Point| {
-        let st = t - s;
-        let len2 = st.norm_squared();
-        let u = if len2 > 0.0 {
-            ((p - s).dot(&st) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p - (s + st * u)).norm()
-    };
+    let to = crate::geom::point_segment_distance;
     to(a, c, d)
         .min(to(b, c, d))
         .min(to(c, a, b))
         .min(to(d, a, b))
-}
-
-/// Whether closed segments `a`–`b` and `c`–`d` share a point.
-pub fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
-    let orient = |p: Point, q: Point, r: Point| (q - p).perp(&(r - p));
-    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
-    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    let on = |p: Point, q: Point, r: Point| {
-        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
-    };
-    (d1 == 0.0 && on(c, d, a))
-        || (d2 == 0.0 && on(c, d, b))
-        || (d3 == 0.0 && on(a, b, c))
-        || (d4 == 0.0 && on(a, b, d))
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
-use crate::geom::Point;
+use crate::geom::{point_segment_distance, Point};
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -267,7 +267,7 @@ fn split_polyline(
     let (a, b) = (points[i], points[j]);
     let chord = (b - a).norm();
     let (k, deviation) = ((i + 1)..j)
-        .map(|k| (k, distance_to_segment(points[k], a, b)))
+        .map(|k| (k, point_segment_distance(points[k], a, b)))
         .fold((i + 1, -1.0), |best, c| if c.1 > best.1 { c } else { best });
     let bent = deviation > options.bend_ratio * chord && chord >= 2.0 * options.min_bone_px;
     if bent || !shape.segment_inside(a, b) {
@@ -275,17 +275,6 @@ fn split_polyline(
         joints.push(k);
         split_polyline(points, k, j, shape, options, joints);
     }
-}
-
-pub fn distance_to_segment(p: Point, a: Point, b: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
 
 pub fn polyline_length(points: &[Point]) -> f64 {
@@ -354,7 +343,7 @@ pub fn limit_bones(bones: &mut Vec<ProtoBone>, max: Option<usize>, shape: &Shape
                 }
                 Some((
                     c,
-                    distance_to_segment(bones[c].head, bones[p].head, bones[c].tail),
+                    point_segment_distance(bones[c].head, bones[p].head, bones[c].tail),
                 ))
             })
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));

@@ -20,8 +20,8 @@
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
-use super::skeleton::{distance_to_segment, BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
-use crate::geom::Point;
+use super::skeleton::{BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
+use crate::geom::{point_segment_distance, Point};
 use serde::{Deserialize, Serialize};
 
 /// A known skeleton topology.
@@ -286,7 +286,7 @@ fn bend_index(points: &[Point], bend_ratio: f64) -> usize {
     }
     let (a, b) = (points[0], points[n - 1]);
     let (k, dev) = (1..n - 1)
-        .map(|k| (k, distance_to_segment(points[k], a, b)))
+        .map(|k| (k, point_segment_distance(points[k], a, b)))
         .fold((1, -1.0), |best, c| if c.1 > best.1 { c } else { best });
     let (lo, hi) = (fraction_index(points, 0.25), fraction_index(points, 0.75));
     if dev > bend_ratio * (b - a).norm() && (lo..=hi).contains(&k) {

@@ -20,8 +20,8 @@
 
 use super::scribbles::{hex, ScribbleError, Stroke, StrokeFile, MAX_COORDINATE_PX};
 use super::{ColorizeError, ColorizeOptions, Colorized, PreparedLineArt, Scribbles};
+use crate::geom::segment_distance;
 use crate::geom::Point;
-use crate::weights::boundary::segment_distance;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

@@ -61,28 +61,6 @@ pub fn fit(canvas_px: [u32; 2], available: Vec2) -> View {
     }
 }
 
-/// A part's texture drawn over its mesh at `positions` (canvas px); uv = rest position / canvas.
-pub fn textured_mesh(
-    placed: &Placed,
-    texture: &TextureHandle,
-    canvas_px: [u32; 2],
-    rest: &[[f64; 2]],
-    positions: &[Point],
-    triangles: &[[u32; 3]],
-) -> Shape {
-    let mut mesh = egui::Mesh::with_texture(texture.id());
-    let size = [canvas_px[0] as f64, canvas_px[1] as f64];
-    for (r, p) in rest.iter().zip(positions) {
-        mesh.vertices.push(egui::epaint::Vertex {
-            pos: placed.screen_from_canvas([p.x, p.y]),
-            uv: Pos2::new((r[0] / size[0]) as f32, (r[1] / size[1]) as f32),
-            color: Color32::WHITE,
-        });
-    }
-    mesh.indices = triangles.iter().flatten().copied().collect();
-    Shape::mesh(mesh)
-}
-
 /// A whole layer image as one quad at rest.
 pub fn image_quad(placed: &Placed, texture: &TextureHandle, canvas_px: [u32; 2]) -> Shape {
     let rect = egui::Rect::from_two_pos(
@@ -212,7 +190,7 @@ pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Ve
 
 /// The handle nearest to `at` (screen points) within [`PICK_RADIUS_PT`], by name.
 pub fn pick(placed: &Placed, handles: &Handles, at: Pos2) -> Option<String> {
-    use crate::weights::boundary::segment_distance;
+    use crate::geom::segment_distance;
     // Measured in canvas px, then compared in screen points: the view only scales.
     let c = placed.canvas_from_screen(at);
     let c = Point::new(c[0], c[1]);

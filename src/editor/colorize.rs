@@ -727,7 +727,7 @@ impl EditorApp {
                     let p = placed.canvas_from_screen(at);
                     if points
                         .last()
-                        .is_none_or(|q| super::distance(*q, p) >= BRUSH_STEP_PX)
+                        .is_none_or(|q| super::rig_mode::distance(*q, p) >= BRUSH_STEP_PX)
                     {
                         points.push(p);
                     }

@@ -1,4 +1,5 @@
-//! Animate mode's panel and canvas overlay.
+//! Animate mode's panel: the transport, the dopesheet and the curve editor (the playhead,
+//! playback and onion skins are [`super::animate_mode`]'s).
 //!
 //! In: the document's animation being edited, the playhead, pointer and keys. Out: document
 //! commands — `SetKey` and `DeleteKeys` at the playhead, `MoveKeys`, `PasteKeys`,
@@ -7,23 +8,14 @@
 //! frame rate, frame steps), the dopesheet (a row per timeline, one per handle and channel:
 //! click, shift-click and box-select keys, drag them in time snapped to frames, copy, paste at
 //! the playhead, delete), the curve editor of the selected key's outgoing segment (linear,
-//! stepped, Bézier with two draggable handles over the channel's value graph), and onion skins
-//! (the posed outlines of neighbouring frames behind the current pose, cached per frame time).
+//! stepped, Bézier with two draggable handles over the channel's value graph).
 
-use super::identity::Identity;
-use super::{canvas, EditorApp, Mode};
+use super::animate_mode::{OnionOptions, MAX_ONION_FRAMES};
+use super::{EditorApp, Mode};
 use crate::anim::edit::{self, CopiedKey, KeyRef, Segment, TimelineId, KEY_TIME_TOLERANCE_S};
 use crate::anim::{Animation, Curve};
 use crate::document::Command;
-use crate::geom::Point;
-use crate::ik::RigIk;
-use crate::pipeline::Scene;
-use crate::rig::pose::Affine;
-use crate::rig::Pose;
-use crate::skin::Blend;
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Rect, Sense, Shape, Stroke};
-use std::collections::BTreeMap;
-use std::sync::Arc;
 
 /// Height of a dopesheet row (the ruler, the summary and each timeline), points.
 pub const ROW_HEIGHT_PT: f32 = 18.0;
@@ -31,37 +23,10 @@ pub const ROW_HEIGHT_PT: f32 = 18.0;
 pub const LABEL_WIDTH_PT: f32 = 150.0;
 /// Horizontal distance within which a click picks a key, points.
 pub const KEY_PICK_PT: f32 = 6.0;
-/// Most neighbouring frames an onion skin shows on each side.
-pub const MAX_ONION_FRAMES: usize = 8;
-/// Posed frames the onion skin keeps; more and the cache starts again.
-const ONION_CACHE_FRAMES: usize = 64;
 /// Size of the curve editor's graph, points.
 const CURVE_GRAPH_PT: [f32; 2] = [300.0, 150.0];
 /// Screen distance within which a press grabs a Bézier handle, points.
 const HANDLE_PICK_PT: f32 = 9.0;
-
-/// Onion skinning: the posed outlines of `frames` frames before (red) and after (green) the
-/// playhead, the nearest at `opacity`, fading with distance.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OnionOptions {
-    /// Default off.
-    pub enabled: bool,
-    /// Default 2, at most [`MAX_ONION_FRAMES`].
-    pub frames: usize,
-    /// Default 0.5.
-    pub opacity: f32,
-}
-
-impl Default for OnionOptions {
-    fn default() -> Self {
-        OnionOptions {
-            enabled: false,
-            frames: 2,
-            opacity: 0.5,
-        }
-    }
-}
 
 /// Where last frame's dopesheet was drawn (tests convert key times to screen with it).
 #[derive(Clone, Debug)]
@@ -164,18 +129,6 @@ enum SheetGesture {
     },
 }
 
-/// Posed outlines of neighbouring frames, for one rig and one version of the animation.
-#[derive(Default)]
-struct OnionCache {
-    scene: Option<Identity<Scene>>,
-    animation: Option<(String, serde_json::Value)>,
-    /// Boundary edges (vertex pairs) of each part's mesh.
-    outlines: Vec<Vec<[u32; 2]>>,
-    /// Posed vertex positions by frame time (µs).
-    frames: BTreeMap<i64, Vec<Vec<Point>>>,
-    ik: Option<(Identity<Scene>, RigIk)>,
-}
-
 /// Animate mode's state beside the document.
 pub struct TimelineState {
     /// Keys selected in the dopesheet.
@@ -190,11 +143,6 @@ pub struct TimelineState {
     pub sheet: Option<SheetLayout>,
     pub curve: Option<CurveLayout>,
     gesture: Option<SheetGesture>,
-    onion_cache: OnionCache,
-    /// Real time played since the last frame step, s.
-    play_clock_s: f64,
-    /// Whether playback ran last frame (starting again from the end rewinds first).
-    was_playing: bool,
     /// The animation the selection belongs to.
     selection_of: String,
 }
@@ -210,56 +158,9 @@ impl Default for TimelineState {
             sheet: None,
             curve: None,
             gesture: None,
-            onion_cache: OnionCache::default(),
-            play_clock_s: 0.0,
-            was_playing: false,
             selection_of: String::new(),
         }
     }
-}
-
-/// Skinning transformations and vertex positions of `pose`: forward kinematics, or the
-/// skinning IK when the pose has drags (`ik` holds the solver, made on first need and kept for
-/// warm starts). The canvas and the onion skins both pose through this.
-pub(super) fn transforms_and_positions(
-    scene: &Arc<Scene>,
-    pose: &Pose,
-    ik: &mut Option<(Identity<Scene>, RigIk)>,
-) -> Result<(Vec<Affine>, Vec<Vec<Point>>), String> {
-    let transforms = if pose.ik.is_empty() {
-        scene.handle_transforms(pose).map_err(|e| e.to_string())?
-    } else {
-        if ik.as_ref().is_none_or(|(k, _)| !k.is(scene)) {
-            let solver = scene.rig_ik().map_err(|e| e.to_string())?;
-            *ik = Some((Identity::of(scene), solver));
-        }
-        let Some((_, solver)) = ik.as_mut() else {
-            return Err("no IK solver".into());
-        };
-        solver
-            .transforms(pose)
-            .map_err(|e| e.to_string())?
-            .transforms
-    };
-    let positions = scene
-        .positions_from_transforms(&transforms, pose, Blend::Linear)
-        .map_err(|e| e.to_string())?;
-    Ok((transforms, positions))
-}
-
-/// Edges used by one triangle only: the outline of a mesh (holes included).
-fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut count: BTreeMap<[u32; 2], u32> = BTreeMap::new();
-    for t in triangles {
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            *count.entry([a.min(b), a.max(b)]).or_default() += 1;
-        }
-    }
-    count
-        .into_iter()
-        .filter(|(_, n)| *n == 1)
-        .map(|(e, _)| e)
-        .collect()
 }
 
 fn diamond(center: Pos2, radius: f32, fill: Color32, stroke: Stroke) -> Shape {
@@ -285,90 +186,6 @@ fn channel_name(channels: usize, c: usize) -> String {
 }
 
 impl EditorApp {
-    /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
-    pub fn set_time(&mut self, time_s: f64) {
-        self.time_s = time_s.max(0.0);
-        self.shown = None;
-    }
-
-    /// The current animation's length: its last key, at least [`super::MIN_TIMELINE_S`].
-    pub fn timeline_length_s(&self) -> f64 {
-        crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0)
-            .max(super::MIN_TIMELINE_S)
-    }
-
-    /// Seconds per frame at the frame rate: File → Render's, so playback shows the frames a
-    /// render writes (the rig document keeps no frame rate of its own).
-    fn frame_s(&self) -> f64 {
-        1.0 / self
-            .render_settings
-            .fps
-            .clamp(1.0, crate::playback::MAX_FPS)
-    }
-
-    /// `time_s` on the nearest frame.
-    pub fn snap_to_frame(&self, time_s: f64) -> f64 {
-        (time_s / self.frame_s()).round() * self.frame_s()
-    }
-
-    /// Where playback ends (and loops): the last key, or the timeline's length when every key
-    /// is at 0.
-    fn play_end_s(&self) -> f64 {
-        let end = crate::document::animation_named(self.doc.state(), &self.animation)
-            .map(|a| a.duration_s())
-            .unwrap_or(0.0);
-        if end > KEY_TIME_TOLERANCE_S {
-            end
-        } else {
-            self.timeline_length_s()
-        }
-    }
-
-    /// Plays frame by frame at the frame rate: the playhead only ever shows frames (as a render
-    /// does), stepping as many as the real time elapsed covers. Looping wraps at the last key,
-    /// which a cycle's first key repeats, so it is not shown twice; otherwise playback stops on
-    /// the last key.
-    pub(super) fn advance_playback(&mut self, ctx: &egui::Context) {
-        if !self.playing || self.mode != Mode::Animate {
-            self.timeline.play_clock_s = 0.0;
-            self.timeline.was_playing = false;
-            return;
-        }
-        ctx.request_repaint();
-        let frame_s = self.frame_s();
-        let end = self.play_end_s();
-        if !self.timeline.was_playing {
-            self.timeline.was_playing = true;
-            // Play pressed on the last frame starts over.
-            if self.time_s >= end - KEY_TIME_TOLERANCE_S {
-                self.set_time(0.0);
-                return;
-            }
-        }
-        self.timeline.play_clock_s += f64::from(ctx.input(|i| i.stable_dt));
-        let steps = (self.timeline.play_clock_s / frame_s + 1e-9).floor();
-        if steps < 1.0 {
-            return;
-        }
-        self.timeline.play_clock_s = (self.timeline.play_clock_s - steps * frame_s).max(0.0);
-        let mut t = ((self.time_s / frame_s).round() + steps) * frame_s;
-        if t >= end - KEY_TIME_TOLERANCE_S {
-            if self.timeline.looping {
-                t = self.snap_to_frame(t.rem_euclid(end));
-                if t >= end - KEY_TIME_TOLERANCE_S {
-                    t = 0.0;
-                }
-            } else {
-                t = end;
-                self.playing = false;
-                self.timeline.was_playing = false;
-            }
-        }
-        self.set_time(t);
-    }
-
     /// Animate mode's keyboard: copy, paste, and delete of the selected keys (run before the
     /// editor's shortcuts, so Delete deletes keys rather than the selected handle).
     pub(super) fn timeline_shortcuts(&mut self, ctx: &egui::Context) {
@@ -414,8 +231,8 @@ impl EditorApp {
 
     /// Copies the selected keys to the editor's clipboard.
     pub fn copy_keys(&mut self) {
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        match edit::copy_keys(&json, &self.timeline.selection) {
+        let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
+        match edit::copy_keys(&animation, &self.timeline.selection) {
             Ok(keys) => self.timeline.clipboard = keys,
             Err(e) => self.message = Some(e.to_string()),
         }
@@ -427,10 +244,10 @@ impl EditorApp {
         if self.timeline.clipboard.is_empty() {
             return;
         }
-        let at_s = self.snap_to_frame(self.time_s).max(0.0);
+        let at_s = self.snap_to_frame(self.animate.time_s).max(0.0);
         let keys = self.timeline.clipboard.clone();
         if self.apply(Command::PasteKeys {
-            animation: self.animation.clone(),
+            animation: self.animate.animation.clone(),
             at_s,
             keys: keys.clone(),
         }) {
@@ -449,7 +266,7 @@ impl EditorApp {
             return;
         }
         if self.apply(Command::DeleteTimelineKeys {
-            animation: self.animation.clone(),
+            animation: self.animate.animation.clone(),
             keys: self.timeline.selection.clone(),
         }) {
             self.timeline.selection.clear();
@@ -461,18 +278,22 @@ impl EditorApp {
         let frame_s = self.frame_s();
         ui.horizontal(|ui| {
             ui.label("Animation");
-            ui.add(egui::TextEdit::singleline(&mut self.animation).desired_width(120.0));
-            let play = if self.playing { "Pause" } else { "Play" };
+            ui.add(egui::TextEdit::singleline(&mut self.animate.animation).desired_width(120.0));
+            let play = if self.animate.playing {
+                "Pause"
+            } else {
+                "Play"
+            };
             if ui.button(play).clicked() {
-                self.playing = !self.playing;
+                self.animate.playing = !self.animate.playing;
             }
             ui.checkbox(&mut self.timeline.looping, "Loop");
             if ui.button("Previous frame").clicked() {
-                let t = ((self.time_s / frame_s).round() - 1.0).max(0.0) * frame_s;
+                let t = ((self.animate.time_s / frame_s).round() - 1.0).max(0.0) * frame_s;
                 self.set_time(t);
             }
             if ui.button("Next frame").clicked() {
-                let t = ((self.time_s / frame_s).round() + 1.0) * frame_s;
+                let t = ((self.animate.time_s / frame_s).round() + 1.0) * frame_s;
                 self.set_time(t);
             }
             ui.add(
@@ -481,7 +302,7 @@ impl EditorApp {
                     .speed(0.1)
                     .suffix(" fps"),
             );
-            let mut t = self.time_s;
+            let mut t = self.animate.time_s;
             let length = self.timeline_length_s();
             if ui
                 .add(egui::Slider::new(&mut t, 0.0..=length).text("s"))
@@ -491,20 +312,20 @@ impl EditorApp {
             }
             if ui.button("Set key").clicked() {
                 let pose = self.edited_pose();
-                let animation = self.animation.clone();
+                let animation = self.animate.animation.clone();
                 if self.apply(Command::SetKey {
                     animation,
-                    time_s: self.time_s,
+                    time_s: self.animate.time_s,
                     pose,
                 }) {
-                    self.shown = None;
+                    self.animate.shown = None;
                 }
             }
             if ui.button("Delete key").clicked() {
-                let animation = self.animation.clone();
+                let animation = self.animate.animation.clone();
                 self.apply(Command::DeleteKeys {
                     animation,
-                    time_s: self.time_s,
+                    time_s: self.animate.time_s,
                 });
             }
         });
@@ -539,11 +360,11 @@ impl EditorApp {
             );
             ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
         });
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        let timelines = edit::timelines(&json);
+        let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
+        let timelines = edit::timelines(&animation);
         // Another animation, undo, redo and other edits can take selected keys away.
-        if self.timeline.selection_of != self.animation {
-            self.timeline.selection_of = self.animation.clone();
+        if self.timeline.selection_of != self.animate.animation {
+            self.timeline.selection_of = self.animate.animation.clone();
             self.timeline.selection.clear();
         }
         self.timeline.selection.retain(|k| {
@@ -562,7 +383,7 @@ impl EditorApp {
                 .max_width(width)
                 .show(ui, |ui| self.dopesheet(ui, width, &timelines));
             ui.separator();
-            ui.vertical(|ui| self.curve_editor(ui, &json));
+            ui.vertical(|ui| self.curve_editor(ui, &animation));
         });
     }
 
@@ -755,7 +576,7 @@ impl EditorApp {
                 egui::StrokeKind::Inside,
             );
         }
-        let x = layout.x_of(self.time_s);
+        let x = layout.x_of(self.animate.time_s);
         painter.line_segment(
             [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
             Stroke::new(2.0, Color32::RED),
@@ -846,7 +667,7 @@ impl EditorApp {
                 {
                     let keys = self.timeline.selection.clone();
                     if self.apply(Command::MoveKeys {
-                        animation: self.animation.clone(),
+                        animation: self.animate.animation.clone(),
                         keys,
                         delta_s,
                     }) {
@@ -925,14 +746,14 @@ impl EditorApp {
 
     /// The curve of the one selected key's outgoing segment: its kind, and for a Bézier the
     /// graph of one channel with its two handles to drag.
-    fn curve_editor(&mut self, ui: &mut egui::Ui, json: &serde_json::Value) {
+    fn curve_editor(&mut self, ui: &mut egui::Ui, animation: &Animation) {
         self.timeline.curve = None;
         let [key] = self.timeline.selection.as_slice() else {
             ui.label("Select one key to edit the curve to the next key.");
             return;
         };
         let key = key.clone();
-        let segment = match edit::segment(json, &key) {
+        let segment = match edit::segment(animation, &key) {
             Ok(s) => s,
             Err(e) => {
                 ui.label(e.to_string());
@@ -965,7 +786,7 @@ impl EditorApp {
             }
             if let Some(curve) = chosen {
                 self.apply(Command::SetCurve {
-                    animation: self.animation.clone(),
+                    animation: self.animate.animation.clone(),
                     key: key.clone(),
                     curve,
                 });
@@ -1133,96 +954,11 @@ impl EditorApp {
                 self.timeline.gesture.take()
             {
                 self.apply(Command::SetCurve {
-                    animation: self.animation.clone(),
+                    animation: self.animate.animation.clone(),
                     key,
                     curve: Curve::Bezier(numbers),
                 });
             }
         }
-    }
-
-    /// Onion skins for the canvas: the posed outlines of the frames around the playhead,
-    /// earlier ones red, later ones green, fading with distance (empty when off).
-    pub(super) fn onion_shapes(
-        &mut self,
-        scene: &Arc<Scene>,
-        placed: &canvas::Placed,
-    ) -> Vec<Shape> {
-        let options = self.timeline.onion;
-        if !options.enabled || self.mode != Mode::Animate {
-            return Vec::new();
-        }
-        let json = crate::document::animation_json(self.doc.state(), &self.animation);
-        let Ok(animation) = Animation::from_json(&self.animation, &json) else {
-            return Vec::new();
-        };
-        let frame_s = self.frame_s();
-        let cache = &mut self.timeline.onion_cache;
-        if cache.scene.as_ref().is_none_or(|k| !k.is(scene)) {
-            cache.scene = Some(Identity::of(scene));
-            cache.outlines = scene
-                .doc
-                .parts
-                .iter()
-                .map(|p| boundary_edges(&p.mesh.triangles))
-                .collect();
-            cache.frames.clear();
-        }
-        let version = (self.animation.clone(), json);
-        if cache.animation.as_ref() != Some(&version) {
-            cache.animation = Some(version);
-            cache.frames.clear();
-        }
-        if cache.frames.len() > ONION_CACHE_FRAMES {
-            cache.frames.clear();
-        }
-        let now = (self.time_s / frame_s).round() * frame_s;
-        let end = animation.duration_s();
-        let frames = options.frames.min(MAX_ONION_FRAMES);
-        if frames == 0 {
-            return Vec::new();
-        }
-        let mut shapes = Vec::new();
-        for k in (1..=frames).rev() {
-            let fade = options.opacity * (frames + 1 - k) as f32 / frames as f32;
-            for (sign, rgb) in [(-1.0, [255, 90, 90]), (1.0, [90, 230, 120])] {
-                let t = now + sign * k as f64 * frame_s;
-                if t < -KEY_TIME_TOLERANCE_S || t > end + KEY_TIME_TOLERANCE_S {
-                    continue;
-                }
-                let micros = (t * 1e6).round() as i64;
-                if !cache.frames.contains_key(&micros) {
-                    let pose = animation.sample(t.max(0.0), false);
-                    // A frame that cannot be posed is left out; the canvas reports the error.
-                    let Ok((_, positions)) = transforms_and_positions(scene, &pose, &mut cache.ik)
-                    else {
-                        continue;
-                    };
-                    cache.frames.insert(micros, positions);
-                }
-                let Some(positions) = cache.frames.get(&micros) else {
-                    continue;
-                };
-                let color =
-                    Color32::from_rgba_unmultiplied(rgb[0], rgb[1], rgb[2], (fade * 255.0) as u8);
-                let stroke = Stroke::new(1.2, color);
-                for (edges, part) in cache.outlines.iter().zip(positions) {
-                    for [a, b] in edges {
-                        let (Some(p), Some(q)) = (part.get(*a as usize), part.get(*b as usize))
-                        else {
-                            continue;
-                        };
-                        shapes.push(Shape::line_segment(
-                            [
-                                placed.screen_from_canvas([p.x, p.y]),
-                                placed.screen_from_canvas([q.x, q.y]),
-                            ],
-                            stroke,
-                        ));
-                    }
-                }
-            }
-        }
-        shapes
     }
 }

@@ -104,6 +104,11 @@ pub struct IkOptions {
     /// Local/global iterations per frame when momentum is in play: the balance of inertia and
     /// elasticity needs a converged frame, or the motion comes out overdamped. Default 32.
     pub momentum_iterations: usize,
+    /// The fixed time step at which momentum is simulated, s: a frame at time t of an
+    /// animation is the simulation from the animation's start to t in steps of this length
+    /// (and one shorter step to reach t), so the motion does not depend on the output frame
+    /// rate. Default 1/60 s.
+    pub momentum_step_s: f64,
     /// How far outside every part an ik drag's `at` may lie and still grip the nearest
     /// triangle, px. Default 2.
     pub grip_tolerance_px: f64,
@@ -145,9 +150,16 @@ impl Default for IkOptions {
             momentum: BTreeMap::new(),
             momentum_damping_per_s: 3.16,
             momentum_iterations: 32,
+            momentum_step_s: 1.0 / 60.0,
         }
     }
 }
+
+/// Shortest momentum step accepted, s: a step of 1e-4 s simulates 10,000 solves per second of
+/// animation.
+pub const MIN_MOMENTUM_STEP_S: f64 = 1e-4;
+/// Longest momentum step accepted, s.
+pub const MAX_MOMENTUM_STEP_S: f64 = 0.1;
 
 /// What is wrong with an IK request.
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
@@ -176,4 +188,6 @@ pub enum IkError {
     UnknownMomentumHandle(String),
     #[error("momentum of '{0}' must be a finite number ≥ 0 s")]
     BadMomentum(String),
+    #[error("momentum_step_s must be a number of seconds in [{min}, {max}], not {0:e}", min = MIN_MOMENTUM_STEP_S, max = MAX_MOMENTUM_STEP_S)]
+    BadMomentumStep(f64),
 }

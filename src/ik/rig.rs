@@ -14,7 +14,7 @@
 
 use super::fast::{ColumnDofs, DragRow, FastIk, IkSolution, Joint, Problem};
 use super::subspace::{add_skinning_row, SkinnedMesh};
-use super::{HandleDofs, IkError, IkOptions};
+use super::{HandleDofs, IkError, IkOptions, MAX_MOMENTUM_STEP_S, MIN_MOMENTUM_STEP_S};
 use crate::geom::Point;
 use crate::rig::handles::Handles;
 use crate::rig::pose::{handle_columns, handle_transforms, Affine, IkDrag, Pose};
@@ -60,6 +60,12 @@ impl RigIk {
                 return Err(IkError::BadMomentum(name.clone()));
             }
             inertia_s[j] = tau;
+        }
+        let step_s = options.momentum_step_s;
+        if !options.momentum.is_empty()
+            && !(MIN_MOMENTUM_STEP_S..=MAX_MOMENTUM_STEP_S).contains(&step_s)
+        {
+            return Err(IkError::BadMomentumStep(step_s));
         }
         let solver = FastIk::precompute(&meshes, names.len(), options)?;
         Ok(RigIk {
@@ -111,8 +117,18 @@ impl RigIk {
         Ok(solution)
     }
 
+    /// The skinning transformations of the static pose `pose`, as a fresh solver finds them:
+    /// solved from the forward-kinematics pose, with no warm start and no guarded triangles
+    /// carried over, so the answer depends on the pose alone. The last factorization is reused
+    /// when the problem's structure is the same, which changes the cost, never the answer.
+    pub fn solve_pose(&mut self, pose: &Pose) -> Result<IkSolution, IkError> {
+        self.solver.reset();
+        self.transforms(pose)
+    }
+
     /// The skinning transformations for `pose`: forward kinematics if it has no drags, the
-    /// skinning IK otherwise (warm-started from the previous call).
+    /// skinning IK otherwise (warm-started from the previous call: a speed device for
+    /// interactive use; [`RigIk::solve_pose`] is the answer of record).
     pub fn transforms(&mut self, pose: &Pose) -> Result<IkSolution, IkError> {
         let drags = self.cached_drag_rows(pose)?;
         let problem = self.problem_with(pose, None, drags)?;

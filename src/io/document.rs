@@ -1,17 +1,19 @@
 //! The native rig document (`sinew-rig`, version 1).
 //!
-//! In: a JSON file as in `docs/formats.md`. Out: a [`RigDocument`] that has been checked: format
-//! name and version known, triangle indices in range, coordinates finite, weight rows matching
-//! vertices and handles, part names unique. Image paths are stored relative to the document's folder.
-//! Saving writes atomically.
+//! In: a JSON file as in `docs/formats.md`. Out: a [`RigDocument`] that has been checked: format name and
+//! version known, triangle indices in range, coordinates finite, weight rows matching vertices
+//! and handles, part names unique, animations well formed (each on its own, see
+//! [`Animation::from_json`]; against the rig: [`RigDocument::check_animations`]). Image paths are
+//! stored relative to the document's folder. Saving writes atomically.
 
 use super::atomic::write_atomic;
+use crate::anim::{AnimError, Animation};
 use crate::geom::Point;
 use crate::mesh::{Mesh, MeshOptions};
 use crate::rig::{HandleError, Handles};
 use crate::trace::TraceOptions;
 use crate::weights::WeightOptions;
-use serde::{Deserialize, Serialize};
+use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -34,11 +36,14 @@ pub struct RigDocument {
     pub parts: Vec<PartDoc>,
     #[serde(default)]
     pub handles: Handles,
-    /// Animations by name. Kept verbatim: the timeline model reads them (the schema describes
-    /// each as the animation it is parsed into, `crate::anim::Animation`).
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    /// Animations by name, parsed and checked each on its own when the document is read.
+    #[serde(
+        default,
+        skip_serializing_if = "BTreeMap::is_empty",
+        deserialize_with = "deserialize_animations"
+    )]
     #[schemars(with = "crate::schema::Animations")]
-    pub animations: BTreeMap<String, serde_json::Value>,
+    pub animations: BTreeMap<String, Animation>,
     /// The options the meshes were built with, so a re-trace reproduces them.
     #[serde(default)]
     pub options: BuildOptions,
@@ -114,6 +119,17 @@ pub enum DocumentError {
     WrongVersion { path: PathBuf, found: String },
     #[error("{path}: {reason}")]
     Invalid { path: PathBuf, reason: String },
+    #[error("{path}: {source}")]
+    Animation { path: PathBuf, source: AnimError },
+}
+
+/// The `animations` map through [`crate::anim::animations_from_json`], whose messages name the
+/// animation, the timeline and the key.
+fn deserialize_animations<'de, D: Deserializer<'de>>(
+    deserializer: D,
+) -> Result<BTreeMap<String, Animation>, D::Error> {
+    let value = serde_json::Value::deserialize(deserializer)?;
+    crate::anim::animations_from_json(&value).map_err(serde::de::Error::custom)
 }
 
 impl From<&Mesh> for MeshDoc {
@@ -169,7 +185,7 @@ impl RigDocument {
             reason: e.to_string(),
         };
         // Format and version first, so a newer document says so instead of failing on a field.
-        let value: serde_json::Value = serde_json::from_str(text).map_err(json_error)?;
+        let mut value: serde_json::Value = serde_json::from_str(text).map_err(json_error)?;
         let field = |name: &str| {
             value
                 .get(name)
@@ -188,12 +204,25 @@ impl RigDocument {
                 found: field("version"),
             });
         }
+        // The animations on their own, for an error that keeps its place in them.
+        let animations = match value.as_object_mut().and_then(|o| o.remove("animations")) {
+            Some(animations) => {
+                crate::anim::animations_from_json(&animations).map_err(|source| {
+                    DocumentError::Animation {
+                        path: path.into(),
+                        source,
+                    }
+                })?
+            }
+            None => BTreeMap::new(),
+        };
         // Valid JSON by now: what is left is a field of the wrong shape.
-        let doc: RigDocument =
+        let mut doc: RigDocument =
             serde_json::from_value(value).map_err(|e| DocumentError::Invalid {
                 path: path.into(),
                 reason: format!("not a valid rig document: {e}"),
             })?;
+        doc.animations = animations;
         doc.validate().map_err(|reason| DocumentError::Invalid {
             path: path.into(),
             reason,
@@ -212,6 +241,15 @@ impl RigDocument {
             path: path.into(),
             source,
         })
+    }
+
+    /// Checks every animation against the handles and the parts: the names its timelines use,
+    /// its cages' vertex counts, its draw orders (see [`Animation::check_rig`]). Not part of
+    /// [`RigDocument::validate`]: an edited rig may drop a handle an animation still names, and
+    /// the document must still open; what poses an animation checks it first.
+    pub fn check_animations(&self) -> Result<(), AnimError> {
+        let parts: Vec<&str> = self.parts.iter().map(|p| p.name.as_str()).collect();
+        crate::anim::check_animations(&self.animations, &self.handles, &parts)
     }
 
     /// The image of `part`, resolved against the folder of the document at `doc_path`.
@@ -357,6 +395,95 @@ mod tests {
         assert_eq!(
             RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
             doc
+        );
+    }
+
+    /// Whether two JSON values say the same: numbers compared as numbers (`0` and `0.0` alike).
+    fn same_json(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+        use serde_json::Value;
+        match (a, b) {
+            (Value::Number(x), Value::Number(y)) => x.as_f64() == y.as_f64(),
+            (Value::Array(x), Value::Array(y)) => {
+                x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same_json(x, y))
+            }
+            (Value::Object(x), Value::Object(y)) => {
+                x.len() == y.len()
+                    && x.iter()
+                        .all(|(k, v)| y.get(k).is_some_and(|w| same_json(v, w)))
+            }
+            _ => a == b,
+        }
+    }
+
+    #[test]
+    fn animations_are_read_once_and_written_back_as_they_were() {
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/assets/character/animations.json"
+        );
+        let text = std::fs::read_to_string(file).unwrap();
+        let bundled: serde_json::Value = serde_json::from_str(&text).unwrap();
+        // The animations file on its own.
+        let parsed = crate::anim::animations_from_json(&bundled).unwrap();
+        assert_eq!(parsed.len(), 3);
+        assert!(same_json(&serde_json::to_value(&parsed).unwrap(), &bundled));
+        // In a rig document: load, save, load.
+        let mut v = serde_json::to_value(sample()).unwrap();
+        v["animations"] = bundled.clone();
+        let p = Path::new("r.json");
+        let doc = RigDocument::from_json(&v.to_string(), p).unwrap();
+        assert_eq!(doc.animations, parsed);
+        let saved: serde_json::Value =
+            serde_json::from_str(&serde_json::to_string_pretty(&doc).unwrap()).unwrap();
+        assert!(same_json(&saved, &v), "{saved}");
+        assert_eq!(RigDocument::from_json(&saved.to_string(), p).unwrap(), doc);
+        // Through serde alone (no `from_json`), the same animations.
+        let direct: RigDocument = serde_json::from_value(v).unwrap();
+        assert_eq!(direct, doc);
+        // The comparison sees a changed number.
+        let mut changed = bundled;
+        changed["walk"]["bones"]["hip"]["translate"][0]["time"] = 0.5.into();
+        assert!(!same_json(
+            &serde_json::to_value(&parsed).unwrap(),
+            &changed
+        ));
+    }
+
+    #[test]
+    fn a_bad_animation_fails_the_document_with_its_place() {
+        let p = Path::new("r.json");
+        let mut v = serde_json::to_value(sample()).unwrap();
+        v["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
+            {"time": 0, "value": 1}, {"time": 0, "value": 2}]}}}});
+        let e = RigDocument::from_json(&v.to_string(), p)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "r.json: animation 'go', bones.a.rotate: key 1 at 0 s does not come after the \
+             previous key at 0 s"
+        );
+        v["animations"] = serde_json::json!([1]);
+        let e = RigDocument::from_json(&v.to_string(), p)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "r.json: animations: expected an object: name → animation"
+        );
+        // Serde alone gives the same reason.
+        let e = serde_json::from_value::<RigDocument>(v)
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "animations: expected an object: name → animation");
+        // Names the rig lacks do not stop it loading; posing checks them.
+        v = serde_json::to_value(sample()).unwrap();
+        v["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
+            {"time": 0, "value": 1}]}}}});
+        let doc = RigDocument::from_json(&v.to_string(), p).unwrap();
+        assert_eq!(
+            doc.check_animations().unwrap_err().to_string(),
+            "animation 'go' names bone 'a', which the rig does not have"
         );
     }
 

@@ -79,11 +79,6 @@ pub fn fan_mesh(center: Point, radius: f64, segments: u32) -> (Vec<Point>, Vec<[
 /// Distance from `p` to the closed polyline `ring`.
 pub fn distance_to_ring(p: Point, ring: &[Point]) -> f64 {
     (0..ring.len())
-        .map(|i| {
-            let (a, b) = (ring[i], ring[(i + 1) % ring.len()]);
-            let ab = b - a;
-            let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
-            (p - (a + t * ab)).norm()
-        })
+        .map(|i| crate::geom::point_segment_distance(p, ring[i], ring[(i + 1) % ring.len()]))
         .fold(f64::INFINITY, f64::min)
 }

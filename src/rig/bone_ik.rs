@@ -31,47 +31,12 @@
 //! The Spine port works in Spine's axes: world and bone frames with y flipped (sinew's y points
 //! down), so that spine-core's formulas, signs and special cases carry over unchanged.
 
+use super::frames::{
+    bone_rest_frame, bone_world_frames, screen_angle_deg, Affine, Pose, PoseError,
+};
+pub use super::handles::BoneIk;
 use super::handles::Handles;
-use super::pose::{bone_rest_frame, bone_world_frames, screen_angle_deg, Affine, Pose, PoseError};
 use crate::geom::{Point, Vec2};
-use serde::{Deserialize, Serialize};
-
-/// An IK constraint of the handles file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct BoneIk {
-    pub name: String,
-    /// The chain, root first; each bone the parent of the next.
-    pub bones: Vec<String>,
-    /// The bone whose head the chain's end reaches for.
-    pub target: String,
-    /// Two bones: the child's local rotation comes out positive (counter-clockwise on screen),
-    /// Spine's `bendPositive`. Default true.
-    #[serde(default = "default_true")]
-    pub bend_positive: bool,
-    /// 0: forward kinematics only; 1: fully solved. Values outside [0, 1] are clamped. Default 1.
-    #[serde(default = "default_one")]
-    pub mix: f64,
-    /// Distance before full extension over which a two-bone chain eases, px (in the frame of the
-    /// chain root's parent, see the module doc). Default 0.
-    #[serde(default)]
-    pub softness_px: f64,
-}
-
-impl BoneIk {
-    /// The mix as applied: clamped to [0, 1] (what an exporter must write).
-    pub fn applied_mix(&self) -> f64 {
-        self.mix.clamp(0.0, 1.0)
-    }
-}
-
-fn default_true() -> bool {
-    true
-}
-
-fn default_one() -> f64 {
-    1.0
-}
 
 /// FABRIK iterations for chains longer than two bones.
 pub const FABRIK_ITERATIONS: usize = 32;
@@ -149,7 +114,7 @@ fn bone_pose<'a>(
     pose: &'a mut Pose,
     handles: &Handles,
     bone: usize,
-) -> &'a mut super::pose::BonePose {
+) -> &'a mut super::frames::BonePose {
     pose.bones
         .entry(handles.bones[bone].name.clone())
         .or_default()

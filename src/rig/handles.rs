@@ -65,7 +65,44 @@ pub struct Handles {
     /// Classic bone IK constraints (see [`super::bone_ik`]), applied in order during forward
     /// kinematics.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub ik: Vec<super::bone_ik::BoneIk>,
+    pub ik: Vec<BoneIk>,
+}
+
+/// An IK constraint of the handles file (solved by [`super::bone_ik`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BoneIk {
+    pub name: String,
+    /// The chain, root first; each bone the parent of the next.
+    pub bones: Vec<String>,
+    /// The bone whose head the chain's end reaches for.
+    pub target: String,
+    /// Two bones: the child's local rotation comes out positive (counter-clockwise on screen),
+    /// Spine's `bendPositive`. Default true.
+    #[serde(default = "default_true")]
+    pub bend_positive: bool,
+    /// 0: forward kinematics only; 1: fully solved. Values outside [0, 1] are clamped. Default 1.
+    #[serde(default = "default_one")]
+    pub mix: f64,
+    /// Distance before full extension over which a two-bone chain eases, px (in the frame of the
+    /// chain root's parent, see the module doc). Default 0.
+    #[serde(default)]
+    pub softness_px: f64,
+}
+
+impl BoneIk {
+    /// The mix as applied: clamped to [0, 1] (what an exporter must write).
+    pub fn applied_mix(&self) -> f64 {
+        self.mix.clamp(0.0, 1.0)
+    }
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_one() -> f64 {
+    1.0
 }
 
 /// What is wrong with a set of handles.
@@ -269,7 +306,7 @@ impl Handles {
     /// Every IK chain is a parent-linked run of known bones whose target is a known bone that the
     /// chain does not move.
     fn check_ik(&self) -> Result<(), HandleError> {
-        let bad = |c: &super::bone_ik::BoneIk, problem: String| HandleError::BadIkConstraint {
+        let bad = |c: &BoneIk, problem: String| HandleError::BadIkConstraint {
             name: c.name.clone(),
             problem,
         };
@@ -535,7 +572,7 @@ mod tests {
             head: [x, 0.0],
             tail: [x, 10.0],
         };
-        let ik = |name: &str, chain: &str, target: &str| super::super::bone_ik::BoneIk {
+        let ik = |name: &str, chain: &str, target: &str| BoneIk {
             name: name.into(),
             bones: vec![chain.into()],
             target: target.into(),

@@ -1,8 +1,12 @@
 //! Handles and posing: bones (a forest of skeletons), loose points, cages and regions; the pose
 //! file and forward kinematics, with classic bone IK constraints ([`bone_ik`]).
+//!
+//! Imports go one way: [`handles`] ← [`frames`] (the pose model, bone frames) ← [`bone_ik`] ←
+//! [`pose`] (skinning transformations, constraints applied) ← [`fk_edit`].
 
 pub mod bone_ik;
 pub mod fk_edit;
+pub mod frames;
 pub mod handles;
 pub mod pose;
 

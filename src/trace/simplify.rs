@@ -12,7 +12,7 @@
 //! Douglas–Peucker rerun on both halves). Conflicts are found with a spatial hash of the chords,
 //! so each round costs about linear time.
 
-use crate::geom::{ring_signed_area2, Point};
+use crate::geom::{point_segment_distance, ring_signed_area2, triangle_area2 as orient, Point};
 
 /// Chords closer than this are treated as touching. Traced rings are far further apart than
 /// this (interpolated crossings are at least 1/510 px from any sample), so only conflicts the
@@ -458,21 +458,6 @@ fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
         || point_segment_distance(b, c, d) < m
         || point_segment_distance(c, a, b) < m
         || point_segment_distance(d, a, b) < m
-}
-
-fn orient(a: Point, b: Point, c: Point) -> f64 {
-    (b - a).perp(&(c - a))
-}
-
-fn point_segment_distance(p: Point, a: Point, b: Point) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
 
 /// Even-odd test of `p` against the loop formed by `steps` steps of the ring from `start` and

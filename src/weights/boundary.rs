@@ -10,24 +10,12 @@
 //! [`handle_columns`]: crate::rig::handle_columns
 
 use super::solve::BoundaryConditions;
-use crate::geom::{point_in_ring, Point, Vec2};
+use crate::geom::{point_in_ring, segment_distance, Point, Vec2};
 use crate::rig::Handles;
 
 /// How far (px) a vertex may be from handle geometry and still lie on it: the mesher puts
 /// handle vertices on the geometry up to floating-point rounding of edge splits.
 pub const ON_HANDLE_TOLERANCE_PX: f64 = 1e-6;
-
-/// Distance from `p` to segment a–b, and the parameter of the closest point (0 at a, 1 at b).
-pub fn segment_distance(p: Point, a: Point, b: Point) -> (f64, f64) {
-    let d = b - a;
-    let len2 = d.norm_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(&d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    ((p - (a + d * t)).norm(), t)
-}
 
 fn pt(a: [f64; 2]) -> Point {
     Point::new(a[0], a[1])

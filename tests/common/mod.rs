@@ -194,7 +194,14 @@ pub fn painted(w: u32, h: u32) -> RgbaImage {
 /// The bundled character (`assets/character`), rigged from its layers and handles with default
 /// options.
 pub fn character_scene() -> sinew::pipeline::Scene {
-    use sinew::pipeline::{self, Layer, Scene};
+    let (doc, images) = character_rig();
+    sinew::pipeline::Scene::new(doc, &images).expect("a scene")
+}
+
+/// The bundled character's rig document (no animations) and its part images, as
+/// [`character_scene`] builds them.
+pub fn character_rig() -> (sinew::io::RigDocument, Vec<RgbaImage>) {
+    use sinew::pipeline::{self, Layer};
     let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
     let list: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
@@ -219,5 +226,5 @@ pub fn character_scene() -> sinew::pipeline::Scene {
     )
     .expect("the character rigs");
     let images: Vec<RgbaImage> = layers.into_iter().map(|l| l.image).collect();
-    Scene::new(doc, &images).expect("a scene")
+    (doc, images)
 }

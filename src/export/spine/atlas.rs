@@ -14,6 +14,7 @@
 
 use super::mesh::RegionRect;
 use super::SpineError;
+use crate::geom::pack::{pack_shelves, ShelfLayout};
 use image::{Rgba, RgbaImage};
 use serde::{Deserialize, Serialize};
 
@@ -109,32 +110,33 @@ pub fn pack_atlas(
             .cmp(&regions[a].2.height)
             .then(regions[a].0.cmp(&regions[b].0))
     });
-    let mut placed = vec![None; regions.len()];
-    let (mut page, mut x, mut y, mut shelf) = (0usize, pad, pad, 0u32);
-    let mut page_heights = vec![0u32];
-    for i in order {
-        let r = regions[i].2;
-        if x + r.width + pad > page_width {
-            x = pad;
-            y += shelf + pad;
-            shelf = 0;
-        }
-        if y + r.height + pad > max {
-            page += 1;
-            page_heights.push(0);
-            x = pad;
-            y = pad;
-            shelf = 0;
-        }
-        placed[i] = Some((page, x, y));
-        x += r.width + pad;
-        shelf = shelf.max(r.height);
-        page_heights[page] = page_heights[page].max(y + r.height + pad);
-    }
-    let mut pages: Vec<AtlasPage> = page_heights
+    let sizes: Vec<(u64, u64)> = order
         .iter()
+        .map(|&i| {
+            (
+                u64::from(regions[i].2.width),
+                u64::from(regions[i].2.height),
+            )
+        })
+        .collect();
+    let layout = ShelfLayout {
+        width: u64::from(page_width),
+        padding: u64::from(pad),
+        margin: u64::from(pad),
+        page_height: Some(u64::from(max)),
+    };
+    let packing = pack_shelves(&sizes, &layout);
+    let mut placed = vec![None; regions.len()];
+    for (&i, p) in order.iter().zip(&packing.placements) {
+        // Within a page, whose sides are at most `max` (a u32).
+        placed[i] = Some((p.page, p.x as u32, p.y as u32));
+    }
+    let mut pages: Vec<AtlasPage> = packing
+        .pages
+        .iter()
+        .map(|&[_, h]| h as u32)
         .enumerate()
-        .map(|(k, &h)| AtlasPage {
+        .map(|(k, h)| AtlasPage {
             file_name: if k == 0 {
                 format!("{base}.png")
             } else {

@@ -24,8 +24,9 @@ use super::timelines::num;
 use super::SpineError;
 use crate::anim::Animation;
 use crate::geom::Point;
-use crate::pipeline::PipelineError;
+use crate::pipeline::{PipelineError, Scene};
 use crate::rig::{handle_transforms, Affine, Handles, Pose};
+use crate::scene::PlayOptions;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
@@ -58,20 +59,18 @@ pub fn bake_times(duration_s: f64, fps: f64) -> Vec<f64> {
     times
 }
 
-/// The path's transformations at each bake time (the pose sampled exactly, not looping).
+/// The animation's frames at each bake time, through the one pose path
+/// ([`crate::scene::frames`]: exact curves, not looping, skinning IK and momentum included).
 pub fn sample_path(
+    scene: &Scene,
     animation: &Animation,
     times: &[f64],
-    path: &dyn Fn(&Pose) -> Result<Vec<Affine>, PipelineError>,
 ) -> Result<Vec<(Pose, Vec<Affine>)>, PipelineError> {
-    times
-        .iter()
-        .map(|&t| {
-            let pose = animation.sample(t, false);
-            let transforms = path(&pose)?;
-            Ok((pose, transforms))
-        })
-        .collect()
+    let frames = crate::scene::frames(scene, animation, times, PlayOptions::default())?;
+    Ok(frames
+        .into_iter()
+        .map(|frame| (frame.pose, frame.transforms))
+        .collect())
 }
 
 /// The skeleton bones to bake, by index.

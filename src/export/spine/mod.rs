@@ -26,6 +26,7 @@ pub mod constraints;
 pub mod decimate;
 pub mod frame;
 pub mod mesh;
+pub mod played;
 pub mod skeleton;
 pub mod timelines;
 
@@ -239,6 +240,57 @@ fn check_name(kind: &'static str, name: &str, in_atlas: bool) -> Result<(), Spin
     Ok(())
 }
 
+/// What the export bakes of one animation: the bake times, the animation's frames there (pose
+/// and transformations, through the one pose path), the skeleton bones whose keys are baked, and
+/// the exported IK constraints switched off because a bone of their chain is baked.
+pub struct BakePlan {
+    pub times: Vec<f64>,
+    pub samples: Vec<(Pose, Vec<crate::rig::Affine>)>,
+    pub baked: std::collections::BTreeSet<usize>,
+    pub switched_off: Vec<usize>,
+}
+
+/// The [`BakePlan`] of `animation` (named `name`) on `scene` exported as `skeleton`.
+pub fn plan_bake(
+    scene: &Scene,
+    name: &str,
+    animation: &anim::Animation,
+    skeleton: &Skeleton,
+    options: &SpineOptions,
+) -> Result<BakePlan, SpineError> {
+    let doc = &scene.doc;
+    let samples = animation.duration_s() * options.bake_fps;
+    if samples.is_nan() || samples > MAX_BAKE_SAMPLES {
+        return Err(SpineError::TooLong {
+            animation: name.to_string(),
+            samples,
+        });
+    }
+    // Spine solves one- and two-bone constraints itself; longer chains are baked.
+    let exported_ik = constraints::exported(&doc.handles);
+    let spine_handles = constraints::with_constraints(&doc.handles, &exported_ik);
+    // Where a handle's transformation is compared when deciding what to bake.
+    let corners = crate::playback::rest_corners(doc);
+    let times = bake::bake_times(animation.duration_s(), options.bake_fps);
+    let samples = bake::sample_path(scene, animation, &times).map_err(SpineError::Pose)?;
+    let mut baked = bake::bones_to_bake(
+        options.bake,
+        &spine_handles,
+        skeleton,
+        &samples,
+        &corners,
+        options.bake_tolerance_px,
+    )?;
+    let switched_off =
+        constraints::switch_off_baked(&doc.handles, skeleton, &exported_ik, &mut baked);
+    Ok(BakePlan {
+        times,
+        samples,
+        baked,
+        switched_off,
+    })
+}
+
 /// Exports `scene` as `name`. `images` are the parts' images in part order.
 pub fn export_spine(
     scene: &Scene,
@@ -287,9 +339,7 @@ pub fn export_spine(
             return Err(SpineError::DuplicateConstraint(constraint.name.clone()));
         }
     }
-    // Spine solves one- and two-bone constraints itself; longer chains are baked.
     let exported_ik = constraints::exported(&doc.handles);
-    let spine_handles = constraints::with_constraints(&doc.handles, &exported_ik);
     let frame = SpineFrame::for_canvas(doc.canvas);
     let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
     let columns = handle_columns(&doc.handles);
@@ -362,33 +412,18 @@ pub fn export_spine(
     let atlas = atlas::pack_atlas(name, &regions, &options.atlas)?;
 
     // Animations: native timelines, and baked keys for what they cannot express.
-    let animations = anim::load_animations(doc)?;
+    doc.check_animations()?;
+    let animations = &doc.animations;
     let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
-    // Where a handle's transformation is compared when deciding what to bake.
-    let corners = crate::playback::rest_corners(doc);
-    let path = |pose: &Pose| scene.handle_transforms(pose);
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
-    for (anim_name, animation) in &animations {
-        let samples = animation.duration_s() * options.bake_fps;
-        if samples.is_nan() || samples > MAX_BAKE_SAMPLES {
-            return Err(SpineError::TooLong {
-                animation: anim_name.clone(),
-                samples,
-            });
-        }
-        let times = bake::bake_times(animation.duration_s(), options.bake_fps);
-        let samples = bake::sample_path(animation, &times, &path).map_err(SpineError::Pose)?;
-        let mut baked = bake::bones_to_bake(
-            options.bake,
-            &spine_handles,
-            &skeleton,
-            &samples,
-            &corners,
-            options.bake_tolerance_px,
-        )?;
-        let switched_off =
-            constraints::switch_off_baked(&doc.handles, &skeleton, &exported_ik, &mut baked);
+    for (anim_name, animation) in animations {
+        let BakePlan {
+            times,
+            samples,
+            baked,
+            switched_off,
+        } = plan_bake(scene, anim_name, animation, &skeleton, options)?;
         let timelines::NativeTimelines {
             mut bones,
             slots,

@@ -26,6 +26,7 @@
 use super::folder::digits_for;
 use super::timing::{frame_durations, MS_PER_S};
 use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
+use crate::geom::pack::{pack_shelves, ShelfLayout};
 use crate::io::atomic::write_atomic;
 use crate::io::image::encode_png;
 use image::RgbaImage;
@@ -355,25 +356,24 @@ struct Packing {
     height: u32,
 }
 
-/// Shelf packing in the given order: rectangles go left to right, a new shelf starts below the
-/// tallest of the current one when the next would pass `shelf_width`. Returns positions and the
-/// used (width, height); u64 so absurd inputs cannot overflow.
+/// Shelf packing in the given order from the sheet's corner, shelves at most `shelf_width` wide
+/// (see [`pack_shelves`]). Returns positions and the used (width, height); u64 so absurd inputs
+/// cannot overflow.
 fn shelves(sizes: &[(u32, u32)], padding: u64, shelf_width: u64) -> (Vec<(u64, u64)>, u64, u64) {
-    let (mut x, mut y, mut shelf_h, mut used_w) = (0u64, 0u64, 0u64, 0u64);
-    let mut positions = Vec::with_capacity(sizes.len());
-    for &(w, h) in sizes {
-        let (w, h) = (u64::from(w), u64::from(h));
-        if x > 0 && x + w > shelf_width {
-            y += shelf_h + padding;
-            x = 0;
-            shelf_h = 0;
-        }
-        positions.push((x, y));
-        used_w = used_w.max(x + w);
-        shelf_h = shelf_h.max(h);
-        x += w + padding;
-    }
-    (positions, used_w, y + shelf_h)
+    let sizes: Vec<(u64, u64)> = sizes
+        .iter()
+        .map(|&(w, h)| (u64::from(w), u64::from(h)))
+        .collect();
+    let layout = ShelfLayout {
+        width: shelf_width,
+        padding,
+        margin: 0,
+        page_height: None,
+    };
+    let packed = pack_shelves(&sizes, &layout);
+    let [width, height] = packed.pages[0];
+    let positions = packed.placements.iter().map(|p| (p.x, p.y)).collect();
+    (positions, width, height)
 }
 
 /// Packs the rectangles into a sheet about as wide as tall, or `max_side` wide if that is too

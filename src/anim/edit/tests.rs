@@ -1,0 +1,373 @@
+//! [`super`]'s edits on typed animations: what they do, what they refuse.
+
+use super::*;
+use serde_json::json;
+
+fn parsed(name: &str, v: Value) -> Animation {
+    Animation::from_json(name, &v).unwrap()
+}
+
+fn rotate(bone: &str) -> TimelineId {
+    TimelineId::Bone {
+        bone: bone.into(),
+        channel: TransformChannel::Rotate,
+    }
+}
+
+fn key(timeline: &TimelineId, time_s: f64) -> KeyRef {
+    KeyRef {
+        timeline: timeline.clone(),
+        time_s,
+    }
+}
+
+/// `arm` rotates 0 → 90 → 0 over keys at 0, 1, 2; its translate has one key; one IK drag.
+fn walk() -> Animation {
+    parsed(
+        "walk",
+        json!({
+            "bones": {"arm": {
+                "rotate": [{"time": 0, "value": 0}, {"time": 1, "value": 90},
+                           {"time": 2, "value": 0}],
+                "translate": [{"time": 1, "value": [3, 4]}]}},
+            "ik": [{"at": [1, 2], "to": [{"time": 0, "value": [5, 6]}]}],
+            "parts": {"head": {"visible": [{"time": 0, "value": true}]}}
+        }),
+    )
+}
+
+fn times(animation: &Animation, timeline: &TimelineId) -> Vec<f64> {
+    timelines(animation)
+        .into_iter()
+        .find(|(t, _)| t == timeline)
+        .map(|(_, times)| times)
+        .unwrap_or_default()
+}
+
+fn arm_rotate(animation: &Animation) -> &[crate::anim::Key<f64>] {
+    animation.bones["arm"].rotate.as_deref().unwrap_or_default()
+}
+
+fn rotate_values(animation: &Animation) -> Vec<f64> {
+    arm_rotate(animation).iter().map(|k| k.value).collect()
+}
+
+fn bezier(numbers: &[f64]) -> Curve {
+    Curve::Bezier(numbers.to_vec())
+}
+
+#[test]
+fn lists_every_timeline_with_its_times() {
+    let listed = timelines(&walk());
+    let ids: Vec<String> = listed.iter().map(|(t, _)| t.label()).collect();
+    assert_eq!(
+        ids,
+        ["arm rotate", "arm translate", "ik[0]", "head visible"]
+    );
+    assert_eq!(listed[0].1, vec![0.0, 1.0, 2.0]);
+    assert!(!TimelineId::PartVisible {
+        part: "head".into()
+    }
+    .has_curves());
+}
+
+#[test]
+fn moving_keys_keeps_values_and_reorders() {
+    let arm = rotate("arm");
+    let moved = move_keys("walk", &walk(), &[key(&arm, 0.0)], 1.5).unwrap();
+    assert_eq!(times(&moved, &arm), vec![1.0, 1.5, 2.0]);
+    assert_eq!(rotate_values(&moved), vec![90.0, 0.0, 0.0]);
+    // A block moves past the places its own keys leave.
+    let block = [key(&arm, 1.0), key(&arm, 2.0)];
+    let moved = move_keys("walk", &walk(), &block, 1.0).unwrap();
+    assert_eq!(times(&moved, &arm), vec![0.0, 2.0, 3.0]);
+    assert_eq!(rotate_values(&moved), vec![0.0, 90.0, 0.0]);
+    // Other timelines of the same handle stay.
+    let translate = TimelineId::Bone {
+        bone: "arm".into(),
+        channel: TransformChannel::Translate,
+    };
+    assert_eq!(times(&moved, &translate), vec![1.0]);
+}
+
+#[test]
+fn moves_that_collide_or_leave_time_are_refused() {
+    let arm = rotate("arm");
+    let walk = walk();
+    assert_eq!(
+        move_keys("walk", &walk, &[key(&arm, 0.0)], 1.0),
+        Err(EditError::Collision {
+            timeline: "arm rotate".into(),
+            time_s: 1.0
+        })
+    );
+    assert_eq!(
+        move_keys("walk", &walk, &[key(&arm, 1.0)], -1.5),
+        Err(EditError::BadTime(-0.5))
+    );
+    assert!(matches!(
+        move_keys("walk", &walk, &[key(&arm, 1.0)], f64::NAN),
+        Err(EditError::BadShift(_))
+    ));
+    assert!(matches!(
+        move_keys("walk", &walk, &[key(&arm, 0.5)], 0.1),
+        Err(EditError::UnknownKey { .. })
+    ));
+    assert!(matches!(
+        move_keys("walk", &walk, &[key(&rotate("leg"), 0.0)], 0.1),
+        Err(EditError::UnknownTimeline(_))
+    ));
+    // A collision on one timeline refuses the whole move.
+    let both = [key(&TimelineId::Ik { index: 0 }, 0.0), key(&arm, 0.0)];
+    assert!(move_keys("walk", &walk, &both, 1.0).is_err());
+}
+
+/// `walk` with a Bézier segment from the arm's key at 0 to its key at 1.
+fn curved_walk() -> Animation {
+    set_curve(
+        "walk",
+        &walk(),
+        &key(&rotate("arm"), 0.0),
+        &Curve::Bezier(vec![0.25, 10.0, 0.75, 80.0]),
+    )
+    .unwrap()
+}
+
+#[test]
+fn bezier_handles_keep_their_fraction_of_the_segment() {
+    let arm = rotate("arm");
+    let curved = curved_walk();
+    // Stretching the segment to 0 → 2 doubles the handle times; values stay.
+    let stretched = move_keys("walk", &curved, &[key(&arm, 1.0), key(&arm, 2.0)], 1.0).unwrap();
+    assert_eq!(
+        arm_rotate(&stretched)[0].curve,
+        bezier(&[0.5, 10.0, 1.5, 80.0])
+    );
+    // Deleting the key that ended the segment stretches it to the next one.
+    let deleted = delete_keys("walk", &curved, &[key(&arm, 1.0)]).unwrap();
+    assert_eq!(
+        arm_rotate(&deleted)[0].curve,
+        bezier(&[0.5, 10.0, 1.5, 80.0])
+    );
+    // Moving the curved key itself shifts and squeezes its handles with it.
+    let shifted = move_keys("walk", &curved, &[key(&arm, 0.0)], 0.5).unwrap();
+    assert_eq!(
+        arm_rotate(&shifted)[0].curve,
+        bezier(&[0.625, 10.0, 0.875, 80.0])
+    );
+}
+
+#[test]
+fn deleting_the_last_keys_removes_the_timeline_and_its_owner() {
+    let arm = rotate("arm");
+    let translate = TimelineId::Bone {
+        bone: "arm".into(),
+        channel: TransformChannel::Translate,
+    };
+    let all: Vec<KeyRef> = [0.0, 1.0, 2.0].iter().map(|&t| key(&arm, t)).collect();
+    let gone = delete_keys("walk", &walk(), &all).unwrap();
+    assert!(gone.bones["arm"].rotate.is_none());
+    assert_eq!(times(&gone, &translate), vec![1.0]);
+    let mut rest = all.clone();
+    rest.push(key(&translate, 1.0));
+    rest.push(key(&TimelineId::Ik { index: 0 }, 0.0));
+    let gone = delete_keys("walk", &walk(), &rest).unwrap();
+    assert!(gone.bones.is_empty(), "{gone:?}");
+    assert!(gone.ik.is_empty(), "{gone:?}");
+    assert!(matches!(
+        delete_keys("walk", &walk(), &[key(&arm, 3.0)]),
+        Err(EditError::UnknownKey { .. })
+    ));
+}
+
+#[test]
+fn emptying_several_ik_drags_in_one_edit_removes_each() {
+    let drag =
+        |at: f64, time: f64| json!({"at": [at, at], "to": [{"time": time, "value": [at, 0]}]});
+    let three = parsed(
+        "walk",
+        json!({"ik": [drag(0.0, 0.0), drag(5.0, 0.0), drag(9.0, 1.0)]}),
+    );
+    let keys = [
+        key(&TimelineId::Ik { index: 0 }, 0.0),
+        key(&TimelineId::Ik { index: 1 }, 0.0),
+    ];
+    // Drag 1 is still drag 1 after drag 0 lost its last key.
+    let left = delete_keys("walk", &three, &keys).unwrap();
+    assert_eq!(left.ik.len(), 1);
+    assert_eq!(left.ik[0].at, [9.0, 9.0]);
+}
+
+#[test]
+fn a_copied_key_of_another_kind_is_refused() {
+    let copied = CopiedKey {
+        timeline: rotate("arm"),
+        offset_s: 0.0,
+        key: json!({"time": 0, "value": [1, 2]}),
+        next_time_s: None,
+    };
+    let refused = paste_keys("walk", &walk(), 0.5, &[copied]).unwrap_err();
+    assert!(
+        matches!(&refused, EditError::MalformedKey { key: 0, .. }),
+        "{refused}"
+    );
+    assert!(refused
+        .to_string()
+        .starts_with("arm rotate: copied key 0 is malformed"));
+}
+
+#[test]
+fn copy_and_paste_at_a_time() {
+    let arm = rotate("arm");
+    let ik = TimelineId::Ik { index: 0 };
+    let walk = walk();
+    let copied = copy_keys(&walk, &[key(&arm, 1.0), key(&arm, 2.0), key(&ik, 0.0)]).unwrap();
+    assert_eq!(copied.len(), 3);
+    assert_eq!(copied[0].offset_s, 1.0);
+    assert_eq!(copied[2].offset_s, 0.0);
+    let pasted = paste_keys("walk", &walk, 2.0, &copied).unwrap();
+    // Offsets count from the earliest copied key (the IK drag's at 0): 90 at 3, 0 at 4.
+    assert_eq!(times(&pasted, &arm), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
+    assert_eq!(rotate_values(&pasted), vec![0.0, 90.0, 0.0, 90.0, 0.0]);
+    assert_eq!(times(&pasted, &ik), vec![0.0, 2.0]);
+    // Pasting over existing keys replaces them.
+    let over = paste_keys("walk", &walk, 1.0, &copied[..1]).unwrap();
+    assert_eq!(times(&over, &arm), vec![0.0, 1.0, 2.0]);
+    assert_eq!(rotate_values(&over), vec![0.0, 90.0, 90.0]);
+    // Into an animation without that timeline: created; an IK drag must exist.
+    let empty = Animation::default();
+    let created = paste_keys("other", &empty, 0.5, &copied[..2]).unwrap();
+    assert_eq!(times(&created, &arm), vec![1.5, 2.5]);
+    assert_eq!(
+        paste_keys("other", &empty, 0.0, &copied[2..]),
+        Err(EditError::UnknownTimeline("ik[0]".into()))
+    );
+    assert!(matches!(
+        paste_keys("walk", &walk, -1.0, &copied),
+        Err(EditError::BadTime(_))
+    ));
+}
+
+#[test]
+fn pasted_bezier_handles_fit_their_new_segment() {
+    let arm = rotate("arm");
+    let curved = curved_walk();
+    let copied = copy_keys(&curved, &[key(&arm, 0.0)]).unwrap();
+    let pasted = paste_keys("walk", &curved, 1.5, &copied).unwrap();
+    // The segment 1.5 → 2 is half as long as the copied 0 → 1.
+    assert_eq!(
+        arm_rotate(&pasted)[2].curve,
+        bezier(&[1.625, 10.0, 1.875, 80.0])
+    );
+    pasted.validate("walk").unwrap();
+}
+
+#[test]
+fn curves_are_set_and_checked() {
+    let arm = rotate("arm");
+    let walk = walk();
+    let stepped = set_curve("walk", &walk, &key(&arm, 1.0), &Curve::Stepped).unwrap();
+    assert_eq!(arm_rotate(&stepped)[1].curve, Curve::Stepped);
+    let back = set_curve("walk", &stepped, &key(&arm, 1.0), &Curve::Linear).unwrap();
+    assert_eq!(back, walk);
+    assert!(matches!(
+        set_curve(
+            "walk",
+            &walk,
+            &key(&arm, 2.0),
+            &Curve::Bezier(vec![2.0, 0.0, 2.0, 0.0])
+        ),
+        Err(EditError::LastKey { .. })
+    ));
+    assert!(matches!(
+        set_curve(
+            "walk",
+            &walk,
+            &key(
+                &TimelineId::PartVisible {
+                    part: "head".into()
+                },
+                0.0
+            ),
+            &Curve::Stepped
+        ),
+        Err(EditError::NoCurves(_))
+    ));
+    // The timeline check refuses a wrong length and a handle outside the segment.
+    let ik = TimelineId::Ik { index: 0 };
+    let longer = paste_keys(
+        "walk",
+        &walk,
+        1.0,
+        &copy_keys(&walk, &[key(&ik, 0.0)]).unwrap(),
+    )
+    .unwrap();
+    assert!(matches!(
+        set_curve(
+            "walk",
+            &longer,
+            &key(&ik, 0.0),
+            &Curve::Bezier(vec![0.3, 1.0, 0.6, 2.0])
+        ),
+        Err(EditError::Animation(AnimError::Timeline {
+            problem: crate::anim::TimelineError::CurveLength { .. },
+            ..
+        }))
+    ));
+    assert!(matches!(
+        set_curve(
+            "walk",
+            &walk,
+            &key(&arm, 0.0),
+            &Curve::Bezier(vec![1.5, 1.0, 0.6, 2.0])
+        ),
+        Err(EditError::Animation(AnimError::Timeline {
+            problem: crate::anim::TimelineError::CurveTime { .. },
+            ..
+        }))
+    ));
+}
+
+#[test]
+fn a_segment_and_its_linear_bezier_play_alike() {
+    let ik = TimelineId::Ik { index: 0 };
+    let walk = walk();
+    let two = paste_keys(
+        "walk",
+        &walk,
+        0.8,
+        &[CopiedKey {
+            timeline: ik.clone(),
+            offset_s: 0.0,
+            key: json!({"time": 0, "value": [9, -2]}),
+            next_time_s: None,
+        }],
+    )
+    .unwrap();
+    let segment = segment(&two, &key(&ik, 0.0)).unwrap();
+    assert_eq!((segment.start_s, segment.end_s), (0.0, 0.8));
+    assert_eq!(segment.start, vec![5.0, 6.0]);
+    assert_eq!(segment.end, vec![9.0, -2.0]);
+    assert_eq!(segment.channels(), 2);
+    let bezier = Segment {
+        curve: Curve::Bezier(segment.linear_bezier()),
+        ..segment.clone()
+    };
+    for i in 0..=10 {
+        let t = 0.08 * i as f64;
+        for c in 0..2 {
+            let (a, b) = (segment.value_at(c, t), bezier.value_at(c, t));
+            assert!((a - b).abs() < 1e-9, "{t} {c}: {a} {b}");
+        }
+    }
+    // And the document's sampling agrees once the curve is stored.
+    let stored = set_curve("walk", &two, &key(&ik, 0.0), &bezier.curve).unwrap();
+    let pose = stored.sample(0.2, false);
+    assert!((pose.ik[0].to[0] - 6.0).abs() < 1e-9, "{:?}", pose.ik);
+    let rotate_last = segment_error(&walk);
+    assert!(matches!(rotate_last, Err(EditError::LastKey { .. })));
+}
+
+fn segment_error(walk: &Animation) -> Result<Segment, EditError> {
+    segment(walk, &key(&rotate("arm"), 2.0))
+}
