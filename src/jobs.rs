@@ -7,7 +7,7 @@
 //! own glue for the same library calls. [`crate::document`] stays about the editable document:
 //! it does not reach into export, playback or the automatic rig.
 
-use crate::anim::{self, AnimError};
+use crate::anim::AnimError;
 use crate::autorig::{self, AutorigError, AutorigOptions, LayerRef, Proposal};
 use crate::document::{Document, DocumentError};
 use crate::export::spine::{self, SpineError, SpineOptions};
