@@ -16,7 +16,7 @@ use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
 use sinew::pipeline::{self, PartReport, Scene};
-use sinew::playback::{self, FrameView};
+use sinew::playback;
 use sinew::render;
 use sinew::rig::{Handles, Pose};
 use sinew::schema::SchemaKind;

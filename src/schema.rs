@@ -11,8 +11,8 @@
 //! - [`IkOptions`] and [`HandleDofs`] (the rig document's `options.ik`): through mirror types
 //!   whose conversions destructure every field and variant, so a field added to the options
 //!   without its schema does not compile;
-//! - the rig document's `animations`, kept as raw JSON in [`crate::io::RigDocument`], are
-//!   described as the [`Animation`]s they are parsed into.
+//! - the rig document's `animations`, read with [`Animation::from_json`] (not a derived
+//!   parser) into [`crate::io::RigDocument`], are described as those [`Animation`]s.
 //!
 //! A schema checks the shape of a file (fields, types, value names, fixed lengths); what needs
 //! the whole file or the rig (handle names that exist, key times that increase, weight rows that
@@ -95,8 +95,8 @@ pub fn schema(kind: SchemaKind) -> Schema {
 }
 
 /// The animations map: name → animation (an animations file, or the rig document's
-/// `animations`). The rig document keeps each entry as raw JSON and parses it with
-/// [`Animation::from_json`].
+/// `animations`). The rig document parses each entry with [`Animation::from_json`] when it is
+/// read.
 pub type Animations = BTreeMap<String, Animation>;
 
 impl JsonSchema for Curve {

@@ -119,10 +119,14 @@ fn a_written_rig_validates() {
         pipeline::build_rig(&[layer], &dir, &BuildOptions::default(), &handles).expect("rigs");
     doc.animations.insert(
         "nod".into(),
-        json!({"bones": {"head": {"rotate": [
-            {"time": 0, "value": 0, "curve": [0.1, 0, 0.2, 10]},
-            {"time": 0.5, "value": 10}
-        ]}}}),
+        anim::Animation::from_json(
+            "nod",
+            &json!({"bones": {"head": {"rotate": [
+                {"time": 0, "value": 0, "curve": [0.1, 0, 0.2, 10]},
+                {"time": 0.5, "value": 10}
+            ]}}}),
+        )
+        .expect("an animation"),
     );
     doc.locked = vec!["body".into()];
     let rig = dir.join("rig.json");
@@ -176,9 +180,7 @@ fn load(kind: SchemaKind, text: &str) -> Result<(), String> {
         SchemaKind::Rig => {
             let doc = RigDocument::from_json(text, Path::new("example.json"))
                 .map_err(|e| e.to_string())?;
-            anim::load_animations(&doc)
-                .map(|_| ())
-                .map_err(|e| e.to_string())
+            doc.check_animations().map_err(|e| e.to_string())
         }
         SchemaKind::Pose => serde_json::from_value::<Pose>(value)
             .map(|_| ())
@@ -383,5 +385,5 @@ fn the_rig_the_command_writes_for_the_character_validates() {
         "the rig with the bundled animations",
     );
     let doc = RigDocument::from_json(&written.to_string(), &rig).expect("sinew reads it back");
-    anim::load_animations(&doc).expect("the animations fit the rig");
+    doc.check_animations().expect("the animations fit the rig");
 }

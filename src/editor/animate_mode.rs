@@ -224,7 +224,12 @@ impl EditorApp {
                 .collect();
             cache.frames.clear();
         }
-        let version = (self.animate.animation.clone(), animation.clone(), sampling, blend);
+        let version = (
+            self.animate.animation.clone(),
+            animation.clone(),
+            sampling,
+            blend,
+        );
         if cache.animation.as_ref() != Some(&version) {
             cache.animation = Some(version);
             cache.frames.clear();
