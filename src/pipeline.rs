@@ -504,10 +504,25 @@ impl Scene {
     /// baking alike: forward kinematics (bone IK constraints included), then the skinning IK
     /// when the pose has drags, solved from the forward-kinematics pose (no warm start).
     pub fn handle_transforms(&self, pose: &Pose) -> Result<Vec<Affine>, PipelineError> {
+        self.handle_transforms_with(&mut None, pose)
+    }
+
+    /// [`Scene::handle_transforms`] with a solver kept in `ik` (made on first need) for its
+    /// factorization only: [`RigIk::solve_pose`] starts every solve from the forward-kinematics
+    /// pose, so the answer is the same as with a fresh solver.
+    pub fn handle_transforms_with(
+        &self,
+        ik: &mut Option<RigIk>,
+        pose: &Pose,
+    ) -> Result<Vec<Affine>, PipelineError> {
         if pose.ik.is_empty() {
             return Ok(handle_transforms(&self.doc.handles, pose)?);
         }
-        Ok(self.rig_ik()?.transforms(pose)?.transforms)
+        let solver = match ik {
+            Some(solver) => solver,
+            None => ik.insert(self.rig_ik()?),
+        };
+        Ok(solver.solve_pose(pose)?.transforms)
     }
 
     /// Every part's vertex positions in `pose` (forward kinematics, then linear blend

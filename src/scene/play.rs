@@ -18,7 +18,7 @@
 use crate::anim::{Animation, SampleOptions};
 use crate::ik::RigIk;
 use crate::pipeline::{PipelineError, Scene};
-use crate::rig::{handle_transforms, Affine, Pose};
+use crate::rig::{Affine, Pose};
 use rayon::prelude::*;
 
 /// Latest time a rig with momentum is simulated to, s: the simulation runs from the
@@ -95,7 +95,7 @@ impl<'a> Playhead<'a> {
         let transforms = if self.has_momentum() {
             self.simulate(time_s, &pose)?
         } else {
-            static_transforms(self.scene, &mut self.ik, &pose)?
+            self.scene.handle_transforms_with(&mut self.ik, &pose)?
         };
         Ok(Frame {
             time_s,
@@ -137,23 +137,6 @@ impl<'a> Playhead<'a> {
     }
 }
 
-/// The static pose's transforms: forward kinematics, or the skinning IK solved from it with the
-/// solver in `ik` (made on first need), exactly as [`Scene::handle_transforms`] poses.
-fn static_transforms(
-    scene: &Scene,
-    ik: &mut Option<RigIk>,
-    pose: &Pose,
-) -> Result<Vec<Affine>, PipelineError> {
-    if pose.ik.is_empty() {
-        return Ok(handle_transforms(&scene.doc.handles, pose)?);
-    }
-    let solver = match ik {
-        Some(solver) => solver,
-        None => ik.insert(scene.rig_ik()?),
-    };
-    Ok(solver.solve_pose(pose)?.transforms)
-}
-
 /// The frames of `animation` at `times_s` (any order). Without momentum they are solved in
 /// parallel; with it, in order of time on one simulation. Either way each frame is what
 /// [`Playhead::frame`] gives for its time alone.
@@ -184,7 +167,7 @@ pub fn frames(
             || None,
             |ik, &time_s| {
                 let pose = animation.sample_with(time_s, options.looping, &options.sampling);
-                let transforms = static_transforms(scene, ik, &pose)?;
+                let transforms = scene.handle_transforms_with(ik, &pose)?;
                 Ok(Frame {
                     time_s,
                     pose,
