@@ -23,6 +23,10 @@
 //! [`IkOptions::rigidity`] asks) are held near rotations by a penalty λ‖L − R‖² (R the nearest rotation, refreshed in every local step); λ is
 //! the column's rigidity times its own stiffness in A, so the term is unit-free. Hard constraints
 //! are met exactly whenever they are feasible; infeasible ones are met in the least-squares sense.
+//! (In the coupled step, joints are met by the parametrization and drags by a stiff
+//! least-squares term.) A cold solve of a problem with rigid columns runs from two starts and
+//! keeps the result that misses the hard drags least, then has the least energy, so the answer
+//! depends on the problem alone.
 //!
 //! After the iterations, the [`super::fold`] guard checks the skinned triangles' orientation; a
 //! triangle (nearly) folded over gets a rigidity term of its own, the system is factored again

@@ -78,7 +78,9 @@ pub struct IkOptions {
     /// (dragging, animation frames). Default 8.
     pub iterations: usize,
     /// Iterations at most for a solve with no previous solution to start from (a single
-    /// pose): it starts from the forward-kinematics pose, further away. Default 64.
+    /// pose): it starts from the forward-kinematics pose, further away; with rigid bones the
+    /// problem is not convex, and it runs from two starts (the relaxed affine solution and the
+    /// forward-kinematics pose), keeping the better result. Default 64.
     pub cold_iterations: usize,
     /// Stop when no skinned point moves more than this between two iterations, px. Default 0.01.
     pub tolerance_px: f64,

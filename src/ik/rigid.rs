@@ -61,6 +61,8 @@ pub struct CoupledStep {
     params: Vec<Param>,
     /// Per column that follows another: (column, parent, the 3 × 3 map of the parent's rows).
     follows: Vec<(usize, usize, [[f64; 3]; 3])>,
+    /// The columns with parameters or parents, each after the column it depends on.
+    order: Vec<usize>,
     /// vec(T) = P w + (constant entries); P is 6m × n_w, row c·3m + k for T[k, c].
     p: DMatrix<f64>,
     /// Σ_c P_cᵀ Q P_c.
@@ -147,39 +149,10 @@ impl CoupledStep {
                 follows.push((j, *parent, map));
             }
         }
+        let order = dependency_order(&params, &follows)?;
         let mut p = DMatrix::<f64>::zeros(2 * dim, n_w);
-        // Columns are filled once the columns they depend on are: joined rigid columns and
-        // followers after their parents (parents are acyclic, so each sweep fills at least one).
-        let mut filled: Vec<bool> = params
-            .iter()
-            .zip(columns)
-            .map(|(param, c)| {
-                matches!(param, Param::None) && !matches!(c, ColumnDofs::Follows { .. })
-            })
-            .collect();
-        while filled.iter().any(|f| !f) {
-            let before = filled.iter().filter(|f| **f).count();
-            for j in 0..m {
-                if filled[j] {
-                    continue;
-                }
-                let depends_on = match params[j] {
-                    Param::Similarity {
-                        joined: Some(parent),
-                        ..
-                    } => Some(parent),
-                    Param::None => follows.iter().find(|f| f.0 == j).map(|f| f.1),
-                    _ => None,
-                };
-                if depends_on.is_some_and(|parent| !filled[parent]) {
-                    continue;
-                }
-                fill_column(&mut p, dim, j, &params[j], follows.iter().find(|f| f.0 == j));
-                filled[j] = true;
-            }
-            if filled.iter().filter(|f| **f).count() == before {
-                return Err(IkError::Singular);
-            }
+        for &j in &order {
+            fill_column(&mut p, dim, j, &params[j], follows.iter().find(|f| f.0 == j));
         }
         let kept: Vec<usize> = (0..e_t.nrows()).filter(|&k| !eliminated[k]).collect();
         let e_kept = e_t.select_rows(&kept);
@@ -192,6 +165,7 @@ impl CoupledStep {
         Ok(CoupledStep {
             params,
             follows,
+            order,
             p,
             h_w,
             e_w,
@@ -204,63 +178,36 @@ impl CoupledStep {
     /// T): a rigid column's pivot, a joined column's joint where its parent puts it, carried to
     /// the columns that follow them.
     pub fn add_constants(&self, q: &mut DMatrix<f64>) {
-        let m = self.params.len();
-        let mut done: Vec<bool> = (0..m)
-            .map(|j| {
-                matches!(self.params[j], Param::None) && !self.follows.iter().any(|f| f.0 == j)
-            })
-            .collect();
-        while done.iter().any(|d| !d) {
-            let before = done.iter().filter(|d| **d).count();
-            for j in 0..m {
-                if done[j] {
-                    continue;
-                }
-                let follow = self.follows.iter().find(|f| f.0 == j);
-                let depends_on = match self.params[j] {
+        for &j in &self.order {
+            match (&self.params[j], self.follows.iter().find(|f| f.0 == j)) {
+                (
                     Param::Similarity {
+                        pivot,
                         joined: Some(parent),
                         ..
-                    } => Some(parent),
-                    _ => follow.map(|f| f.1),
-                };
-                if depends_on.is_some_and(|parent| !done[parent]) {
-                    continue;
+                    },
+                    _,
+                ) => {
+                    // Where the parent puts the joint, the pivot's own offset cancelling.
+                    for c in 0..2 {
+                        q[(3 * j + 2, c)] += pivot[0] * q[(3 * parent, c)]
+                            + pivot[1] * q[(3 * parent + 1, c)]
+                            + q[(3 * parent + 2, c)];
+                    }
                 }
-                match (&self.params[j], follow) {
-                    (
-                        Param::Similarity {
-                            pivot,
-                            joined: Some(parent),
-                            ..
-                        },
-                        _,
-                    ) => {
-                        // Where the parent puts the joint, the pivot's own offset cancelling.
-                        for c in 0..2 {
-                            q[(3 * j + 2, c)] += pivot[0] * q[(3 * parent, c)]
-                                + pivot[1] * q[(3 * parent + 1, c)]
-                                + q[(3 * parent + 2, c)];
+                (Param::Similarity { pivot, .. }, _) => {
+                    q[(3 * j + 2, 0)] += pivot[0];
+                    q[(3 * j + 2, 1)] += pivot[1];
+                }
+                (_, Some(&(_, parent, map))) => {
+                    for c in 0..2 {
+                        let from = [0, 1, 2].map(|l| q[(3 * parent + l, c)]);
+                        for (k, row) in map.iter().enumerate() {
+                            q[(3 * j + k, c)] = (0..3).map(|l| row[l] * from[l]).sum();
                         }
                     }
-                    (Param::Similarity { pivot, .. }, _) => {
-                        q[(3 * j + 2, 0)] += pivot[0];
-                        q[(3 * j + 2, 1)] += pivot[1];
-                    }
-                    (_, Some(&(_, parent, map))) => {
-                        for c in 0..2 {
-                            let from = [0, 1, 2].map(|l| q[(3 * parent + l, c)]);
-                            for (k, row) in map.iter().enumerate() {
-                                q[(3 * j + k, c)] = (0..3).map(|l| row[l] * from[l]).sum();
-                            }
-                        }
-                    }
-                    _ => {}
                 }
-                done[j] = true;
-            }
-            if done.iter().filter(|d| **d).count() == before {
-                break;
+                _ => {}
             }
         }
     }
@@ -435,6 +382,45 @@ impl CoupledStep {
         let flat = &self.p * &w;
         Ok(DMatrix::from_fn(dim, 2, |k, c| flat[c * dim + k] + q[(k, c)]))
     }
+}
+
+/// The columns that have parameters or follow another, each after the column it depends on
+/// (a joined rigid column after its parent, a follower after the column it follows).
+fn dependency_order(
+    params: &[Param],
+    follows: &[(usize, usize, [[f64; 3]; 3])],
+) -> Result<Vec<usize>, IkError> {
+    let depends_on = |j: usize| match params[j] {
+        Param::Similarity {
+            joined: Some(parent),
+            ..
+        } => Some(parent),
+        Param::None => follows.iter().find(|f| f.0 == j).map(|f| f.1),
+        _ => None,
+    };
+    let needed: Vec<bool> = (0..params.len())
+        .map(|j| !matches!(params[j], Param::None) || depends_on(j).is_some())
+        .collect();
+    let mut placed = vec![false; params.len()];
+    let mut order = Vec::new();
+    while order.len() < needed.iter().filter(|n| **n).count() {
+        let before = order.len();
+        for j in 0..params.len() {
+            if placed[j] || !needed[j] {
+                continue;
+            }
+            if depends_on(j).is_some_and(|parent| needed[parent] && !placed[parent]) {
+                continue;
+            }
+            placed[j] = true;
+            order.push(j);
+        }
+        if order.len() == before {
+            // Parents are validated acyclic; a cycle here is a malformed problem.
+            return Err(IkError::Singular);
+        }
+    }
+    Ok(order)
 }
 
 /// Writes column `j`'s rows of P (both output coordinates) from its parametrization; a follower
