@@ -382,8 +382,15 @@ fn closing_with_unsaved_changes_asks_first() {
     ));
     h.get_by_label("Save").click();
     h.run();
-    assert!(h.state().saving());
-    assert_eq!(h.state().closing(), Closing::Waiting);
+    // (A small save may already be done by the end of the frames run.)
+    assert!(
+        h.state().saving() || h.state().closing() == Closing::Allowed,
+        "{:?}",
+        h.state().closing()
+    );
+    if h.state().saving() {
+        assert_eq!(h.state().closing(), Closing::Waiting);
+    }
     wait_for(&mut h, |app| app.closing() == Closing::Allowed);
     assert_eq!(h.state().closing(), Closing::Allowed);
     assert!(!h.state().doc.dirty());
