@@ -13,6 +13,7 @@ use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
 use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
+use sinew::io::outputs::{check_not_overwriting, check_outputs, parent_dir};
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
 use sinew::pipeline::{self, PartReport, Scene};
@@ -468,70 +469,6 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
     );
     for note in &proposal.notes {
         println!("  {note}");
-    }
-    Ok(())
-}
-
-/// The file `path` names, resolved through links when it (or its folder) exists.
-fn resolved(path: &Path) -> PathBuf {
-    if let Ok(p) = path.canonicalize() {
-        return p;
-    }
-    match (
-        path.parent().map(|d| {
-            if d.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                d
-            }
-        }),
-        path.file_name(),
-    ) {
-        (Some(dir), Some(name)) => dir
-            .canonicalize()
-            .map(|d| d.join(name))
-            .unwrap_or_else(|_| path.to_path_buf()),
-        _ => path.to_path_buf(),
-    }
-}
-
-/// Fails, before any work, when an output file names an input (the input would be written
-/// over, say a sprite with rig JSON) or another output, or lies in a folder that does not
-/// exist (the outputs written before it would be left behind). Absent (`None`) outputs are
-/// skipped; output folders, which the commands make where missing, are not passed here.
-fn check_outputs<'a>(
-    inputs: impl IntoIterator<Item = &'a Path>,
-    outputs: impl IntoIterator<Item = Option<&'a Path>> + Clone,
-) -> Result<()> {
-    for output in outputs.clone().into_iter().flatten() {
-        let folder = parent_dir(output);
-        if !folder.as_os_str().is_empty() && !folder.is_dir() {
-            bail!(
-                "{}: cannot write there: folder {} does not exist",
-                output.display(),
-                folder.display()
-            );
-        }
-    }
-    check_not_overwriting(inputs, outputs)
-}
-
-/// Fails when an output file names an input or another output.
-fn check_not_overwriting<'a>(
-    inputs: impl IntoIterator<Item = &'a Path>,
-    outputs: impl IntoIterator<Item = Option<&'a Path>>,
-) -> Result<()> {
-    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
-    let mut seen: Vec<PathBuf> = Vec::new();
-    for output in outputs.into_iter().flatten() {
-        let at = resolved(output);
-        if inputs.contains(&at) {
-            bail!("{}: the output would overwrite an input", output.display());
-        }
-        if seen.contains(&at) {
-            bail!("{}: two outputs name the same file", output.display());
-        }
-        seen.push(at);
     }
     Ok(())
 }
@@ -1001,11 +938,3 @@ fn report_spine_export(export: &spine::SpineExport, written: &[PathBuf]) {
 
 /// Frame rate of the demo's renders.
 const DEMO_FPS: f64 = 24.0;
-
-/// The folder a file will be written in (`.` for a bare file name).
-fn parent_dir(path: &Path) -> &Path {
-    match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    }
-}

@@ -19,7 +19,7 @@
 //! locked ([`Command::SetLocked`]): painting leaves locked handles' weights alone, and
 //! [`compute_rig`] keeps them from the previous rig while it recomputes the others.
 
-use crate::anim::edit::{self, CopiedKey, KeyRef};
+use crate::anim::edit::{self, put_key, CopiedKey, KeyRef};
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
 use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
@@ -71,6 +71,11 @@ pub enum DocumentError {
     Animation(#[from] crate::anim::AnimError),
     #[error("a key time must be a finite number of seconds ≥ 0, not {0}")]
     KeyTime(f64),
+    #[error(
+        "nothing to key at {0} s: the keys there already hold this pose (pose a bone or drag a \
+         point first)"
+    )]
+    NothingToKey(f64),
     #[error("'{name}' has {expected} vertices, not {got}")]
     PolygonSize {
         name: String,
@@ -268,13 +273,16 @@ pub struct Document {
     state: State,
     /// Where the document is saved; image paths in the file are relative to its folder.
     pub path: Option<PathBuf>,
-    undo: Vec<State>,
-    redo: Vec<State>,
-    /// Whether there are changes since the last save.
-    pub dirty: bool,
-    /// Counts changes (commands, undo and redo steps), so that a save written from a snapshot
-    /// on another thread clears `dirty` only if nothing changed meanwhile.
+    /// Earlier states with their revisions (the last is the one before the current state).
+    undo: Vec<(State, u64)>,
+    redo: Vec<(State, u64)>,
+    /// The revision of the current state: every command makes a new one; undo and redo bring
+    /// back the revision of the state they restore.
     revision: u64,
+    /// The last revision handed out.
+    last_revision: u64,
+    /// The revision last saved (or opened); `None` when no state of this document is on disk.
+    saved_revision: Option<u64>,
 }
 
 impl Default for Document {
@@ -300,8 +308,10 @@ impl Document {
             path: None,
             undo: Vec::new(),
             redo: Vec::new(),
-            dirty: false,
             revision: 0,
+            last_revision: 0,
+            // An empty document has nothing worth saving.
+            saved_revision: Some(0),
         }
     }
 
@@ -347,8 +357,9 @@ impl Document {
             path: Some(path.to_path_buf()),
             undo: Vec::new(),
             redo: Vec::new(),
-            dirty: false,
             revision: 0,
+            last_revision: 0,
+            saved_revision: Some(0),
         })
     }
 
@@ -381,30 +392,38 @@ impl Document {
     pub fn apply(&mut self, command: Command) -> Result<(), DocumentError> {
         let next = apply_to(&self.state, command)?;
         let previous = std::mem::replace(&mut self.state, next);
-        self.undo.push(previous);
+        self.undo.push((previous, self.revision));
         if self.undo.len() > UNDO_LIMIT {
             self.undo.remove(0);
         }
         self.redo.clear();
-        self.dirty = true;
-        self.revision += 1;
+        self.last_revision += 1;
+        self.revision = self.last_revision;
         Ok(())
     }
 
     /// Steps back one command; false when there is nothing to undo.
     pub fn undo(&mut self) -> bool {
-        let stepped = swap_in(&mut self.state, &mut self.undo, &mut self.redo);
-        self.dirty |= stepped;
-        self.revision += stepped as u64;
-        stepped
+        swap_in(
+            (&mut self.state, &mut self.revision),
+            &mut self.undo,
+            &mut self.redo,
+        )
     }
 
     /// Re-applies the last undone command; false when there is nothing to redo.
     pub fn redo(&mut self) -> bool {
-        let stepped = swap_in(&mut self.state, &mut self.redo, &mut self.undo);
-        self.dirty |= stepped;
-        self.revision += stepped as u64;
-        stepped
+        swap_in(
+            (&mut self.state, &mut self.revision),
+            &mut self.redo,
+            &mut self.undo,
+        )
+    }
+
+    /// Whether the current state differs from the one last saved (or opened): undoing back to
+    /// the saved state makes the document clean again.
+    pub fn dirty(&self) -> bool {
+        self.saved_revision != Some(self.revision)
     }
 
     /// The rig document as it would be saved at `path`. A stale rig is saved with its meshes
@@ -451,9 +470,8 @@ impl Document {
             return;
         }
         self.path = Some(job.target.clone());
-        if self.revision == job.revision {
-            self.dirty = false;
-        }
+        // Edits made while it was written keep the document modified, as they should.
+        self.saved_revision = Some(job.revision);
     }
 
     /// What [`crate::jobs::render_animation`] needs, copied out of the current state (for
@@ -551,11 +569,17 @@ impl SaveJob {
     }
 }
 
-/// Makes the last state of `from` current, pushing the current one onto `to`.
-fn swap_in(state: &mut State, from: &mut Vec<State>, to: &mut Vec<State>) -> bool {
+/// Makes the last state of `from` current (with its revision), pushing the current one onto
+/// `to`.
+fn swap_in(
+    (state, revision): (&mut State, &mut u64),
+    from: &mut Vec<(State, u64)>,
+    to: &mut Vec<(State, u64)>,
+) -> bool {
     match from.pop() {
-        Some(other) => {
-            to.push(std::mem::replace(state, other));
+        Some((other, other_revision)) => {
+            let previous = std::mem::replace(state, other);
+            to.push((previous, std::mem::replace(revision, other_revision)));
             true
         }
         None => false,
@@ -732,8 +756,12 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             pose,
         } => {
             check_key_time(time_s)?;
-            let mut anim = animation_named(state, &animation);
+            let before = animation_named(state, &animation);
+            let mut anim = before.clone();
             key_pose(&mut anim, time_s, &pose);
+            if anim == before && state.animations.contains_key(&animation) {
+                return Err(DocumentError::NothingToKey(time_s));
+            }
             store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }
@@ -977,31 +1005,8 @@ fn store_animation(next: &mut State, name: &str, anim: Animation) -> Result<(), 
     Ok(())
 }
 
-/// Puts a linear key at `time_s` into `keys` (kept sorted), replacing one at the same time.
-fn put_key<V>(keys: &mut Vec<Key<V>>, time_s: f64, value: V) {
-    match keys
-        .iter()
-        .position(|k| k.time > time_s - KEY_TIME_TOLERANCE_S)
-    {
-        Some(i) if (keys[i].time - time_s).abs() <= KEY_TIME_TOLERANCE_S => {
-            keys[i].value = value;
-        }
-        Some(i) => keys.insert(
-            i,
-            Key {
-                time: time_s,
-                value,
-                curve: Curve::Linear,
-            },
-        ),
-        None => keys.push(Key {
-            time: time_s,
-            value,
-            curve: Curve::Linear,
-        }),
-    }
-}
-
+/// Keys every bone and point channel and every IK drag of `pose` at `time_s` ([`put_key`]: a key
+/// inside a segment splits its curve, so the motion around it stays as it was).
 fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
     for (name, b) in &pose.bones {
         let t = anim.bones.entry(name.clone()).or_default();

@@ -12,6 +12,7 @@ use crate::autorig::{self, AutorigError, AutorigOptions, LayerRef, Proposal};
 use crate::document::{Document, DocumentError};
 use crate::export::spine::{self, SpineError, SpineOptions};
 use crate::io::sequence::{self, SequenceError, SequenceReport};
+use crate::io::outputs::{check_not_overwriting, OutputError};
 use crate::io::RigDocument;
 use crate::pipeline::{Layer, PipelineError, Scene};
 use crate::playback::{self, PlaybackError, RenderAnimationError, RenderSettings};
@@ -37,6 +38,8 @@ pub enum JobError {
     Sequence(#[from] SequenceError),
     #[error(transparent)]
     Autorig(#[from] AutorigError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
 }
 
 /// Exports the document's current state for Spine's runtimes into `dir` (see
@@ -55,6 +58,18 @@ pub fn export_spine(
     let images: Vec<_> = doc.state().layers.iter().map(|l| l.image.clone()).collect();
     let scene = Scene::new(rig, &images)?;
     let export = spine::export_spine(&scene, &images, name, options)?;
+    // As `sinew export spine` checks: no file of the export may write over the document or a
+    // part's image (an export into the document's folder under its name would), nor another.
+    let targets: Vec<PathBuf> = export
+        .file_names()
+        .into_iter()
+        .map(|file| dir.join(file))
+        .collect();
+    let layers: Vec<&Path> = doc.state().layers.iter().map(|l| l.path.as_path()).collect();
+    check_not_overwriting(
+        doc.path.as_deref().into_iter().chain(layers),
+        targets.iter().map(|t| Some(t.as_path())),
+    )?;
     Ok(export.write(dir)?)
 }
 

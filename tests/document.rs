@@ -205,7 +205,7 @@ fn saves_atomically_and_reopens_ready_to_pose() {
     let mut doc = arm_document_with(layer);
     let path = dir.join("arm.json");
     doc.save(&path).unwrap();
-    assert!(!doc.dirty);
+    assert!(!doc.dirty());
     let reopened = Document::open(&path).unwrap();
     assert!(reopened.posable().is_some());
     assert_eq!(reopened.state().handles, doc.state().handles);
@@ -216,6 +216,13 @@ fn saves_atomically_and_reopens_ready_to_pose() {
         tail: [250.0, 40.0],
     })
     .unwrap();
+    // "Modified" is the state against the saved one: undoing back to it is clean again,
+    // redoing the edit is modified again.
+    assert!(doc.dirty());
+    doc.undo();
+    assert!(!doc.dirty());
+    doc.redo();
+    assert!(doc.dirty());
     let autosaved = doc.autosave(&path).unwrap();
     assert_eq!(autosaved, autosave_path(&path));
     let reopened = Document::open(&autosaved).unwrap();

@@ -235,6 +235,131 @@ pub fn bezier_value(t0: f64, v0: f64, handles: &[f64], t1: f64, v1: f64, t: f64)
     cubic([v0, cy1, cy2, v1], s)
 }
 
+/// Splits the cubic with control values `p` at parameter `s` (de Casteljau): the control
+/// values of its part over [0, s] and of its part over [s, 1], which together trace the same
+/// curve.
+pub fn split_cubic(p: [f64; 4], s: f64) -> ([f64; 4], [f64; 4]) {
+    let lerp = |a: f64, b: f64| a + (b - a) * s;
+    let (a, b, c) = (lerp(p[0], p[1]), lerp(p[1], p[2]), lerp(p[2], p[3]));
+    let (d, e) = (lerp(a, b), lerp(b, c));
+    let f = lerp(d, e);
+    ([p[0], a, d, f], [f, e, c, p[3]])
+}
+
+/// A segment's curve split by a key inserted at time `t` strictly between its keys (t0, `v0`)
+/// and (t1, `v1`), so that the two new segments play what the one did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplitCurve {
+    /// The curve from the first key to the inserted one.
+    pub before: Curve,
+    /// The curve from the inserted key to the second one.
+    pub after: Curve,
+    /// The segment's value at `t`, per number (what the inserted key must hold for the motion
+    /// to be unchanged).
+    pub value: Vec<f64>,
+}
+
+/// Splits the segment from (t0, `v0`) to (t1, `v1`) with `curve` at `t` ∈ (t0, t1): linear
+/// and stepped segments stay what they are; a Bézier is split by de Casteljau at the parameter
+/// where its time is `t`, channel by channel, so the sampled motion is unchanged. `per_channel`
+/// is [`super::timeline::Channels::CURVE_PER_CHANNEL`]: false when one curve gives a 0..1
+/// fraction of the way for all numbers (cage polygons); its two parts are then rescaled to
+/// their own segments. A Bézier of the wrong length is split as the linear segment it samples
+/// as.
+pub fn split_curve(
+    curve: &Curve,
+    (t0, v0): (f64, &[f64]),
+    (t1, v1): (f64, &[f64]),
+    t: f64,
+    per_channel: bool,
+) -> SplitCurve {
+    let f = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+    let lerp = |fraction: f64| -> Vec<f64> {
+        v0.iter()
+            .zip(v1)
+            .map(|(a, b)| a + (b - a) * fraction)
+            .collect()
+    };
+    let linear = |fraction: f64| SplitCurve {
+        before: Curve::Linear,
+        after: Curve::Linear,
+        value: lerp(fraction),
+    };
+    let numbers = match curve {
+        Curve::Linear => return linear(f),
+        Curve::Stepped => {
+            return SplitCurve {
+                before: Curve::Stepped,
+                after: Curve::Stepped,
+                value: v0.to_vec(),
+            }
+        }
+        Curve::Bezier(numbers) => numbers,
+    };
+    let channels = if per_channel { v0.len() } else { 1 };
+    if numbers.len() != channels * BEZIER_NUMBERS_PER_CHANNEL || v1.len() != v0.len() {
+        return linear(f);
+    }
+    // Control times stay inside their new segments (rounding could push one a hair out).
+    let (mut before, mut after, mut value) = (Vec::new(), Vec::new(), Vec::new());
+    let inside = |x: f64, lo: f64, hi: f64| x.clamp(lo, hi);
+    for (c, h) in numbers.chunks_exact(BEZIER_NUMBERS_PER_CHANNEL).enumerate() {
+        let x = [t0, h[0], h[2], t1];
+        let s = solve_bezier_parameter(x, t);
+        let (xl, xr) = split_cubic(x, s);
+        let y = if per_channel {
+            [v0[c], h[1], h[3], v1[c]]
+        } else {
+            [0.0, h[1], h[3], 1.0]
+        };
+        let (yl, yr) = split_cubic(y, s);
+        if per_channel {
+            before.extend([inside(xl[1], t0, t), yl[1], inside(xl[2], t0, t), yl[2]]);
+            after.extend([inside(xr[1], t, t1), yr[1], inside(xr[2], t, t1), yr[2]]);
+            value.push(yl[3]);
+            continue;
+        }
+        // One fraction curve: each part's fractions rescaled to run 0..1 over its own segment
+        // (where the split point is at an end of the value range, that part does not move and
+        // is linear).
+        let fraction = yl[3];
+        let scale = |y: f64, from: f64, span: f64| (y - from) / span;
+        before = if fraction.abs() > f64::EPSILON {
+            vec![
+                inside(xl[1], t0, t),
+                scale(yl[1], 0.0, fraction),
+                inside(xl[2], t0, t),
+                scale(yl[2], 0.0, fraction),
+            ]
+        } else {
+            Vec::new()
+        };
+        after = if (1.0 - fraction).abs() > f64::EPSILON {
+            vec![
+                inside(xr[1], t, t1),
+                scale(yr[1], fraction, 1.0 - fraction),
+                inside(xr[2], t, t1),
+                scale(yr[2], fraction, 1.0 - fraction),
+            ]
+        } else {
+            Vec::new()
+        };
+        value = lerp(fraction);
+    }
+    let curve_of = |numbers: Vec<f64>| {
+        if numbers.is_empty() {
+            Curve::Linear
+        } else {
+            Curve::Bezier(numbers)
+        }
+    };
+    SplitCurve {
+        before: curve_of(before),
+        after: curve_of(after),
+        value,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -339,5 +464,71 @@ mod tests {
             serde_json::to_string(&Curve::Stepped).unwrap(),
             "\"stepped\""
         );
+    }
+
+    #[test]
+    fn splitting_a_bezier_leaves_the_motion_unchanged() {
+        // Two channels, eased differently; split at a time inside.
+        let (t0, t1, t) = (0.5, 2.0, 1.1);
+        let (v0, v1) = ([0.0, 10.0], [90.0, -30.0]);
+        let numbers = vec![1.2, -20.0, 1.3, 130.0, 0.6, 10.0, 1.9, -30.0];
+        let split = split_curve(
+            &Curve::Bezier(numbers.clone()),
+            (t0, &v0),
+            (t1, &v1),
+            t,
+            true,
+        );
+        let (Curve::Bezier(before), Curve::Bezier(after)) = (&split.before, &split.after) else {
+            panic!("{split:?}");
+        };
+        for c in 0..2 {
+            let h = &numbers[4 * c..4 * c + 4];
+            let (hb, ha) = (&before[4 * c..4 * c + 4], &after[4 * c..4 * c + 4]);
+            assert!(hb[0] >= t0 && hb[2] <= t && ha[0] >= t && ha[2] <= t1);
+            let at_t = bezier_value(t0, v0[c], h, t1, v1[c], t);
+            assert!((split.value[c] - at_t).abs() < 1e-9, "{c}");
+            for k in 0..=200 {
+                let time = t0 + (t1 - t0) * k as f64 / 200.0;
+                let whole = bezier_value(t0, v0[c], h, t1, v1[c], time);
+                let parts = if time <= t {
+                    bezier_value(t0, v0[c], hb, t, split.value[c], time)
+                } else {
+                    bezier_value(t, split.value[c], ha, t1, v1[c], time)
+                };
+                assert!((whole - parts).abs() < 1e-9, "{c} {time}: {whole} vs {parts}");
+            }
+        }
+        // Linear and stepped segments stay so; their value at t is theirs.
+        let linear = split_curve(&Curve::Linear, (0.0, &[0.0]), (2.0, &[4.0]), 0.5, true);
+        assert_eq!((linear.before, linear.after), (Curve::Linear, Curve::Linear));
+        assert_eq!(linear.value, vec![1.0]);
+        let stepped = split_curve(&Curve::Stepped, (0.0, &[3.0]), (2.0, &[4.0]), 0.5, true);
+        assert_eq!(stepped.after, Curve::Stepped);
+        assert_eq!(stepped.value, vec![3.0]);
+    }
+
+    #[test]
+    fn splitting_a_fraction_curve_rescales_both_parts() {
+        // One 0..1 curve for all numbers (a cage): each part runs 0..1 over its own segment.
+        let h = vec![0.4, 0.0, 0.6, 1.0];
+        let (v0, v1) = ([0.0, 0.0], [10.0, 20.0]);
+        let split = split_curve(&Curve::Bezier(h.clone()), (0.0, &v0), (1.0, &v1), 0.3, false);
+        let f = bezier_value(0.0, 0.0, &h, 1.0, 1.0, 0.3);
+        assert!((split.value[0] - 10.0 * f).abs() < 1e-9);
+        assert!((split.value[1] - 20.0 * f).abs() < 1e-9);
+        let (Curve::Bezier(before), Curve::Bezier(after)) = (&split.before, &split.after) else {
+            panic!("{split:?}");
+        };
+        for k in 0..=100 {
+            let time = k as f64 / 100.0;
+            let whole = bezier_value(0.0, 0.0, &h, 1.0, 1.0, time);
+            let parts = if time <= 0.3 {
+                f * bezier_value(0.0, 0.0, before, 0.3, 1.0, time)
+            } else {
+                f + (1.0 - f) * bezier_value(0.3, 0.0, after, 1.0, 1.0, time)
+            };
+            assert!((whole - parts).abs() < 1e-9, "{time}");
+        }
     }
 }

@@ -25,7 +25,8 @@
 
 mod keys;
 
-use super::curve::{Curve, BEZIER_NUMBERS_PER_CHANNEL};
+use super::curve::{split_curve, Curve, BEZIER_NUMBERS_PER_CHANNEL};
+use super::timeline::Channels;
 use super::{AnimError, Animation, Key};
 use keys::{entries_of, find, write_keys, EditKey, Entry, TimelineEdit};
 use serde::{Deserialize, Serialize};
@@ -395,6 +396,70 @@ pub fn copy_keys(animation: &Animation, keys: &[KeyRef]) -> Result<Vec<CopiedKey
         keys::edit_timeline(&mut scratch, &timeline, false, &mut copy)?;
     }
     Ok(copy.out)
+}
+
+/// Keys `value` at `time_s` in one timeline's sorted `keys` (as keying a pose does): a key
+/// already at that time (within [`KEY_TIME_TOLERANCE_S`]) takes the value; a new key between
+/// two others splits their segment ([`super::curve::split_curve`]: de Casteljau for a Bézier),
+/// so the motion around it is what it was. Where `value` differs from the motion's value at
+/// `time_s`, the Bézier handles on either side of the new key move with it by the difference
+/// (a per-channel curve), so the curve keeps its tangents there. A key before the first or
+/// after the last one is linear.
+pub fn put_key<V: Channels>(keys: &mut Vec<Key<V>>, time_s: f64, value: V) {
+    let at = keys
+        .iter()
+        .position(|k| k.time > time_s - KEY_TIME_TOLERANCE_S);
+    let Some(i) = at else {
+        keys.push(Key {
+            time: time_s,
+            value,
+            curve: Curve::Linear,
+        });
+        return;
+    };
+    if (keys[i].time - time_s).abs() <= KEY_TIME_TOLERANCE_S {
+        keys[i].value = value;
+        return;
+    }
+    let mut curve = Curve::Linear;
+    if i > 0 {
+        let (previous, next) = (&keys[i - 1], &keys[i]);
+        let split = split_curve(
+            &previous.curve,
+            (previous.time, previous.value.numbers()),
+            (next.time, next.value.numbers()),
+            time_s,
+            V::CURVE_PER_CHANNEL,
+        );
+        let (mut before, mut after) = (split.before, split.after);
+        if V::CURVE_PER_CHANNEL {
+            // The handles beside the new key follow its value (cy2 before it, cy1 after it).
+            let moved = value.numbers().iter().zip(&split.value).map(|(v, s)| v - s);
+            for (c, delta) in moved.enumerate() {
+                let base = c * BEZIER_NUMBERS_PER_CHANNEL;
+                if let Curve::Bezier(n) = &mut before {
+                    if let Some(cy2) = n.get_mut(base + 3) {
+                        *cy2 += delta;
+                    }
+                }
+                if let Curve::Bezier(n) = &mut after {
+                    if let Some(cy1) = n.get_mut(base + 1) {
+                        *cy1 += delta;
+                    }
+                }
+            }
+        }
+        keys[i - 1].curve = before;
+        curve = after;
+    }
+    keys.insert(
+        i,
+        Key {
+            time: time_s,
+            value,
+            curve,
+        },
+    );
 }
 
 /// Writes `keys` at `at_s` plus their offsets, creating timelines as needed (an IK drag's

@@ -116,6 +116,27 @@ impl EditorApp {
         )
     }
 
+    /// Play or pause (the Play button, Space).
+    pub(super) fn toggle_playback(&mut self) {
+        self.animate.playing = !self.animate.playing;
+    }
+
+    /// Keys the edited pose at the playhead (*Set key*); says what it did, or why not. A key
+    /// inside a segment splits its curve, so the motion around it stays (the library's
+    /// [`crate::anim::edit::put_key`]).
+    pub fn set_key(&mut self) {
+        let pose = self.edited_pose();
+        let (animation, time_s) = (self.animate.animation.clone(), self.animate.time_s);
+        if self.apply(crate::document::Command::SetKey {
+            animation: animation.clone(),
+            time_s,
+            pose,
+        }) {
+            self.animate.shown = None;
+            self.message = Some(format!("keyed '{animation}' at {time_s:.3} s"));
+        }
+    }
+
     /// Moves the playhead; an edited but unkeyed pose is dropped, as in other animation tools.
     pub fn set_time(&mut self, time_s: f64) {
         self.animate.time_s = time_s.max(0.0);

@@ -33,7 +33,7 @@ impl EditorApp {
         if self.closing == Closing::Allowed {
             return;
         }
-        self.closing = if self.doc.dirty {
+        self.closing = if self.doc.dirty() {
             Closing::Asking
         } else if self.saving() || self.rendering() {
             Closing::Waiting
@@ -98,7 +98,7 @@ impl EditorApp {
         self.close_requests(ctx);
         if self.closing == Closing::Waiting && !self.saving() && !self.rendering() {
             // A failed save, or an edit while it ran, leaves changes to ask about again.
-            if self.doc.dirty {
+            if self.doc.dirty() {
                 self.closing = Closing::Asking;
             } else {
                 self.close(ctx);
@@ -168,9 +168,9 @@ impl EditorApp {
     /// keeps the window open when nothing was saved (the status bar says why).
     fn save_then_close(&mut self, ctx: &egui::Context) {
         self.save();
-        self.closing = if self.saving() || (!self.doc.dirty && self.rendering()) {
+        self.closing = if self.saving() || (!self.doc.dirty() && self.rendering()) {
             Closing::Waiting
-        } else if self.doc.dirty {
+        } else if self.doc.dirty() {
             Closing::Open
         } else {
             Closing::Allowed

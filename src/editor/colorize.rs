@@ -238,7 +238,7 @@ impl EditorApp {
                 self.mode = Mode::Colorize;
                 self.message = Some(format!("opened line art {} ({w}×{h} px)", path.display()));
             }
-            Err(e) => self.message = Some(format!("cannot open {}: {e}", path.display())),
+            Err(e) => self.fail(format!("cannot open {}: {e}", path.display())),
         }
     }
 
@@ -315,7 +315,7 @@ impl EditorApp {
         let target = crate::document::autosave_path(file);
         match session.write_strokes(&target) {
             Ok(()) => c.saved_strokes = Some(strokes.clone()),
-            Err(e) => self.message = Some(format!("autosave failed: {e}")),
+            Err(e) => self.fail(format!("autosave failed: {e}")),
         }
     }
 
@@ -398,6 +398,7 @@ impl EditorApp {
             Err(SessionError::Colorize(ColorizeError::Cancelled)) => {}
             Err(e) => {
                 self.message = Some(e.to_string());
+                self.message_is_error = true;
                 c.failed = Some(strokes.as_ref().clone());
             }
         }
@@ -604,7 +605,7 @@ impl EditorApp {
         match session.apply(command) {
             Ok(()) => true,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 false
             }
         }
@@ -757,7 +758,7 @@ impl EditorApp {
                         match session.apply(command) {
                             // Passing over paper erases nothing: no message for that.
                             Ok(()) | Err(SessionError::NothingToErase { .. }) => {}
-                            Err(e) => self.message = Some(e.to_string()),
+                            Err(e) => self.fail(e.to_string()),
                         }
                     }
                 }

@@ -192,6 +192,9 @@ impl EditorApp {
         let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
         let rect = response.rect;
         painter.rect_filled(rect, 0.0, Color32::from_gray(40));
+        if self.doc.state().layers.is_empty() {
+            drop_hint(ui, rect);
+        }
         let canvas_px = self
             .doc
             .state()
@@ -224,7 +227,7 @@ impl EditorApp {
                 };
                 let drawn = posed.and_then(|()| self.picture(&ctx, scene, rect, &placed));
                 if let Err(e) = drawn {
-                    self.message = Some(e);
+                    self.fail(e);
                 }
                 if let Some(picture) = &self.drawing.picture {
                     let size = egui::vec2(
@@ -341,3 +344,22 @@ impl EditorApp {
         }
     }
 }
+
+/// What an empty canvas says: where images come from (brighter while files hover over it).
+fn drop_hint(ui: &mut egui::Ui, rect: Rect) {
+    let hovering = ui.input(|i| !i.raw.hovered_files.is_empty());
+    let color = if hovering {
+        Color32::WHITE
+    } else {
+        Color32::from_gray(150)
+    };
+    let text = egui::RichText::new(DROP_HINT).size(18.0).color(color);
+    ui.put(
+        Rect::from_center_size(rect.center(), egui::vec2(rect.width().min(420.0), 60.0)),
+        egui::Label::new(text).selectable(false),
+    );
+}
+
+/// The empty canvas' hint.
+pub const DROP_HINT: &str = "Drop PNG images here (or File → Import layer…)";
+

@@ -1,6 +1,7 @@
 //! Files: open, import, save and autosave (written on other threads when they must trace and
 //! mesh first), the view saved beside a document, File → Export Spine and File → Render, and
-//! the File menu that drives them.
+//! the shared save/open logic the File menu ([`super::file_menu`]), drops and the close dialog
+//! call.
 //!
 //! In: paths typed in the File menu or dropped on the window. Out: the document read or
 //! written through [`crate::document`], messages for the status bar.
@@ -9,7 +10,6 @@ use super::canvas::View;
 use super::{animate_mode, EditorApp, Mode};
 use crate::document::{Command, Document, DocumentError};
 use crate::pipeline::Layer;
-use crate::skin::Blend;
 use eframe::egui;
 use std::path::{Path, PathBuf};
 
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 pub const AUTOSAVE_INTERVAL_S: f64 = 30.0;
 
 /// File → Render's output scale, output px per canvas px.
-const RENDER_SCALE_RANGE: (f64, f64) = (0.05, 8.0);
+pub(super) const RENDER_SCALE_RANGE: (f64, f64) = (0.05, 8.0);
 
 /// The view saved beside a document (`NAME.view.json`), so reopening shows it as it was left.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -93,43 +93,6 @@ pub fn load_view(path: &Path) -> Option<ViewState> {
 }
 
 impl EditorApp {
-    /// The File menu: open, import, save, export for Spine, render, and colorize mode's files.
-    pub(super) fn file_menu(&mut self, ui: &mut egui::Ui) {
-        let label = ui.label("Rig or PNG path:");
-        ui.text_edit_singleline(&mut self.open_path)
-            .labelled_by(label.id);
-        if ui.button("Open rig").clicked() {
-            let path = PathBuf::from(&self.open_path);
-            self.open(&path);
-        }
-        if ui.button("Import layer").clicked() {
-            let path = PathBuf::from(&self.open_path);
-            self.import_layer(&path);
-        }
-        if ui.button("Save").clicked() {
-            self.save();
-        }
-        ui.separator();
-        ui.label("Export folder:");
-        ui.text_edit_singleline(&mut self.export_dir);
-        spine_options_ui(ui, &mut self.spine_options);
-        if ui.button("Export Spine").clicked() {
-            let dir = PathBuf::from(&self.export_dir);
-            self.message = Some(self.export_spine(&dir));
-        }
-        ui.label("Render the current animation to (.gif, .png sheet or a folder):");
-        ui.text_edit_singleline(&mut self.render_path);
-        render_settings_ui(ui, &mut self.render_settings);
-        if ui
-            .add_enabled(self.render.is_none(), egui::Button::new("Render"))
-            .clicked()
-        {
-            let ctx = ui.ctx().clone();
-            self.start_render(&ctx);
-        }
-        self.colorize_file_menu(ui);
-    }
-
     /// Imports a PNG as a new front layer; a bad file leaves the document as it was.
     pub fn import_layer(&mut self, path: &Path) {
         let loaded = crate::io::load_png(path);
@@ -147,7 +110,7 @@ impl EditorApp {
                     self.view = None;
                 }
             }
-            Err(e) => self.message = Some(e.to_string()),
+            Err(e) => self.fail(e.to_string()),
         }
     }
 
@@ -155,26 +118,46 @@ impl EditorApp {
     pub fn open(&mut self, path: &Path) {
         match Document::open(path) {
             Ok(doc) => {
-                // Colorize mode's line art and strokes are not part of the rig document.
-                let colorize = std::mem::take(&mut self.colorize);
-                // An autosave still being written stays watched, so a new one for the same
-                // file does not start beside it; a save still being written is reported when
-                // it is done.
-                let autosaving = self.autosaving.take();
-                let saving = self.saving.take().map(|saving| Saving {
-                    this_document: false,
-                    ..saving
-                });
-                *self = EditorApp::new(doc);
-                self.autosaving = autosaving;
-                self.saving = saving;
-                self.colorize = colorize;
+                self.replace_document(doc);
                 if let Some(view) = load_view(path) {
                     self.restore_view(view);
                 }
+                self.remember_recent(path);
             }
-            Err(e) => self.message = Some(format!("cannot open {}: {e}", path.display())),
+            Err(e) => self.fail(format!("cannot open {}: {e}", path.display())),
         }
+    }
+
+    /// Starts a new, empty document in place of the current one (File → New, Ctrl+N).
+    pub fn new_document(&mut self) {
+        self.replace_document(Document::new());
+        self.message = Some("new document".into());
+    }
+
+    /// Puts `doc` in place of the current document, with a fresh view. What is not part of the
+    /// document carries over: colorize mode's line art and strokes, the recent files, the
+    /// message log, writes still under way.
+    fn replace_document(&mut self, doc: Document) {
+        let colorize = std::mem::take(&mut self.colorize);
+        let log = std::mem::take(&mut self.log);
+        let recent = std::mem::take(&mut self.recent);
+        let recent_file = self.recent_file.take();
+        // An autosave still being written stays watched, so a new one for the same file does
+        // not start beside it; a save still being written is reported when it is done.
+        let autosaving = self.autosaving.take();
+        let saving = self.saving.take().map(|saving| Saving {
+            this_document: false,
+            ..saving
+        });
+        let repaint = self.repaint.take();
+        *self = EditorApp::new(doc);
+        self.autosaving = autosaving;
+        self.saving = saving;
+        self.colorize = colorize;
+        self.log = log;
+        self.recent = recent;
+        self.recent_file = recent_file;
+        self.repaint = repaint;
     }
 
     /// What the view looks like now, for [`ViewState`]'s side file.
@@ -265,8 +248,10 @@ impl EditorApp {
             return format!("saving {}…", path.display());
         }
         if let Err(e) = self.doc.save(path) {
-            return e.to_string();
+            self.message_is_error = true;
+            return format!("cannot save {}: {e}", path.display());
         }
+        self.remember_recent(path);
         self.save_view(path)
     }
 
@@ -292,10 +277,14 @@ impl EditorApp {
         self.message = Some(match outcome {
             Ok(path) if saving.this_document => {
                 self.doc.saved(&saving.job);
+                self.remember_recent(&path);
                 self.save_view(&path)
             }
             Ok(path) => format!("saved {}", path.display()),
-            Err(e) => format!("cannot save {}: {e}", saving.job.target().display()),
+            Err(e) => {
+                self.message_is_error = true;
+                format!("cannot save {}: {e}", saving.job.target().display())
+            }
         });
     }
 
@@ -332,7 +321,7 @@ impl EditorApp {
         let job = match self.doc.render_job() {
             Ok(job) => job,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 return;
             }
         };
@@ -387,12 +376,30 @@ impl EditorApp {
         })
     }
 
+    /// File → Save (Ctrl+S): to the document's file; a document never saved asks where.
     pub(super) fn save(&mut self) {
         let Some(path) = self.save_target() else {
-            self.message = Some("type a .json file name in the File menu first".into());
+            self.message = Some("type a .json file name to save to first".into());
+            self.ask_path(super::file_menu::PathAction::SaveAs);
             return;
         };
         self.message = Some(self.save_to(&path));
+    }
+
+    /// File → Save as: a rig document is a `.json` file (a typed PNG path must never be
+    /// written over); the document takes the new path once it is written.
+    pub fn save_as(&mut self, path: &Path) {
+        if !path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            self.fail(format!(
+                "{}: a rig document is saved as a .json file",
+                path.display()
+            ));
+            return;
+        }
+        self.message = Some(self.save_to(path));
     }
 
     pub(super) fn autosave(&mut self, ctx: &egui::Context) {
@@ -404,7 +411,7 @@ impl EditorApp {
         }
         self.last_autosave_s = now;
         self.autosave_scribbles();
-        if self.doc.dirty && self.autosaving.is_none() {
+        if self.doc.dirty() && self.autosaving.is_none() {
             if let Some(path) = self.doc.path.clone() {
                 self.start_autosave(&path, ctx);
             }
@@ -428,7 +435,7 @@ impl EditorApp {
         };
         self.autosaving = None;
         if let Err(e) = outcome {
-            self.message = Some(format!("autosave failed: {e}"));
+            self.fail(format!("autosave failed: {e}"));
         }
     }
 
@@ -436,124 +443,4 @@ impl EditorApp {
     pub fn autosaving(&self) -> bool {
         self.autosaving.is_some()
     }
-}
-
-/// The fields of `sinew export spine`'s options.
-fn spine_options_ui(ui: &mut egui::Ui, options: &mut crate::export::spine::SpineOptions) {
-    use crate::export::spine::{BakeMode, SpineVersion};
-    egui::Grid::new("spine options").show(ui, |ui| {
-        ui.label("Spine version");
-        egui::ComboBox::from_id_salt("spine version")
-            .selected_text(format!("{:?}", options.version))
-            .show_ui(ui, |ui| {
-                for v in [SpineVersion::V4_1, SpineVersion::V4_2, SpineVersion::V4_3] {
-                    ui.selectable_value(&mut options.version, v, format!("{v:?}"));
-                }
-            });
-        ui.end_row();
-        ui.label("Bake");
-        egui::ComboBox::from_id_salt("spine bake")
-            .selected_text(format!("{:?}", options.bake))
-            .show_ui(ui, |ui| {
-                for b in [BakeMode::Auto, BakeMode::All] {
-                    ui.selectable_value(&mut options.bake, b, format!("{b:?}"));
-                }
-            });
-        ui.end_row();
-        ui.label("Bake keys per second");
-        ui.add(
-            egui::DragValue::new(&mut options.bake_fps)
-                .range(1.0..=crate::playback::MAX_FPS)
-                .speed(0.2),
-        );
-        ui.end_row();
-        optional_count(
-            ui,
-            "At most influences per vertex",
-            &mut options.max_influences,
-            4,
-            1..=16,
-        );
-        optional_count(
-            ui,
-            "At most vertices per mesh",
-            &mut options.max_vertices,
-            200,
-            3..=100_000,
-        );
-    });
-}
-
-/// A checkbox and a number for an optional limit (`None`: unchecked); `default` when checked.
-fn optional_count(
-    ui: &mut egui::Ui,
-    label: &str,
-    value: &mut Option<usize>,
-    default: usize,
-    range: std::ops::RangeInclusive<usize>,
-) {
-    ui.label(label);
-    ui.horizontal(|ui| {
-        let mut on = value.is_some();
-        let mut n = value.unwrap_or(default);
-        ui.checkbox(&mut on, "");
-        ui.add_enabled(on, egui::DragValue::new(&mut n).range(range));
-        *value = on.then_some(n);
-    });
-    ui.end_row();
-}
-
-/// The fields of `sinew render`'s options.
-fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderSettings) {
-    use crate::anim::CurveEvaluation;
-    egui::Grid::new("render settings").show(ui, |ui| {
-        ui.label("Frames per second");
-        ui.add(
-            egui::DragValue::new(&mut settings.fps)
-                .range(1.0..=crate::playback::MAX_FPS)
-                .speed(0.2),
-        );
-        ui.end_row();
-        ui.label("Scale (output px per canvas px)");
-        ui.add(
-            egui::DragValue::new(&mut settings.scale)
-                .range(RENDER_SCALE_RANGE.0..=RENDER_SCALE_RANGE.1)
-                .speed(0.01),
-        );
-        ui.end_row();
-        ui.label("Background");
-        ui.horizontal(|ui| {
-            let mut opaque = settings.background.is_some();
-            ui.checkbox(&mut opaque, "");
-            match (opaque, settings.background) {
-                (true, Some(mut rgba)) => {
-                    ui.color_edit_button_srgba_unmultiplied(&mut rgba);
-                    settings.background = Some(rgba);
-                }
-                (true, None) => settings.background = Some([255, 255, 255, 255]),
-                (false, _) => {
-                    settings.background = None;
-                    ui.label("transparent");
-                }
-            }
-        });
-        ui.end_row();
-        ui.label("Blend");
-        egui::ComboBox::from_id_salt("render blend")
-            .selected_text(format!("{:?}", settings.blend))
-            .show_ui(ui, |ui| {
-                for blend in [Blend::Linear, Blend::Dqs, Blend::Stretch] {
-                    ui.selectable_value(&mut settings.blend, blend, format!("{blend:?}"));
-                }
-            });
-        ui.end_row();
-        let mut spine = settings.sampling.curves == CurveEvaluation::SpineRuntime;
-        ui.checkbox(&mut spine, "Curves as Spine's runtimes play them");
-        settings.sampling.curves = if spine {
-            CurveEvaluation::SpineRuntime
-        } else {
-            CurveEvaluation::Exact
-        };
-        ui.end_row();
-    });
 }

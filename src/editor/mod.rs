@@ -11,7 +11,9 @@
 //! ([`colorize`]). The canvas ([`drawing`], helpers in [`canvas`]) draws a pose as `sinew
 //! render` does: posed through [`pose_mode::pose_frame`] (or [`crate::scene::Playhead`] at the
 //! playhead), drawn from the library's draw list
-//! ([`crate::playback::pose_draws`]) by its renderer. Files and the File menu are [`file`]'s.
+//! ([`crate::playback::pose_draws`]) by its renderer. Files are [`file`]'s; the File menu, its
+//! windows and its shortcuts [`file_menu`]'s; the status bar's messages and their log
+//! [`messages`]'.
 
 pub mod animate_mode;
 pub mod canvas;
@@ -19,8 +21,10 @@ pub mod closing;
 pub mod colorize;
 pub mod drawing;
 pub mod file;
+pub mod file_menu;
 pub mod gizmo;
 mod identity;
+pub mod messages;
 pub mod paint;
 pub mod pose_mode;
 pub mod rig_mode;
@@ -114,6 +118,16 @@ pub struct EditorApp {
     pub drawing: drawing::Drawing,
     /// The File menu's path field (rigs to open, PNGs to import, where to save).
     open_path: String,
+    /// The File menu's windows (typed paths, Export Spine, Render, New's question).
+    pub files: file_menu::FileWindows,
+    /// Recently opened or saved documents, newest first.
+    pub recent: Vec<PathBuf>,
+    /// Where the recent files are kept between runs (none: only in memory).
+    recent_file: Option<PathBuf>,
+    /// Every message so far, and when the latest appeared.
+    pub log: messages::MessageLog,
+    /// The message set this frame is an error (see [`EditorApp::fail`]).
+    message_is_error: bool,
     last_autosave_s: f64,
     /// The autosave being written on another thread (a document never rigged is traced and
     /// meshed to be saved, too slow for the UI thread on large images).
@@ -176,6 +190,11 @@ impl EditorApp {
             animate: animate_mode::AnimateMode::new(first_animation),
             drawing: Default::default(),
             open_path,
+            files: Default::default(),
+            recent: Vec::new(),
+            recent_file: None,
+            log: Default::default(),
+            message_is_error: false,
             last_autosave_s: 0.0,
             autosaving: None,
             saving: None,
@@ -209,7 +228,7 @@ impl EditorApp {
         match self.doc.apply(command) {
             Ok(()) => true,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 false
             }
         }
@@ -220,6 +239,8 @@ impl EditorApp {
         let started = Instant::now();
         let ctx = ui.ctx().clone();
         self.repaint = Some(ctx.clone());
+        let now_s = ctx.input(|i| i.time);
+        self.log_message(now_s);
         self.dialog_takes_input(&ctx);
         self.poll_worker();
         self.poll_render();
@@ -227,6 +248,8 @@ impl EditorApp {
         self.warm_ik();
         self.colorize_frame_start(&ctx);
         self.dropped_files(&ctx);
+        // Ctrl+N/O/S first: they take their key events, which no other shortcut then sees.
+        self.file_shortcuts(&ctx);
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
@@ -244,8 +267,11 @@ impl EditorApp {
         if self.show_help {
             help_window(&ctx, &mut self.show_help);
         }
+        self.file_windows(&ctx);
+        self.log_window(&ctx);
         self.close_dialog(&ctx);
         self.take_screenshot(&ctx);
+        self.log_message(now_s);
         self.last_frame_ms = started.elapsed().as_secs_f64() * 1e3;
     }
 
@@ -269,27 +295,21 @@ impl EditorApp {
 
     fn shortcuts(&mut self, ctx: &egui::Context) {
         let typing = ctx.text_edit_focused();
-        let (animate, space) = ctx.input(|i| {
-            (
-                !typing && i.key_pressed(Key::Num3),
-                !typing && i.key_pressed(Key::Space),
-            )
-        });
-        if animate {
+        // Each key event with its own modifiers: Ctrl+3 is not 3.
+        let plain = |key: Key| !typing && ctx.input(|i| file_menu::plain_key(i, key));
+        if plain(Key::Num3) {
             self.mode = Mode::Animate;
         }
-        if space && self.mode == Mode::Animate {
-            self.animate.playing = !self.animate.playing;
+        if plain(Key::Space) && self.mode == Mode::Animate {
+            self.toggle_playback();
         }
-        let (undo, redo, delete, rig, pose, help, escape) = ctx.input_mut(|i| {
+        let (delete, rig, pose) = (plain(Key::Delete), plain(Key::Num1), plain(Key::Num2));
+        let (undo, redo, help, escape) = ctx.input_mut(|i| {
             let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
             let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
             (
                 undo,
                 redo,
-                !typing && i.key_pressed(Key::Delete),
-                !typing && i.key_pressed(Key::Num1),
-                !typing && i.key_pressed(Key::Num2),
                 i.key_pressed(Key::F1) || (!typing && i.key_pressed(Key::Questionmark)),
                 i.key_pressed(Key::Escape),
             )
@@ -326,7 +346,7 @@ impl EditorApp {
 
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
-            ui.menu_button("File", |ui| self.file_menu(ui));
+            self.file_menu_button(ui);
             if ui
                 .add_enabled(self.can_undo_in_mode(), egui::Button::new("Undo"))
                 .clicked()
@@ -358,14 +378,12 @@ impl EditorApp {
                 "{} layers, {} handles{}",
                 state.layers.len(),
                 state.handles.names().count(),
-                if self.doc.dirty { ", modified" } else { "" }
+                if self.doc.dirty() { ", modified" } else { "" }
             ));
             ui.separator();
             ui.label(format!("frame {:.1} ms", self.last_frame_ms));
-            if let Some(message) = &self.message {
-                ui.separator();
-                ui.label(message);
-            }
+            ui.separator();
+            self.message_ui(ui);
         });
     }
 
@@ -456,6 +474,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "rig mode / pose mode / animate mode / colorize mode",
     ),
     ("Space", "play or pause (animate mode)"),
+    ("Ctrl+N", "new document"),
+    ("Ctrl+O", "open a rig"),
+    ("Ctrl+S", "save"),
+    ("Ctrl+Shift+S", "save as"),
     ("Ctrl+Z", "undo"),
     ("Ctrl+Shift+Z", "redo"),
     (
@@ -513,6 +535,17 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         None => Document::new(),
     };
     let mut app = EditorApp::new(doc);
+    // Recent files live in the user's configuration folder (XDG), when there is one.
+    let config = std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .filter(|p| p.is_absolute())
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")));
+    if let Some(config) = config {
+        app.keep_recent_in(config.join("sinew").join("recent.json"));
+    }
+    if let Some(path) = &start.rig {
+        app.remember_recent(path);
+    }
     if let Some(view) = start.rig.as_deref().and_then(load_view) {
         app.restore_view(view);
     }

@@ -84,7 +84,7 @@ impl EditorApp {
         let (_, _, locked) = match part_weights_for_painting(self.doc.state(), &part) {
             Ok(found) => found,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 return None;
             }
         };
@@ -103,7 +103,7 @@ impl EditorApp {
         let mesh = match PaintMesh::new(&part_doc.mesh.vertices, &part_doc.mesh.triangles) {
             Ok(mesh) => mesh,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 return None;
             }
         };
@@ -129,7 +129,7 @@ impl EditorApp {
         let dabs = match dab_centres(&stroke.samples_px, &self.paint.options) {
             Ok(dabs) => dabs,
             Err(e) => {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 return;
             }
         };
@@ -146,7 +146,7 @@ impl EditorApp {
                 centre,
                 &self.paint.options,
             ) {
-                self.message = Some(e.to_string());
+                self.fail(e.to_string());
                 return;
             }
         }

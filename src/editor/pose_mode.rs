@@ -242,7 +242,7 @@ impl EditorApp {
             match shown_position(scene, rest, &posed.transforms) {
                 Ok(shown) => Some((rest, shown)),
                 Err(e) => {
-                    app.message = Some(e);
+                    app.fail(e);
                     None
                 }
             }
@@ -341,6 +341,7 @@ impl EditorApp {
             if let Some(at) = pointer {
                 if let Err(e) = g.update(handles, placed.canvas_from_screen(at)) {
                     self.message = Some(e.to_string());
+                    self.message_is_error = true;
                 }
             }
             let (confirm, cancel) = if g.modal {
@@ -371,7 +372,15 @@ impl EditorApp {
                 (Key::S, gizmo::FkKind::Scale),
             ]
             .into_iter()
-            .find(|(k, _)| !typing && i.modifiers.is_none() && i.key_pressed(*k))
+            // The key event's own modifiers: a quick Ctrl+S has released Ctrl by the end
+            // of the frame, and must not scale.
+            .find(|(k, _)| {
+                !typing
+                    && i.events.iter().any(|e| {
+                        matches!(e, egui::Event::Key { key, pressed: true, modifiers, .. }
+                            if key == k && modifiers.is_none())
+                    })
+            })
             .map(|(_, kind)| kind)
         });
         let pressed = if response.drag_started_by(egui::PointerButton::Primary) {
@@ -398,7 +407,7 @@ impl EditorApp {
             modal,
         ) {
             Ok(g) => self.gesture = Some(Gesture::Fk(Box::new(g))),
-            Err(e) => self.message = Some(e.to_string()),
+            Err(e) => self.fail(e.to_string()),
         }
         true
     }

@@ -130,7 +130,7 @@ impl EditorApp {
                     }
                 }
                 Err(DocumentError::Cancelled) => self.message = Some("cancelled".into()),
-                Err(e) => self.message = Some(e.to_string()),
+                Err(e) => self.fail(e.to_string()),
             }
         }
     }

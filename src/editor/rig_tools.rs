@@ -327,7 +327,7 @@ impl EditorApp {
                 }
                 Ok(Err(e)) => {
                     self.rig_tools.autorig_job = None;
-                    self.message = Some(format!("automatic rig: {e}"));
+                    self.fail(format!("automatic rig: {e}"));
                 }
                 Err(std::sync::mpsc::TryRecvError::Empty) => {}
                 Err(std::sync::mpsc::TryRecvError::Disconnected) => {

@@ -234,7 +234,7 @@ impl EditorApp {
         let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
         match edit::copy_keys(&animation, &self.timeline.selection) {
             Ok(keys) => self.timeline.clipboard = keys,
-            Err(e) => self.message = Some(e.to_string()),
+            Err(e) => self.fail(e.to_string()),
         }
     }
 
@@ -277,15 +277,16 @@ impl EditorApp {
     pub(super) fn animate_panel(&mut self, ui: &mut egui::Ui) {
         let frame_s = self.frame_s();
         ui.horizontal(|ui| {
-            ui.label("Animation");
-            ui.add(egui::TextEdit::singleline(&mut self.animate.animation).desired_width(120.0));
+            let label = ui.label("Animation");
+            ui.add(egui::TextEdit::singleline(&mut self.animate.animation).desired_width(120.0))
+                .labelled_by(label.id);
             let play = if self.animate.playing {
                 "Pause"
             } else {
                 "Play"
             };
             if ui.button(play).clicked() {
-                self.animate.playing = !self.animate.playing;
+                self.toggle_playback();
             }
             ui.checkbox(&mut self.timeline.looping, "Loop");
             if ui.button("Previous frame").clicked() {
@@ -311,15 +312,7 @@ impl EditorApp {
                 self.set_time(t);
             }
             if ui.button("Set key").clicked() {
-                let pose = self.edited_pose();
-                let animation = self.animate.animation.clone();
-                if self.apply(Command::SetKey {
-                    animation,
-                    time_s: self.animate.time_s,
-                    pose,
-                }) {
-                    self.animate.shown = None;
-                }
+                self.set_key();
             }
             if ui.button("Delete key").clicked() {
                 let animation = self.animate.animation.clone();

@@ -371,3 +371,58 @@ fn a_segment_and_its_linear_bezier_play_alike() {
 fn segment_error(walk: &Animation) -> Result<Segment, EditError> {
     segment(walk, &key(&rotate("arm"), 2.0))
 }
+
+#[test]
+fn a_key_put_inside_an_eased_segment_leaves_the_motion_unchanged() {
+    use crate::anim::sample::sample_keys;
+    let eased = vec![
+        Key {
+            time: 0.0,
+            value: [0.0, 0.0],
+            curve: Curve::Bezier(vec![0.6, 0.0, 0.7, 40.0, 0.2, -5.0, 0.9, 30.0]),
+        },
+        Key {
+            time: 1.0,
+            value: [40.0, 20.0],
+            curve: Curve::Linear,
+        },
+    ];
+    let mut keys = eased.clone();
+    let at = 0.35;
+    let value = sample_keys(&keys, at).unwrap();
+    put_key(&mut keys, at, value);
+    assert_eq!(keys.len(), 3);
+    // The result is a valid timeline (handles inside their segments), and plays the same.
+    let animation = Animation {
+        bones: [(
+            "arm".to_string(),
+            crate::anim::BoneTimelines {
+                translate: Some(keys.clone()),
+                ..Default::default()
+            },
+        )]
+        .into(),
+        ..Default::default()
+    };
+    animation.validate("eased").unwrap();
+    for k in 0..=100 {
+        let t = k as f64 / 100.0;
+        let (a, b) = (
+            sample_keys(&eased, t).unwrap(),
+            sample_keys(&keys, t).unwrap(),
+        );
+        assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9, "{t}: {a:?} {b:?}");
+    }
+    // A different value moves the curve there, and only near the new key.
+    let mut moved = eased.clone();
+    put_key(&mut moved, at, [value[0] + 5.0, value[1]]);
+    let b = sample_keys(&moved, at).unwrap();
+    assert!((b[0] - value[0] - 5.0).abs() < 1e-9);
+    assert_eq!(sample_keys(&moved, 1.0), sample_keys(&eased, 1.0));
+    // On an existing key it replaces the value; after the last one it appends a linear key.
+    put_key(&mut moved, 1.0, [1.0, 2.0]);
+    put_key(&mut moved, 2.0, [3.0, 4.0]);
+    assert_eq!(moved.len(), 4);
+    assert_eq!(moved[2].value, [1.0, 2.0]);
+    assert_eq!(moved[3].curve, Curve::Linear);
+}

@@ -1,0 +1,263 @@
+//! The File menu, its windows and its shortcuts, driven by input events only: clicks on
+//! widgets found by their label, typed text, keys with modifiers.
+
+use super::*;
+
+fn scratch(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()))
+}
+
+#[test]
+fn the_file_menus_field_takes_a_click_and_typing_and_imports_a_png() {
+    let dir = scratch("menu-field");
+    let png = bar_png(&dir);
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+    h.get_by_label("File").click();
+    h.run();
+    // A click into the field keeps the menu open (its buttons are still there) and the field
+    // takes the typing.
+    type_into(&mut h, "Rig or PNG path:", &png.display().to_string());
+    assert_eq!(
+        h.get_by_label("Rig or PNG path:").value().as_deref(),
+        Some(png.display().to_string().as_str())
+    );
+    h.get_by_label("Import layer").click();
+    h.run();
+    assert_eq!(
+        h.state().doc.state().layers.len(),
+        1,
+        "{:?}",
+        h.state().message
+    );
+    // The action closed the menu.
+    assert!(h.query_by_label("Import layer").is_none());
+    // The modified document shows so; typing S in a field never reaches a shortcut.
+    h.get_by_label_contains("modified");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_layers() {
+    let dir = scratch("shortcuts");
+    let png = bar_png(&dir);
+    let json = dir.join("bar.json");
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+
+    // An empty document cannot be saved: the save says why and writes nothing.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    h.get_by_label("Save to this path");
+    type_into(&mut h, "Path:", &dir.join("empty.json").display().to_string());
+    h.key_press(Key::Enter);
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("no layers to save"), "{message}");
+    assert!(!dir.join("empty.json").exists());
+    assert!(h.state().log.errors() >= 1);
+
+    // Import through File → Import layer…, the path typed in its window.
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Import layer…").click();
+    h.run();
+    type_into(&mut h, "Path:", &png.display().to_string());
+    h.get_by_label("Import").click();
+    h.run();
+    assert_eq!(h.state().doc.state().layers.len(), 1);
+    assert!(h.state().doc.dirty());
+
+    // Ctrl+S on a document never saved asks where (a PNG path is refused), then saves there.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    type_into(&mut h, "Path:", &png.display().to_string());
+    h.key_press(Key::Enter);
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains(".json"), "{message}");
+    assert!(crate::io::load_png(&png).is_ok(), "the PNG was written over");
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::S);
+    h.run();
+    type_into(&mut h, "Path:", &json.display().to_string());
+    h.key_press(Key::Enter);
+    h.run();
+    wait_for(&mut h, |app| !app.saving());
+    assert_eq!(h.state().doc.path.as_deref(), Some(json.as_path()));
+    assert!(!h.state().doc.dirty(), "{:?}", h.state().message);
+    assert!(json.is_file());
+    assert_eq!(h.state().recent.first(), Some(&json));
+
+    // Ctrl+N: a clean document starts over at once.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::N);
+    h.run();
+    assert!(h.state().doc.path.is_none());
+    assert_eq!(h.state().doc.state().layers.len(), 0);
+
+    // Ctrl+O: the path window; Open.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::O);
+    h.run();
+    type_into(&mut h, "Path:", &json.display().to_string());
+    h.get_by_label("Open").click();
+    h.run();
+    assert_eq!(h.state().doc.path.as_deref(), Some(json.as_path()));
+    assert_eq!(h.state().doc.state().layers.len(), 1);
+
+    // A modified document asks before Ctrl+N throws it away.
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Import layer…").click();
+    h.run();
+    type_into(&mut h, "Path:", &png.display().to_string());
+    h.get_by_label("Import").click();
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("already exists"), "{message}");
+    h.key_press(Key::Num1);
+    h.get_by_label("Point").click();
+    h.run();
+    click(&mut h, [40.0, 24.0]);
+    assert!(h.state().doc.dirty());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::N);
+    h.run();
+    h.get_by_label("Keep editing").click();
+    h.run();
+    assert_eq!(h.state().doc.path.as_deref(), Some(json.as_path()));
+    h.key_press_modifiers(Modifiers::COMMAND, Key::N);
+    h.run();
+    h.get_by_label("Discard and start new").click();
+    h.run();
+    assert!(h.state().doc.path.is_none());
+    // Undoing back to the saved state is clean again (after reopening, then one edit).
+    h.key_press_modifiers(Modifiers::COMMAND, Key::O);
+    h.run();
+    type_into(&mut h, "Path:", &json.display().to_string());
+    h.key_press(Key::Enter);
+    h.run();
+    h.get_by_label("Point").click();
+    h.run();
+    click(&mut h, [40.0, 24.0]);
+    assert!(h.state().doc.dirty());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(!h.state().doc.dirty());
+    assert!(h.query_by_label_contains("modified").is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_quick_ctrl_s_in_pose_mode_saves_and_never_scales() {
+    let mut h = open_character("ctrl-s");
+    let path = h.state().doc.path.clone().expect("a file");
+    h.key_press(Key::Num2);
+    h.run();
+    click(&mut h, [256.0, 225.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    h.hover_at(screen(&h, [300.0, 240.0]));
+    h.step();
+    // Ctrl down, S down and up, Ctrl up, all within one frame (as a quick press arrives from
+    // the window system; the harness' own chord spreads them over frames).
+    let key = |pressed| egui::Event::Key {
+        key: Key::S,
+        physical_key: None,
+        pressed,
+        repeat: false,
+        modifiers: Modifiers::COMMAND,
+    };
+    h.input_mut().events.extend([
+        egui::Event::ModifiersChanged(Modifiers::COMMAND),
+        key(true),
+        key(false),
+        egui::Event::ModifiersChanged(Modifiers::NONE),
+    ]);
+    h.step();
+    h.hover_at(screen(&h, [330.0, 260.0]));
+    h.step();
+    h.run();
+    assert!(h.state().gesture.is_none(), "Ctrl+S started a scale");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert_eq!(message, format!("saved {}", path.display()));
+    // S alone still scales.
+    h.key_press(Key::S);
+    h.step();
+    assert!(matches!(h.state().gesture, Some(Gesture::Fk(_))));
+    h.key_press(Key::Escape);
+    h.run();
+}
+
+#[test]
+fn messages_expire_from_the_status_bar_and_errors_stay_in_the_log() {
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::O);
+    h.run();
+    type_into(&mut h, "Path:", "/nonexistent/rig.json");
+    h.key_press(Key::Enter);
+    h.run();
+    let message = h.state().message.clone().expect("an error");
+    h.get_by_label(&message);
+    // Frames go by (the harness' clock): the status bar lets it go, the log keeps it.
+    for _ in 0..((messages::MESSAGE_SHOWN_S + 1.0) * 60.0) as usize {
+        h.step();
+    }
+    h.run();
+    assert!(h.query_by_label(&message).is_none());
+    h.get_by_label("Log (1 errors)").click();
+    h.run();
+    h.get_by_label_contains("/nonexistent/rig.json");
+}
+
+/// A file dropped on the window, as the window system hands it to egui.
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn an_empty_canvas_asks_for_images_and_takes_a_dropped_png() {
+    let dir = scratch("drop");
+    let png = bar_png(&dir);
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+    h.get_by_label(drawing::DROP_HINT);
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(png.clone())));
+    h.run();
+    assert_eq!(h.state().doc.state().layers.len(), 1, "{:?}", h.state().message);
+    assert!(h.query_by_label(drawing::DROP_HINT).is_none());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn export_spine_from_its_window_refuses_to_write_over_the_document() {
+    let mut h = open_character("export-window");
+    let path = h.state().doc.path.clone().expect("a file");
+    let dir = path.parent().expect("a folder").to_path_buf();
+    let before = std::fs::read(&path).expect("the document");
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Export Spine…").click();
+    h.run();
+    // Into the document's own folder, the export's character.json would be the document.
+    type_into(&mut h, "Export folder:", &dir.display().to_string());
+    h.get_by_label("Export").click();
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("would overwrite an input"), "{message}");
+    assert_eq!(std::fs::read(&path).expect("the document"), before);
+    let spine = dir.join("spine");
+    type_into(&mut h, "Export folder:", &spine.display().to_string());
+    h.get_by_label("Export").click();
+    h.run();
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("exported"), "{message}");
+    assert!(spine.join("character.json").is_file());
+}

@@ -1,0 +1,119 @@
+//! The rules every shell follows before it writes: an output never names an input (a sprite
+//! written over with rig JSON, say) nor another output, and lies in a folder that exists. The
+//! CLI checks its outputs with these before any work; the editor's exports check theirs with
+//! the same functions.
+
+use std::path::{Path, PathBuf};
+
+/// Why the outputs cannot be written; nothing was written.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum OutputError {
+    #[error("{}: cannot write there: folder {} does not exist", .path.display(), .folder.display())]
+    MissingFolder { path: PathBuf, folder: PathBuf },
+    #[error("{}: the output would overwrite an input", .0.display())]
+    OverwritesInput(PathBuf),
+    #[error("{}: two outputs name the same file", .0.display())]
+    SameOutput(PathBuf),
+}
+
+/// The file `path` names, resolved through links when it (or its folder) exists.
+pub fn resolved(path: &Path) -> PathBuf {
+    if let Ok(p) = path.canonicalize() {
+        return p;
+    }
+    match (
+        path.parent().map(|d| {
+            if d.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                d
+            }
+        }),
+        path.file_name(),
+    ) {
+        (Some(dir), Some(name)) => dir
+            .canonicalize()
+            .map(|d| d.join(name))
+            .unwrap_or_else(|_| path.to_path_buf()),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// The folder `path` is in (`.` for a bare file name).
+pub fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+/// Fails, before any work, when an output file names an input or another output, or lies in
+/// a folder that does not exist (the outputs written before it would be left behind). Absent
+/// (`None`) outputs are skipped; output folders, which the commands make where missing, are
+/// not passed here.
+pub fn check_outputs<'a>(
+    inputs: impl IntoIterator<Item = &'a Path>,
+    outputs: impl IntoIterator<Item = Option<&'a Path>> + Clone,
+) -> Result<(), OutputError> {
+    for output in outputs.clone().into_iter().flatten() {
+        let folder = parent_dir(output);
+        if !folder.as_os_str().is_empty() && !folder.is_dir() {
+            return Err(OutputError::MissingFolder {
+                path: output.to_path_buf(),
+                folder: folder.to_path_buf(),
+            });
+        }
+    }
+    check_not_overwriting(inputs, outputs)
+}
+
+/// Fails when an output file names an input or another output.
+pub fn check_not_overwriting<'a>(
+    inputs: impl IntoIterator<Item = &'a Path>,
+    outputs: impl IntoIterator<Item = Option<&'a Path>>,
+) -> Result<(), OutputError> {
+    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for output in outputs.into_iter().flatten() {
+        let at = resolved(output);
+        if inputs.contains(&at) {
+            return Err(OutputError::OverwritesInput(output.to_path_buf()));
+        }
+        if seen.contains(&at) {
+            return Err(OutputError::SameOutput(output.to_path_buf()));
+        }
+        seen.push(at);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_output_naming_an_input_or_another_output_is_refused() {
+        let dir = std::env::temp_dir().join(format!("sinew-outputs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let input = dir.join("in.png");
+        std::fs::write(&input, b"x").unwrap();
+        let other = dir.join("out.json");
+        // The same file through another spelling is still the input.
+        let spelled = dir.join(".").join("in.png");
+        assert_eq!(
+            check_outputs([input.as_path()], [Some(spelled.as_path())]),
+            Err(OutputError::OverwritesInput(spelled.clone()))
+        );
+        assert_eq!(
+            check_outputs([input.as_path()], [Some(other.as_path()), Some(other.as_path())]),
+            Err(OutputError::SameOutput(other.clone()))
+        );
+        let missing = dir.join("nowhere/out.json");
+        assert!(matches!(
+            check_outputs([input.as_path()], [Some(missing.as_path())]),
+            Err(OutputError::MissingFolder { .. })
+        ));
+        assert_eq!(check_outputs([input.as_path()], [Some(other.as_path()), None]), Ok(()));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
