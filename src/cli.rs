@@ -504,7 +504,8 @@ fn check_outputs<'a>(
     outputs: impl IntoIterator<Item = Option<&'a Path>> + Clone,
 ) -> Result<()> {
     for output in outputs.clone().into_iter().flatten() {
-        let folder = parent_dir(output);
+        let target = check_output_kind(output, io::atomic::OutputKind::File)?;
+        let folder = parent_dir(&target);
         if !folder.as_os_str().is_empty() && !folder.is_dir() {
             bail!(
                 "{}: cannot write there: folder {} does not exist",
@@ -514,6 +515,14 @@ fn check_outputs<'a>(
         }
     }
     check_not_overwriting(inputs, outputs)
+}
+
+/// Fails when `output` exists and is not of `kind` (a named pipe or a device given as a file,
+/// a file given as a frame folder; symbolic links are followed, as writes go through them).
+/// Returns the path a write replaces.
+fn check_output_kind(output: &Path, kind: io::atomic::OutputKind) -> Result<PathBuf> {
+    io::atomic::resolve_output(output, kind)
+        .with_context(|| format!("{}: cannot write", output.display()))
 }
 
 /// Fails when an output file names an input or another output.
@@ -719,6 +728,9 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
             vec![args.output.clone(), args.output.with_extension("json")]
         }
     };
+    if files.is_empty() {
+        check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
+    }
     let images = part_images(&args.rig, &scene.doc);
     check_outputs(
         std::iter::once(args.rig.as_path()).chain(images.iter().map(PathBuf::as_path)),
@@ -969,7 +981,12 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
         .map(|file| args.output.join(file))
         .collect();
     let sprites = part_images(&args.rig, &scene.doc);
-    // The export folder is made where missing: only the overwriting is checked.
+    // The export folder is made where missing: only what is there and the overwriting are
+    // checked.
+    check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
+    for target in &targets {
+        check_output_kind(target, io::atomic::OutputKind::File)?;
+    }
     check_not_overwriting(
         std::iter::once(args.rig.as_path()).chain(sprites.iter().map(PathBuf::as_path)),
         targets.iter().map(|t| Some(t.as_path())),
