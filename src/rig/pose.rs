@@ -467,8 +467,21 @@ mod tests {
             far.bones.insert("upper".into(), local);
             assert_eq!(
                 handle_transforms(&arm(), &far).err(),
-                Some(PoseError::OutOfRange("upper".into()))
+                Some(PoseError::TooLarge("upper".into(), 1e300))
             );
         }
+        // Within the numbers' limit, but the posed transformation goes beyond its own.
+        let mut far = Pose::default();
+        far.bones.insert(
+            "upper".into(),
+            BonePose {
+                scale: [MAX_POSE_VALUE, 1.0],
+                ..Default::default()
+            },
+        );
+        assert_eq!(
+            handle_transforms(&arm(), &far).err(),
+            Some(PoseError::OutOfRange("upper".into()))
+        );
     }
 }
