@@ -26,7 +26,7 @@ use crate::rig::{Handles, Pose};
 use schemars::{json_schema, JsonSchema, Schema, SchemaGenerator};
 use serde::Serialize;
 use std::borrow::Cow;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A file kind with a schema.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -187,6 +187,10 @@ struct IkOptionsSchema {
     iterations: usize,
     cold_iterations: usize,
     tolerance_px: f64,
+    bones: crate::ik::BoneDofs,
+    /// Bones that may scale uniformly when `bones` is rigid.
+    #[serde(skip_serializing_if = "BTreeSet::is_empty")]
+    stretch: BTreeSet<String>,
     rigidity: f64,
     region_rigidity: f64,
     allow_uniform_scale: bool,
@@ -224,6 +228,8 @@ impl From<IkOptions> for IkOptionsSchema {
             iterations,
             cold_iterations,
             tolerance_px,
+            bones,
+            stretch,
             rigidity,
             region_rigidity,
             allow_uniform_scale,
@@ -247,6 +253,8 @@ impl From<IkOptions> for IkOptionsSchema {
             iterations,
             cold_iterations,
             tolerance_px,
+            bones,
+            stretch,
             rigidity,
             region_rigidity,
             allow_uniform_scale,

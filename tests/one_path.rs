@@ -142,3 +142,37 @@ fn frames_with_momentum_do_not_depend_on_the_frame_rate() {
         "momentum left the tail where FK puts it ({lagged} px)"
     );
 }
+
+#[test]
+fn no_bone_changes_length_under_ik_in_the_bundled_animations() {
+    // Bones are rigid under the skinning IK (the rig allows no stretch): every bone's linear
+    // part has the singular values forward kinematics gives it, in every frame of every
+    // bundled animation, while the IK moves bones away from forward kinematics.
+    let scene = common::character_scene();
+    let bones = scene.doc.handles.bones.len();
+    let mut moved_by_ik = 0;
+    for (name, animation) in animations() {
+        let times = playback::frame_times(animation.duration_s(), 30.0).expect("frame times");
+        let frames = sinew::scene::frames(&scene, &animation, &times, PlayOptions::default())
+            .expect("plays");
+        let mut worst = 0.0_f64;
+        for frame in &frames {
+            let mut fk_pose = frame.pose.clone();
+            fk_pose.ik.clear();
+            let fk = scene.handle_transforms(&fk_pose).expect("fk");
+            for (solved, fk) in frame.transforms[..bones].iter().zip(&fk[..bones]) {
+                let (s, f) = (
+                    solved.linear.svd(false, false).singular_values,
+                    fk.linear.svd(false, false).singular_values,
+                );
+                worst = worst.max((s[0] - f[0]).abs()).max((s[1] - f[1]).abs());
+                if (solved.linear - fk.linear).norm() > 1e-3 {
+                    moved_by_ik += 1;
+                }
+            }
+        }
+        println!("{name}: bone scales differ from forward kinematics by {worst:.1e} at most");
+        assert!(worst < 1e-9, "{name}: a bone changed length by {worst}");
+    }
+    assert!(moved_by_ik > 0, "no animation turns a bone by IK");
+}

@@ -17,8 +17,10 @@
 //! targets: [`FastIk`] keeps it while only targets change, so a drag in the editor costs a few
 //! small dense products per iteration. The last solution warm-starts the next.
 //!
-//! Rigid handles (regions always, bones when [`IkOptions::rigidity`] asks) are held near
-//! rotations by a penalty λ‖L − R‖² (R the nearest rotation, refreshed in every local step); λ is
+//! Rigid columns ([`ColumnDofs::Rigid`]: bones by default) are rotations exactly: a problem
+//! with one is solved by the coupled Gauss–Newton global step of [`super::rigid`] instead of the
+//! factorized one. Near-rigid handles (regions always, affine bones when
+//! [`IkOptions::rigidity`] asks) are held near rotations by a penalty λ‖L − R‖² (R the nearest rotation, refreshed in every local step); λ is
 //! the column's rigidity times its own stiffness in A, so the term is unit-free. Hard constraints
 //! are met exactly whenever they are feasible; infeasible ones are met in the least-squares sense.
 //!
@@ -29,6 +31,7 @@
 
 use super::arap::{best_rotation, nearest_rotation};
 use super::fold::FoldCheck;
+use super::rigid::CoupledStep;
 use super::subspace::Subspace;
 use super::{IkError, IkOptions};
 use crate::rig::pose::Affine;
@@ -44,8 +47,14 @@ pub enum ColumnDofs {
     Affine { rigidity: f64 },
     /// Translation only, the linear part held at `linear`.
     Translation { linear: Matrix2<f64> },
-    /// `T_parent ∘ local`, where `parent` is an `Affine` column (a keyed bone under a free one).
+    /// `T_parent ∘ local`, where `parent` is an `Affine` or `Rigid` column (a keyed bone under
+    /// a free one).
     Follows { parent: usize, local: Affine },
+    /// A rotation and a translation, exactly (a bone that keeps its length), turning about
+    /// `pivot` (rest canvas px, e.g. the bone's head: only the solver's conditioning depends on
+    /// it); `scale`: it may also scale uniformly (a bone allowed to stretch). Solved by the
+    /// coupled step of [`super::rigid`].
+    Rigid { pivot: [f64; 2], scale: bool },
 }
 
 /// The point `at` (rest canvas px) moves with `child` and with `parent` alike.
@@ -145,6 +154,11 @@ struct System {
     guard: Vec<Guard>,
     /// Per guarded triangle: X Pᵀ λ Uᵀ (nz × 2), times its cluster's Rᵀ gives its share of z.
     x_pt_guard: Vec<DMatrix<f64>>,
+    /// Per guarded triangle: Uᵀ λ (3m × 2), for the coupled step.
+    guard_rhs: Vec<DMatrix<f64>>,
+    /// The coupled global step, when the problem has rigid columns (then P, X, Y and the
+    /// products with them are empty).
+    coupled: Option<CoupledStep>,
 }
 
 /// A triangle held near its cluster's rotation: λ‖J − R‖²_F (see [`super::fold`]).
@@ -184,6 +198,8 @@ pub struct FastIk {
     guard: Vec<Guard>,
     system: Option<System>,
     previous: Option<DMatrix<f64>>,
+    /// The solver of the relaxed problem that starts a cold rigid solve ([`FastIk::relaxed_start`]).
+    relaxed: Option<Box<FastIk>>,
 }
 
 fn affine_to_rows(t: &Affine, out: &mut DMatrix<f64>, j: usize) {
@@ -231,6 +247,7 @@ impl FastIk {
             guard: Vec::new(),
             system: None,
             previous: None,
+            relaxed: None,
         }
     }
 
@@ -272,7 +289,8 @@ impl FastIk {
             });
         }
         let dim = 3 * m;
-        // Offsets of free parameters.
+        let coupled_needed = CoupledStep::needed(&problem.columns);
+        // Offsets of free parameters (of the factorized step).
         let mut offset = vec![usize::MAX; m];
         let mut nz = 0;
         for (j, c) in problem.columns.iter().enumerate() {
@@ -285,8 +303,11 @@ impl FastIk {
                     offset[j] = nz;
                     nz += 1;
                 }
-                ColumnDofs::Fixed(_) | ColumnDofs::Follows { .. } => {}
+                ColumnDofs::Fixed(_) | ColumnDofs::Follows { .. } | ColumnDofs::Rigid { .. } => {}
             }
+        }
+        if coupled_needed {
+            nz = 0;
         }
         let mut p = DMatrix::<f64>::zeros(dim, nz);
         let mut rigid = Vec::new();
@@ -295,8 +316,10 @@ impl FastIk {
         for (j, c) in problem.columns.iter().enumerate() {
             match c {
                 ColumnDofs::Affine { rigidity } => {
-                    for k in 0..3 {
-                        p[(3 * j + k, offset[j] + k)] = 1.0;
+                    if !coupled_needed {
+                        for k in 0..3 {
+                            p[(3 * j + k, offset[j] + k)] = 1.0;
+                        }
                     }
                     if *rigidity > 0.0 {
                         let stiffness = 0.5 * (a[(3 * j, 3 * j)] + a[(3 * j + 1, 3 * j + 1)]);
@@ -306,7 +329,12 @@ impl FastIk {
                         rigid.push((j, offset[j], lambda));
                     }
                 }
-                ColumnDofs::Translation { .. } => p[(3 * j + 2, offset[j])] = 1.0,
+                ColumnDofs::Translation { .. } if !coupled_needed => {
+                    p[(3 * j + 2, offset[j])] = 1.0
+                }
+                // The coupled step parametrizes these itself.
+                ColumnDofs::Translation { .. } | ColumnDofs::Rigid { .. } => {}
+                ColumnDofs::Follows { .. } if coupled_needed => {}
                 ColumnDofs::Follows { parent, local } => {
                     let pj = *parent;
                     if !matches!(problem.columns.get(pj), Some(ColumnDofs::Affine { .. })) {
@@ -380,6 +408,26 @@ impl FastIk {
             guard_rhs.push(u.transpose() * g.lambda);
         }
         let e_t = DMatrix::from_fn(hard.len(), dim, |r, c| hard[r][c]);
+        if coupled_needed {
+            let coupled = CoupledStep::new(&problem.columns, &q_t, &e_t)?;
+            return Ok(System {
+                problem: problem.clone(),
+                x: DMatrix::zeros(0, 0),
+                y: DMatrix::zeros(0, e_t.nrows()),
+                x_pt_b: DMatrix::zeros(0, self.subspace.b.ncols()),
+                p,
+                q_t,
+                e_t,
+                rigid,
+                anchor_weight,
+                energy_per_gram,
+                column_hold,
+                guard: guard.to_vec(),
+                x_pt_guard: Vec::new(),
+                guard_rhs,
+                coupled: Some(coupled),
+            });
+        }
         let h = p.tr_mul(&(&q_t * &p));
         let e = &e_t * &p;
         // Null-space method: z = z_p + N y with E z_p = e in the least-squares sense.
@@ -415,6 +463,8 @@ impl FastIk {
             column_hold,
             guard: guard.to_vec(),
             x_pt_guard,
+            guard_rhs,
+            coupled: None,
         })
     }
 
@@ -441,6 +491,9 @@ impl FastIk {
                 prev.clone(),
                 warm_iterations.unwrap_or(self.options.iterations),
             ),
+            _ if CoupledStep::needed(&problem.columns) => {
+                (self.relaxed_start(problem)?, self.options.cold_iterations)
+            }
             _ => (stack(&problem.anchor), self.options.cold_iterations),
         };
         let mut iterations = 0;
@@ -489,6 +542,45 @@ impl FastIk {
         })
     }
 
+    /// A cold start for a problem with rigid columns: the solution with those columns affine
+    /// (a convex problem, one answer), each rigid column then turned to its nearest rotation
+    /// about its pivot. Starting from the forward-kinematics pose instead, the rigid problem's
+    /// iterations settle in whichever local optimum lies nearest that pose.
+    fn relaxed_start(&mut self, problem: &Problem) -> Result<DMatrix<f64>, IkError> {
+        let relaxed = Problem {
+            columns: problem
+                .columns
+                .iter()
+                .map(|c| match c {
+                    ColumnDofs::Rigid { .. } => ColumnDofs::Affine { rigidity: 0.0 },
+                    other => other.clone(),
+                })
+                .collect(),
+            ..problem.clone()
+        };
+        let solver = self.relaxed.get_or_insert_with(|| {
+            let mut s = FastIk::new(self.subspace.clone(), self.extent_px, self.options.clone());
+            s.options.fold_check_triangles = 0;
+            Box::new(s)
+        });
+        solver.reset();
+        let solution = solver.solve(&relaxed)?;
+        let mut transforms = solution.transforms;
+        for (t, c) in transforms.iter_mut().zip(&problem.columns) {
+            if let ColumnDofs::Rigid { pivot, scale } = c {
+                let pivot = nalgebra::Point2::new(pivot[0], pivot[1]);
+                let moved = t.apply(pivot);
+                let mut linear = nearest_rotation(&t.linear);
+                if *scale {
+                    linear *= ((linear.transpose() * t.linear).trace() * 0.5).max(0.0);
+                }
+                t.linear = linear;
+                t.translation = moved.coords - linear * pivot.coords;
+            }
+        }
+        Ok(stack(&transforms))
+    }
+
     /// Guards the checked triangles that `t` folds (nearly) over and that the free parameters can
     /// turn back; returns whether the guard changed.
     fn guard_folds(&mut self, t: &DMatrix<f64>) -> bool {
@@ -505,7 +597,10 @@ impl FastIk {
             let (u, area, cluster) = self.folds.jacobian_map(fold.triangle);
             // A triangle folded by handles the pose fixes is the pose's doing: no free
             // parameter moves it, and a guard would only weigh on the factorization.
-            let free_part = (&u * &system.p).norm();
+            let free_part = match &system.coupled {
+                Some(coupled) => coupled.free_part(&u),
+                None => (&u * &system.p).norm(),
+            };
             if free_part <= FOLD_FREE_SHARE * u.norm() {
                 continue;
             }
@@ -543,8 +638,13 @@ impl FastIk {
                         q[(3 * j + 1, cc)] = linear[(cc, 1)];
                     }
                 }
-                ColumnDofs::Affine { .. } | ColumnDofs::Follows { .. } => {}
+                ColumnDofs::Affine { .. }
+                | ColumnDofs::Follows { .. }
+                | ColumnDofs::Rigid { .. } => {}
             }
+        }
+        if let Some(coupled) = &system.coupled {
+            coupled.add_constants(&mut q);
         }
         let anchor = stack(&problem.anchor);
         let stiffness = self.handle_stiffness();
@@ -580,12 +680,16 @@ impl FastIk {
         }
         let e_q = &system.e_t * &q;
         let e = DMatrix::from_fn(targets.len(), 2, |r, c| targets[r][c] - e_q[(r, c)]);
-        let z_const = &system.x * system.p.tr_mul(&f_const) + &system.y * &e;
+        let z_const = match system.coupled {
+            Some(_) => DMatrix::zeros(0, 2),
+            None => &system.x * system.p.tr_mul(&f_const) + &system.y * &e,
+        };
 
         let r_count = self.subspace.cluster_count;
         let nz = system.p.ncols();
         let mut r_flat = DMatrix::<f64>::zeros(2 * r_count, 2);
-        let mut rigid_rhs = DMatrix::<f64>::zeros(nz, 2);
+        let rhs_rows = if system.coupled.is_some() { dim } else { nz };
+        let mut rigid_rhs = DMatrix::<f64>::zeros(rhs_rows, 2);
         let mut iterations = 0;
         for _ in 0..limit.max(1) {
             iterations += 1;
@@ -606,7 +710,10 @@ impl FastIk {
                 r_flat[(2 * k + 1, 1)] = r[(1, 1)];
             }
             rigid_rhs.fill(0.0);
+            // The coupled step takes the pull in T space (rows 3j, 3j + 1).
+            let coupled = system.coupled.is_some();
             for &(j, o, lambda) in &system.rigid {
+                let o = if coupled { 3 * j } else { o };
                 let l = rows_to_affine(t, j).linear;
                 let mut target = nearest_rotation(&l);
                 if self.options.allow_uniform_scale {
@@ -619,14 +726,22 @@ impl FastIk {
                 }
             }
             // Global step.
-            let mut z = &z_const + &system.x_pt_b * &r_flat;
-            if !system.rigid.is_empty() {
-                z += &system.x * &rigid_rhs;
-            }
-            for (g, x_pt_u) in system.guard.iter().zip(&system.x_pt_guard) {
-                z += x_pt_u * r_flat.view((2 * g.cluster, 0), (2, 2));
-            }
-            let next = &system.p * &z + &q;
+            let next = if let Some(coupled) = &system.coupled {
+                let mut f = &f_const + &self.subspace.b * &r_flat + &rigid_rhs;
+                for (g, u_lambda) in system.guard.iter().zip(&system.guard_rhs) {
+                    f += u_lambda * r_flat.view((2 * g.cluster, 0), (2, 2));
+                }
+                coupled.step(t, &f, &e, &q)?
+            } else {
+                let mut z = &z_const + &system.x_pt_b * &r_flat;
+                if !system.rigid.is_empty() {
+                    z += &system.x * &rigid_rhs;
+                }
+                for (g, x_pt_u) in system.guard.iter().zip(&system.x_pt_guard) {
+                    z += x_pt_u * r_flat.view((2 * g.cluster, 0), (2, 2));
+                }
+                &system.p * &z + &q
+            };
             let change = (0..m)
                 .map(|j| {
                     let d = rows_to_affine(&next, j);

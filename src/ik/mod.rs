@@ -12,6 +12,7 @@
 //! - [`fold`]: the orientation guard: triangles about to fold over are held near rigid.
 //! - [`fast`]: the local/global solver over the reduced energy (factorized per constraint set,
 //!   solved per frame).
+//! - [`rigid`]: its global step when bones are rigid (rotations exactly, a Gauss–Newton step).
 //! - [`rig`]: a rig and a pose → which handles are free, fixed or following, joints, drags,
 //!   momentum (secondary motion across the frames of a sequence).
 //! - [`reference`]: the full per-vertex ARAP deformation, the quality bound tests compare with.
@@ -21,6 +22,7 @@ pub mod cluster;
 pub mod fast;
 pub mod fold;
 pub mod reference;
+pub mod rigid;
 pub mod rig;
 pub mod subspace;
 
@@ -29,7 +31,25 @@ pub use rig::RigIk;
 pub use subspace::SkinnedMesh;
 
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
+
+/// How a free bone may move under the skinning IK.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum BoneDofs {
+    /// Rotation and translation, exactly: a bone keeps its length, as in Spine, so exports
+    /// carry no accidental scale or shear (bones named in [`IkOptions::stretch`] may also scale
+    /// uniformly).
+    #[default]
+    Rigid,
+    /// Rotation, translation and uniform scale, for every bone.
+    Uniform,
+    /// Any affine map, kept close to rigid only by the ARAP energy (and
+    /// [`IkOptions::rigidity`]): the handles of Fast Automatic Skinning Transformations.
+    Affine,
+}
 
 /// How a free handle that is not a bone may move.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -62,24 +82,23 @@ pub struct IkOptions {
     pub cold_iterations: usize,
     /// Stop when no skinned point moves more than this between two iterations, px. Default 0.01.
     pub tolerance_px: f64,
-    /// How strongly free bones are held to rotations, relative to their own share of the
-    /// energy. Default 0: like every handle of Fast Automatic Skinning Transformations, bones
-    /// are affine maps that the ARAP energy keeps close to rigid. Measured on the bundled
-    /// character's quality drags
-    /// (tests/ik.rs; energy ratio to the reduced optimum over free affine maps, largest bone
-    /// stretch on the head-left and lean-right drags): 0 gives 1.02–1.13× and 10–13%; 0.015
-    /// gives 1.06–1.17× and 7–9%; 0.03 already 1.12–1.38× and 5.5–7%; 1 gives 1.6–4.4× and
-    /// 1.2–1.6%; 100 gives 1.6–5.6× and 1.1–1.5% (strictly rigid bones make linear blending
-    /// crease at the joints). A drag that rigid bones cannot reach still stretches them (the
-    /// head pulled up from pinned feet: about 20% at any rigidity). Set it (e.g. 100) for
-    /// strictly rigid bones. Small values are not the default because the pull slows the
-    /// local/global iterations: with `momentum_iterations` 32, 0.015 leaves momentum frames
-    /// overdamped (at 24 fps the test tail's swing shrinks from 16 to 5 px).
+    /// How free bones move. Default rigid.
+    pub bones: BoneDofs,
+    /// Bones (by name) that may scale uniformly when `bones` is rigid, like Spine's IK
+    /// `stretch`. Default: none.
+    #[serde(skip_serializing_if = "BTreeSet::is_empty")]
+    pub stretch: BTreeSet<String>,
+    /// With `bones` affine: how strongly free bones are held near rotations by a penalty,
+    /// relative to their own share of the energy. Default 0 (the ARAP energy alone). Measured
+    /// on the bundled character's quality drags: 0 gives bones stretched by 10–13%, 1 by
+    /// 1.2–1.6%, 100 by 1.1–1.5%, and a penalty slows the local/global iterations; bones that
+    /// keep their length exactly are `bones: rigid`, the default.
     pub rigidity: f64,
     /// How strongly regions (and points or cage vertices set to `rigid`) are held to rotations,
     /// in the same units as `rigidity`. Default 100.
     pub region_rigidity: f64,
-    /// Rigid handles may also scale uniformly. Default false.
+    /// Near-rigid handles (regions, points or cage vertices set to `rigid`) may also scale
+    /// uniformly. Default false.
     pub allow_uniform_scale: bool,
     /// Free point handles. Default affine.
     pub points: HandleDofs,
@@ -135,6 +154,8 @@ impl Default for IkOptions {
             iterations: 8,
             cold_iterations: 64,
             tolerance_px: 0.01,
+            bones: BoneDofs::Rigid,
+            stretch: BTreeSet::new(),
             rigidity: 0.0,
             region_rigidity: 100.0,
             allow_uniform_scale: false,
@@ -186,6 +207,8 @@ pub enum IkError {
     Singular,
     #[error("momentum names '{0}', which is not a handle column of the rig")]
     UnknownMomentumHandle(String),
+    #[error("ik stretch names '{0}', which is not a bone of the rig")]
+    UnknownStretchBone(String),
     #[error("momentum of '{0}' must be a finite number ≥ 0 s")]
     BadMomentum(String),
     #[error("momentum_step_s must be a number of seconds in [{min}, {max}], not {0:e}", min = MIN_MOMENTUM_STEP_S, max = MAX_MOMENTUM_STEP_S)]

@@ -6,7 +6,8 @@
 //! Which handles the solver may move: a bone or point or cage the pose names is *keyed* and
 //! keeps what the pose gives it — relative to its nearest unkeyed ancestor bone if it has one
 //! (a keyed forearm under a free upper arm turns with it), absolutely otherwise. Every other
-//! handle is free: bones affine (or near-rigid, [`IkOptions::rigidity`]), regions near-rigid,
+//! handle is free: bones rigid (rotation and translation, [`IkOptions::bones`]), regions
+//! near-rigid,
 //! points and cage vertices as
 //! [`IkOptions::points`] and [`IkOptions::cage_vertices`] say. A free bone's head stays on its
 //! parent ([`IkOptions::connect_joints`]). Disjoint skeletons are coupled only through the
@@ -14,7 +15,7 @@
 
 use super::fast::{ColumnDofs, DragRow, FastIk, IkSolution, Joint, Problem};
 use super::subspace::{add_skinning_row, SkinnedMesh};
-use super::{HandleDofs, IkError, IkOptions, MAX_MOMENTUM_STEP_S, MIN_MOMENTUM_STEP_S};
+use super::{BoneDofs, HandleDofs, IkError, IkOptions, MAX_MOMENTUM_STEP_S, MIN_MOMENTUM_STEP_S};
 use crate::geom::Point;
 use crate::rig::handles::Handles;
 use crate::rig::pose::{handle_columns, handle_transforms, Affine, IkDrag, Pose};
@@ -66,6 +67,13 @@ impl RigIk {
             && !(MIN_MOMENTUM_STEP_S..=MAX_MOMENTUM_STEP_S).contains(&step_s)
         {
             return Err(IkError::BadMomentumStep(step_s));
+        }
+        if let Some(name) = options
+            .stretch
+            .iter()
+            .find(|name| !handles.bones.iter().any(|b| &b.name == *name))
+        {
+            return Err(IkError::UnknownStretchBone(name.clone()));
         }
         let solver = FastIk::precompute(&meshes, names.len(), options)?;
         Ok(RigIk {
@@ -205,8 +213,15 @@ impl RigIk {
         for (i, bone) in handles.bones.iter().enumerate() {
             let parent = bone.parent.as_deref().and_then(bone_index);
             if !keyed(i) {
-                columns.push(ColumnDofs::Affine {
-                    rigidity: options.rigidity,
+                columns.push(match options.bones {
+                    BoneDofs::Rigid | BoneDofs::Uniform => ColumnDofs::Rigid {
+                        pivot: bone.head,
+                        scale: options.bones == BoneDofs::Uniform
+                            || options.stretch.contains(&bone.name),
+                    },
+                    BoneDofs::Affine => ColumnDofs::Affine {
+                        rigidity: options.rigidity,
+                    },
                 });
                 if let (Some(p), true) = (parent, options.connect_joints) {
                     joints.push(Joint {
@@ -299,7 +314,9 @@ impl RigIk {
                 if tau <= 0.0
                     || !matches!(
                         c,
-                        ColumnDofs::Affine { .. } | ColumnDofs::Translation { .. }
+                        ColumnDofs::Affine { .. }
+                            | ColumnDofs::Translation { .. }
+                            | ColumnDofs::Rigid { .. }
                     )
                 {
                     continue;

@@ -1,0 +1,373 @@
+//! The global step when some handle columns are rigid: rotation and translation only, so a bone
+//! keeps its length as in Spine (optionally with a uniform scale, like Spine's IK `stretch`).
+//!
+//! In: the T-space quadratic form Q (3m × 3m) and hard-constraint rows E (r × 3m) of
+//! [`super::fast`], the columns' degrees of freedom, and per iteration the right-hand side F
+//! (3m × 2), the constraint targets (r × 2) and the current T. Out: the next T, minimizing
+//! tr(Tᵀ Q T) − 2 tr(Tᵀ F) subject to E T = targets over the columns' degrees of freedom.
+//!
+//! A rotation couples T's two output columns, so the step works on vec(T) (6m entries). Every
+//! free column is parametrized linearly by a vector w: an affine column by its six entries, a
+//! translation by two, a rigid column by a similarity (a, b, tₓ, t_y) about its pivot c:
+//! L = [[a, −b], [b, a]], translation t + c − L c. A rigid column without scale keeps (a, b) on
+//! the unit circle by a Gauss–Newton step: the step moves its angle θ along the circle's tangent
+//! (−b, a), and the new (a, b) is the old one turned by exactly that angle (a retraction), so the
+//! column is a rotation after every step, never approximately. Keyed children of a rigid bone
+//! follow it through their fixed local transform.
+//!
+//! Hard constraints (joints, drags) enter through the Schur complement S = E H⁻¹ Eᵀ of the
+//! step's Hessian H, damped by [`SCHUR_DAMPING`]: constraints that rigid bones cannot all meet
+//! (a drag beyond the reach of a limb) are met in the damped least-squares sense, and a limb
+//! stretched straight (where S is nearly singular) turns by at most [`MAX_TURN_RAD`] per step.
+
+use super::fast::ColumnDofs;
+use super::IkError;
+use nalgebra::{DMatrix, DVector};
+
+/// Largest turn of a rigid column in one step, rad: steps that would turn a column further are
+/// shortened as a whole.
+pub const MAX_TURN_RAD: f64 = 0.5;
+
+/// Damping of the constraints' Schur complement, relative to its largest diagonal entry.
+pub const SCHUR_DAMPING: f64 = 1e-10;
+
+/// How one column's entries of T depend on the parameters w.
+#[derive(Clone, Debug, PartialEq)]
+enum Param {
+    /// No parameter (fixed, or following another column).
+    None,
+    /// Six entries (rows 3j..3j+2 of output coordinate 0, then of coordinate 1) from `offset`.
+    Affine { offset: usize },
+    /// Two translation entries from `offset`.
+    Translation { offset: usize },
+    /// (a, b, tₓ, t_y) from `offset`, about `pivot`; `scale`: (a, b) may leave the unit circle.
+    Similarity {
+        offset: usize,
+        pivot: [f64; 2],
+        scale: bool,
+    },
+}
+
+/// The precomputed coupled step of one problem structure.
+#[derive(Clone, Debug)]
+pub struct CoupledStep {
+    params: Vec<Param>,
+    /// Per column that follows another: (column, parent, the 3 × 3 map of the parent's rows).
+    follows: Vec<(usize, usize, [[f64; 3]; 3])>,
+    /// vec(T) = P w + (constant entries); P is 6m × n_w, row c·3m + k for T[k, c].
+    p: DMatrix<f64>,
+    /// Σ_c P_cᵀ Q P_c.
+    h_w: DMatrix<f64>,
+    /// (I₂ ⊗ E) P: row c·r + k for constraint k's coordinate c.
+    e_w: DMatrix<f64>,
+}
+
+impl CoupledStep {
+    /// Whether a problem needs the coupled step: it has a rigid column.
+    pub fn needed(columns: &[ColumnDofs]) -> bool {
+        columns.iter().any(|c| matches!(c, ColumnDofs::Rigid { .. }))
+    }
+
+    /// Prepares the step for `columns` with the quadratic form `q_t` and hard rows `e_t`.
+    pub fn new(
+        columns: &[ColumnDofs],
+        q_t: &DMatrix<f64>,
+        e_t: &DMatrix<f64>,
+    ) -> Result<Self, IkError> {
+        let m = columns.len();
+        let dim = 3 * m;
+        let mut params = Vec::with_capacity(m);
+        let mut n_w = 0;
+        for c in columns {
+            params.push(match c {
+                ColumnDofs::Affine { .. } => {
+                    n_w += 6;
+                    Param::Affine { offset: n_w - 6 }
+                }
+                ColumnDofs::Translation { .. } => {
+                    n_w += 2;
+                    Param::Translation { offset: n_w - 2 }
+                }
+                ColumnDofs::Rigid { pivot, scale } => {
+                    n_w += 4;
+                    Param::Similarity {
+                        offset: n_w - 4,
+                        pivot: *pivot,
+                        scale: *scale,
+                    }
+                }
+                ColumnDofs::Fixed(_) | ColumnDofs::Follows { .. } => Param::None,
+            });
+        }
+        let mut p = DMatrix::<f64>::zeros(2 * dim, n_w);
+        for (j, param) in params.iter().enumerate() {
+            match *param {
+                Param::None => {}
+                Param::Affine { offset } => {
+                    for c in 0..2 {
+                        for k in 0..3 {
+                            p[(c * dim + 3 * j + k, offset + 3 * c + k)] = 1.0;
+                        }
+                    }
+                }
+                Param::Translation { offset } => {
+                    for c in 0..2 {
+                        p[(c * dim + 3 * j + 2, offset + c)] = 1.0;
+                    }
+                }
+                Param::Similarity {
+                    offset: o, pivot, ..
+                } => {
+                    let [cx, cy] = pivot;
+                    // Coordinate 0: L₀₀ = a, L₀₁ = −b, tₓ + cₓ − (a cₓ − b c_y).
+                    p[(3 * j, o)] = 1.0;
+                    p[(3 * j + 1, o + 1)] = -1.0;
+                    p[(3 * j + 2, o)] = -cx;
+                    p[(3 * j + 2, o + 1)] = cy;
+                    p[(3 * j + 2, o + 2)] = 1.0;
+                    // Coordinate 1: L₁₀ = b, L₁₁ = a, t_y + c_y − (b cₓ + a c_y).
+                    p[(dim + 3 * j, o + 1)] = 1.0;
+                    p[(dim + 3 * j + 1, o)] = 1.0;
+                    p[(dim + 3 * j + 2, o)] = -cy;
+                    p[(dim + 3 * j + 2, o + 1)] = -cx;
+                    p[(dim + 3 * j + 2, o + 3)] = 1.0;
+                }
+            }
+        }
+        let mut follows = Vec::new();
+        for (j, c) in columns.iter().enumerate() {
+            let ColumnDofs::Follows { parent, local } = c else {
+                continue;
+            };
+            let pj = *parent;
+            if !matches!(
+                columns.get(pj),
+                Some(ColumnDofs::Affine { .. } | ColumnDofs::Rigid { .. })
+            ) {
+                return Err(IkError::BadFollow {
+                    column: j,
+                    parent: pj,
+                });
+            }
+            // Row k of T_j (per coordinate) = Σ_l map[k][l] · row l of T_parent.
+            let (g, gt) = (local.linear, local.translation);
+            let map = [
+                [g[(0, 0)], g[(1, 0)], 0.0],
+                [g[(0, 1)], g[(1, 1)], 0.0],
+                [gt[0], gt[1], 1.0],
+            ];
+            for c in 0..2 {
+                for (k, row) in map.iter().enumerate() {
+                    for (l, &coefficient) in row.iter().enumerate() {
+                        if coefficient == 0.0 {
+                            continue;
+                        }
+                        let from = p.row(c * dim + 3 * pj + l).clone_owned() * coefficient;
+                        let mut to = p.row_mut(c * dim + 3 * j + k);
+                        to += from;
+                    }
+                }
+            }
+            follows.push((j, pj, map));
+        }
+        let (p0, p1) = (p.rows(0, dim), p.rows(dim, dim));
+        let h_w = p0.tr_mul(&(q_t * p0)) + p1.tr_mul(&(q_t * p1));
+        let r = e_t.nrows();
+        let mut e_w = DMatrix::<f64>::zeros(2 * r, n_w);
+        e_w.rows_mut(0, r).copy_from(&(e_t * p0));
+        e_w.rows_mut(r, r).copy_from(&(e_t * p1));
+        Ok(CoupledStep {
+            params,
+            follows,
+            p,
+            h_w,
+            e_w,
+        })
+    }
+
+    /// Adds the constant entries of the parametrization to `q` (3m × 2, the fixed entries of
+    /// T): a rigid column's pivot, carried to the columns that follow it.
+    pub fn add_constants(&self, q: &mut DMatrix<f64>) {
+        for (j, param) in self.params.iter().enumerate() {
+            if let Param::Similarity { pivot, .. } = param {
+                q[(3 * j + 2, 0)] += pivot[0];
+                q[(3 * j + 2, 1)] += pivot[1];
+            }
+        }
+        for &(j, parent, map) in &self.follows {
+            for c in 0..2 {
+                let from = [0, 1, 2].map(|l| q[(3 * parent + l, c)]);
+                for (k, row) in map.iter().enumerate() {
+                    q[(3 * j + k, c)] = (0..3).map(|l| row[l] * from[l]).sum();
+                }
+            }
+        }
+    }
+
+    /// How much the parameters move `u · T` (u: k × 3m, applied per output coordinate), for
+    /// telling a fold the free columns can undo from one the fixed ones make.
+    pub fn free_part(&self, u: &DMatrix<f64>) -> f64 {
+        let dim = u.ncols();
+        (u * self.p.rows(0, dim)).norm() + (u * self.p.rows(dim, dim)).norm()
+    }
+
+    /// The parameters of `t` (3m × 2), a rigid column's (a, b) put back on the unit circle.
+    fn parameters(&self, t: &DMatrix<f64>) -> DVector<f64> {
+        let mut w = DVector::zeros(self.p.ncols());
+        for (j, param) in self.params.iter().enumerate() {
+            match *param {
+                Param::None => {}
+                Param::Affine { offset } => {
+                    for c in 0..2 {
+                        for k in 0..3 {
+                            w[offset + 3 * c + k] = t[(3 * j + k, c)];
+                        }
+                    }
+                }
+                Param::Translation { offset } => {
+                    for c in 0..2 {
+                        w[offset + c] = t[(3 * j + 2, c)];
+                    }
+                }
+                Param::Similarity {
+                    offset: o,
+                    pivot: [cx, cy],
+                    scale,
+                } => {
+                    let (l00, l01, l10, l11) = (
+                        t[(3 * j, 0)],
+                        t[(3 * j + 1, 0)],
+                        t[(3 * j, 1)],
+                        t[(3 * j + 1, 1)],
+                    );
+                    let (mut a, mut b) = (0.5 * (l00 + l11), 0.5 * (l10 - l01));
+                    if !scale {
+                        let r = a.hypot(b);
+                        (a, b) = if r > 0.0 && r.is_finite() {
+                            (a / r, b / r)
+                        } else {
+                            (1.0, 0.0)
+                        };
+                    }
+                    // Keep the column's pivot where T puts it.
+                    let (px, py) = (
+                        l00 * cx + l01 * cy + t[(3 * j + 2, 0)],
+                        l10 * cx + l11 * cy + t[(3 * j + 2, 1)],
+                    );
+                    w[o] = a;
+                    w[o + 1] = b;
+                    w[o + 2] = px - cx;
+                    w[o + 3] = py - cy;
+                }
+            }
+        }
+        w
+    }
+
+    /// One step from `t`: minimizes tr(Tᵀ Q T) − 2 tr(Tᵀ F) over the step's parameters with
+    /// E T = targets, where `g_w` = Σ_c P_cᵀ (F − Q q)_c and `e` = targets − E q (stacked by
+    /// coordinate) are the linear terms `rhs` makes. `q` holds T's constant entries
+    /// ([`CoupledStep::add_constants`] applied).
+    pub fn step(
+        &self,
+        t: &DMatrix<f64>,
+        f_minus_q: &DMatrix<f64>,
+        e: &DMatrix<f64>,
+        q: &DMatrix<f64>,
+    ) -> Result<DMatrix<f64>, IkError> {
+        let dim = t.nrows();
+        let n_w = self.p.ncols();
+        let (p0, p1) = (self.p.rows(0, dim), self.p.rows(dim, dim));
+        let g_w = p0.tr_mul(&f_minus_q.column(0)) + p1.tr_mul(&f_minus_q.column(1));
+        let r = e.nrows();
+        let mut e_vec = DVector::zeros(2 * r);
+        e_vec.rows_mut(0, r).copy_from(&e.column(0));
+        e_vec.rows_mut(r, r).copy_from(&e.column(1));
+        let w0 = self.parameters(t);
+
+        // u: the step's unknowns; each maps to at most two entries of w.
+        let mut map: Vec<[(usize, f64); 2]> = Vec::with_capacity(n_w);
+        let mut turns = Vec::new();
+        for param in &self.params {
+            match *param {
+                Param::None => {}
+                Param::Affine { offset } => {
+                    map.extend((0..6).map(|k| [(offset + k, 1.0), (offset + k, 0.0)]))
+                }
+                Param::Translation { offset } => {
+                    map.extend((0..2).map(|k| [(offset + k, 1.0), (offset + k, 0.0)]))
+                }
+                Param::Similarity {
+                    offset: o,
+                    scale: true,
+                    ..
+                } => map.extend((0..4).map(|k| [(o + k, 1.0), (o + k, 0.0)])),
+                Param::Similarity {
+                    offset: o,
+                    scale: false,
+                    ..
+                } => {
+                    turns.push((map.len(), o));
+                    map.push([(o, -w0[o + 1]), (o + 1, w0[o])]);
+                    map.push([(o + 2, 1.0), (o + 2, 0.0)]);
+                    map.push([(o + 3, 1.0), (o + 3, 0.0)]);
+                }
+            }
+        }
+        let n_u = map.len();
+        // The reduced gradient and Hessian: g_u = Cᵀ (g_w − H_w w₀), H_u = Cᵀ H_w C.
+        let residual = &g_w - &self.h_w * &w0;
+        let g_u = DVector::from_fn(n_u, |i, _| map[i].iter().map(|&(a, ca)| ca * residual[a]).sum());
+        let h_u = DMatrix::from_fn(n_u, n_u, |i, k| {
+            let mut s = 0.0;
+            for &(a, ca) in &map[i] {
+                for &(b, cb) in &map[k] {
+                    s += ca * cb * self.h_w[(a, b)];
+                }
+            }
+            s
+        });
+        let ridge = 1e-12 * (0..n_u).map(|i| h_u[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let h_reg = &h_u + DMatrix::identity(n_u, n_u) * ridge;
+        let cholesky = h_reg.cholesky().ok_or(IkError::Singular)?;
+        let mut delta = cholesky.solve(&g_u);
+        if r > 0 {
+            let e_u = DMatrix::from_fn(2 * r, n_u, |row, i| {
+                map[i].iter().map(|&(a, ca)| ca * self.e_w[(row, a)]).sum()
+            });
+            let e_u0 = &e_vec - &self.e_w * &w0;
+            let y = cholesky.solve(&e_u.transpose());
+            let mut s = &e_u * &y;
+            let damping = SCHUR_DAMPING
+                * (0..2 * r).map(|i| s[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+            for i in 0..2 * r {
+                s[(i, i)] += damping;
+            }
+            let s = s.cholesky().ok_or(IkError::Singular)?;
+            let lambda = s.solve(&(&e_u * &delta - e_u0));
+            delta -= y * lambda;
+        }
+        let largest_turn = turns.iter().map(|&(i, _)| delta[i].abs()).fold(0.0, f64::max);
+        if !largest_turn.is_finite() || delta.iter().any(|v| !v.is_finite()) {
+            return Err(IkError::NonFinite);
+        }
+        if largest_turn > MAX_TURN_RAD {
+            delta *= MAX_TURN_RAD / largest_turn;
+        }
+        let mut w = w0.clone();
+        for (i, entries) in map.iter().enumerate() {
+            for &(a, ca) in entries {
+                w[a] += ca * delta[i];
+            }
+        }
+        // Retraction: a rigid column's (a, b) turned by exactly its angle.
+        for &(i, o) in &turns {
+            let (sin, cos) = delta[i].sin_cos();
+            let (a, b) = (w0[o], w0[o + 1]);
+            w[o] = a * cos - b * sin;
+            w[o + 1] = a * sin + b * cos;
+        }
+        let flat = &self.p * &w;
+        Ok(DMatrix::from_fn(dim, 2, |k, c| flat[c * dim + k] + q[(k, c)]))
+    }
+}
