@@ -219,3 +219,35 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
     assert!(t.elapsed().as_secs_f64() < 10.0, "refusing took {:?}", t.elapsed());
     assert!(!out.exists());
 }
+
+#[test]
+fn a_cage_crossing_the_outline_is_named_not_blamed_on_the_image() {
+    let dir = scratch("cage-outline");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let out = dir.join("r.json");
+    // Half inside the drawing, half outside the canvas.
+    let handles = write(
+        &dir,
+        "h.json",
+        &json!({"cages": [{"name": "belly", "polygon": [[30, 28], [120, 28], [120, 36], [30, 36]]}]}),
+    );
+    let message = assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&out)],
+        "cage 'belly': its edge 0 (vertices 0–1) crosses the drawing's outline",
+    );
+    assert!(!message.contains("outline edges cross each other"), "{message}");
+    let two = write(
+        &dir,
+        "two.json",
+        &json!({"cages": [
+            {"name": "a", "polygon": [[-10, -10], [80, -10], [80, 80], [-10, 80]]},
+            {"name": "b", "polygon": [[-20, 30], [90, 30], [90, 34], [-20, 34]]}
+        ]}),
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&two), "-o", s(&out)],
+        "cage 'a': it crosses cage 'b'",
+    );
+    assert!(!out.exists());
+}

@@ -288,7 +288,7 @@ fn check_keys<V: Channels>(keys: &[Key<V>]) -> Result<(), TimelineError> {
         if !values.iter().all(|v| v.is_finite()) {
             return Err(TimelineError::NonFinite { key: i });
         }
-        if let Some(value) = too_large(&values) {
+        if let Some(value) = too_large(values) {
             return Err(TimelineError::ValueTooLarge { key: i, value });
         }
         let Curve::Bezier(numbers) = &k.curve else {
