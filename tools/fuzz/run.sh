@@ -60,7 +60,8 @@ if ! command -v cargo-afl >/dev/null 2>&1; then
         exit 0
     fi
 fi
-if ! cargo afl config --build >"$repo/target/fuzz-afl-build.log" 2>&1; then
+if ! cargo afl config --build >"$repo/target/fuzz-afl-build.log" 2>&1 \
+    && ! grep -q "was already built" "$repo/target/fuzz-afl-build.log"; then
     echo "fuzz: SKIPPED: cargo-afl cannot build AFL++ here (needs make and a C compiler; see target/fuzz-afl-build.log)"
     exit 0
 fi
