@@ -68,14 +68,15 @@ fi
 cd fuzz
 cargo afl build --release --locked 2>"$repo/target/fuzz-build.log" || cargo afl build --release 2>>"$repo/target/fuzz-build.log"
 failed=0
+mkdir -p out
 for target in "${targets[@]}"; do
     out=out/$target
     rm -rf "$out"
     # No UI, no CPU governor or core-pattern demands (CI containers cannot change them); the
     # run ends after $seconds s.
     AFL_NO_UI=1 AFL_SKIP_CPUFREQ=1 AFL_I_DONT_CARE_ABOUT_MISSING_CRASHES=1 \
-        AFL_NO_AFFINITY=1 AFL_SKIP_BIN_CHECK=0 \
-        cargo afl fuzz -V "$seconds" -i "seeds/$target" -o "$out" \
+        AFL_NO_AFFINITY=1 \
+        cargo afl fuzz -V "$seconds" -t 2000+ -i "seeds/$target" -o "$out" \
         "target/release/$target" >"$out.log" 2>&1 || true
     stats=$out/default/fuzzer_stats
     if [[ ! -f $stats ]]; then
