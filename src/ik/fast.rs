@@ -409,7 +409,7 @@ impl FastIk {
         }
         let e_t = DMatrix::from_fn(hard.len(), dim, |r, c| hard[r][c]);
         if coupled_needed {
-            let coupled = CoupledStep::new(&problem.columns, &q_t, &e_t)?;
+            let coupled = CoupledStep::new(&problem.columns, &problem.joints, &q_t, &e_t, stiffness)?;
             return Ok(System {
                 problem: problem.clone(),
                 x: DMatrix::zeros(0, 0),
@@ -486,16 +486,56 @@ impl FastIk {
             self.guard.clear();
         }
         let dim = 3 * self.subspace.column_count;
-        let (mut t, iteration_limit) = match &self.previous {
-            Some(prev) if prev.nrows() == dim => (
-                prev.clone(),
-                warm_iterations.unwrap_or(self.options.iterations),
-            ),
-            _ if CoupledStep::needed(&problem.columns) => {
-                (self.relaxed_start(problem)?, self.options.cold_iterations)
+        let (t, iterations) = match &self.previous {
+            Some(prev) if prev.nrows() == dim => {
+                let limit = warm_iterations.unwrap_or(self.options.iterations);
+                self.iterate_from(problem, prev.clone(), limit)?
             }
-            _ => (stack(&problem.anchor), self.options.cold_iterations),
+            _ if CoupledStep::needed(&problem.columns) => {
+                // Rigid columns make the problem non-convex: of the two starts, the result that
+                // misses the hard drags least (then has the least energy) is the answer, so it
+                // depends on the problem alone.
+                let limit = self.options.cold_iterations;
+                let relaxed = self.relaxed_start(problem)?;
+                let (t_a, n_a) = self.iterate_from(problem, relaxed, limit)?;
+                let guard_a = std::mem::take(&mut self.guard);
+                let (t_b, n_b) = self.iterate_from(problem, stack(&problem.anchor), limit)?;
+                let score = |t: &DMatrix<f64>| {
+                    let miss = hard_misses_px(problem, t).iter().map(|m| m * m).sum::<f64>();
+                    // Misses that differ by less than this are ties, px².
+                    ((miss / MISS_TIE_PX2).round(), self.reduced_energy(t))
+                };
+                if score(&t_b) < score(&t_a) {
+                    (t_b, n_a + n_b)
+                } else {
+                    self.guard = guard_a;
+                    (t_a, n_a + n_b)
+                }
+            }
+            _ => {
+                let limit = self.options.cold_iterations;
+                self.iterate_from(problem, stack(&problem.anchor), limit)?
+            }
         };
+        let drag_error_px = hard_misses_px(problem, &t).into_iter().fold(0.0, f64::max);
+        let energy = self.reduced_energy(&t);
+        self.previous = Some(t.clone());
+        Ok(IkSolution {
+            transforms: unstack(&t),
+            iterations,
+            drag_error_px,
+            energy,
+        })
+    }
+
+    /// Local/global iterations from `t` with fold-guard rounds; returns the result and how many
+    /// iterations ran.
+    fn iterate_from(
+        &mut self,
+        problem: &Problem,
+        mut t: DMatrix<f64>,
+        iteration_limit: usize,
+    ) -> Result<(DMatrix<f64>, usize), IkError> {
         let mut iterations = 0;
         for round in 0..=self.options.fold_rounds {
             let current = matches!(&self.system,
@@ -522,24 +562,7 @@ impl FastIk {
                 break;
             }
         }
-        let drag_error_px = problem
-            .drags
-            .iter()
-            .filter(|d| d.weight.is_none())
-            .map(|d| {
-                let row = DVector::from_column_slice(&d.row);
-                let pos = t.tr_mul(&row);
-                (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
-            })
-            .fold(0.0, f64::max);
-        let energy = self.reduced_energy(&t);
-        self.previous = Some(t.clone());
-        Ok(IkSolution {
-            transforms: unstack(&t),
-            iterations,
-            drag_error_px,
-            energy,
-        })
+        Ok((t, iterations))
     }
 
     /// A cold start for a problem with rigid columns: the solution with those columns affine
@@ -775,6 +798,24 @@ impl FastIk {
         let quadratic = (t.transpose() * &s.a * t).trace();
         (quadratic - 2.0 * cross + s.energy_constant).max(0.0)
     }
+}
+
+/// Two solutions whose summed squared hard-drag misses differ by less than this are ranked by
+/// their energy, px².
+pub const MISS_TIE_PX2: f64 = 1e-4;
+
+/// How far each hard drag's point lies from its target under `t`, px.
+fn hard_misses_px(problem: &Problem, t: &DMatrix<f64>) -> Vec<f64> {
+    problem
+        .drags
+        .iter()
+        .filter(|d| d.weight.is_none())
+        .map(|d| {
+            let row = DVector::from_column_slice(&d.row);
+            let pos = t.tr_mul(&row);
+            (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
+        })
+        .collect()
 }
 
 /// The pseudo-inverse of `e` (nz × rows) and an orthonormal basis of its null space (nz × k),

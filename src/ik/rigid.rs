@@ -15,12 +15,14 @@
 //! column is a rotation after every step, never approximately. Keyed children of a rigid bone
 //! follow it through their fixed local transform.
 //!
-//! Hard constraints (joints, drags) enter through the Schur complement S = E H⁻¹ Eᵀ of the
-//! step's Hessian H, damped by [`SCHUR_DAMPING`]: constraints that rigid bones cannot all meet
-//! (a drag beyond the reach of a limb) are met in the damped least-squares sense, and a limb
-//! stretched straight (where S is nearly singular) turns by at most [`MAX_TURN_RAD`] per step.
+//! A joint at a rigid column's pivot is met by the parametrization itself: the column's
+//! translation keeps its pivot where its parent puts it, so a skeleton's joints never leave the
+//! solution. The other hard rows (drags) enter as a stiff least-squares term ([`HARD_WEIGHT`]):
+//! drags the limbs can reach are met, drags beyond their reach are met in the least-squares
+//! sense (the pins and the dragged point share the miss), and a step turns no column by more
+//! than [`MAX_TURN_RAD`].
 
-use super::fast::ColumnDofs;
+use super::fast::{ColumnDofs, Joint};
 use super::IkError;
 use nalgebra::{DMatrix, DVector};
 
@@ -28,8 +30,10 @@ use nalgebra::{DMatrix, DVector};
 /// shortened as a whole.
 pub const MAX_TURN_RAD: f64 = 0.5;
 
-/// Damping of the constraints' Schur complement, relative to its largest diagonal entry.
-pub const SCHUR_DAMPING: f64 = 1e-10;
+/// Weight of the hard rows the parametrization does not meet itself (drags), relative to the
+/// stiffness of moving one handle (the mean translation diagonal of A): a drag within reach is
+/// met to within the energy's pull over this weight (well under 0.01 px).
+pub const HARD_WEIGHT: f64 = 1e6;
 
 /// How one column's entries of T depend on the parameters w.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,10 +45,13 @@ enum Param {
     /// Two translation entries from `offset`.
     Translation { offset: usize },
     /// (a, b, tₓ, t_y) from `offset`, about `pivot`; `scale`: (a, b) may leave the unit circle.
+    /// With `joined`, only (a, b): the pivot is a joint on column `joined`, so the translation
+    /// keeps the pivot where that column puts it.
     Similarity {
         offset: usize,
         pivot: [f64; 2],
         scale: bool,
+        joined: Option<usize>,
     },
 }
 
@@ -58,8 +65,13 @@ pub struct CoupledStep {
     p: DMatrix<f64>,
     /// Σ_c P_cᵀ Q P_c.
     h_w: DMatrix<f64>,
-    /// (I₂ ⊗ E) P: row c·r + k for constraint k's coordinate c.
+    /// (I₂ ⊗ E′) P, E′ the hard rows left after the joints the parametrization meets: row
+    /// c·r′ + k for kept constraint k's coordinate c.
     e_w: DMatrix<f64>,
+    /// The rows of E kept in E′.
+    kept: Vec<usize>,
+    /// [`HARD_WEIGHT`] in energy units.
+    hard_weight: f64,
 }
 
 impl CoupledStep {
@@ -68,17 +80,22 @@ impl CoupledStep {
         columns.iter().any(|c| matches!(c, ColumnDofs::Rigid { .. }))
     }
 
-    /// Prepares the step for `columns` with the quadratic form `q_t` and hard rows `e_t`.
+    /// Prepares the step for `columns` with the quadratic form `q_t` and hard rows `e_t`, whose
+    /// first rows are `joints`. A joint at a rigid column's pivot is met by the parametrization
+    /// itself (the column's translation follows its parent) and leaves the constraints.
     pub fn new(
         columns: &[ColumnDofs],
+        joints: &[Joint],
         q_t: &DMatrix<f64>,
         e_t: &DMatrix<f64>,
+        handle_stiffness: f64,
     ) -> Result<Self, IkError> {
         let m = columns.len();
         let dim = 3 * m;
         let mut params = Vec::with_capacity(m);
+        let mut eliminated = vec![false; e_t.nrows()];
         let mut n_w = 0;
-        for c in columns {
+        for (j, c) in columns.iter().enumerate() {
             params.push(match c {
                 ColumnDofs::Affine { .. } => {
                     n_w += 6;
@@ -89,117 +106,161 @@ impl CoupledStep {
                     Param::Translation { offset: n_w - 2 }
                 }
                 ColumnDofs::Rigid { pivot, scale } => {
-                    n_w += 4;
+                    let joint = joints.iter().position(|k| {
+                        k.child == j && k.at == *pivot && k.parent != j && k.parent < m
+                    });
+                    let joined = joint.map(|k| {
+                        eliminated[k] = true;
+                        joints[k].parent
+                    });
+                    let offset = n_w;
+                    n_w += if joined.is_some() { 2 } else { 4 };
                     Param::Similarity {
-                        offset: n_w - 4,
+                        offset,
                         pivot: *pivot,
                         scale: *scale,
+                        joined,
                     }
                 }
                 ColumnDofs::Fixed(_) | ColumnDofs::Follows { .. } => Param::None,
             });
         }
-        let mut p = DMatrix::<f64>::zeros(2 * dim, n_w);
-        for (j, param) in params.iter().enumerate() {
-            match *param {
-                Param::None => {}
-                Param::Affine { offset } => {
-                    for c in 0..2 {
-                        for k in 0..3 {
-                            p[(c * dim + 3 * j + k, offset + 3 * c + k)] = 1.0;
-                        }
-                    }
-                }
-                Param::Translation { offset } => {
-                    for c in 0..2 {
-                        p[(c * dim + 3 * j + 2, offset + c)] = 1.0;
-                    }
-                }
-                Param::Similarity {
-                    offset: o, pivot, ..
-                } => {
-                    let [cx, cy] = pivot;
-                    // Coordinate 0: L₀₀ = a, L₀₁ = −b, tₓ + cₓ − (a cₓ − b c_y).
-                    p[(3 * j, o)] = 1.0;
-                    p[(3 * j + 1, o + 1)] = -1.0;
-                    p[(3 * j + 2, o)] = -cx;
-                    p[(3 * j + 2, o + 1)] = cy;
-                    p[(3 * j + 2, o + 2)] = 1.0;
-                    // Coordinate 1: L₁₀ = b, L₁₁ = a, t_y + c_y − (b cₓ + a c_y).
-                    p[(dim + 3 * j, o + 1)] = 1.0;
-                    p[(dim + 3 * j + 1, o)] = 1.0;
-                    p[(dim + 3 * j + 2, o)] = -cy;
-                    p[(dim + 3 * j + 2, o + 1)] = -cx;
-                    p[(dim + 3 * j + 2, o + 3)] = 1.0;
-                }
-            }
-        }
         let mut follows = Vec::new();
         for (j, c) in columns.iter().enumerate() {
-            let ColumnDofs::Follows { parent, local } = c else {
-                continue;
-            };
-            let pj = *parent;
-            if !matches!(
-                columns.get(pj),
-                Some(ColumnDofs::Affine { .. } | ColumnDofs::Rigid { .. })
-            ) {
-                return Err(IkError::BadFollow {
-                    column: j,
-                    parent: pj,
-                });
-            }
-            // Row k of T_j (per coordinate) = Σ_l map[k][l] · row l of T_parent.
-            let (g, gt) = (local.linear, local.translation);
-            let map = [
-                [g[(0, 0)], g[(1, 0)], 0.0],
-                [g[(0, 1)], g[(1, 1)], 0.0],
-                [gt[0], gt[1], 1.0],
-            ];
-            for c in 0..2 {
-                for (k, row) in map.iter().enumerate() {
-                    for (l, &coefficient) in row.iter().enumerate() {
-                        if coefficient == 0.0 {
-                            continue;
-                        }
-                        let from = p.row(c * dim + 3 * pj + l).clone_owned() * coefficient;
-                        let mut to = p.row_mut(c * dim + 3 * j + k);
-                        to += from;
-                    }
+            if let ColumnDofs::Follows { parent, local } = c {
+                if !matches!(
+                    columns.get(*parent),
+                    Some(ColumnDofs::Affine { .. } | ColumnDofs::Rigid { .. })
+                ) {
+                    return Err(IkError::BadFollow {
+                        column: j,
+                        parent: *parent,
+                    });
                 }
+                // Row k of T_j (per coordinate) = Σ_l map[k][l] · row l of T_parent.
+                let (g, gt) = (local.linear, local.translation);
+                let map = [
+                    [g[(0, 0)], g[(1, 0)], 0.0],
+                    [g[(0, 1)], g[(1, 1)], 0.0],
+                    [gt[0], gt[1], 1.0],
+                ];
+                follows.push((j, *parent, map));
             }
-            follows.push((j, pj, map));
         }
+        let mut p = DMatrix::<f64>::zeros(2 * dim, n_w);
+        // Columns are filled once the columns they depend on are: joined rigid columns and
+        // followers after their parents (parents are acyclic, so each sweep fills at least one).
+        let mut filled: Vec<bool> = params
+            .iter()
+            .zip(columns)
+            .map(|(param, c)| {
+                matches!(param, Param::None) && !matches!(c, ColumnDofs::Follows { .. })
+            })
+            .collect();
+        while filled.iter().any(|f| !f) {
+            let before = filled.iter().filter(|f| **f).count();
+            for j in 0..m {
+                if filled[j] {
+                    continue;
+                }
+                let depends_on = match params[j] {
+                    Param::Similarity {
+                        joined: Some(parent),
+                        ..
+                    } => Some(parent),
+                    Param::None => follows.iter().find(|f| f.0 == j).map(|f| f.1),
+                    _ => None,
+                };
+                if depends_on.is_some_and(|parent| !filled[parent]) {
+                    continue;
+                }
+                fill_column(&mut p, dim, j, &params[j], follows.iter().find(|f| f.0 == j));
+                filled[j] = true;
+            }
+            if filled.iter().filter(|f| **f).count() == before {
+                return Err(IkError::Singular);
+            }
+        }
+        let kept: Vec<usize> = (0..e_t.nrows()).filter(|&k| !eliminated[k]).collect();
+        let e_kept = e_t.select_rows(&kept);
         let (p0, p1) = (p.rows(0, dim), p.rows(dim, dim));
         let h_w = p0.tr_mul(&(q_t * p0)) + p1.tr_mul(&(q_t * p1));
-        let r = e_t.nrows();
+        let r = kept.len();
         let mut e_w = DMatrix::<f64>::zeros(2 * r, n_w);
-        e_w.rows_mut(0, r).copy_from(&(e_t * p0));
-        e_w.rows_mut(r, r).copy_from(&(e_t * p1));
+        e_w.rows_mut(0, r).copy_from(&(&e_kept * p0));
+        e_w.rows_mut(r, r).copy_from(&(&e_kept * p1));
         Ok(CoupledStep {
             params,
             follows,
             p,
             h_w,
             e_w,
+            kept,
+            hard_weight: HARD_WEIGHT * handle_stiffness,
         })
     }
 
     /// Adds the constant entries of the parametrization to `q` (3m × 2, the fixed entries of
-    /// T): a rigid column's pivot, carried to the columns that follow it.
+    /// T): a rigid column's pivot, a joined column's joint where its parent puts it, carried to
+    /// the columns that follow them.
     pub fn add_constants(&self, q: &mut DMatrix<f64>) {
-        for (j, param) in self.params.iter().enumerate() {
-            if let Param::Similarity { pivot, .. } = param {
-                q[(3 * j + 2, 0)] += pivot[0];
-                q[(3 * j + 2, 1)] += pivot[1];
-            }
-        }
-        for &(j, parent, map) in &self.follows {
-            for c in 0..2 {
-                let from = [0, 1, 2].map(|l| q[(3 * parent + l, c)]);
-                for (k, row) in map.iter().enumerate() {
-                    q[(3 * j + k, c)] = (0..3).map(|l| row[l] * from[l]).sum();
+        let m = self.params.len();
+        let mut done: Vec<bool> = (0..m)
+            .map(|j| {
+                matches!(self.params[j], Param::None) && !self.follows.iter().any(|f| f.0 == j)
+            })
+            .collect();
+        while done.iter().any(|d| !d) {
+            let before = done.iter().filter(|d| **d).count();
+            for j in 0..m {
+                if done[j] {
+                    continue;
                 }
+                let follow = self.follows.iter().find(|f| f.0 == j);
+                let depends_on = match self.params[j] {
+                    Param::Similarity {
+                        joined: Some(parent),
+                        ..
+                    } => Some(parent),
+                    _ => follow.map(|f| f.1),
+                };
+                if depends_on.is_some_and(|parent| !done[parent]) {
+                    continue;
+                }
+                match (&self.params[j], follow) {
+                    (
+                        Param::Similarity {
+                            pivot,
+                            joined: Some(parent),
+                            ..
+                        },
+                        _,
+                    ) => {
+                        // Where the parent puts the joint, the pivot's own offset cancelling.
+                        for c in 0..2 {
+                            q[(3 * j + 2, c)] += pivot[0] * q[(3 * parent, c)]
+                                + pivot[1] * q[(3 * parent + 1, c)]
+                                + q[(3 * parent + 2, c)];
+                        }
+                    }
+                    (Param::Similarity { pivot, .. }, _) => {
+                        q[(3 * j + 2, 0)] += pivot[0];
+                        q[(3 * j + 2, 1)] += pivot[1];
+                    }
+                    (_, Some(&(_, parent, map))) => {
+                        for c in 0..2 {
+                            let from = [0, 1, 2].map(|l| q[(3 * parent + l, c)]);
+                            for (k, row) in map.iter().enumerate() {
+                                q[(3 * j + k, c)] = (0..3).map(|l| row[l] * from[l]).sum();
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+                done[j] = true;
+            }
+            if done.iter().filter(|d| **d).count() == before {
+                break;
             }
         }
     }
@@ -233,6 +294,7 @@ impl CoupledStep {
                     offset: o,
                     pivot: [cx, cy],
                     scale,
+                    joined,
                 } => {
                     let (l00, l01, l10, l11) = (
                         t[(3 * j, 0)],
@@ -256,8 +318,10 @@ impl CoupledStep {
                     );
                     w[o] = a;
                     w[o + 1] = b;
-                    w[o + 2] = px - cx;
-                    w[o + 3] = py - cy;
+                    if joined.is_none() {
+                        w[o + 2] = px - cx;
+                        w[o + 3] = py - cy;
+                    }
                 }
             }
         }
@@ -279,6 +343,7 @@ impl CoupledStep {
         let n_w = self.p.ncols();
         let (p0, p1) = (self.p.rows(0, dim), self.p.rows(dim, dim));
         let g_w = p0.tr_mul(&f_minus_q.column(0)) + p1.tr_mul(&f_minus_q.column(1));
+        let e = e.select_rows(&self.kept);
         let r = e.nrows();
         let mut e_vec = DVector::zeros(2 * r);
         e_vec.rows_mut(0, r).copy_from(&e.column(0));
@@ -299,26 +364,28 @@ impl CoupledStep {
                 }
                 Param::Similarity {
                     offset: o,
-                    scale: true,
-                    ..
-                } => map.extend((0..4).map(|k| [(o + k, 1.0), (o + k, 0.0)])),
-                Param::Similarity {
-                    offset: o,
-                    scale: false,
+                    scale,
+                    joined,
                     ..
                 } => {
-                    turns.push((map.len(), o));
-                    map.push([(o, -w0[o + 1]), (o + 1, w0[o])]);
-                    map.push([(o + 2, 1.0), (o + 2, 0.0)]);
-                    map.push([(o + 3, 1.0), (o + 3, 0.0)]);
+                    if scale {
+                        map.extend((0..2).map(|k| [(o + k, 1.0), (o + k, 0.0)]));
+                    } else {
+                        turns.push((map.len(), o));
+                        map.push([(o, -w0[o + 1]), (o + 1, w0[o])]);
+                    }
+                    if joined.is_none() {
+                        map.push([(o + 2, 1.0), (o + 2, 0.0)]);
+                        map.push([(o + 3, 1.0), (o + 3, 0.0)]);
+                    }
                 }
             }
         }
         let n_u = map.len();
         // The reduced gradient and Hessian: g_u = Cᵀ (g_w − H_w w₀), H_u = Cᵀ H_w C.
         let residual = &g_w - &self.h_w * &w0;
-        let g_u = DVector::from_fn(n_u, |i, _| map[i].iter().map(|&(a, ca)| ca * residual[a]).sum());
-        let h_u = DMatrix::from_fn(n_u, n_u, |i, k| {
+        let g_u: DVector<f64> = DVector::from_fn(n_u, |i, _| map[i].iter().map(|&(a, ca)| ca * residual[a]).sum());
+        let h_u: DMatrix<f64> = DMatrix::from_fn(n_u, n_u, |i, k| {
             let mut s = 0.0;
             for &(a, ca) in &map[i] {
                 for &(b, cb) in &map[k] {
@@ -327,26 +394,24 @@ impl CoupledStep {
             }
             s
         });
-        let ridge = 1e-12 * (0..n_u).map(|i| h_u[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
-        let h_reg = &h_u + DMatrix::identity(n_u, n_u) * ridge;
-        let cholesky = h_reg.cholesky().ok_or(IkError::Singular)?;
-        let mut delta = cholesky.solve(&g_u);
+        let mut h_u = h_u;
+        let mut g_u = g_u;
         if r > 0 {
+            // The hard rows as a stiff least-squares term: met (to within the energy's pull over
+            // `self.hard_weight`) when the limbs reach, met in the least-squares sense when not.
             let e_u = DMatrix::from_fn(2 * r, n_u, |row, i| {
                 map[i].iter().map(|&(a, ca)| ca * self.e_w[(row, a)]).sum()
             });
             let e_u0 = &e_vec - &self.e_w * &w0;
-            let y = cholesky.solve(&e_u.transpose());
-            let mut s = &e_u * &y;
-            let damping = SCHUR_DAMPING
-                * (0..2 * r).map(|i| s[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
-            for i in 0..2 * r {
-                s[(i, i)] += damping;
-            }
-            let s = s.cholesky().ok_or(IkError::Singular)?;
-            let lambda = s.solve(&(&e_u * &delta - e_u0));
-            delta -= y * lambda;
+            h_u += e_u.tr_mul(&e_u) * self.hard_weight;
+            g_u += e_u.tr_mul(&e_u0) * self.hard_weight;
         }
+        let ridge = 1e-12 * (0..n_u).map(|i| h_u[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        for i in 0..n_u {
+            h_u[(i, i)] += ridge;
+        }
+        let cholesky = h_u.cholesky().ok_or(IkError::Singular)?;
+        let mut delta = cholesky.solve(&g_u);
         let largest_turn = turns.iter().map(|&(i, _)| delta[i].abs()).fold(0.0, f64::max);
         if !largest_turn.is_finite() || delta.iter().any(|v| !v.is_finite()) {
             return Err(IkError::NonFinite);
@@ -369,5 +434,78 @@ impl CoupledStep {
         }
         let flat = &self.p * &w;
         Ok(DMatrix::from_fn(dim, 2, |k, c| flat[c * dim + k] + q[(k, c)]))
+    }
+}
+
+/// Writes column `j`'s rows of P (both output coordinates) from its parametrization; a follower
+/// or a joined column reads its parent's rows, which must be written already.
+fn fill_column(
+    p: &mut DMatrix<f64>,
+    dim: usize,
+    j: usize,
+    param: &Param,
+    follow: Option<&(usize, usize, [[f64; 3]; 3])>,
+) {
+    match *param {
+        Param::None => {
+            if let Some(&(_, parent, map)) = follow {
+                for c in 0..2 {
+                    for (k, row) in map.iter().enumerate() {
+                        for (l, &coefficient) in row.iter().enumerate() {
+                            if coefficient != 0.0 {
+                                let from = p.row(c * dim + 3 * parent + l) * coefficient;
+                                let mut to = p.row_mut(c * dim + 3 * j + k);
+                                to += from;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Param::Affine { offset } => {
+            for c in 0..2 {
+                for k in 0..3 {
+                    p[(c * dim + 3 * j + k, offset + 3 * c + k)] = 1.0;
+                }
+            }
+        }
+        Param::Translation { offset } => {
+            for c in 0..2 {
+                p[(c * dim + 3 * j + 2, offset + c)] = 1.0;
+            }
+        }
+        Param::Similarity {
+            offset: o,
+            pivot: [cx, cy],
+            joined,
+            ..
+        } => {
+            // L = [[a, −b], [b, a]]; the translation's −L c part.
+            p[(3 * j, o)] = 1.0;
+            p[(3 * j + 1, o + 1)] = -1.0;
+            p[(dim + 3 * j, o + 1)] = 1.0;
+            p[(dim + 3 * j + 1, o)] = 1.0;
+            p[(3 * j + 2, o)] = -cx;
+            p[(3 * j + 2, o + 1)] = cy;
+            p[(dim + 3 * j + 2, o)] = -cy;
+            p[(dim + 3 * j + 2, o + 1)] = -cx;
+            match joined {
+                // c + t: t free (c is a constant entry).
+                None => {
+                    p[(3 * j + 2, o + 2)] = 1.0;
+                    p[(dim + 3 * j + 2, o + 3)] = 1.0;
+                }
+                // The parent's image of c.
+                Some(parent) => {
+                    for c in 0..2 {
+                        let from = p.row(c * dim + 3 * parent) * cx
+                            + p.row(c * dim + 3 * parent + 1) * cy
+                            + p.row(c * dim + 3 * parent + 2);
+                        let mut to = p.row_mut(c * dim + 3 * j + 2);
+                        to += from;
+                    }
+                }
+            }
+        }
     }
 }
