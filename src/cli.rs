@@ -13,7 +13,7 @@ use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
 use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
-use sinew::io::outputs::{check_not_overwriting, check_outputs, parent_dir};
+use sinew::io::outputs::{check_not_overwriting, check_output_kind, check_outputs, parent_dir};
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
 use sinew::pipeline::{self, PartReport, Scene};
@@ -656,6 +656,9 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
             vec![args.output.clone(), args.output.with_extension("json")]
         }
     };
+    if files.is_empty() {
+        check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
+    }
     let images = part_images(&args.rig, &scene.doc);
     check_outputs(
         std::iter::once(args.rig.as_path()).chain(images.iter().map(PathBuf::as_path)),
@@ -906,7 +909,12 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
         .map(|file| args.output.join(file))
         .collect();
     let sprites = part_images(&args.rig, &scene.doc);
-    // The export folder is made where missing: only the overwriting is checked.
+    // The export folder is made where missing: only what is there and the overwriting are
+    // checked.
+    check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
+    for target in &targets {
+        check_output_kind(target, io::atomic::OutputKind::File)?;
+    }
     check_not_overwriting(
         std::iter::once(args.rig.as_path()).chain(sprites.iter().map(PathBuf::as_path)),
         targets.iter().map(|t| Some(t.as_path())),

@@ -118,6 +118,13 @@ pub enum MeshError {
     NonFinite,
     #[error("outline edges cross each other")]
     CrossingOutlines,
+    #[error(
+        "cage {cage}: its edge {edge} crosses the drawing's outline; a cage must enclose the \
+         part's outline or lie inside it (move that edge's vertices out or in)"
+    )]
+    CageCrossesOutline { cage: usize, edge: usize },
+    #[error("cage {first} and cage {second} cross each other: cages must not overlap")]
+    CagesCross { first: usize, second: usize },
     #[error("invalid mesh option: {0}")]
     InvalidOptions(String),
     #[error(
@@ -318,6 +325,9 @@ pub fn triangulate_with_handles(
         .iter()
         .map(Vec::as_slice)
         .collect();
+    if let Some(error) = crossing_extension(&rings, &extensions) {
+        return Err(error);
+    }
     let (points, edges) =
         constraint_graph(&rings.iter().chain(&extensions).copied().collect::<Vec<_>>())?;
     let mut conflict = false;
@@ -613,6 +623,41 @@ fn constraint_graph(rings: &[&[Point]]) -> Result<ConstraintGraph, MeshError> {
         }
     }
     Ok((points, edges))
+}
+
+/// Which domain extension (cage) crosses an outline ring or another extension: the mesher
+/// would otherwise report it as the image's crossing outlines. A shared vertex is no crossing
+/// (the constraint graph merges it); touching anywhere else is.
+fn crossing_extension(rings: &[&[Point]], extensions: &[&[Point]]) -> Option<MeshError> {
+    let edges = |ring: &[Point]| -> Vec<[Point; 2]> {
+        (0..ring.len())
+            .map(|i| [ring[i], ring[(i + 1) % ring.len()]])
+            .collect()
+    };
+    let crosses = |[a, b]: [Point; 2], [c, d]: [Point; 2]| {
+        let shared = a == c || a == d || b == c || b == d;
+        !shared && crate::geom::segments_touch(a, b, c, d)
+    };
+    let outline: Vec<[Point; 2]> = rings.iter().flat_map(|r| edges(r)).collect();
+    for (cage, ring) in extensions.iter().enumerate() {
+        for (edge, e) in edges(ring).into_iter().enumerate() {
+            if outline.iter().any(|&o| crosses(e, o)) {
+                return Some(MeshError::CageCrossesOutline { cage, edge });
+            }
+        }
+        for (other, ring2) in extensions.iter().enumerate().skip(cage + 1) {
+            if edges(ring)
+                .into_iter()
+                .any(|e| edges(ring2).into_iter().any(|o| crosses(e, o)))
+            {
+                return Some(MeshError::CagesCross {
+                    first: cage,
+                    second: other,
+                });
+            }
+        }
+    }
+    None
 }
 
 /// A ring vertex whose two edges turn by less than this (the sine of the turn) is dropped.

@@ -60,6 +60,8 @@ pub enum PipelineError {
     NoShape { path: PathBuf, min_area_px2: f64 },
     #[error("{path}: {source}")]
     Mesh { path: PathBuf, source: MeshError },
+    #[error("handles: cage '{cage}': {problem}")]
+    Cage { cage: String, problem: String },
     #[error("part '{part}': {source}")]
     Render { part: String, source: RenderError },
     #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
@@ -245,10 +247,11 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
                 None,
             )
         } else {
-            let geometry = handle_geometry(&handles.for_part(&layer.name));
+            let bound = handles.for_part(&layer.name);
+            let geometry = handle_geometry(&bound);
             let embedded =
                 mesh::triangulate_with_handles(&outlines, &geometry, canvas_area, &options.mesh)
-                    .map_err(mesh_error)?;
+                    .map_err(|e| cage_error(&bound, e).unwrap_or_else(mesh_error))?;
             let colors = options
                 .weights
                 .content_aware
@@ -294,6 +297,27 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
         return Err(PipelineError::HandleOutside(columns[column].clone()));
     }
     Ok((doc, stats))
+}
+
+/// A mesh error that concerns a cage, named (the image is not at fault); others back as they are.
+fn cage_error(handles: &Handles, error: MeshError) -> Result<PipelineError, MeshError> {
+    let name = |i: usize| handles.cages.get(i).map_or("?", |c| c.name.as_str()).to_string();
+    match error {
+        MeshError::CageCrossesOutline { cage, edge } => Ok(PipelineError::Cage {
+            cage: name(cage),
+            problem: format!(
+                "its edge {edge} (vertices {edge}–{}) crosses the drawing's outline: a cage \
+                 must enclose the part's outline or lie inside it; move that edge's vertices \
+                 out or in",
+                (edge + 1) % handles.cages[cage].polygon.len()
+            ),
+        }),
+        MeshError::CagesCross { first, second } => Ok(PipelineError::Cage {
+            cage: name(first),
+            problem: format!("it crosses cage '{}': cages must not overlap", name(second)),
+        }),
+        other => Err(other),
+    }
 }
 
 /// The geometry every mesh must carry for the handles: bone segments, point positions, cage

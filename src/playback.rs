@@ -153,6 +153,10 @@ pub enum RenderAnimationError {
     Runtime(#[from] crate::export::spine::SpineError),
 }
 
+/// The smallest side the scaled canvas may have, px: a scale that draws it smaller renders
+/// nothing recognisable (a 1×1 px frame).
+pub const MIN_SCALED_SIDE_PX: f64 = 1.0;
+
 /// What is wrong with a playback request.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlaybackError {
@@ -162,6 +166,15 @@ pub enum PlaybackError {
     Fps(f64),
     #[error("the scale must be a positive number, not {0}")]
     Scale(f64),
+    #[error(
+        "the scale {scale:e} draws the {}×{} px canvas smaller than {MIN_SCALED_SIDE_PX} px a \
+         side: use a scale of at least {min_scale:e}", canvas[0], canvas[1]
+    )]
+    ScaleTooSmall {
+        scale: f64,
+        canvas: [u32; 2],
+        min_scale: f64,
+    },
     #[error("the output size must be at least 1×1 px")]
     Size,
     #[error(
@@ -196,6 +209,14 @@ impl FrameView {
     ) -> Result<Self, PlaybackError> {
         if !(scale.is_finite() && scale > 0.0) {
             return Err(PlaybackError::Scale(scale));
+        }
+        let shortest = canvas_px.iter().copied().min().unwrap_or(0).max(1);
+        if f64::from(shortest) * scale < MIN_SCALED_SIDE_PX {
+            return Err(PlaybackError::ScaleTooSmall {
+                scale,
+                canvas: canvas_px,
+                min_scale: MIN_SCALED_SIDE_PX / f64::from(shortest),
+            });
         }
         let size = size_px.map_or_else(
             || canvas_px.map(|c| (f64::from(c) * scale).ceil().max(1.0)),

@@ -334,13 +334,17 @@ fn folder_holds_numbered_frames() {
     let dir = temp_dir("folder");
     let frames = synthetic_animation(32, 5);
     let out = dir.join("frames");
-    // A leftover from a longer render is reported, not deleted.
-    std::fs::create_dir_all(&out).unwrap();
+    // A frame of a longer earlier render goes with it; the user's files and folders stay.
+    std::fs::create_dir_all(out.join("refs")).unwrap();
     std::fs::write(out.join("frame_0007.png"), b"old").unwrap();
     std::fs::write(out.join("notes.txt"), b"keep").unwrap();
+    std::fs::write(out.join("refs/a.txt"), b"keep too").unwrap();
     let report = write_sequence(&frames, 12.0, &out, &SequenceOptions::default()).unwrap();
     assert_eq!(report.format, SequenceFormat::Folder);
     assert_eq!(report.stale_files, vec![out.join("frame_0007.png")]);
+    assert!(!out.join("frame_0007.png").exists());
+    assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"keep");
+    assert_eq!(std::fs::read(out.join("refs/a.txt")).unwrap(), b"keep too");
     let mut names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

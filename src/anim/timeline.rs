@@ -218,6 +218,10 @@ pub enum TimelineError {
     },
     #[error("key {key} has a value that is not a finite number")]
     NonFinite { key: usize },
+    #[error("key {key} has a value beyond ±{MAX_KEY_VALUE} (px, degrees or scale): {value:e}")]
+    ValueTooLarge { key: usize, value: f64 },
+    #[error("key {key} has a curve value beyond ±{MAX_KEY_VALUE}: {value:e}")]
+    CurveValueTooLarge { key: usize, value: f64 },
     #[error("key {key} has a curve of {got} numbers; expected {expected} (4 per value channel)")]
     CurveLength {
         key: usize,
@@ -238,6 +242,17 @@ pub enum TimelineError {
     },
     #[error("key {key} lists part '{name}' twice")]
     DuplicatePart { key: usize, name: String },
+}
+
+/// The largest magnitude of a key's value or of a Bézier handle's value, in the channel's
+/// units (px, degrees, scale factor, 0..1 fraction): a rotation of 1e300° or a handle at 1e300
+/// has no meaning and overflows what is computed from it. Posing limits the result further
+/// ([`crate::rig::pose::MAX_POSED_PX`], [`crate::rig::pose::MAX_POSED_SCALE`]).
+pub const MAX_KEY_VALUE: f64 = 1e6;
+
+/// The first number of `numbers` beyond ±[`MAX_KEY_VALUE`].
+fn too_large(numbers: &[f64]) -> Option<f64> {
+    numbers.iter().copied().find(|v| v.abs() > MAX_KEY_VALUE)
 }
 
 /// Times: finite, ≥ 0, strictly increasing; at least one key.
@@ -269,8 +284,12 @@ fn check_times(times: impl Iterator<Item = f64>) -> Result<(), TimelineError> {
 fn check_keys<V: Channels>(keys: &[Key<V>]) -> Result<(), TimelineError> {
     check_times(keys.iter().map(|k| k.time))?;
     for (i, k) in keys.iter().enumerate() {
-        if !k.value.numbers().iter().all(|v| v.is_finite()) {
+        let values = k.value.numbers();
+        if !values.iter().all(|v| v.is_finite()) {
             return Err(TimelineError::NonFinite { key: i });
+        }
+        if let Some(value) = too_large(values) {
+            return Err(TimelineError::ValueTooLarge { key: i, value });
         }
         let Curve::Bezier(numbers) = &k.curve else {
             continue;
@@ -285,6 +304,10 @@ fn check_keys<V: Channels>(keys: &[Key<V>]) -> Result<(), TimelineError> {
         }
         if !numbers.iter().all(|v| v.is_finite()) {
             return Err(TimelineError::CurveNonFinite { key: i });
+        }
+        let handle_values: Vec<f64> = numbers.chunks_exact(2).map(|pair| pair[1]).collect();
+        if let Some(value) = too_large(&handle_values) {
+            return Err(TimelineError::CurveValueTooLarge { key: i, value });
         }
         if let Some(next) = keys.get(i + 1) {
             let inside = |cx: f64| cx >= k.time && cx <= next.time;
@@ -426,6 +449,12 @@ impl Animation {
             if !drag.at.iter().all(|v| v.is_finite()) {
                 return Err(fail(format!("ik[{i}].at"))(TimelineError::NonFinite {
                     key: 0,
+                }));
+            }
+            if let Some(value) = too_large(&drag.at) {
+                return Err(fail(format!("ik[{i}].at"))(TimelineError::ValueTooLarge {
+                    key: 0,
+                    value,
                 }));
             }
             check_keys(&drag.to).map_err(fail(format!("ik[{i}].to")))?;

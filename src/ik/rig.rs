@@ -167,11 +167,10 @@ impl RigIk {
             .iter()
             .map(|drag| {
                 let key = drag.at.map(f64::to_bits);
+                // The same check as an uncached drag's: a cached grip is no licence.
+                check_drag(drag)?;
                 match self.gripped.get(&key) {
-                    Some(row)
-                        if drag.to.iter().all(|v| v.is_finite())
-                            && drag.weight.is_none_or(|w| w.is_finite() && w >= 0.0) =>
-                    {
+                    Some(row) => {
                         Ok(DragRow {
                             row: row.clone(),
                             target: drag.to,
@@ -341,23 +340,7 @@ impl RigIk {
 
     /// The skinning row of the material point a drag grips, and its target.
     pub fn drag_row(&self, drag: &IkDrag) -> Result<DragRow, IkError> {
-        let values = [
-            drag.at[0],
-            drag.at[1],
-            drag.to[0],
-            drag.to[1],
-            drag.weight.unwrap_or(1.0),
-        ];
-        if values.iter().any(|v| !v.is_finite()) || drag.weight.is_some_and(|w| w < 0.0) {
-            return Err(IkError::NonFinite);
-        }
-        if drag
-            .to
-            .iter()
-            .any(|v| v.abs() > crate::rig::pose::MAX_POSED_PX)
-        {
-            return Err(IkError::TargetTooFar(drag.to[0], drag.to[1]));
-        }
+        check_drag(drag)?;
         let at = Point::new(drag.at[0], drag.at[1]);
         let (mesh, triangle, barycentric) =
             grip(&self.meshes, at, self.solver.options.grip_tolerance_px)
@@ -424,4 +407,18 @@ pub fn skinned_position(row: &[f64], transforms: &[Affine]) -> Point {
         y += a * t.linear[(1, 0)] + b * t.linear[(1, 1)] + c * t.translation.y;
     }
     Point::new(x, y)
+}
+
+/// A drag's one check ([`IkDrag::check`]), in the IK's own terms where it has them.
+fn check_drag(drag: &IkDrag) -> Result<(), IkError> {
+    let values = [drag.at[0], drag.at[1], drag.to[0], drag.to[1]];
+    if values.iter().any(|v| !v.is_finite())
+        || drag.weight.is_some_and(|w| !(w.is_finite() && w >= 0.0))
+    {
+        return Err(IkError::NonFinite);
+    }
+    if drag.to.iter().any(|v| v.abs() > crate::rig::pose::MAX_POSED_PX) {
+        return Err(IkError::TargetTooFar(drag.to[0], drag.to[1]));
+    }
+    Ok(drag.check()?)
 }

@@ -1,21 +1,114 @@
-//! Writing files so that a reader never sees half of one.
+//! Writing outputs so that a reader never sees half of one, and so that only what sinew may
+//! replace is replaced.
 //!
-//! The content goes to a temporary file beside the target, which is then renamed over it: the
-//! rename is atomic on one file system, so the target holds either its old or its new content.
+//! Like `cp`, a write goes *through* a symbolic link to the file it names (atomically there: the
+//! link stays a link, its target gets the new content); an existing output that is not a regular
+//! file (a named pipe, a device such as `/dev/full`, a socket, a folder) is refused, never replaced.
+//! The content goes to a temporary file beside the (resolved) target, which is then renamed over
+//! it: the rename is atomic on one file system, so the target holds either its old or its new
+//! content. Temporaries are named `.NAME.PID.N.tmp`; ones left by a process that was killed are
+//! removed by the next write of the same target ([`remove_stale_temporaries`]).
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
-/// Writes `bytes` to `path` atomically (temporary file + rename).
+/// Symbolic links followed from an output path before giving up (as the kernel's own limit).
+pub const MAX_SYMLINK_HOPS: usize = 40;
+
+/// What an output path must be where it already exists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputKind {
+    /// A regular file (replaced whole).
+    File,
+    /// A folder (a frame folder or an export folder, written into).
+    Folder,
+}
+
+/// Why an output path cannot be written; an [`io::Error`] of kind `InvalidInput` carrying it is
+/// what the writers return, so their messages say it on one line.
+fn refuse(message: String) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidInput, message)
+}
+
+/// What a non-regular file is, for messages.
+fn describe(file_type: &fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_fifo() {
+            return "a named pipe";
+        }
+        if file_type.is_char_device() || file_type.is_block_device() {
+            return "a device";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    if file_type.is_dir() {
+        "a folder"
+    } else if file_type.is_file() {
+        "a regular file"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// The path a write of `path` replaces: `path` itself, or, through symbolic links, the file they
+/// name (which need not exist yet, as `cp` creates it). Where something exists there, it must be
+/// of `kind`; anything else (a pipe, a device, a socket, a folder where a file is expected and
+/// the other way round) is refused.
+pub fn resolve_output(path: &Path, kind: OutputKind) -> io::Result<PathBuf> {
+    let mut at = path.to_path_buf();
+    for _ in 0..=MAX_SYMLINK_HOPS {
+        let meta = match fs::symlink_metadata(&at) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(at),
+            Err(e) => return Err(e),
+        };
+        let file_type = meta.file_type();
+        if file_type.is_symlink() {
+            let target = fs::read_link(&at)?;
+            at = match at.parent() {
+                Some(dir) if target.is_relative() => dir.join(target),
+                _ => target,
+            };
+            continue;
+        }
+        let fits = match kind {
+            OutputKind::File => file_type.is_file(),
+            OutputKind::Folder => file_type.is_dir(),
+        };
+        if !fits {
+            let wanted = match kind {
+                OutputKind::File => "a regular file",
+                OutputKind::Folder => "a folder",
+            };
+            let via = if at == path {
+                String::new()
+            } else {
+                format!(" (the link leads to {})", at.display())
+            };
+            return Err(refuse(format!(
+                "it is {}{via}, not {wanted}: sinew replaces only {wanted}s; remove it or choose another path",
+                describe(&file_type)
+            )));
+        }
+        return Ok(at);
+    }
+    Err(refuse(format!(
+        "more than {MAX_SYMLINK_HOPS} symbolic links in a row (a loop?)"
+    )))
+}
+
+/// Writes `bytes` to `path` atomically (temporary file + rename), through symbolic links; an
+/// existing `path` that is not a regular file is refused (see [`resolve_output`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let tmp = temporary_sibling(path);
-    let result = (|| {
-        let mut file = fs::File::create(&tmp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        fs::rename(&tmp, path)
-    })();
+    let target = resolve_output(path, OutputKind::File)?;
+    remove_stale_temporaries(&target);
+    let tmp = temporary_sibling(&target);
+    let result = write_new(&tmp, bytes).and_then(|()| fs::rename(&tmp, &target));
     if result.is_err() {
         // The temporary file may not exist; nothing else to report.
         let _ = fs::remove_file(&tmp);
@@ -23,26 +116,106 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
+/// Creates `path` (which must not exist) with `bytes`, synced to disk.
+pub fn write_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()
+}
+
 /// `dir/.name.PID.N.tmp`: hidden, unique per process and write (two threads writing the same
 /// target never share a temporary file), on the same file system as `path`.
-fn temporary_sibling(path: &Path) -> PathBuf {
+pub fn temporary_sibling(path: &Path) -> PathBuf {
     static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let name = path
-        .file_name()
+    path.with_file_name(format!(
+        ".{}.{}.{n}.tmp",
+        file_name(path),
+        std::process::id()
+    ))
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()))
+        .unwrap_or_default()
+}
+
+/// The process id in a temporary's name `.NAME.PID.N.tmp` of target name `name`.
+fn temporary_pid(entry: &str, name: &str) -> Option<u32> {
+    let rest = entry
+        .strip_prefix('.')?
+        .strip_prefix(name)?
+        .strip_prefix('.')?
+        .strip_suffix(".tmp")?;
+    let (pid, n) = rest.split_once('.')?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    (digits(pid) && digits(n)).then(|| pid.parse().ok())?
+}
+
+/// Whether process `pid` may still be running (and writing its temporaries). Where that cannot
+/// be told (no `/proc`), every process may be.
+fn may_be_running(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
+}
+
+/// The temporaries of `target` (see [`temporary_sibling`]) left beside it by processes that are
+/// no longer running (a killed run), sorted.
+pub fn stale_temporaries(target: &Path) -> Vec<PathBuf> {
+    let name = file_name(target);
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut stale: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .filter(|e| {
+            e.file_name()
+                .to_str()
+                .and_then(|n| temporary_pid(n, &name))
+                .is_some_and(|pid| !may_be_running(pid))
+        })
+        .map(|e| dir.join(e.file_name()))
+        .collect();
+    stale.sort();
+    stale
+}
+
+/// Removes the stale temporary files of `target` (see [`stale_temporaries`]). Best effort: a
+/// temporary that cannot be removed stays (it is hidden and harms nothing). Temporary folders
+/// are left to [`crate::io::sequence::folder`], which knows what may be in them.
+pub fn remove_stale_temporaries(target: &Path) {
+    for tmp in stale_temporaries(target) {
+        if fs::symlink_metadata(&tmp).is_ok_and(|m| m.is_file()) {
+            let _ = fs::remove_file(tmp);
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("sinew-atomic-{name}-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
     #[test]
     fn replaces_content_and_leaves_no_temporary() {
-        let dir = std::env::temp_dir().join(format!("sinew-atomic-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("replace");
         let target = dir.join("a.json");
         write_atomic(&target, b"old").unwrap();
         write_atomic(&target, b"new").unwrap();
@@ -55,8 +228,7 @@ mod tests {
 
     #[test]
     fn writes_of_one_target_from_two_threads_do_not_mix() {
-        let dir = std::env::temp_dir().join(format!("sinew-atomic-two-{}", std::process::id()));
-        fs::create_dir_all(&dir).unwrap();
+        let dir = scratch("two");
         let target = dir.join("a.json");
         let contents = [vec![b'a'; 1 << 20], vec![b'b'; 1 << 20]];
         std::thread::scope(|scope| {
@@ -73,5 +245,71 @@ mod tests {
         assert!(contents.contains(&written), "the target mixes two writes");
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
         fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn writes_go_through_symbolic_links_and_folders_are_refused() {
+        let dir = scratch("links");
+        let real = dir.join("real.png");
+        fs::write(&real, b"old").unwrap();
+        let link = dir.join("link.png");
+        std::os::unix::fs::symlink("real.png", &link).unwrap();
+        let chain = dir.join("chain.png");
+        std::os::unix::fs::symlink(&link, &chain).unwrap();
+        write_atomic(&chain, b"new").unwrap();
+        assert!(fs::symlink_metadata(&link).unwrap().is_symlink());
+        assert!(fs::symlink_metadata(&chain).unwrap().is_symlink());
+        assert_eq!(fs::read(&real).unwrap(), b"new");
+        // A dangling link creates its target, as cp does.
+        let dangling = dir.join("dangling.png");
+        std::os::unix::fs::symlink("made.png", &dangling).unwrap();
+        write_atomic(&dangling, b"made").unwrap();
+        assert_eq!(fs::read(dir.join("made.png")).unwrap(), b"made");
+        // A loop is refused.
+        let a = dir.join("a");
+        std::os::unix::fs::symlink("b", &a).unwrap();
+        std::os::unix::fs::symlink("a", dir.join("b")).unwrap();
+        let err = write_atomic(&a, b"x").unwrap_err();
+        assert!(err.to_string().contains("symbolic links"), "{err}");
+        // A folder where a file is expected, and a file where a folder is.
+        let err = write_atomic(&dir, b"x").unwrap_err();
+        assert!(err.to_string().contains("it is a folder"), "{err}");
+        let err = resolve_output(&real, OutputKind::Folder).unwrap_err();
+        assert!(err.to_string().contains("not a folder"), "{err}");
+        assert_eq!(resolve_output(&link, OutputKind::File).unwrap(), real);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept() {
+        let dir = scratch("stale");
+        let target = dir.join("walk.json");
+        fs::write(&target, b"previous").unwrap();
+        // A pid above the kernel's largest (4194304) never runs.
+        let dead = dir.join(".walk.json.4294967294.0.tmp");
+        let live = dir.join(format!(".walk.json.{}.7.tmp", std::process::id()));
+        let other = dir.join(".other.json.4294967294.0.tmp");
+        let unlike = dir.join(".walk.json.12x.0.tmp");
+        for p in [&dead, &live, &other, &unlike] {
+            fs::write(p, b"half").unwrap();
+        }
+        if Path::new("/proc/self").exists() {
+            assert_eq!(stale_temporaries(&target), vec![dead.clone()]);
+            write_atomic(&target, b"next").unwrap();
+            assert!(!dead.exists());
+        }
+        for p in [&live, &other, &unlike] {
+            assert!(p.exists(), "{}", p.display());
+        }
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn temporary_names_parse() {
+        assert_eq!(temporary_pid(".a.png.12.3.tmp", "a.png"), Some(12));
+        assert_eq!(temporary_pid(".a.png.12.tmp", "a.png"), None);
+        assert_eq!(temporary_pid(".b.png.12.3.tmp", "a.png"), None);
+        assert_eq!(temporary_pid(".a.png.1.2.3.tmp", "a.png"), None);
     }
 }

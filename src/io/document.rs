@@ -223,6 +223,14 @@ impl RigDocument {
                 reason: format!("not a valid rig document: {e}"),
             })?;
         doc.animations = animations;
+        // A document with no part draws nothing (a blank PNG) and exports nothing; only the
+        // editor makes one, before its first layer, and never saves it.
+        if doc.parts.is_empty() {
+            return Err(DocumentError::Invalid {
+                path: path.into(),
+                reason: "the rig has no parts (\"parts\": []): rig at least one image (sinew rig IMAGE...)".into(),
+            });
+        }
         doc.validate().map_err(|reason| DocumentError::Invalid {
             path: path.into(),
             reason,
@@ -287,8 +295,8 @@ impl RigDocument {
 }
 
 /// Mesh coordinates beyond this (px, either sign) are refused: no canvas is that large, and
-/// skinning such a vertex overflows.
-pub const MAX_COORDINATE_PX: f64 = 1e6;
+/// skinning such a vertex overflows. The same limit as the handles'.
+pub use crate::rig::handles::MAX_COORDINATE_PX;
 /// How far a weight may lie outside [0, 1], and a row's sum from one, by rounding.
 pub const WEIGHT_TOLERANCE: f64 = 1e-6;
 

@@ -14,6 +14,22 @@ pub enum OutputError {
     OverwritesInput(PathBuf),
     #[error("{}: two outputs name the same file", .0.display())]
     SameOutput(PathBuf),
+    /// An existing entry of the wrong kind (a named pipe or a device given as a file, a file
+    /// given as a frame folder), or a link that cannot be followed.
+    #[error("{}: cannot write: {reason}", .path.display())]
+    WrongKind { path: PathBuf, reason: String },
+}
+
+/// Fails when `output` exists and is not of `kind` (symbolic links are followed, as writes go
+/// through them). Returns the path a write replaces.
+pub fn check_output_kind(
+    output: &Path,
+    kind: crate::io::atomic::OutputKind,
+) -> Result<PathBuf, OutputError> {
+    crate::io::atomic::resolve_output(output, kind).map_err(|e| OutputError::WrongKind {
+        path: output.to_path_buf(),
+        reason: e.to_string(),
+    })
 }
 
 /// The file `path` names, resolved through links when it (or its folder) exists.
@@ -47,8 +63,8 @@ pub fn parent_dir(path: &Path) -> &Path {
     }
 }
 
-/// Fails, before any work, when an output file names an input or another output, or lies in
-/// a folder that does not exist (the outputs written before it would be left behind). Absent
+/// Fails, before any work, when an output file names an input or another output, exists and
+/// is not a regular file (after links), or lies in a folder that does not exist (the outputs written before it would be left behind). Absent
 /// (`None`) outputs are skipped; output folders, which the commands make where missing, are
 /// not passed here.
 pub fn check_outputs<'a>(
@@ -56,7 +72,8 @@ pub fn check_outputs<'a>(
     outputs: impl IntoIterator<Item = Option<&'a Path>> + Clone,
 ) -> Result<(), OutputError> {
     for output in outputs.clone().into_iter().flatten() {
-        let folder = parent_dir(output);
+        let target = check_output_kind(output, crate::io::atomic::OutputKind::File)?;
+        let folder = parent_dir(&target);
         if !folder.as_os_str().is_empty() && !folder.is_dir() {
             return Err(OutputError::MissingFolder {
                 path: output.to_path_buf(),

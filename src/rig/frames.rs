@@ -193,6 +193,12 @@ pub enum PoseError {
     },
     #[error("the pose of '{0}' has a value that is not a finite number")]
     NonFinite(String),
+    #[error("the pose of '{0}' has the value {1:e}, beyond ±{MAX_POSE_VALUE} (px, degrees or scale)")]
+    TooLarge(String, f64),
+    #[error("ik drag {0}")]
+    BadDrag(String),
+    #[error("the pose of part '{0}' has a color channel outside [0, 1]")]
+    Color(String),
     #[error("the pose of '{0}' makes its transformation singular (a zero scale?)")]
     Singular(String),
     #[error(
@@ -200,6 +206,69 @@ pub enum PoseError {
          {MAX_POSED_SCALE}"
     )]
     OutOfRange(String),
+}
+
+/// The largest magnitude of a number in a pose (px, degrees, scale factors): a rotation of
+/// 1e300° has no meaning and loses every digit in the rotation it makes.
+pub const MAX_POSE_VALUE: f64 = 1e6;
+
+impl IkDrag {
+    /// Every number finite, `at` and `to` within ±[`MAX_POSED_PX`], a weight ≥ 0: the one check
+    /// of a drag, wherever it comes from (a pose file, an animation's keys, the editor).
+    pub fn check(&self) -> Result<(), PoseError> {
+        let numbers = [self.at[0], self.at[1], self.to[0], self.to[1]];
+        if !finite(&numbers) || self.weight.is_some_and(|w| !(w.is_finite() && w >= 0.0)) {
+            return Err(PoseError::BadDrag(format!(
+                "at {:?} to {:?}: every number must be finite (and a weight ≥ 0)",
+                self.at, self.to
+            )));
+        }
+        if numbers.iter().any(|v| v.abs() > MAX_POSED_PX) {
+            return Err(PoseError::BadDrag(format!(
+                "at [{:e}, {:e}] to [{:e}, {:e}] lies beyond ±{MAX_POSED_PX} px",
+                self.at[0], self.at[1], self.to[0], self.to[1]
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl Pose {
+    /// The checks that need no rig: every number finite and within ±[`MAX_POSE_VALUE`], drags
+    /// as [`IkDrag::check`], part colours in [0, 1]. [`crate::rig::handle_transforms`] runs it
+    /// first, so every pose is checked where it is posed.
+    pub fn check_values(&self) -> Result<(), PoseError> {
+        let bad = |name: &str, numbers: &[f64]| {
+            if !finite(numbers) {
+                Err(PoseError::NonFinite(name.to_string()))
+            } else if let Some(v) = numbers.iter().find(|v| v.abs() > MAX_POSE_VALUE) {
+                Err(PoseError::TooLarge(name.to_string(), *v))
+            } else {
+                Ok(())
+            }
+        };
+        for (name, b) in &self.bones {
+            let [t0, t1] = b.translate;
+            bad(name, &[b.rotate, t0, t1, b.scale[0], b.scale[1], b.shear[0], b.shear[1]])?;
+        }
+        for (name, p) in &self.points {
+            let [t0, t1] = p.translate;
+            bad(name, &[p.rotate, t0, t1, p.scale[0], p.scale[1], p.shear[0], p.shear[1]])?;
+        }
+        for (name, c) in &self.cages {
+            let numbers: Vec<f64> = c.polygon.iter().flatten().copied().collect();
+            bad(name, &numbers)?;
+        }
+        for drag in &self.ik {
+            drag.check()?;
+        }
+        for (name, part) in &self.parts {
+            if !part.color.iter().all(|c| (0.0..=1.0).contains(c)) {
+                return Err(PoseError::Color(name.clone()));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// How far a posed handle may move anything, px (either sign): no canvas is that large, and

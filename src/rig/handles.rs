@@ -128,6 +128,86 @@ pub enum HandleError {
     EmptyBind(String),
     #[error("ik constraint '{name}': {problem}")]
     BadIkConstraint { name: String, problem: String },
+    #[error("handle '{name}' has a coordinate beyond ±{MAX_COORDINATE_PX} px: {value:e}")]
+    TooFar { name: String, value: f64 },
+    #[error("{kind} '{name}': {problem}")]
+    BadPolygon {
+        kind: &'static str,
+        name: String,
+        problem: String,
+    },
+    #[error(
+        "the handles make {columns} weight columns (one per bone, point, cage vertex and \
+         region): at most {MAX_WEIGHT_COLUMNS}; use fewer handles or cages of fewer vertices"
+    )]
+    TooManyColumns { columns: usize },
+}
+
+/// Handle coordinates beyond this (px, either sign) are refused: no canvas is that large, and a
+/// bone that long overflows its length (and the Spine export's `length`). Also the limit of a
+/// rig document's mesh vertices ([`crate::io::document::MAX_COORDINATE_PX`] is this).
+pub const MAX_COORDINATE_PX: f64 = 1e6;
+/// The most weight columns a set of handles may make: each column is one weight solve over the
+/// mesh, and each a skinning-IK unknown (a 1000-bone chain takes most of a minute).
+pub const MAX_WEIGHT_COLUMNS: usize = 256;
+/// A cage or region encloses at least this area, px²: less is a line (collinear points).
+pub const MIN_POLYGON_AREA_PX2: f64 = 1e-6;
+
+/// What is wrong with a cage's or region's outline: a repeated vertex, edges that cross or
+/// double back, or no area. `None` for a simple polygon.
+pub fn polygon_problem(polygon: &[[f64; 2]]) -> Option<String> {
+    use crate::geom::{segments_touch, triangle_area2, Point};
+    let n = polygon.len();
+    let p: Vec<Point> = polygon.iter().map(|v| Point::new(v[0], v[1])).collect();
+    for i in 0..n {
+        if p[i] == p[(i + 1) % n] {
+            return Some(format!("vertex {} repeats vertex {i}", (i + 1) % n));
+        }
+    }
+    for i in 0..n {
+        let (a, b, c) = (p[i], p[(i + 1) % n], p[(i + 2) % n]);
+        if n > 3 && triangle_area2(a, b, c) == 0.0 && (a - b).dot(&(c - b)) > 0.0 {
+            return Some(format!(
+                "edges {i} and {} double back on each other at vertex {}",
+                (i + 1) % n,
+                (i + 1) % n
+            ));
+        }
+        for j in i + 2..n {
+            if i == 0 && j == n - 1 {
+                continue; // adjacent through the closing edge
+            }
+            if segments_touch(p[i], p[(i + 1) % n], p[j], p[(j + 1) % n]) {
+                return Some(format!(
+                    "edge {i} (vertices {i}–{}) crosses edge {j} (vertices {j}–{}): the outline \
+                     must not cross itself (a bow tie); reorder the vertices",
+                    (i + 1) % n,
+                    (j + 1) % n
+                ));
+            }
+        }
+    }
+    let area2: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % n]);
+            a.x * b.y - a.y * b.x
+        })
+        .sum();
+    if area2.abs() / 2.0 < MIN_POLYGON_AREA_PX2 {
+        return Some("it has no area: its vertices lie on one line".into());
+    }
+    None
+}
+
+/// Every coordinate of handle `name` within ±[`MAX_COORDINATE_PX`].
+fn check_reach<'a>(name: &str, mut values: impl Iterator<Item = &'a f64>) -> Result<(), HandleError> {
+    match values.find(|v| v.abs() > MAX_COORDINATE_PX) {
+        Some(&value) => Err(HandleError::TooFar {
+            name: name.to_string(),
+            value,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Bones shorter than this (px) are degenerate: they have no direction.
@@ -272,6 +352,7 @@ impl Handles {
             if !b.head.iter().chain(&b.tail).all(|v| v.is_finite()) {
                 return Err(HandleError::NonFinite(b.name.clone()));
             }
+            check_reach(&b.name, b.head.iter().chain(&b.tail))?;
             if (b.tail[0] - b.head[0]).hypot(b.tail[1] - b.head[1]) < MIN_BONE_LENGTH_PX {
                 return Err(HandleError::DegenerateBone(b.name.clone()));
             }
@@ -280,6 +361,7 @@ impl Handles {
             if !p.at.iter().all(|v| v.is_finite()) {
                 return Err(HandleError::NonFinite(p.name.clone()));
             }
+            check_reach(&p.name, p.at.iter())?;
         }
         let polygons = self.cages.iter().map(|c| ("cage", &c.name, &c.polygon));
         for (kind, name, polygon) in
@@ -298,6 +380,21 @@ impl Handles {
                     name: name.clone(),
                 });
             }
+            check_reach(name, polygon.iter().flatten())?;
+            if let Some(problem) = polygon_problem(polygon) {
+                return Err(HandleError::BadPolygon {
+                    kind,
+                    name: name.clone(),
+                    problem,
+                });
+            }
+        }
+        let columns = self.bones.len()
+            + self.points.len()
+            + self.cages.iter().map(|c| c.polygon.len()).sum::<usize>()
+            + self.regions.len();
+        if columns > MAX_WEIGHT_COLUMNS {
+            return Err(HandleError::TooManyColumns { columns });
         }
         self.check_parents()?;
         self.check_ik()

@@ -8,7 +8,7 @@
 
 pub use super::frames::{
     bone_rest_frame, bone_world_frames, rotation, screen_angle_deg, Affine, BonePose, CagePose,
-    IkDrag, PartPose, PointPose, Pose, PoseError, MAX_POSED_PX, MAX_POSED_SCALE,
+    IkDrag, PartPose, PointPose, Pose, PoseError, MAX_POSED_PX, MAX_POSED_SCALE, MAX_POSE_VALUE,
 };
 use super::frames::{check_names, finite, local_linear, within_reach};
 use super::handles::Handles;
@@ -136,6 +136,7 @@ pub fn bone_stretches_under(
 /// [`handle_columns`] lists them: bones, points, cage vertices, regions (regions stay at rest
 /// unless IK moves them). The rig's bone IK constraints apply first.
 pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, PoseError> {
+    pose.check_values()?;
     let constrained;
     let pose = if handles.ik.is_empty() {
         pose
@@ -466,8 +467,21 @@ mod tests {
             far.bones.insert("upper".into(), local);
             assert_eq!(
                 handle_transforms(&arm(), &far).err(),
-                Some(PoseError::OutOfRange("upper".into()))
+                Some(PoseError::TooLarge("upper".into(), 1e300))
             );
         }
+        // Within the numbers' limit, but the posed transformation goes beyond its own.
+        let mut far = Pose::default();
+        far.bones.insert(
+            "upper".into(),
+            BonePose {
+                scale: [MAX_POSE_VALUE, 1.0],
+                ..Default::default()
+            },
+        );
+        assert_eq!(
+            handle_transforms(&arm(), &far).err(),
+            Some(PoseError::OutOfRange("upper".into()))
+        );
     }
 }

@@ -317,6 +317,13 @@ pub fn export_spine(
             reason: "a file name cannot contain / or \\ (the output folder is -o)",
         });
     }
+    if name.starts_with('.') {
+        return Err(SpineError::BadName {
+            kind: "file",
+            name: name.to_string(),
+            reason: "a name starting with '.' makes hidden files ('..json' for '.'); start it with a letter or digit",
+        });
+    }
     check_name("root bone", &options.root_bone, false)?;
     for part in &doc.parts {
         check_name("part", &part.name, true)?;
@@ -670,23 +677,36 @@ impl SpineExport {
             .collect()
     }
 
-    /// Writes every file into `dir` (created if missing): each goes to a hidden temporary file
-    /// first, and only when all are written are they renamed into place, so a failure while
-    /// writing (disk full, no permission) leaves `dir` without any new or half-written file.
-    /// The renames themselves are atomic one by one, not as a set. Returns the paths written.
+    /// Writes every file into `dir` (created if missing; a symbolic link to a folder is
+    /// followed): each goes to a hidden temporary file beside its target first (temporaries a
+    /// killed run left there are removed), and only when all are written are they renamed into
+    /// place, so a failure while writing (disk full, no permission) leaves `dir` without any new
+    /// or half-written file. A target that is a symbolic link is written through (its file is
+    /// replaced); one that is not a regular file is refused before anything is written. The
+    /// renames themselves are atomic one by one, not as a set. Returns the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, SpineError> {
         let fail = |path: &Path| {
             let path = path.to_path_buf();
             move |source| SpineError::Write { path, source }
         };
-        std::fs::create_dir_all(dir).map_err(fail(dir))?;
+        let real_dir = io::atomic::resolve_output(dir, io::atomic::OutputKind::Folder)
+            .map_err(fail(dir))?;
+        std::fs::create_dir_all(&real_dir).map_err(fail(dir))?;
         let files = self.files();
+        let mut targets = Vec::with_capacity(files.len());
+        for (file, _) in &files {
+            let path = dir.join(file);
+            let target = io::atomic::resolve_output(&real_dir.join(file), io::atomic::OutputKind::File)
+                .map_err(fail(&path))?;
+            io::atomic::remove_stale_temporaries(&target);
+            targets.push((path, target));
+        }
         let mut temporaries = Vec::with_capacity(files.len());
         let result = (|| {
-            for (file, bytes) in &files {
-                let tmp = dir.join(format!(".{file}.{}.tmp", std::process::id()));
+            for ((_, bytes), (_, target)) in files.iter().zip(&targets) {
+                let tmp = io::atomic::temporary_sibling(target);
                 temporaries.push(tmp.clone());
-                io::write_atomic(&tmp, bytes).map_err(fail(&tmp))?;
+                io::atomic::write_new(&tmp, bytes).map_err(fail(&tmp))?;
             }
             Ok(())
         })();
@@ -697,10 +717,9 @@ impl SpineExport {
             return Err(e);
         }
         let mut written = Vec::with_capacity(files.len());
-        for ((file, _), tmp) in files.iter().zip(&temporaries) {
-            let target = dir.join(file);
-            std::fs::rename(tmp, &target).map_err(fail(&target))?;
-            written.push(target);
+        for ((path, target), tmp) in targets.into_iter().zip(&temporaries) {
+            std::fs::rename(tmp, &target).map_err(fail(&path))?;
+            written.push(path);
         }
         Ok(written)
     }

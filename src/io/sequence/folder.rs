@@ -1,15 +1,26 @@
 //! Numbered PNG frames in a folder: `frame_0000.png`, `frame_0001.png`, ….
 //!
 //! In: straight-alpha RGBA8 frames, frames per second (only for the report; PNG has no timing),
-//! the folder (created if missing). Out: one PNG per frame, each written atomically, numbered from
-//! 0 with enough zero-padding (at least [`MIN_DIGITS`]) that names sort in frame order.
+//! the folder (created if missing). Out: one PNG per frame, numbered from 0 with enough
+//! zero-padding (at least [`MIN_DIGITS`]) that names sort in frame order.
+//!
+//! The folder changes in one step: the frames are written into a hidden sibling folder
+//! (`.NAME.PID.N.tmp`, see [`crate::io::atomic`]), which then takes the folder's place by one
+//! atomic exchange of the two names (Linux's `renameat2(RENAME_EXCHANGE)`; elsewhere two
+//! renames). So at any moment, a kill included, the folder holds exactly the previous complete
+//! render or the new one; the previous render's frames (`frame_` + digits + `.png`) all go,
+//! including those the new render has no number for. Files sinew did not write stay as they
+//! are: each is hard-linked into the new folder before the exchange (the same file, untouched);
+//! subfolders are moved over right after it. A temporary folder left by a killed run is tidied by
+//! the next run into the same folder (its frames removed, anything else moved back).
 
 use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
-use crate::io::atomic::write_atomic;
+use crate::io::atomic::{resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind};
 use crate::io::image::encode_png;
 use image::RgbaImage;
 use rayon::prelude::*;
-use std::path::{Path, PathBuf};
+use std::fs;
+use std::path::Path;
 
 /// Name of every frame file before its number.
 pub const FRAME_PREFIX: &str = "frame_";
@@ -26,7 +37,16 @@ pub fn frame_file_name(index: usize, digits: usize) -> String {
     format!("{FRAME_PREFIX}{index:0digits$}.png")
 }
 
-/// Writes `frames` into the folder `dir` as numbered PNGs.
+/// Whether `name` is a frame file's name (`frame_` + digits + `.png`): what a render writes.
+pub fn is_frame_name(name: &str) -> bool {
+    name.strip_prefix(FRAME_PREFIX)
+        .and_then(|n| n.strip_suffix(".png"))
+        .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// Writes `frames` into the folder `dir` as numbered PNGs, replacing the render there (see the
+/// module doc). `dir` may be a symbolic link to a folder (the folder it names is replaced); an
+/// existing `dir` that is not a folder is refused.
 pub fn write_folder(
     frames: &[RgbaImage],
     fps: f64,
@@ -34,58 +54,181 @@ pub fn write_folder(
 ) -> Result<SequenceReport, SequenceError> {
     let size = check_frames(frames)?;
     check_fps(fps)?;
-    std::fs::create_dir_all(dir).map_err(write_error(dir))?;
+    let target = resolve_output(dir, OutputKind::Folder).map_err(write_error(dir))?;
+    if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
+        fs::create_dir_all(parent).map_err(write_error(parent))?;
+    }
+    for stale in stale_temporaries(&target) {
+        tidy_stale_folder(&stale, &target);
+    }
     let digits = digits_for(frames.len());
-    let paths: Vec<PathBuf> = (0..frames.len())
-        .map(|i| dir.join(frame_file_name(i, digits)))
+    let names: Vec<String> = (0..frames.len())
+        .map(|i| frame_file_name(i, digits))
         .collect();
-    // PNG compression dominates; frames are independent. Results are gathered in frame order so
-    // the error reported (the first frame's) does not depend on scheduling.
-    let results: Vec<Result<(), SequenceError>> = frames
-        .par_iter()
-        .zip(&paths)
-        .map(|(frame, path)| {
-            let bytes = encode_png(frame).map_err(|e| SequenceError::Encode {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
-            write_atomic(path, &bytes).map_err(write_error(path))
-        })
-        .collect();
-    results.into_iter().collect::<Result<(), _>>()?;
-    let stale_files = stale_frames(dir, &paths);
+    let staging = temporary_sibling(&target);
+    fs::create_dir(&staging).map_err(write_error(&staging))?;
+    let result = fill_and_swap(frames, &names, &staging, &target);
+    if result.is_err() {
+        // Before the swap the staging folder holds only new frames and links; after a failed
+        // swap the same. Nothing of the user's is in it.
+        let _ = fs::remove_dir_all(&staging);
+    }
+    let removed = result?;
     Ok(SequenceReport {
         format: SequenceFormat::Folder,
-        files: paths,
+        files: names.iter().map(|n| dir.join(n)).collect(),
         frame_count: frames.len(),
         frame_size_px: size,
         duration_s: frames.len() as f64 / fps,
         palette_colours: None,
         sheet_size_px: None,
-        stale_files,
+        stale_files: removed.iter().map(|n| dir.join(n)).collect(),
     })
 }
 
-/// Files named like frames (`frame_` + digits + `.png`) in `dir` that are not in `written`,
-/// sorted. An unreadable folder listing gives none: the frames themselves were written.
-fn stale_frames(dir: &Path, written: &[PathBuf]) -> Vec<PathBuf> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return Vec::new();
-    };
-    let mut stale: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .and_then(|n| n.strip_prefix(FRAME_PREFIX))
-                .and_then(|n| n.strip_suffix(".png"))
-                .is_some_and(|n| !n.is_empty() && n.bytes().all(|b| b.is_ascii_digit()))
+/// Writes the frames into `staging`, puts it in `target`'s place and returns the names of the
+/// previous render's frames that the new one has no file for (removed with it), sorted.
+fn fill_and_swap(
+    frames: &[RgbaImage],
+    names: &[String],
+    staging: &Path,
+    target: &Path,
+) -> Result<Vec<String>, SequenceError> {
+    // PNG compression dominates; frames are independent. Results are gathered in frame order so
+    // the error reported (the first frame's) does not depend on scheduling.
+    let results: Vec<Result<(), SequenceError>> = frames
+        .par_iter()
+        .zip(names)
+        .map(|(frame, name)| {
+            let path = staging.join(name);
+            let bytes = encode_png(frame).map_err(|e| SequenceError::Encode {
+                path: path.clone(),
+                reason: e.to_string(),
+            })?;
+            write_new(&path, &bytes).map_err(write_error(&path))
         })
-        .filter(|p| !written.contains(p))
         .collect();
-    stale.sort();
-    stale
+    results.into_iter().collect::<Result<(), _>>()?;
+    if !target.exists() {
+        fs::rename(staging, target).map_err(write_error(target))?;
+        return Ok(Vec::new());
+    }
+    // The user's files and links come along as hard links; subfolders move after the swap.
+    let mut after_swap = Vec::new();
+    let mut removed = Vec::new();
+    for entry in fs::read_dir(target).map_err(write_error(target))? {
+        let entry = entry.map_err(write_error(target))?;
+        let name = entry.file_name();
+        if name.to_str().is_some_and(is_frame_name) {
+            if !names.iter().any(|n| name.to_str() == Some(n)) {
+                removed.push(name.to_string_lossy().into_owned());
+            }
+            continue;
+        }
+        let path = entry.path();
+        // Where a hard link is not possible (another file system's rules), the entry moves
+        // after the swap like a subfolder.
+        if entry.file_type().map_err(write_error(&path))?.is_dir()
+            || fs::hard_link(&path, staging.join(&name)).is_err()
+        {
+            after_swap.push(name);
+        }
+    }
+    if let Ok(meta) = fs::metadata(target) {
+        let _ = fs::set_permissions(staging, meta.permissions());
+    }
+    exchange(staging, target).map_err(write_error(target))?;
+    // `staging` now holds the previous render.
+    for name in after_swap {
+        let from = staging.join(&name);
+        fs::rename(&from, target.join(&name)).map_err(write_error(&from))?;
+    }
+    let _ = fs::remove_dir_all(staging);
+    removed.sort();
+    Ok(removed)
+}
+
+/// Swaps the names of two folders in one step where the system can (Linux), else by two
+/// renames (with a moment between them when `target` is missing).
+fn exchange(staging: &Path, target: &Path) -> std::io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes());
+        let (a, b) = (c(staging)?, c(target)?);
+        // SAFETY: both are valid NUL-terminated paths that live across the call.
+        let rc = unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                a.as_ptr(),
+                libc::AT_FDCWD,
+                b.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            )
+        };
+        if rc == 0 {
+            return Ok(());
+        }
+        let error = std::io::Error::last_os_error();
+        // A file system or kernel without the exchange: fall back to two renames.
+        if !matches!(
+            error.raw_os_error(),
+            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::ENOTSUP)
+        ) {
+            return Err(error);
+        }
+    }
+    let aside = temporary_sibling(target);
+    fs::rename(target, &aside)?;
+    if let Err(e) = fs::rename(staging, target) {
+        let _ = fs::rename(&aside, target);
+        return Err(e);
+    }
+    fs::rename(&aside, staging)
+}
+
+/// Tidies a temporary folder a killed run left beside `target`: frames and links to files that
+/// `target` also holds go; anything else is moved back into `target` where `target` lacks it
+/// (or kept where it is when it cannot be); the folder goes when empty. A temporary *file* of
+/// that name is removed.
+fn tidy_stale_folder(stale: &Path, target: &Path) {
+    let Ok(meta) = fs::symlink_metadata(stale) else {
+        return;
+    };
+    if !meta.is_dir() {
+        let _ = fs::remove_file(stale);
+        return;
+    }
+    if let Ok(entries) = fs::read_dir(stale) {
+        for entry in entries.filter_map(|e| e.ok()) {
+            let name = entry.file_name();
+            let path = entry.path();
+            let back = target.join(&name);
+            if name.to_str().is_some_and(is_frame_name) || same_file(&path, &back) {
+                let _ = fs::remove_file(&path);
+            } else if !back.exists() && target.is_dir() {
+                let _ = fs::rename(&path, &back);
+            }
+        }
+    }
+    let _ = fs::remove_dir(stale);
+}
+
+/// Whether `a` and `b` are one file (hard links of it), not following symbolic links.
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (fs::symlink_metadata(a), fs::symlink_metadata(b)) {
+            (Ok(x), Ok(y)) => !x.is_dir() && x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (a, b);
+        false
+    }
 }
 
 #[cfg(test)]
@@ -99,5 +242,9 @@ mod tests {
         assert_eq!(digits_for(10_001), 5);
         assert_eq!(frame_file_name(7, 4), "frame_0007.png");
         assert_eq!(frame_file_name(12345, 5), "frame_12345.png");
+        assert!(is_frame_name("frame_0007.png"));
+        assert!(!is_frame_name("frame_.png"));
+        assert!(!is_frame_name("frame_07.PNG"));
+        assert!(!is_frame_name("notes.txt"));
     }
 }

@@ -9,7 +9,9 @@
 //! - `NAME.png`: a sprite sheet with `NAME.json` beside it, TexturePacker's "JSON hash" layout
 //!   ([`sheet`]).
 //!
-//! Every file is written atomically, and identical input gives byte-identical files.
+//! Every file is written atomically (a frame folder as a whole), through symbolic links, and never
+//! over anything but a regular file (a folder for frames); identical input gives byte-identical
+//! files.
 
 pub mod background;
 pub mod folder;
@@ -112,8 +114,8 @@ pub struct SequenceReport {
     pub palette_colours: Option<usize>,
     /// Sheet only: the sheet's size, px.
     pub sheet_size_px: Option<(u32, u32)>,
-    /// Folder only: `frame_N.png` files already in the folder that this sequence did not write
-    /// (left from a longer earlier render). They are reported, never deleted.
+    /// Folder only: `frame_N.png` files of the previous render that this one has no frame for
+    /// (it was longer); they went with the previous render (see [`folder`]).
     pub stale_files: Vec<PathBuf>,
 }
 

@@ -1,0 +1,253 @@
+//! Input that used to be accepted (exit 0, a blank or invalid output) or ran for minutes is
+//! refused up front: one line naming what is wrong and what to change, exit code 2, no output.
+
+mod command;
+mod common;
+
+use command::{assert_bad_input, s, scratch, sinew};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+
+/// A one-bone rig of a 64 px critter; its document and path.
+fn rig(dir: &Path) -> (Value, PathBuf) {
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let handles = dir.join("handles.json");
+    std::fs::write(
+        &handles,
+        r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
+    )
+    .unwrap();
+    let rig = dir.join("rig.json");
+    let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["animations"] = json!({"go": {"bones": {"a": {"rotate": [
+        {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
+    ]}}}});
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    (doc, rig)
+}
+
+fn write(dir: &Path, name: &str, value: &Value) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, value.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn export_names_that_make_hidden_files_are_refused() {
+    let dir = scratch("name");
+    let (_, rig) = rig(&dir);
+    let out = dir.join("export");
+    for name in [".", "..", ".hidden"] {
+        assert_bad_input(
+            &["export", "spine", s(&rig), "-o", s(&out), "--name", name],
+            "a name starting with '.'",
+        );
+    }
+    assert!(!out.exists());
+}
+
+#[test]
+fn ik_drag_targets_have_one_limit_in_pose_render_and_export() {
+    let dir = scratch("drag");
+    let (mut doc, _) = rig(&dir);
+    let pose = write(&dir, "far.json", &json!({"ik": [{"at": [32, 30], "to": [1e7, 0]}]}));
+    let rig_path = write(&dir, "r.json", &doc);
+    let png = dir.join("out.png");
+    assert_bad_input(
+        &["pose", s(&rig_path), "--pose", s(&pose), "-o", s(&png)],
+        "beyond ±1000000 px",
+    );
+    // The same target keyed in an animation: refused when the document is read, whichever
+    // command reads it (render used to take it from a cached grip).
+    doc["animations"]["far"] = json!({"ik": [{"at": [32, 30], "to": [
+        {"time": 0, "value": [32, 30]}, {"time": 0.5, "value": [1e7, 0]}
+    ]}]});
+    let rig_path = write(&dir, "far-rig.json", &doc);
+    let gif = dir.join("out.gif");
+    for args in [
+        vec!["render", s(&rig_path), "--anim", "far", "-o", s(&gif)],
+        vec!["pose", s(&rig_path), "--anim", "far", "-o", s(&png)],
+        vec!["export", "spine", s(&rig_path), "-o", s(&dir.join("e"))],
+    ] {
+        assert_bad_input(&args, "beyond ±1000000");
+    }
+    assert!(!gif.exists() && !png.exists());
+}
+
+#[test]
+fn a_rig_without_parts_is_refused_on_load() {
+    let dir = scratch("parts");
+    let (mut doc, _) = rig(&dir);
+    doc["parts"] = json!([]);
+    let rig_path = write(&dir, "empty.json", &doc);
+    assert_bad_input(
+        &["pose", s(&rig_path), "-o", s(&dir.join("p.png"))],
+        "the rig has no parts",
+    );
+}
+
+#[test]
+fn a_scale_that_rounds_the_frame_to_nothing_is_refused() {
+    let dir = scratch("scale");
+    let (_, rig_path) = rig(&dir);
+    let gif = dir.join("tiny.gif");
+    assert_bad_input(
+        &["render", s(&rig_path), "--anim", "go", "--scale", "1e-9", "-o", s(&gif)],
+        "smaller than 1 px a side: use a scale of at least 1.5625e-2",
+    );
+    assert!(!gif.exists());
+}
+
+#[test]
+fn absurd_magnitudes_are_refused_with_their_limit() {
+    let dir = scratch("magnitudes");
+    let (doc, rig_path) = rig(&dir);
+    let png = dir.join("p.png");
+    // A rotation of 1e300 degrees in a pose, and in an animation's key.
+    let pose = write(&dir, "spin.json", &json!({"bones": {"a": {"rotate": 1e300}}}));
+    assert_bad_input(
+        &["pose", s(&rig_path), "--pose", s(&pose), "-o", s(&png)],
+        "the pose of 'a' has the value 1e300, beyond ±1000000",
+    );
+    let mut spin = doc.clone();
+    spin["animations"]["go"]["bones"]["a"]["rotate"][1]["value"] = json!(1e300);
+    let spin_rig = write(&dir, "spin-rig.json", &spin);
+    assert_bad_input(
+        &["pose", s(&spin_rig), "-o", s(&png)],
+        "key 1 has a value beyond ±1000000",
+    );
+    // A Bézier handle's value of ±1e300.
+    let mut curve = doc.clone();
+    curve["animations"]["go"]["bones"]["a"]["rotate"][0]["curve"] = json!([0.1, 1e300, 0.2, -1e300]);
+    let curve_rig = write(&dir, "curve-rig.json", &curve);
+    assert_bad_input(
+        &["render", s(&curve_rig), "--anim", "go", "-o", s(&dir.join("c.gif"))],
+        "curve value beyond ±1000000",
+    );
+    // A bone tail at 1e200 px and at 1.7e308 px (whose length overflowed to null in Spine JSON).
+    let sprite = dir.join("critter.png");
+    for tail in [1e200, 1.7e308] {
+        let handles = write(
+            &dir,
+            "far-bone.json",
+            &json!({"bones": [{"name": "a", "head": [32, 45], "tail": [32, tail]}]}),
+        );
+        assert_bad_input(
+            &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&dir.join("x.json"))],
+            "handle 'a' has a coordinate beyond ±1000000 px",
+        );
+        let mut far = doc.clone();
+        far["handles"]["bones"][0]["tail"] = json!([32, tail]);
+        let far_rig = write(&dir, "far-rig.json", &far);
+        assert_bad_input(
+            &["export", "spine", s(&far_rig), "-o", s(&dir.join("e"))],
+            "beyond ±1000000 px",
+        );
+    }
+    assert!(!dir.join("x.json").exists() && !dir.join("e").exists());
+}
+
+#[test]
+fn self_intersecting_cages_and_regions_name_the_handle_and_the_edges() {
+    let dir = scratch("bowtie");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let out = dir.join("r.json");
+    let bow_tie = json!([[10, 10], [50, 50], [50, 10], [10, 50]]);
+    for kind in ["regions", "cages"] {
+        let handles = write(
+            &dir,
+            "h.json",
+            &json!({"bones": [{"name": "a", "head": [32, 45], "tail": [32, 20]}],
+                    kind: [{"name": "tie", "polygon": bow_tie}]}),
+        );
+        let message = assert_bad_input(
+            &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&out)],
+            "'tie': edge 0 (vertices 0–1) crosses edge 2 (vertices 2–3)",
+        );
+        assert!(!message.contains("IMAGE"), "{message}");
+    }
+    let collinear = write(
+        &dir,
+        "h.json",
+        &json!({"cages": [{"name": "line", "polygon": [[10, 10], [20, 20], [30, 30], [40, 40]]}]}),
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&collinear), "-o", s(&out)],
+        "cage 'line'",
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
+    let dir = scratch("columns");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let out = dir.join("r.json");
+    // A 1000-bone chain, and a 500-vertex circular cage.
+    let bones: Vec<Value> = (0..1000)
+        .map(|i| {
+            let y = 60.0 - f64::from(i) * 0.05;
+            let mut bone = json!({"name": format!("b{i}"), "head": [32, y], "tail": [32, y - 0.05]});
+            if i > 0 {
+                bone["parent"] = json!(format!("b{}", i - 1));
+            }
+            bone
+        })
+        .collect();
+    let chain = write(&dir, "chain.json", &json!({ "bones": bones }));
+    let t = std::time::Instant::now();
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&chain), "-o", s(&out)],
+        "1000 weight columns",
+    );
+    let polygon: Vec<Value> = (0..500)
+        .map(|i| {
+            let a = f64::from(i) * std::f64::consts::TAU / 500.0;
+            json!([32.0 + 40.0 * a.cos(), 32.0 + 40.0 * a.sin()])
+        })
+        .collect();
+    let cage = write(&dir, "cage.json", &json!({"cages": [{"name": "c", "polygon": polygon}]}));
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&cage), "-o", s(&out), "--monotone"],
+        "use fewer handles or cages of fewer vertices",
+    );
+    assert!(t.elapsed().as_secs_f64() < 10.0, "refusing took {:?}", t.elapsed());
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_cage_crossing_the_outline_is_named_not_blamed_on_the_image() {
+    let dir = scratch("cage-outline");
+    let sprite = dir.join("critter.png");
+    common::critter(64).save(&sprite).unwrap();
+    let out = dir.join("r.json");
+    // Half inside the drawing, half outside the canvas.
+    let handles = write(
+        &dir,
+        "h.json",
+        &json!({"cages": [{"name": "belly", "polygon": [[30, 28], [120, 28], [120, 36], [30, 36]]}]}),
+    );
+    let message = assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&out)],
+        "cage 'belly': its edge 0 (vertices 0–1) crosses the drawing's outline",
+    );
+    assert!(!message.contains("outline edges cross each other"), "{message}");
+    let two = write(
+        &dir,
+        "two.json",
+        &json!({"cages": [
+            {"name": "a", "polygon": [[-10, -10], [80, -10], [80, 80], [-10, 80]]},
+            {"name": "b", "polygon": [[-20, 30], [90, 30], [90, 34], [-20, 34]]}
+        ]}),
+    );
+    assert_bad_input(
+        &["rig", s(&sprite), "--handles", s(&two), "-o", s(&out)],
+        "cage 'a': it crosses cage 'b'",
+    );
+    assert!(!out.exists());
+}
