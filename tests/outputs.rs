@@ -182,11 +182,7 @@ fn a_render_replaces_the_whole_previous_render_and_keeps_other_files() {
     assert_eq!(names, expected);
     assert_eq!(std::fs::read(frames.join("refs/a.txt")).unwrap(), b"mine too");
     // Nothing hidden is left beside the folder.
-    let beside: Vec<String> = listing(&dir)
-        .into_keys()
-        .filter(|n| n.starts_with('.'))
-        .collect();
-    assert!(beside.is_empty(), "{beside:?}");
+    assert_nothing_hidden_in(&dir);
 }
 
 #[test]
@@ -261,11 +257,16 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
     // The next run tidies what a killed one left beside the folder and completes.
     ok(&render("30", &target).iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(listing(&target), new);
-    let beside: Vec<String> = listing(&dir)
+    assert_nothing_hidden_in(&dir);
+}
+
+/// No hidden entry (a temporary or a half-swapped folder) is left in `dir`.
+fn assert_nothing_hidden_in(dir: &Path) {
+    let hidden: Vec<String> = listing(dir)
         .into_keys()
         .filter(|n| n.starts_with('.'))
         .collect();
-    assert!(beside.is_empty(), "{beside:?}");
+    assert!(hidden.is_empty(), "{hidden:?}");
 }
 
 #[test]
