@@ -23,7 +23,7 @@
 //! of them; every blended triangle is a candidate, and when there are more candidates than the
 //! budget, those whose weights change fastest (where linear blending creases) are kept.
 
-use crate::geom::Point;
+use crate::geom::{triangle_area2, Point};
 use nalgebra::{DMatrix, Matrix2};
 
 use super::subspace::SkinnedMesh;
@@ -92,7 +92,7 @@ impl FoldCheck {
         for (mi, mesh) in meshes.iter().enumerate() {
             for (ti, t) in mesh.triangles.iter().enumerate() {
                 let [a, b, c] = t.map(|v| mesh.rest[v as usize]);
-                let area2 = cross(b - a, c - a);
+                let area2 = triangle_area2(a, b, c);
                 if area2.abs() < 1e-12 {
                     continue;
                 }
@@ -161,7 +161,7 @@ impl FoldCheck {
                 })
             });
             let [a, b, c] = tri.map(|v| mesh.rest[v as usize]);
-            let rest_area2 = cross(b - a, c - a);
+            let rest_area2 = triangle_area2(a, b, c);
             check.triangles.push(Checked {
                 corners,
                 rest_area2,
@@ -261,10 +261,6 @@ impl FoldCheck {
         let u = DMatrix::from_column_slice(2, 2, r.as_slice()) * delta;
         (u, tri.area, tri.cluster as usize)
     }
-}
-
-fn cross(u: crate::geom::Vec2, v: crate::geom::Vec2) -> f64 {
-    u.x * v.y - u.y * v.x
 }
 
 /// Inverse of the edge matrix [b − a, c − a] (columns), rows giving the hat gradients of b and c.

@@ -56,7 +56,7 @@ impl CoverageMask {
     }
 
     /// Adds the directed edge `from → to` (region pixels) of a closed loop.
-    pub fn add_edge(&mut self, from: [f64; 2], to: [f64; 2]) {
+    pub fn add_edge(&mut self, from: crate::geom::Point, to: crate::geom::Point) {
         let height = self.height as f64;
         // Going down counts +1, going up −1: a loop's sign is its orientation.
         let (direction, top, bottom) = if from[1] < to[1] {
@@ -219,13 +219,14 @@ fn ramp_integral(u: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::Point;
 
     fn mask_of(width: usize, height: usize, loops: &[Vec<[f64; 2]>]) -> Vec<u8> {
         let mut mask = CoverageMask::default();
         mask.start(width, height);
         for ring in loops {
             for k in 0..ring.len() {
-                mask.add_edge(ring[k], ring[(k + 1) % ring.len()]);
+                mask.add_edge(ring[k].into(), ring[(k + 1) % ring.len()].into());
             }
         }
         mask.finish();
@@ -345,9 +346,9 @@ mod tests {
     fn the_accumulator_is_clean_for_the_next_use() {
         let mut mask = CoverageMask::default();
         mask.start(8, 8);
-        mask.add_edge([1.0, 1.0], [7.3, 6.2]);
-        mask.add_edge([7.3, 6.2], [1.0, 6.0]);
-        mask.add_edge([1.0, 6.0], [1.0, 1.0]);
+        mask.add_edge(Point::from([1.0, 1.0]), Point::from([7.3, 6.2]));
+        mask.add_edge(Point::from([7.3, 6.2]), Point::from([1.0, 6.0]));
+        mask.add_edge(Point::from([1.0, 6.0]), Point::from([1.0, 1.0]));
         mask.finish();
         assert!(mask.coverage_mut().iter().any(|&c| c > 0));
         mask.start(5, 9);

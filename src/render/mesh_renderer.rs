@@ -8,6 +8,7 @@
 use tiny_skia::{Pixmap, Transform};
 
 use crate::geom::Point;
+use nalgebra::Matrix2;
 
 use super::blend::{source_over, tinted, Tint, TintFactors};
 use super::coverage::CoverageMask;
@@ -15,7 +16,6 @@ use super::raster::{floor_i64, for_each_run, to_fixed, FixedPoint, PixelRect, MA
 use super::skirt::skirt_offsets;
 use super::texture::{sampler_coord, sampler_step, Texture};
 use super::topology::{TexturedTriangle, Topology, DEGENERATE_AREA2_PX2};
-use super::vec2::{add, cross, mat_mul, mat_vec, sub};
 use super::RenderError;
 
 /// Whole pixels kept around the part's bounding box in its coverage region, so that rounding can
@@ -31,7 +31,7 @@ pub struct MeshRenderer {
 #[derive(Default)]
 pub(super) struct DrawScratch {
     coverage: CoverageMask,
-    points: Vec<[f64; 2]>,
+    points: Vec<Point>,
     fixed: Vec<FixedPoint>,
     maps: Vec<Option<TextureMap>>,
 }
@@ -147,8 +147,8 @@ impl MeshRenderer {
             };
             let (a, b) = (points[edge.from as usize], points[edge.to as usize]);
             let outward = (
-                to_fixed(add(a, offsets[edge.from_slot])),
-                to_fixed(add(b, offsets[edge.to_slot])),
+                to_fixed(a + offsets[edge.from_slot]),
+                to_fixed(b + offsets[edge.to_slot]),
             );
             let (Some(a_out), Some(b_out)) = outward else {
                 continue;
@@ -164,7 +164,7 @@ impl MeshRenderer {
     }
 
     /// The exact area coverage of the part's boundary loops over `region`.
-    fn cover(&self, points: &[[f64; 2]], region: PixelRect, coverage: &mut CoverageMask) {
+    fn cover(&self, points: &[Point], region: PixelRect, coverage: &mut CoverageMask) {
         let (width, height) = (
             (region.x1 - region.x0) as usize,
             (region.y1 - region.y0) as usize,
@@ -175,8 +175,8 @@ impl MeshRenderer {
             coverage.cover_everything();
             return;
         }
-        let origin = [region.x0 as f64, region.y0 as f64];
-        let local = |v: u32| sub(points[v as usize], origin);
+        let origin = nalgebra::Vector2::new(region.x0 as f64, region.y0 as f64);
+        let local = |v: u32| points[v as usize] - origin;
         for ring in &self.topology.loops {
             for (k, &v) in ring.iter().enumerate() {
                 let next = ring[(k + 1) % ring.len()];
@@ -194,7 +194,7 @@ fn canvas_positions(
     positions_px: &[Point],
     vertex_count: usize,
     canvas_from_world: Transform,
-    points: &mut Vec<[f64; 2]>,
+    points: &mut Vec<Point>,
 ) -> bool {
     if positions_px.len() != vertex_count {
         return false;
@@ -205,22 +205,22 @@ fn canvas_positions(
     points.extend(
         positions_px
             .iter()
-            .map(|p| [sx * p.x + kx * p.y + tx, ky * p.x + sy * p.y + ty]),
+            .map(|p| Point::new(sx * p.x + kx * p.y + tx, ky * p.x + sy * p.y + ty)),
     );
     // The comparison is false for NaN.
     let usable = |v: f64| v.abs() <= MAX_COORD_PX;
-    points.iter().all(|p| usable(p[0]) && usable(p[1]))
+    points.iter().all(|p| usable(p.x) && usable(p.y))
 }
 
 /// The canvas pixels the part can cover: its bounding box with a margin, clipped to the canvas;
 /// `None` if that misses the canvas.
-fn region_around(points: &[[f64; 2]], canvas_width: u32, canvas_height: u32) -> Option<PixelRect> {
+fn region_around(points: &[Point], canvas_width: u32, canvas_height: u32) -> Option<PixelRect> {
     let (min, max) = points.iter().fold(
         ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
         |(min, max), p| {
             (
-                [min[0].min(p[0]), min[1].min(p[1])],
-                [max[0].max(p[0]), max[1].max(p[1])],
+                [min[0].min(p.x), min[1].min(p.y)],
+                [max[0].max(p.x), max[1].max(p.y)],
             )
         },
     );
@@ -254,27 +254,29 @@ struct TextureMap {
 impl TextureMap {
     /// The map taking the triangle's corners at `points` (canvas px) back onto its rest corners,
     /// or `None` when the triangle has (near) zero area on the canvas.
-    fn new(triangle: &TexturedTriangle, points: &[[f64; 2]]) -> Option<Self> {
+    fn new(triangle: &TexturedTriangle, points: &[Point]) -> Option<Self> {
         let [p0, p1, p2] = triangle.vertices.map(|v| points[v as usize]);
-        let (e1, e2) = (sub(p1, p0), sub(p2, p0));
-        let det = cross(e1, e2);
+        let (e1, e2) = (p1 - p0, p2 - p0);
+        let det = e1.x * e2.y - e1.y * e2.x;
         if det.abs() <= DEGENERATE_AREA2_PX2 {
             return None;
         }
         let inverse_det = 1.0 / det;
-        let canvas_edges_inverse = [
-            [e2[1] * inverse_det, -e2[0] * inverse_det],
-            [-e1[1] * inverse_det, e1[0] * inverse_det],
-        ];
-        let linear = mat_mul(triangle.uv_edges, canvas_edges_inverse);
-        let reference_px = p0.map(floor_i64);
-        let center = reference_px.map(|v| v as f64 + 0.5);
-        let uv = add(mat_vec(linear, sub(center, p0)), triangle.uv_origin);
+        let canvas_edges_inverse = Matrix2::new(
+            e2.y * inverse_det,
+            -e2.x * inverse_det,
+            -e1.y * inverse_det,
+            e1.x * inverse_det,
+        );
+        let linear = triangle.uv_edges * canvas_edges_inverse;
+        let reference_px = [floor_i64(p0.x), floor_i64(p0.y)];
+        let center = Point::new(reference_px[0] as f64 + 0.5, reference_px[1] as f64 + 0.5);
+        let uv = triangle.uv_origin + linear * (center - p0);
         Some(TextureMap {
             reference_px,
-            at_reference: uv.map(sampler_coord),
-            step_x: [sampler_step(linear[0][0]), sampler_step(linear[1][0])],
-            step_y: [sampler_step(linear[0][1]), sampler_step(linear[1][1])],
+            at_reference: [sampler_coord(uv.x), sampler_coord(uv.y)],
+            step_x: [sampler_step(linear[(0, 0)]), sampler_step(linear[(1, 0)])],
+            step_y: [sampler_step(linear[(0, 1)]), sampler_step(linear[(1, 1)])],
         })
     }
 

@@ -49,7 +49,6 @@ mod raster;
 mod skirt;
 mod texture;
 mod topology;
-mod vec2;
 mod wireframe;
 
 #[cfg(test)]

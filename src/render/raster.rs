@@ -30,9 +30,9 @@ pub(super) type FixedPoint = [i64; 2];
 
 /// `p` (canvas px) rounded to the nearest fixed-point position, or `None` if it is not finite or
 /// lies beyond [`MAX_COORD_PX`].
-pub(super) fn to_fixed(p: [f64; 2]) -> Option<FixedPoint> {
+pub(super) fn to_fixed(p: crate::geom::Point) -> Option<FixedPoint> {
     let inside = |v: f64| v.abs() <= MAX_COORD_PX;
-    (inside(p[0]) && inside(p[1])).then(|| p.map(|v| round_i64(v * SUBPIXEL as f64)))
+    (inside(p.x) && inside(p.y)).then(|| [p.x, p.y].map(|v| round_i64(v * SUBPIXEL as f64)))
 }
 
 /// Magnitude beyond which the float → integer helpers clamp, far inside `i64`.
@@ -279,7 +279,7 @@ mod tests {
     };
 
     fn fixed(x: f64, y: f64) -> FixedPoint {
-        to_fixed([x, y]).expect("in range")
+        to_fixed(crate::geom::Point::new(x, y)).expect("in range")
     }
 
     /// How many times each pixel of `CLIP` is owned by the given triangles.
@@ -486,10 +486,10 @@ mod tests {
 
     #[test]
     fn coordinates_out_of_range_are_refused() {
-        assert!(to_fixed([MAX_COORD_PX, -MAX_COORD_PX]).is_some());
-        assert!(to_fixed([MAX_COORD_PX * 2.0, 0.0]).is_none());
-        assert!(to_fixed([f64::NAN, 0.0]).is_none());
-        assert_eq!(to_fixed([0.3, -0.3]), Some([77, -77]));
+        assert!(to_fixed(crate::geom::Point::new(MAX_COORD_PX, -MAX_COORD_PX)).is_some());
+        assert!(to_fixed(crate::geom::Point::new(MAX_COORD_PX * 2.0, 0.0)).is_none());
+        assert!(to_fixed(crate::geom::Point::new(f64::NAN, 0.0)).is_none());
+        assert_eq!(to_fixed(crate::geom::Point::new(0.3, -0.3)), Some([77, -77]));
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //! without a gap.
 
 use super::topology::{BoundaryEdge, Topology, DEGENERATE_AREA2_PX2};
-use super::vec2::{add, dot, scale, sub, unit};
+use crate::geom::{Point, Vec2};
 
 /// How far, in output pixels, the skirt extends the mesh past its boundary edges.
 ///
@@ -28,24 +28,27 @@ const MIN_DIRECTION_PX: f64 = 1e-9;
 /// vertex at `points_px` to its skirt corner: along the bisector of the outward normals of its
 /// boundary edges, long enough that every edge's skirt is [`SKIRT_PX`] wide (a mitre), capped at
 /// [`MAX_MITER_RATIO`].
-pub(super) fn skirt_offsets(topology: &Topology, points_px: &[[f64; 2]]) -> Vec<[f64; 2]> {
+pub(super) fn skirt_offsets(topology: &Topology, points_px: &[Point]) -> Vec<Vec2> {
     let edges = &topology.boundary_edges;
-    let normals: Vec<Option<[f64; 2]>> =
+    let normals: Vec<Option<Vec2>> =
         edges.iter().map(|e| outward_normal(e, points_px)).collect();
 
     let slots = topology.boundary_vertices.len();
-    let mut sums = vec![[0.0; 2]; slots];
+    let mut sums = vec![Vec2::zeros(); slots];
     for (e, n) in edges.iter().zip(&normals) {
         if let Some(n) = *n {
-            sums[e.from_slot] = add(sums[e.from_slot], n);
-            sums[e.to_slot] = add(sums[e.to_slot], n);
+            sums[e.from_slot] += n;
+            sums[e.to_slot] += n;
         }
     }
     // Opposite normals cancel at a needle tip or a vertex with no usable edge; such a vertex
     // gets no skirt corner, which only thins the skirt next to it.
-    let bisectors: Vec<Option<[f64; 2]>> = sums
+    let bisectors: Vec<Option<Vec2>> = sums
         .into_iter()
-        .map(|s| unit(s, MIN_DIRECTION_PX))
+        .map(|s| {
+            let length = s.dot(&s).sqrt();
+            (length >= MIN_DIRECTION_PX).then(|| s * (1.0 / length))
+        })
         .collect();
 
     let mut min_cos = vec![1.0f64; slots];
@@ -53,7 +56,7 @@ pub(super) fn skirt_offsets(topology: &Topology, points_px: &[[f64; 2]]) -> Vec<
         if let Some(n) = *n {
             for slot in [e.from_slot, e.to_slot] {
                 if let Some(b) = bisectors[slot] {
-                    min_cos[slot] = min_cos[slot].min(dot(b, n));
+                    min_cos[slot] = min_cos[slot].min(b.dot(&n));
                 }
             }
         }
@@ -62,8 +65,8 @@ pub(super) fn skirt_offsets(topology: &Topology, points_px: &[[f64; 2]]) -> Vec<
         .iter()
         .zip(&min_cos)
         .map(|(b, &cos)| match b {
-            Some(b) => scale(*b, SKIRT_PX / cos.max(1.0 / MAX_MITER_RATIO)),
-            None => [0.0; 2],
+            Some(b) => b * (SKIRT_PX / cos.max(1.0 / MAX_MITER_RATIO)),
+            None => Vec2::zeros(),
         })
         .collect()
 }
@@ -71,20 +74,20 @@ pub(super) fn skirt_offsets(topology: &Topology, points_px: &[[f64; 2]]) -> Vec<
 /// The unit normal of a boundary edge pointing away from its triangle in the current
 /// deformation (so it follows flips and mirroring), or `None` when the edge or the triangle has
 /// collapsed.
-fn outward_normal(edge: &BoundaryEdge, points_px: &[[f64; 2]]) -> Option<[f64; 2]> {
+fn outward_normal(edge: &BoundaryEdge, points_px: &[Point]) -> Option<Vec2> {
     let [a, b, c] = [edge.from, edge.to, edge.opposite].map(|v| points_px[v as usize]);
-    let along = sub(b, a);
-    let length = dot(along, along).sqrt();
+    let along = b - a;
+    let length = along.dot(&along).sqrt();
     if length < MIN_DIRECTION_PX {
         return None;
     }
-    let normal = [along[1] / length, -along[0] / length];
-    let inward_reach = dot(normal, sub(c, a));
+    let normal = Vec2::new(along.y / length, -along.x / length);
+    let inward_reach = normal.dot(&(c - a));
     if (inward_reach * length).abs() <= DEGENERATE_AREA2_PX2 {
         return None;
     }
     Some(if inward_reach > 0.0 {
-        scale(normal, -1.0)
+        -normal
     } else {
         normal
     })
@@ -93,22 +96,21 @@ fn outward_normal(edge: &BoundaryEdge, points_px: &[[f64; 2]]) -> Option<[f64; 2
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::Point;
 
     #[test]
     fn a_square_gets_mitred_corners_pointing_outward() {
         let uv =
             [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)].map(|(x, y)| Point::new(x, y));
         let topology = Topology::new(&uv, &[[0, 1, 2], [0, 2, 3]]).expect("valid mesh");
-        let points: Vec<[f64; 2]> = uv.iter().map(|p| [p.x, p.y]).collect();
+        let points = uv.to_vec();
         let offsets = skirt_offsets(&topology, &points);
         for (slot, &v) in topology.boundary_vertices.iter().enumerate() {
             let p = points[v as usize];
-            let away = sub(p, [5.0, 5.0]);
+            let away = p - Point::new(5.0, 5.0);
             let o = offsets[slot];
             // Diagonal, outward, and √2 long: a 1 px band along both edges.
             assert!((o[0].abs() - 1.0).abs() < 1e-12 && (o[1].abs() - 1.0).abs() < 1e-12);
-            assert!(dot(o, away) > 0.0, "vertex {v}: {o:?}");
+            assert!(o.dot(&away) > 0.0, "vertex {v}: {o:?}");
         }
     }
 
@@ -117,10 +119,9 @@ mod tests {
         // A needle-like triangle: the tip's mitre would be ~19 px long uncapped.
         let uv = [(0.0, 0.0), (40.0, 2.0), (0.0, 4.0)].map(|(x, y)| Point::new(x, y));
         let topology = Topology::new(&uv, &[[0, 1, 2]]).expect("valid mesh");
-        let points: Vec<[f64; 2]> = uv.iter().map(|p| [p.x, p.y]).collect();
-        let offsets = skirt_offsets(&topology, &points);
+        let offsets = skirt_offsets(&topology, &uv);
         for o in offsets {
-            assert!(dot(o, o).sqrt() <= SKIRT_PX * MAX_MITER_RATIO + 1e-9);
+            assert!(o.norm() <= SKIRT_PX * MAX_MITER_RATIO + 1e-9);
         }
     }
 }

@@ -5,8 +5,8 @@
 //! All positions here are texture pixels; nothing depends on the deformation.
 
 use crate::geom::{triangle_area2, Point};
+use nalgebra::Matrix2;
 
-use super::vec2::Mat2;
 use super::RenderError;
 
 /// Twice the area, in px², below which a triangle is treated as degenerate: it cannot define an
@@ -17,11 +17,11 @@ pub(super) const DEGENERATE_AREA2_PX2: f64 = 1e-9;
 pub(super) struct TexturedTriangle {
     pub vertices: [u32; 3],
     /// Texture position of `vertices[0]`.
-    pub uv_origin: [f64; 2],
+    pub uv_origin: Point,
     /// The matrix whose columns are the texture-space edges from `vertices[0]` to `vertices[1]`
     /// and `vertices[2]`: with the same matrix of a frame's edges it gives the triangle's
     /// texture-from-canvas map.
-    pub uv_edges: Mat2,
+    pub uv_edges: Matrix2<f64>,
 }
 
 /// A boundary edge, directed so that its triangle lies on the same side of every boundary edge
@@ -108,15 +108,15 @@ impl TexturedTriangle {
         let (e1, e2) = (b - a, c - a);
         Some(TexturedTriangle {
             vertices,
-            uv_origin: [a.x, a.y],
-            uv_edges: [[e1.x, e2.x], [e1.y, e2.y]],
+            uv_origin: a,
+            uv_edges: Matrix2::new(e1.x, e2.x, e1.y, e2.y),
         })
     }
 
     /// Whether the triangle runs clockwise on screen in texture space (see `triangle_area2`).
     fn is_clockwise(&self) -> bool {
-        let [[a, b], [c, d]] = self.uv_edges;
-        a * d - b * c > 0.0
+        let m = &self.uv_edges;
+        m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)] > 0.0
     }
 }
 
