@@ -1,6 +1,8 @@
 //! What `sinew` does to what is already at an output path: it writes through symbolic links (as
 //! `cp` does), refuses pipes, devices and the wrong kind of entry, replaces a frame folder as a
-//! whole (a kill mid-run included), and tidies the temporaries a killed run left.
+//! whole (a run killed mid-way, or ended by Ctrl+C's SIGINT, included), and tidies the
+//! temporaries a killed run left. Linux: the tests make FIFOs and devices and send signals.
+#![cfg(target_os = "linux")]
 
 mod command;
 mod common;
@@ -238,8 +240,15 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
             .spawn()
             .unwrap();
         std::thread::sleep(full.mul_f64(fraction));
-        // SIGKILL: no handler runs, as when the machine kills a run.
-        let _ = child.kill();
+        // SIGKILL (no handler runs, as when the machine kills a run) and SIGINT (Ctrl+C on a
+        // terminal) in turn.
+        let signal = if outcomes.len() % 2 == 0 {
+            libc::SIGKILL
+        } else {
+            libc::SIGINT
+        };
+        // SAFETY: kill(2) on the child's own pid, which `wait` below has not reaped yet.
+        unsafe { libc::kill(child.id() as libc::pid_t, signal) };
         let status = child.wait().unwrap();
         let now = listing(&target);
         if now == old {
