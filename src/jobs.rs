@@ -11,8 +11,8 @@ use crate::anim::AnimError;
 use crate::autorig::{self, AutorigError, AutorigOptions, LayerRef, Proposal};
 use crate::document::{Document, DocumentError};
 use crate::export::spine::{self, SpineError, SpineOptions};
-use crate::io::sequence::{self, SequenceError, SequenceReport};
 use crate::io::outputs::{check_not_overwriting, OutputError};
+use crate::io::sequence::{self, SequenceError, SequenceReport};
 use crate::io::RigDocument;
 use crate::pipeline::{Layer, PipelineError, Scene};
 use crate::playback::{self, PlaybackError, RenderAnimationError, RenderSettings};
@@ -65,7 +65,12 @@ pub fn export_spine(
         .into_iter()
         .map(|file| dir.join(file))
         .collect();
-    let layers: Vec<&Path> = doc.state().layers.iter().map(|l| l.path.as_path()).collect();
+    let layers: Vec<&Path> = doc
+        .state()
+        .layers
+        .iter()
+        .map(|l| l.path.as_path())
+        .collect();
     check_not_overwriting(
         doc.path.as_deref().into_iter().chain(layers),
         targets.iter().map(|t| Some(t.as_path())),

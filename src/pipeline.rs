@@ -301,7 +301,13 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
 
 /// A mesh error that concerns a cage, named (the image is not at fault); others back as they are.
 fn cage_error(handles: &Handles, error: MeshError) -> Result<PipelineError, MeshError> {
-    let name = |i: usize| handles.cages.get(i).map_or("?", |c| c.name.as_str()).to_string();
+    let name = |i: usize| {
+        handles
+            .cages
+            .get(i)
+            .map_or("?", |c| c.name.as_str())
+            .to_string()
+    };
     match error {
         MeshError::CageCrossesOutline { cage, edge } => Ok(PipelineError::Cage {
             cage: name(cage),

@@ -27,7 +27,11 @@ fn rig(dir: &Path, size: u32, seconds: f64) -> PathBuf {
     .unwrap();
     let rig = dir.join("rig.json");
     let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mut doc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
@@ -73,7 +77,10 @@ fn outputs_are_written_through_symbolic_links() {
     std::os::unix::fs::symlink("real.png", &link).unwrap();
     ok(&["pose", s(&rig), "-o", s(&link)]);
     assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
-    assert!(sinew::io::load_png(&real).is_ok(), "the link's target was not written");
+    assert!(
+        sinew::io::load_png(&real).is_ok(),
+        "the link's target was not written"
+    );
 
     // A frame folder and an export folder behind links: the folders they name are written.
     let frames = dir.join("frames_real");
@@ -81,7 +88,9 @@ fn outputs_are_written_through_symbolic_links() {
     let frames_link = dir.join("frames");
     std::os::unix::fs::symlink("frames_real", &frames_link).unwrap();
     ok(&["render", s(&rig), "--anim", "go", "-o", s(&frames_link)]);
-    assert!(std::fs::symlink_metadata(&frames_link).unwrap().is_symlink());
+    assert!(std::fs::symlink_metadata(&frames_link)
+        .unwrap()
+        .is_symlink());
     assert!(frames.join("frame_0000.png").is_file());
     let export = dir.join("export_real");
     std::fs::create_dir(&export).unwrap();
@@ -118,7 +127,10 @@ fn pipes_devices_and_the_wrong_kind_of_entry_are_refused_and_kept() {
         &["render", s(&rig), "--anim", "go", "-o", s(&fifo)],
         "it is a named pipe",
     );
-    assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
     // A link to a pipe is refused too, naming where it leads.
     let link = dir.join("to-pipe.gif");
     std::os::unix::fs::symlink(&fifo, &link).unwrap();
@@ -134,13 +146,20 @@ fn pipes_devices_and_the_wrong_kind_of_entry_are_refused_and_kept() {
         .args([s(&own), "c", "1", "3"])
         .status()
         .is_ok_and(|st| st.success());
-    let device = if made { own } else { PathBuf::from("/dev/null") };
+    let device = if made {
+        own
+    } else {
+        PathBuf::from("/dev/null")
+    };
     assert_bad_input(&["pose", s(&rig), "-o", s(&device)], "it is a device");
     assert_bad_input(
         &["render", s(&rig), "--anim", "go", "-o", s(&device)],
         "it is a device",
     );
-    assert!(std::fs::metadata(&device).unwrap().file_type().is_char_device());
+    assert!(std::fs::metadata(&device)
+        .unwrap()
+        .file_type()
+        .is_char_device());
 
     // A regular file where a frame folder is expected, a folder where a file is.
     let file = dir.join("frames");
@@ -172,17 +191,38 @@ fn a_render_replaces_the_whole_previous_render_and_keeps_other_files() {
     let dir = scratch("replace");
     let rig = rig(&dir, 64, 1.0);
     let frames = dir.join("frames");
-    ok(&["render", s(&rig), "--anim", "go", "--fps", "24", "-o", s(&frames)]);
+    ok(&[
+        "render",
+        s(&rig),
+        "--anim",
+        "go",
+        "--fps",
+        "24",
+        "-o",
+        s(&frames),
+    ]);
     std::fs::write(frames.join("notes.txt"), b"mine").unwrap();
     std::fs::create_dir(frames.join("refs")).unwrap();
     std::fs::write(frames.join("refs/a.txt"), b"mine too").unwrap();
-    ok(&["render", s(&rig), "--anim", "go", "--fps", "4", "-o", s(&frames)]);
+    ok(&[
+        "render",
+        s(&rig),
+        "--anim",
+        "go",
+        "--fps",
+        "4",
+        "-o",
+        s(&frames),
+    ]);
     let names: Vec<String> = listing(&frames).into_keys().collect();
     let mut expected: Vec<String> = (0..4).map(|i| format!("frame_{i:04}.png")).collect();
     expected.extend(["notes.txt".to_string(), "refs".to_string()]);
     expected.sort();
     assert_eq!(names, expected);
-    assert_eq!(std::fs::read(frames.join("refs/a.txt")).unwrap(), b"mine too");
+    assert_eq!(
+        std::fs::read(frames.join("refs/a.txt")).unwrap(),
+        b"mine too"
+    );
     // Nothing hidden is left beside the folder.
     assert_nothing_hidden_in(&dir);
 }
@@ -209,9 +249,15 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
     // The previous render (11 frames) and the new one (60 frames), made whole for reference.
     let old_ref = dir.join("old");
     let new_ref = dir.join("new");
-    ok(&render("5.5", &old_ref).iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&render("5.5", &old_ref)
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>());
     let t = Instant::now();
-    ok(&render("30", &new_ref).iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&render("30", &new_ref)
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>());
     let full = t.elapsed();
     let mut old = listing(&old_ref);
     let mut new = listing(&new_ref);
@@ -225,7 +271,10 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
     for fraction in [0.2, 0.4, 0.55, 0.7, 0.8, 0.9, 0.95, 1.05] {
         // Back to the previous render; the user's file stays the same file throughout.
         std::fs::create_dir_all(&target).unwrap();
-        for name in listing(&target).into_keys().filter(|n| n.starts_with("frame_")) {
+        for name in listing(&target)
+            .into_keys()
+            .filter(|n| n.starts_with("frame_"))
+        {
             std::fs::remove_file(target.join(name)).unwrap();
         }
         for (name, bytes) in &old {
@@ -264,7 +313,10 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
     }
     eprintln!("{outcomes:?}");
     // The next run tidies what a killed one left beside the folder and completes.
-    ok(&render("30", &target).iter().map(String::as_str).collect::<Vec<_>>());
+    ok(&render("30", &target)
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>());
     assert_eq!(listing(&target), new);
     assert_nothing_hidden_in(&dir);
 }

@@ -20,7 +20,11 @@ fn rig(dir: &Path) -> (Value, PathBuf) {
     .unwrap();
     let rig = dir.join("rig.json");
     let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
     doc["animations"] = json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
@@ -53,7 +57,11 @@ fn export_names_that_make_hidden_files_are_refused() {
 fn ik_drag_targets_have_one_limit_in_pose_render_and_export() {
     let dir = scratch("drag");
     let (mut doc, _) = rig(&dir);
-    let pose = write(&dir, "far.json", &json!({"ik": [{"at": [32, 30], "to": [1e7, 0]}]}));
+    let pose = write(
+        &dir,
+        "far.json",
+        &json!({"ik": [{"at": [32, 30], "to": [1e7, 0]}]}),
+    );
     let rig_path = write(&dir, "r.json", &doc);
     let png = dir.join("out.png");
     assert_bad_input(
@@ -95,7 +103,16 @@ fn a_scale_that_rounds_the_frame_to_nothing_is_refused() {
     let (_, rig_path) = rig(&dir);
     let gif = dir.join("tiny.gif");
     assert_bad_input(
-        &["render", s(&rig_path), "--anim", "go", "--scale", "1e-9", "-o", s(&gif)],
+        &[
+            "render",
+            s(&rig_path),
+            "--anim",
+            "go",
+            "--scale",
+            "1e-9",
+            "-o",
+            s(&gif),
+        ],
         "smaller than 1 px a side: use a scale of at least 1.5625e-2",
     );
     assert!(!gif.exists());
@@ -107,7 +124,11 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
     let (doc, rig_path) = rig(&dir);
     let png = dir.join("p.png");
     // A rotation of 1e300 degrees in a pose, and in an animation's key.
-    let pose = write(&dir, "spin.json", &json!({"bones": {"a": {"rotate": 1e300}}}));
+    let pose = write(
+        &dir,
+        "spin.json",
+        &json!({"bones": {"a": {"rotate": 1e300}}}),
+    );
     assert_bad_input(
         &["pose", s(&rig_path), "--pose", s(&pose), "-o", s(&png)],
         "the pose of 'a' has the value 1e300, beyond ±1000000",
@@ -121,10 +142,18 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
     );
     // A Bézier handle's value of ±1e300.
     let mut curve = doc.clone();
-    curve["animations"]["go"]["bones"]["a"]["rotate"][0]["curve"] = json!([0.1, 1e300, 0.2, -1e300]);
+    curve["animations"]["go"]["bones"]["a"]["rotate"][0]["curve"] =
+        json!([0.1, 1e300, 0.2, -1e300]);
     let curve_rig = write(&dir, "curve-rig.json", &curve);
     assert_bad_input(
-        &["render", s(&curve_rig), "--anim", "go", "-o", s(&dir.join("c.gif"))],
+        &[
+            "render",
+            s(&curve_rig),
+            "--anim",
+            "go",
+            "-o",
+            s(&dir.join("c.gif")),
+        ],
         "curve value beyond ±1000000",
     );
     // A bone tail at 1e200 px and at 1.7e308 px (whose length overflowed to null in Spine JSON).
@@ -136,7 +165,14 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
             &json!({"bones": [{"name": "a", "head": [32, 45], "tail": [32, tail]}]}),
         );
         assert_bad_input(
-            &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&dir.join("x.json"))],
+            &[
+                "rig",
+                s(&sprite),
+                "--handles",
+                s(&handles),
+                "-o",
+                s(&dir.join("x.json")),
+            ],
             "handle 'a' has a coordinate beyond ±1000000 px",
         );
         let mut far = doc.clone();
@@ -192,7 +228,8 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
     let bones: Vec<Value> = (0..1000)
         .map(|i| {
             let y = 60.0 - f64::from(i) * 0.05;
-            let mut bone = json!({"name": format!("b{i}"), "head": [32, y], "tail": [32, y - 0.05]});
+            let mut bone =
+                json!({"name": format!("b{i}"), "head": [32, y], "tail": [32, y - 0.05]});
             if i > 0 {
                 bone["parent"] = json!(format!("b{}", i - 1));
             }
@@ -211,12 +248,28 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
             json!([32.0 + 40.0 * a.cos(), 32.0 + 40.0 * a.sin()])
         })
         .collect();
-    let cage = write(&dir, "cage.json", &json!({"cages": [{"name": "c", "polygon": polygon}]}));
+    let cage = write(
+        &dir,
+        "cage.json",
+        &json!({"cages": [{"name": "c", "polygon": polygon}]}),
+    );
     assert_bad_input(
-        &["rig", s(&sprite), "--handles", s(&cage), "-o", s(&out), "--monotone"],
+        &[
+            "rig",
+            s(&sprite),
+            "--handles",
+            s(&cage),
+            "-o",
+            s(&out),
+            "--monotone",
+        ],
         "use fewer handles or cages of fewer vertices",
     );
-    assert!(t.elapsed().as_secs_f64() < 10.0, "refusing took {:?}", t.elapsed());
+    assert!(
+        t.elapsed().as_secs_f64() < 10.0,
+        "refusing took {:?}",
+        t.elapsed()
+    );
     assert!(!out.exists());
 }
 
@@ -236,7 +289,10 @@ fn a_cage_crossing_the_outline_is_named_not_blamed_on_the_image() {
         &["rig", s(&sprite), "--handles", s(&handles), "-o", s(&out)],
         "cage 'belly': its edge 0 (vertices 0–1) crosses the drawing's outline",
     );
-    assert!(!message.contains("outline edges cross each other"), "{message}");
+    assert!(
+        !message.contains("outline edges cross each other"),
+        "{message}"
+    );
     let two = write(
         &dir,
         "two.json",

@@ -496,12 +496,18 @@ mod tests {
                 } else {
                     bezier_value(t, split.value[c], ha, t1, v1[c], time)
                 };
-                assert!((whole - parts).abs() < 1e-9, "{c} {time}: {whole} vs {parts}");
+                assert!(
+                    (whole - parts).abs() < 1e-9,
+                    "{c} {time}: {whole} vs {parts}"
+                );
             }
         }
         // Linear and stepped segments stay so; their value at t is theirs.
         let linear = split_curve(&Curve::Linear, (0.0, &[0.0]), (2.0, &[4.0]), 0.5, true);
-        assert_eq!((linear.before, linear.after), (Curve::Linear, Curve::Linear));
+        assert_eq!(
+            (linear.before, linear.after),
+            (Curve::Linear, Curve::Linear)
+        );
         assert_eq!(linear.value, vec![1.0]);
         let stepped = split_curve(&Curve::Stepped, (0.0, &[3.0]), (2.0, &[4.0]), 0.5, true);
         assert_eq!(stepped.after, Curve::Stepped);
@@ -513,7 +519,13 @@ mod tests {
         // One 0..1 curve for all numbers (a cage): each part runs 0..1 over its own segment.
         let h = vec![0.4, 0.0, 0.6, 1.0];
         let (v0, v1) = ([0.0, 0.0], [10.0, 20.0]);
-        let split = split_curve(&Curve::Bezier(h.clone()), (0.0, &v0), (1.0, &v1), 0.3, false);
+        let split = split_curve(
+            &Curve::Bezier(h.clone()),
+            (0.0, &v0),
+            (1.0, &v1),
+            0.3,
+            false,
+        );
         let f = bezier_value(0.0, 0.0, &h, 1.0, 1.0, 0.3);
         assert!((split.value[0] - 10.0 * f).abs() < 1e-9);
         assert!((split.value[1] - 20.0 * f).abs() < 1e-9);

@@ -362,4 +362,3 @@ fn drop_hint(ui: &mut egui::Ui, rect: Rect) {
 
 /// The empty canvas' hint.
 pub const DROP_HINT: &str = "Drop PNG images here (or File → Import layer…)";
-

@@ -341,7 +341,11 @@ impl EditorApp {
             .ok()
             .and_then(|b| serde_json::from_slice::<Vec<String>>(&b).ok())
         {
-            self.recent = list.into_iter().map(PathBuf::from).take(MAX_RECENT).collect();
+            self.recent = list
+                .into_iter()
+                .map(PathBuf::from)
+                .take(MAX_RECENT)
+                .collect();
         }
         self.recent_file = Some(file);
     }

@@ -1475,11 +1475,14 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     h.get_by_label("Play");
 
     // Onion skins: at the end only earlier frames exist; in the middle both sides.
-    let frames_to = |h: &Harness<'_, EditorApp>, t: f64| {
-        ((t - h.state().animate.time_s) * fps).round() as i64
-    };
+    let frames_to =
+        |h: &Harness<'_, EditorApp>, t: f64| ((t - h.state().animate.time_s) * fps).round() as i64;
     let steps = frames_to(&h, 0.5);
-    let button = if steps > 0 { "Next frame" } else { "Previous frame" };
+    let button = if steps > 0 {
+        "Next frame"
+    } else {
+        "Previous frame"
+    };
     for _ in 0..steps.abs() {
         h.get_by_label(button).click();
         h.run();

@@ -413,7 +413,8 @@ impl FastIk {
         }
         let e_t = DMatrix::from_fn(hard.len(), dim, |r, c| hard[r][c]);
         if coupled_needed {
-            let coupled = CoupledStep::new(&problem.columns, &problem.joints, &q_t, &e_t, stiffness)?;
+            let coupled =
+                CoupledStep::new(&problem.columns, &problem.joints, &q_t, &e_t, stiffness)?;
             return Ok(System {
                 problem: problem.clone(),
                 x: DMatrix::zeros(0, 0),
@@ -505,7 +506,10 @@ impl FastIk {
                 let guard_a = std::mem::take(&mut self.guard);
                 let (t_b, n_b) = self.iterate_from(problem, stack(&problem.anchor), limit)?;
                 let score = |t: &DMatrix<f64>| {
-                    let miss = hard_misses_px(problem, t).iter().map(|m| m * m).sum::<f64>();
+                    let miss = hard_misses_px(problem, t)
+                        .iter()
+                        .map(|m| m * m)
+                        .sum::<f64>();
                     // Misses that differ by less than this are ties, px².
                     ((miss / MISS_TIE_PX2).round(), self.reduced_energy(t))
                 };

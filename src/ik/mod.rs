@@ -22,8 +22,8 @@ pub mod cluster;
 pub mod fast;
 pub mod fold;
 pub mod reference;
-pub mod rigid;
 pub mod rig;
+pub mod rigid;
 pub mod subspace;
 
 pub use fast::{ColumnDofs, DragRow, FastIk, IkSolution, Joint, Problem};

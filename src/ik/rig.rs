@@ -170,13 +170,11 @@ impl RigIk {
                 // The same check as an uncached drag's: a cached grip is no licence.
                 check_drag(drag)?;
                 match self.gripped.get(&key) {
-                    Some(row) => {
-                        Ok(DragRow {
-                            row: row.clone(),
-                            target: drag.to,
-                            weight: drag.weight,
-                        })
-                    }
+                    Some(row) => Ok(DragRow {
+                        row: row.clone(),
+                        target: drag.to,
+                        weight: drag.weight,
+                    }),
                     _ => {
                         let row = self.drag_row(drag)?;
                         self.gripped.insert(key, row.row.clone());
@@ -417,7 +415,11 @@ fn check_drag(drag: &IkDrag) -> Result<(), IkError> {
     {
         return Err(IkError::NonFinite);
     }
-    if drag.to.iter().any(|v| v.abs() > crate::rig::pose::MAX_POSED_PX) {
+    if drag
+        .to
+        .iter()
+        .any(|v| v.abs() > crate::rig::pose::MAX_POSED_PX)
+    {
         return Err(IkError::TargetTooFar(drag.to[0], drag.to[1]));
     }
     Ok(drag.check()?)

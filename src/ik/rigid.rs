@@ -79,7 +79,9 @@ pub struct CoupledStep {
 impl CoupledStep {
     /// Whether a problem needs the coupled step: it has a rigid column.
     pub fn needed(columns: &[ColumnDofs]) -> bool {
-        columns.iter().any(|c| matches!(c, ColumnDofs::Rigid { .. }))
+        columns
+            .iter()
+            .any(|c| matches!(c, ColumnDofs::Rigid { .. }))
     }
 
     /// Prepares the step for `columns` with the quadratic form `q_t` and hard rows `e_t`, whose
@@ -152,7 +154,13 @@ impl CoupledStep {
         let order = dependency_order(&params, &follows)?;
         let mut p = DMatrix::<f64>::zeros(2 * dim, n_w);
         for &j in &order {
-            fill_column(&mut p, dim, j, &params[j], follows.iter().find(|f| f.0 == j));
+            fill_column(
+                &mut p,
+                dim,
+                j,
+                &params[j],
+                follows.iter().find(|f| f.0 == j),
+            );
         }
         let kept: Vec<usize> = (0..e_t.nrows()).filter(|&k| !eliminated[k]).collect();
         let e_kept = e_t.select_rows(&kept);
@@ -331,7 +339,9 @@ impl CoupledStep {
         let n_u = map.len();
         // The reduced gradient and Hessian: g_u = Cᵀ (g_w − H_w w₀), H_u = Cᵀ H_w C.
         let residual = &g_w - &self.h_w * &w0;
-        let g_u: DVector<f64> = DVector::from_fn(n_u, |i, _| map[i].iter().map(|&(a, ca)| ca * residual[a]).sum());
+        let g_u: DVector<f64> = DVector::from_fn(n_u, |i, _| {
+            map[i].iter().map(|&(a, ca)| ca * residual[a]).sum()
+        });
         let h_u: DMatrix<f64> = DMatrix::from_fn(n_u, n_u, |i, k| {
             let mut s = 0.0;
             for &(a, ca) in &map[i] {
@@ -353,13 +363,20 @@ impl CoupledStep {
             h_u += e_u.tr_mul(&e_u) * self.hard_weight;
             g_u += e_u.tr_mul(&e_u0) * self.hard_weight;
         }
-        let ridge = 1e-12 * (0..n_u).map(|i| h_u[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let ridge = 1e-12
+            * (0..n_u)
+                .map(|i| h_u[(i, i)].abs())
+                .fold(0.0, f64::max)
+                .max(1e-300);
         for i in 0..n_u {
             h_u[(i, i)] += ridge;
         }
         let cholesky = h_u.cholesky().ok_or(IkError::Singular)?;
         let mut delta = cholesky.solve(&g_u);
-        let largest_turn = turns.iter().map(|&(i, _)| delta[i].abs()).fold(0.0, f64::max);
+        let largest_turn = turns
+            .iter()
+            .map(|&(i, _)| delta[i].abs())
+            .fold(0.0, f64::max);
         if !largest_turn.is_finite() || delta.iter().any(|v| !v.is_finite()) {
             return Err(IkError::NonFinite);
         }
@@ -380,7 +397,9 @@ impl CoupledStep {
             w[o + 1] = a * sin + b * cos;
         }
         let flat = &self.p * &w;
-        Ok(DMatrix::from_fn(dim, 2, |k, c| flat[c * dim + k] + q[(k, c)]))
+        Ok(DMatrix::from_fn(dim, 2, |k, c| {
+            flat[c * dim + k] + q[(k, c)]
+        }))
     }
 }
 

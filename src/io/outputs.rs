@@ -122,7 +122,10 @@ mod tests {
             Err(OutputError::OverwritesInput(spelled.clone()))
         );
         assert_eq!(
-            check_outputs([input.as_path()], [Some(other.as_path()), Some(other.as_path())]),
+            check_outputs(
+                [input.as_path()],
+                [Some(other.as_path()), Some(other.as_path())]
+            ),
             Err(OutputError::SameOutput(other.clone()))
         );
         let missing = dir.join("nowhere/out.json");
@@ -130,7 +133,10 @@ mod tests {
             check_outputs([input.as_path()], [Some(missing.as_path())]),
             Err(OutputError::MissingFolder { .. })
         ));
-        assert_eq!(check_outputs([input.as_path()], [Some(other.as_path()), None]), Ok(()));
+        assert_eq!(
+            check_outputs([input.as_path()], [Some(other.as_path()), None]),
+            Ok(())
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

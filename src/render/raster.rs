@@ -489,7 +489,10 @@ mod tests {
         assert!(to_fixed(crate::geom::Point::new(MAX_COORD_PX, -MAX_COORD_PX)).is_some());
         assert!(to_fixed(crate::geom::Point::new(MAX_COORD_PX * 2.0, 0.0)).is_none());
         assert!(to_fixed(crate::geom::Point::new(f64::NAN, 0.0)).is_none());
-        assert_eq!(to_fixed(crate::geom::Point::new(0.3, -0.3)), Some([77, -77]));
+        assert_eq!(
+            to_fixed(crate::geom::Point::new(0.3, -0.3)),
+            Some([77, -77])
+        );
     }
 
     #[test]

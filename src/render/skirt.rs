@@ -30,8 +30,7 @@ const MIN_DIRECTION_PX: f64 = 1e-9;
 /// [`MAX_MITER_RATIO`].
 pub(super) fn skirt_offsets(topology: &Topology, points_px: &[Point]) -> Vec<Vec2> {
     let edges = &topology.boundary_edges;
-    let normals: Vec<Option<Vec2>> =
-        edges.iter().map(|e| outward_normal(e, points_px)).collect();
+    let normals: Vec<Option<Vec2>> = edges.iter().map(|e| outward_normal(e, points_px)).collect();
 
     let slots = topology.boundary_vertices.len();
     let mut sums = vec![Vec2::zeros(); slots];
@@ -86,11 +85,7 @@ fn outward_normal(edge: &BoundaryEdge, points_px: &[Point]) -> Option<Vec2> {
     if (inward_reach * length).abs() <= DEGENERATE_AREA2_PX2 {
         return None;
     }
-    Some(if inward_reach > 0.0 {
-        -normal
-    } else {
-        normal
-    })
+    Some(if inward_reach > 0.0 { -normal } else { normal })
 }
 
 #[cfg(test)]

@@ -193,7 +193,9 @@ pub enum PoseError {
     },
     #[error("the pose of '{0}' has a value that is not a finite number")]
     NonFinite(String),
-    #[error("the pose of '{0}' has the value {1:e}, beyond ±{MAX_POSE_VALUE} (px, degrees or scale)")]
+    #[error(
+        "the pose of '{0}' has the value {1:e}, beyond ±{MAX_POSE_VALUE} (px, degrees or scale)"
+    )]
     TooLarge(String, f64),
     #[error("ik drag {0}")]
     BadDrag(String),
@@ -249,11 +251,21 @@ impl Pose {
         };
         for (name, b) in &self.bones {
             let [t0, t1] = b.translate;
-            bad(name, &[b.rotate, t0, t1, b.scale[0], b.scale[1], b.shear[0], b.shear[1]])?;
+            bad(
+                name,
+                &[
+                    b.rotate, t0, t1, b.scale[0], b.scale[1], b.shear[0], b.shear[1],
+                ],
+            )?;
         }
         for (name, p) in &self.points {
             let [t0, t1] = p.translate;
-            bad(name, &[p.rotate, t0, t1, p.scale[0], p.scale[1], p.shear[0], p.shear[1]])?;
+            bad(
+                name,
+                &[
+                    p.rotate, t0, t1, p.scale[0], p.scale[1], p.shear[0], p.shear[1],
+                ],
+            )?;
         }
         for (name, c) in &self.cages {
             let numbers: Vec<f64> = c.polygon.iter().flatten().copied().collect();

@@ -200,7 +200,10 @@ pub fn polygon_problem(polygon: &[[f64; 2]]) -> Option<String> {
 }
 
 /// Every coordinate of handle `name` within ±[`MAX_COORDINATE_PX`].
-fn check_reach<'a>(name: &str, mut values: impl Iterator<Item = &'a f64>) -> Result<(), HandleError> {
+fn check_reach<'a>(
+    name: &str,
+    mut values: impl Iterator<Item = &'a f64>,
+) -> Result<(), HandleError> {
     match values.find(|v| v.abs() > MAX_COORDINATE_PX) {
         Some(&value) => Err(HandleError::TooFar {
             name: name.to_string(),

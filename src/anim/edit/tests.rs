@@ -411,7 +411,10 @@ fn a_key_put_inside_an_eased_segment_leaves_the_motion_unchanged() {
             sample_keys(&eased, t).unwrap(),
             sample_keys(&keys, t).unwrap(),
         );
-        assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9, "{t}: {a:?} {b:?}");
+        assert!(
+            (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9,
+            "{t}: {a:?} {b:?}"
+        );
     }
     // A different value moves the curve there, and only near the new key.
     let mut moved = eased.clone();

@@ -49,7 +49,11 @@ fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_
     h.key_press_modifiers(Modifiers::COMMAND, Key::S);
     h.run();
     h.get_by_label("Save to this path");
-    type_into(&mut h, "Path:", &dir.join("empty.json").display().to_string());
+    type_into(
+        &mut h,
+        "Path:",
+        &dir.join("empty.json").display().to_string(),
+    );
     h.key_press(Key::Enter);
     h.run();
     let message = h.state().message.clone().unwrap_or_default();
@@ -76,7 +80,10 @@ fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_
     h.run();
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains(".json"), "{message}");
-    assert!(crate::io::load_png(&png).is_ok(), "the PNG was written over");
+    assert!(
+        crate::io::load_png(&png).is_ok(),
+        "the PNG was written over"
+    );
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::S);
     h.run();
     type_into(&mut h, "Path:", &json.display().to_string());
@@ -231,7 +238,12 @@ fn an_empty_canvas_asks_for_images_and_takes_a_dropped_png() {
         .dropped_files
         .push(std::sync::Arc::new(Dropped(png.clone())));
     h.run();
-    assert_eq!(h.state().doc.state().layers.len(), 1, "{:?}", h.state().message);
+    assert_eq!(
+        h.state().doc.state().layers.len(),
+        1,
+        "{:?}",
+        h.state().message
+    );
     assert!(h.query_by_label(drawing::DROP_HINT).is_none());
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -35,7 +35,12 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     type_into(&mut h, "Rig or PNG path:", &png.display().to_string());
     h.get_by_label("Import layer").click();
     h.run();
-    assert_eq!(h.state().doc.state().layers.len(), 1, "{:?}", h.state().message);
+    assert_eq!(
+        h.state().doc.state().layers.len(),
+        1,
+        "{:?}",
+        h.state().message
+    );
 
     // Two bones along the bar, the second continuing the first's skeleton.
     h.get_by_label("Bone").click();
@@ -108,7 +113,11 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     let split = crate::document::animation_named(h.state().doc.state(), "animation");
     for k in 0..=20 {
         let (a, b) = (at(&eased, k), at(&split, k));
-        assert!(distance(a, b) < 1e-6, "at {} s: {a:?} vs {b:?}", k as f64 / 20.0);
+        assert!(
+            distance(a, b) < 1e-6,
+            "at {} s: {a:?} vs {b:?}",
+            k as f64 / 20.0
+        );
     }
 
     // Pose inside the other half of the eased segment and key it: accepted too.

@@ -689,15 +689,16 @@ impl SpineExport {
             let path = path.to_path_buf();
             move |source| SpineError::Write { path, source }
         };
-        let real_dir = io::atomic::resolve_output(dir, io::atomic::OutputKind::Folder)
-            .map_err(fail(dir))?;
+        let real_dir =
+            io::atomic::resolve_output(dir, io::atomic::OutputKind::Folder).map_err(fail(dir))?;
         std::fs::create_dir_all(&real_dir).map_err(fail(dir))?;
         let files = self.files();
         let mut targets = Vec::with_capacity(files.len());
         for (file, _) in &files {
             let path = dir.join(file);
-            let target = io::atomic::resolve_output(&real_dir.join(file), io::atomic::OutputKind::File)
-                .map_err(fail(&path))?;
+            let target =
+                io::atomic::resolve_output(&real_dir.join(file), io::atomic::OutputKind::File)
+                    .map_err(fail(&path))?;
             io::atomic::remove_stale_temporaries(&target);
             targets.push((path, target));
         }

@@ -15,7 +15,9 @@
 //! the next run into the same folder (its frames removed, anything else moved back).
 
 use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
-use crate::io::atomic::{resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind};
+use crate::io::atomic::{
+    resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind,
+};
 use crate::io::image::encode_png;
 use image::RgbaImage;
 use rayon::prelude::*;
