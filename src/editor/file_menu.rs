@@ -420,19 +420,21 @@ fn optional_count(
 fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderSettings) {
     use crate::anim::CurveEvaluation;
     egui::Grid::new("render settings").show(ui, |ui| {
-        ui.label("Frames per second");
+        let label = ui.label("Frames per second");
         ui.add(
             egui::DragValue::new(&mut settings.fps)
                 .range(1.0..=crate::playback::MAX_FPS)
                 .speed(0.2),
-        );
+        )
+        .labelled_by(label.id);
         ui.end_row();
-        ui.label("Scale (output px per canvas px)");
+        let label = ui.label("Scale (output px per canvas px)");
         ui.add(
             egui::DragValue::new(&mut settings.scale)
                 .range(super::file::RENDER_SCALE_RANGE.0..=super::file::RENDER_SCALE_RANGE.1)
                 .speed(0.01),
-        );
+        )
+        .labelled_by(label.id);
         ui.end_row();
         ui.label("Background");
         ui.horizontal(|ui| {

@@ -608,24 +608,32 @@ fn renders_the_current_animation_in_the_background() {
     let path = character_rig("render");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     let gif = path.parent().expect("a folder").join("nod.gif");
-    {
-        let app = h.state_mut();
-        key_nod(app, &[(0.0, 0.0), (0.5, 20.0)]);
-        app.animate.animation = "nod".into();
-        app.render_settings.fps = 8.0;
-        app.render_settings.scale = 0.5;
-        app.render_path = gif.display().to_string();
-    }
+    key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 20.0)]);
     h.run();
-    let ctx = h.ctx.clone();
-    h.state_mut().start_render(&ctx);
-    for _ in 0..BUILD_FRAMES {
-        h.step();
-        if !h.state().rendering() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(50));
+    h.key_press(Key::Num3);
+    h.run();
+    type_into(&mut h, "Animation", "nod");
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Render…").click();
+    h.run();
+    type_into(
+        &mut h,
+        "Render the current animation to (.gif, .png sheet or a folder):",
+        &gif.display().to_string(),
+    );
+    for (field, value) in [
+        ("Frames per second", "8"),
+        ("Scale (output px per canvas px)", "0.5"),
+    ] {
+        type_into(&mut h, field, value);
+        h.key_press(Key::Enter);
+        h.run();
     }
+    // The button, not the window's title.
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
+        .click();
+    wait_for_render(&mut h, 50);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("rendered"), "{message}");
     let bytes = std::fs::read(&gif).expect("the GIF was written");
@@ -635,19 +643,30 @@ fn renders_the_current_animation_in_the_background() {
     let width = u16::from_le_bytes([bytes[6], bytes[7]]);
     assert_eq!(u32::from(width), canvas_width.div_ceil(2));
     // An animation the document does not have: a message, no file.
-    h.state_mut().animate.animation = "nope".into();
-    h.state_mut().render_path = path.with_file_name("nope.gif").display().to_string();
-    h.state_mut().start_render(&ctx);
+    type_into(&mut h, "Animation", "nope");
+    type_into(
+        &mut h,
+        "Render the current animation to (.gif, .png sheet or a folder):",
+        &path.with_file_name("nope.gif").display().to_string(),
+    );
+    // The button, not the window's title.
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
+        .click();
+    wait_for_render(&mut h, 20);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("nope"), "{message}");
+    assert!(!path.with_file_name("nope.gif").exists());
+}
+
+/// Steps frames until the background render ends, sleeping `pause_ms` between them.
+fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
     for _ in 0..BUILD_FRAMES {
         h.step();
         if !h.state().rendering() {
             break;
         }
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::thread::sleep(std::time::Duration::from_millis(pause_ms));
     }
-    let message = h.state().message.clone().unwrap_or_default();
-    assert!(message.contains("nope"), "{message}");
-    assert!(!path.with_file_name("nope.gif").exists());
 }
 
 /// Keys animation "nod": the head turned `degrees` at each `time_s`.
@@ -1271,7 +1290,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let mut h = open_character("dopesheet");
     h.key_press(Key::Num3);
     h.run();
-    h.state_mut().animate.animation = "nod".into();
+    type_into(&mut h, "Animation", "nod");
     // Two keys from the pose: the head at 0° at 0 s and at 20° at 0.5 s.
     for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
         for _ in 0..frames {
@@ -1514,13 +1533,10 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
 fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     use crate::anim::edit::{KeyRef, TransformChannel::*};
     let mut h = open_character("keyboard");
-    {
-        let app = h.state_mut();
-        key_nod(app, &[(0.0, 0.0), (0.5, 30.0)]);
-        app.animate.animation = "nod".into();
-    }
+    key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 30.0)]);
     h.key_press(Key::Num3);
     h.run();
+    type_into(&mut h, "Animation", "nod");
     // Click one key, shift-click another: both selected; shift-click again: deselected.
     let at = key_on_sheet(&h, Rotate, 0.5);
     click_screen(&mut h, at);
