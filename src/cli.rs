@@ -425,7 +425,7 @@ fn print_schema(args: &SchemaArgs) -> Result<()> {
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
-    use sinew::autorig::{self as ar, AutorigOptions, LayerRef};
+    use sinew::autorig::{self as ar, AutorigOptions};
     check_outputs(
         args.images.iter().map(PathBuf::as_path),
         [Some(args.output.as_path()), args.preview.as_deref()],
@@ -438,14 +438,7 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         ..AutorigOptions::default()
     };
     options.skeleton.max_bones = args.bones;
-    let refs: Vec<LayerRef> = layers
-        .iter()
-        .map(|l| LayerRef {
-            name: &l.name,
-            image: &l.image,
-        })
-        .collect();
-    let proposal = ar::autorig(&refs, &options)?;
+    let proposal = sinew::jobs::propose_handles(&layers, &options)?;
     let text = serde_json::to_string_pretty(&proposal.handles)? + "\n";
     let preview = match &args.preview {
         Some(_) => {

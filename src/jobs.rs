@@ -17,7 +17,6 @@ use crate::io::RigDocument;
 use crate::pipeline::{Layer, PipelineError, Scene};
 use crate::playback::{self, PlaybackError, RenderAnimationError, RenderSettings};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Why a job failed. Each variant is the failing stage's own error, shown as it is.
 #[derive(Debug, thiserror::Error)]
@@ -112,15 +111,15 @@ pub fn render_animation(
 
 /// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with
 /// [`crate::document::Command::SetHandles`] and edit like hand-placed ones.
-pub fn propose_handles(
-    layers: &[Arc<Layer>],
+pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
+    layers: &[L],
     options: &AutorigOptions,
 ) -> Result<Proposal, JobError> {
     let refs: Vec<LayerRef> = layers
         .iter()
         .map(|l| LayerRef {
-            name: &l.name,
-            image: &l.image,
+            name: &l.borrow().name,
+            image: &l.borrow().image,
         })
         .collect();
     Ok(autorig::autorig(&refs, options)?)
