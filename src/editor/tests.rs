@@ -101,22 +101,7 @@ fn wait_for_weights(h: &mut Harness<'_, EditorApp>) {
 
 /// A point well inside the torso at rest, canvas px.
 fn torso_point(h: &Harness<'_, EditorApp>) -> [f64; 2] {
-    let scene = h.state().doc.posable().expect("posable").clone();
-    let part = scene
-        .doc
-        .parts
-        .iter()
-        .find(|p| p.name == "torso")
-        .expect("a torso");
-    let v = &part.mesh.vertices;
-    let n = v.len() as f64;
-    let c = v
-        .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
-    // The nearest vertex to the centroid lies on the drawing.
-    *v.iter()
-        .min_by(|a, b| distance(**a, c).total_cmp(&distance(**b, c)))
-        .expect("vertices")
+    part_point(h, "torso")
 }
 
 #[test]
@@ -1627,26 +1612,15 @@ fn largest_move(a: &[Vec<crate::geom::Point>], b: &[Vec<crate::geom::Point>]) ->
 
 /// A rest vertex of part `name` near its centroid (on the drawing), canvas px.
 fn part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
-    let scene = h.state().doc.posable().expect("posable").clone();
-    let part = scene
-        .doc
-        .parts
-        .iter()
-        .find(|p| p.name == name)
-        .expect("the part");
-    let v = &part.mesh.vertices;
-    let n = v.len() as f64;
-    let c = v
-        .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
-    *v.iter()
-        .min_by(|a, b| distance(**a, c).total_cmp(&distance(**b, c)))
-        .expect("vertices")
+    let (part, vertex) = central_vertex(h, name);
+    h.state().doc.posable().expect("posable").doc.parts[part]
+        .mesh
+        .vertices[vertex]
 }
 
-/// Where the canvas shows the vertex [`part_point`] picks, px.
-fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
-    let at = part_point(h, name);
+/// The part named `name` and its vertex nearest the centroid of its rest vertices (it lies on
+/// the drawing).
+fn central_vertex(h: &Harness<'_, EditorApp>, name: &str) -> (usize, usize) {
     let scene = h.state().doc.posable().expect("posable").clone();
     let part = scene
         .doc
@@ -1654,12 +1628,20 @@ fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
         .iter()
         .position(|p| p.name == name)
         .expect("the part");
-    let vertex = scene.doc.parts[part]
-        .mesh
-        .vertices
+    let v = &scene.doc.parts[part].mesh.vertices;
+    let n = v.len() as f64;
+    let c = v
         .iter()
-        .position(|v| *v == at)
-        .expect("the vertex");
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    let vertex = (0..v.len())
+        .min_by(|&a, &b| distance(v[a], c).total_cmp(&distance(v[b], c)))
+        .expect("vertices");
+    (part, vertex)
+}
+
+/// Where the canvas shows the vertex [`part_point`] picks, px.
+fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
+    let (part, vertex) = central_vertex(h, name);
     let shown = shown_vertices(h)[part][vertex];
     [shown.x, shown.y]
 }
