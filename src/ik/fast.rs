@@ -589,10 +589,13 @@ impl FastIk {
                 .collect(),
             ..problem.clone()
         };
+        // No fold check: `FastIk::new` guards no triangles (the start only needs the shape).
         let solver = self.relaxed.get_or_insert_with(|| {
-            let mut s = FastIk::new(self.subspace.clone(), self.extent_px, self.options.clone());
-            s.options.fold_check_triangles = 0;
-            Box::new(s)
+            Box::new(FastIk::new(
+                self.subspace.clone(),
+                self.extent_px,
+                self.options.clone(),
+            ))
         });
         solver.reset();
         let solution = solver.solve(&relaxed)?;
