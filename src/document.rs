@@ -30,6 +30,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
+#[path = "document_animations.rs"]
+pub mod animations;
+pub use animations::{unused_animation_name, AnimationEdit};
+
 /// Undo steps kept; older ones are forgotten.
 pub const UNDO_LIMIT: usize = 200;
 
@@ -93,6 +97,12 @@ pub enum DocumentError {
     },
     #[error(transparent)]
     KeyEdit(#[from] crate::anim::edit::EditError),
+    #[error("there is no animation named '{0}'")]
+    UnknownAnimation(String),
+    #[error("an animation named '{0}' already exists")]
+    AnimationExists(String),
+    #[error("'{0}' cannot name an animation: give it a name without leading or trailing spaces")]
+    AnimationName(String),
 }
 
 /// Why a stroke may change nothing: the vertices the influence limit held back.
@@ -242,6 +252,16 @@ pub enum Command {
         animation: String,
         key: KeyRef,
         curve: Curve,
+    },
+    /// Adds, renames, duplicates or deletes an animation.
+    Animations(AnimationEdit),
+    /// Auto-key: keys at `time_s` only the channels where `pose` differs from `before` (the
+    /// animation's pose there), see [`animations::key_changes`]. Nothing changed → refused.
+    KeyChanges {
+        animation: String,
+        time_s: f64,
+        before: Pose,
+        pose: Pose,
     },
 }
 
@@ -879,6 +899,24 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             edit_animation(&mut next, animation, |name, json| {
                 edit::set_curve(name, json, &key, &curve)
             })?;
+            inputs_changed = false;
+        }
+        Command::Animations(edit) => {
+            animations::apply(&mut next, edit)?;
+            inputs_changed = false;
+        }
+        Command::KeyChanges {
+            animation,
+            time_s,
+            before,
+            pose,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation);
+            if animations::key_changes(&mut anim, time_s, &before, &pose) == 0 {
+                return Err(DocumentError::NothingToKey(time_s));
+            }
+            store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }
     }

@@ -207,6 +207,7 @@ impl EditorApp {
         let live_pose = match &self.gesture {
             Some(Gesture::PoseDrag { pose, .. }) => Some(pose.clone()),
             Some(Gesture::Fk(g)) => Some(g.preview.clone()),
+            Some(Gesture::Numbers(pose)) => Some(pose.clone()),
             _ => None,
         };
         let mut shapes = Vec::new();

@@ -293,9 +293,13 @@ impl EditorApp {
 
     fn render_window(&mut self, ctx: &egui::Context) {
         let mut open = self.files.render;
+        // Over the canvas's right side, not over the side panel's lists.
+        let right_top = ctx.content_rect().right_top() + egui::vec2(-16.0, 48.0);
         egui::Window::new("Render")
             .open(&mut open)
             .collapsible(false)
+            .pivot(egui::Align2::RIGHT_TOP)
+            .default_pos(right_top)
             .show(ctx, |ui| {
                 let label =
                     ui.label("Render the current animation to (.gif, .png sheet or a folder):");

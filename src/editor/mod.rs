@@ -16,15 +16,18 @@
 //! [`messages`]'.
 
 pub mod animate_mode;
+pub mod animation_list;
 pub mod canvas;
 pub mod closing;
 pub mod colorize;
+pub mod curves;
 pub mod drawing;
 pub mod file;
 pub mod file_menu;
 pub mod gizmo;
 mod identity;
 pub mod messages;
+pub mod numbers;
 pub mod paint;
 pub mod pose_mode;
 pub mod rig_mode;
@@ -90,6 +93,8 @@ enum Gesture {
     },
     Pan,
     Paint(paint::PaintStroke),
+    /// A field of the numbers panel being dragged: the pose it shows ([`numbers`]).
+    Numbers(Pose),
 }
 
 /// The editor's state: the document plus what only the view needs.
@@ -114,6 +119,8 @@ pub struct EditorApp {
     pub pose_mode: pose_mode::PoseMode,
     /// Animate mode: the animation edited, the playhead, playback, onion skins.
     pub animate: animate_mode::AnimateMode,
+    /// Animate mode's list of animations.
+    pub animations: animation_list::AnimationList,
     /// The canvas: layer textures and the picture of the posed drawing.
     pub drawing: drawing::Drawing,
     /// The File menu's path field (rigs to open, PNGs to import, where to save).
@@ -188,6 +195,7 @@ impl EditorApp {
             rig_mode: Default::default(),
             pose_mode: Default::default(),
             animate: animate_mode::AnimateMode::new(first_animation),
+            animations: Default::default(),
             drawing: Default::default(),
             open_path,
             files: Default::default(),
@@ -303,6 +311,9 @@ impl EditorApp {
         if plain(Key::Space) && self.mode == Mode::Animate {
             self.toggle_playback();
         }
+        if plain(Key::K) && self.mode == Mode::Animate && self.gesture.is_none() {
+            self.set_key();
+        }
         let (delete, rig, pose) = (plain(Key::Delete), plain(Key::Num1), plain(Key::Num2));
         let (undo, redo, help, escape) = ctx.input_mut(|i| {
             let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
@@ -391,7 +402,16 @@ impl EditorApp {
         // Rig mode's tools outgrow a short window: the panel scrolls.
         egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),
-            Mode::Pose | Mode::Animate => self.pose_panel(ui),
+            Mode::Pose => {
+                self.pose_panel(ui);
+                self.numbers_panel(ui);
+            }
+            Mode::Animate => {
+                self.animation_list(ui);
+                ui.separator();
+                self.pose_panel(ui);
+                self.numbers_panel(ui);
+            }
             Mode::Colorize => self.colorize_panel(ui),
         });
     }
@@ -474,6 +494,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "rig mode / pose mode / animate mode / colorize mode",
     ),
     ("Space", "play or pause (animate mode)"),
+    ("K", "set a key at the playhead (animate mode)"),
     ("Ctrl+N", "new document"),
     ("Ctrl+O", "open a rig"),
     ("Ctrl+S", "save"),

@@ -425,8 +425,29 @@ impl EditorApp {
         }
     }
 
+    /// Makes `pose` the pose edited: the document's in pose mode; in animate mode the pose
+    /// shown until keyed, or keyed at once (the channels it changed) when auto-key is on.
     pub(super) fn commit_pose(&mut self, pose: Pose) {
         match self.mode {
+            Mode::Animate if self.timeline.auto_key => {
+                let before = self.sampled_pose();
+                if pose == before {
+                    self.animate.shown = None;
+                    return;
+                }
+                let (animation, time_s) = (self.animate.animation.clone(), self.animate.time_s);
+                if self.apply(Command::KeyChanges {
+                    animation: animation.clone(),
+                    time_s,
+                    before,
+                    pose: pose.clone(),
+                }) {
+                    self.animate.shown = None;
+                    self.message = Some(format!("auto-keyed '{animation}' at {time_s:.3} s"));
+                } else {
+                    self.animate.shown = Some(pose);
+                }
+            }
             Mode::Animate => self.animate.shown = Some(pose),
             _ => {
                 self.apply(Command::SetPose(pose));

@@ -10,6 +10,7 @@ use egui_kittest::Harness;
 use std::path::Path;
 use std::sync::Arc;
 
+mod animate;
 mod files;
 mod workflow;
 
@@ -597,7 +598,8 @@ fn renders_the_current_animation_in_the_background() {
     h.run();
     h.key_press(Key::Num3);
     h.run();
-    type_into(&mut h, "Animation", "nod");
+    h.get_by_label("nod").click();
+    h.run();
     h.get_by_label("File").click();
     h.run();
     h.get_by_label("Render…").click();
@@ -627,8 +629,12 @@ fn renders_the_current_animation_in_the_background() {
     let canvas_width = h.state().doc.state().layers[0].image.width();
     let width = u16::from_le_bytes([bytes[6], bytes[7]]);
     assert_eq!(u32::from(width), canvas_width.div_ceil(2));
-    // An animation the document does not have: a message, no file.
-    type_into(&mut h, "Animation", "nope");
+    // Deleted from the list, "nod" is gone; the animation edited then has no keys yet, and
+    // rendering it says so and writes no file.
+    h.get_by_label("Delete animation").click();
+    h.run();
+    assert!(h.state().doc.state().animations.is_empty());
+    h.get_by_label("animation (no keys yet)");
     type_into(
         &mut h,
         "Render the current animation to (.gif, .png sheet or a folder):",
@@ -639,7 +645,7 @@ fn renders_the_current_animation_in_the_background() {
         .click();
     wait_for_render(&mut h, 20);
     let message = h.state().message.clone().unwrap_or_default();
-    assert!(message.contains("nope"), "{message}");
+    assert!(message.contains("no animation of that name"), "{message}");
     assert!(!path.with_file_name("nope.gif").exists());
 }
 
@@ -676,6 +682,13 @@ fn head_turned(degrees: f64) -> Pose {
         },
     );
     pose
+}
+
+/// Types `value` into the numbers panel's field `label` and enters it.
+fn set_number(h: &mut Harness<'_, EditorApp>, label: &str, value: f64) {
+    type_into(h, label, &value.to_string());
+    h.key_press(Key::Enter);
+    h.run();
 }
 
 /// Press and release at `at` (canvas px) without moving.
@@ -1275,14 +1288,26 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let mut h = open_character("dopesheet");
     h.key_press(Key::Num3);
     h.run();
-    type_into(&mut h, "Animation", "nod");
-    // Two keys from the pose: the head at 0° at 0 s and at 20° at 0.5 s.
+    // A new animation from the list, renamed "nod".
+    h.get_by_label("New animation").click();
+    h.run();
+    type_into(&mut h, "Rename to:", "nod");
+    h.get_by_label("Rename animation").click();
+    h.run();
+    assert_eq!(h.state().animate.animation, "nod");
+    assert!(h.state().doc.state().animations.contains_key("nod"));
+    // Two keys from the numbers panel: the head (a click on the bone selects it) at 0° at
+    // 0 s and at 20° at 0.5 s.
+    click(&mut h, [256.0, 150.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("head"));
     for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
         for _ in 0..frames {
             h.get_by_label("Next frame").click();
             h.run();
         }
-        h.state_mut().animate.shown = Some(head_turned(degrees));
+        // 0° is the rest pose's: another number first, so the pose names the head.
+        set_number(&mut h, "Rotation", degrees + 5.0);
+        set_number(&mut h, "Rotation", degrees);
         h.get_by_label("Set key").click();
         h.run();
     }
@@ -1428,7 +1453,8 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     h.run();
     h.key_press(Key::Num3);
     h.run();
-    type_into(&mut h, "Animation", "nod");
+    h.get_by_label("nod").click();
+    h.run();
     assert_eq!(h.state().animate.animation, "nod");
     let fps = h.state().render_settings.fps;
     let on_frame = |t: f64| ((t * fps) - (t * fps).round()).abs() < 1e-6;
@@ -1521,7 +1547,8 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 30.0)]);
     h.key_press(Key::Num3);
     h.run();
-    type_into(&mut h, "Animation", "nod");
+    h.get_by_label("nod").click();
+    h.run();
     // Click one key, shift-click another: both selected; shift-click again: deselected.
     let at = key_on_sheet(&h, Rotate, 0.5);
     click_screen(&mut h, at);

@@ -7,13 +7,12 @@
 //! checks are [`crate::anim::edit`]'s) — and pictures: the transport (play, pause, loop at the
 //! frame rate, frame steps), the dopesheet (a row per timeline, one per handle and channel:
 //! click, shift-click and box-select keys, drag them in time snapped to frames, copy, paste at
-//! the playhead, delete), the curve editor of the selected key's outgoing segment (linear,
-//! stepped, Bézier with two draggable handles over the channel's value graph).
+//! the playhead, delete); beside it the curve editor ([`super::curves`]).
 
 use super::animate_mode::{OnionOptions, MAX_ONION_FRAMES};
+use super::curves::{CurveLayout, CURVE_GRAPH_PT};
 use super::{EditorApp, Mode};
-use crate::anim::edit::{self, CopiedKey, KeyRef, Segment, TimelineId, KEY_TIME_TOLERANCE_S};
-use crate::anim::{Animation, Curve};
+use crate::anim::edit::{self, CopiedKey, KeyRef, TimelineId, KEY_TIME_TOLERANCE_S};
 use crate::document::Command;
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Rect, Sense, Shape, Stroke};
 
@@ -23,10 +22,6 @@ pub const ROW_HEIGHT_PT: f32 = 18.0;
 pub const LABEL_WIDTH_PT: f32 = 150.0;
 /// Horizontal distance within which a click picks a key, points.
 pub const KEY_PICK_PT: f32 = 6.0;
-/// Size of the curve editor's graph, points.
-const CURVE_GRAPH_PT: [f32; 2] = [300.0, 150.0];
-/// Screen distance within which a press grabs a Bézier handle, points.
-const HANDLE_PICK_PT: f32 = 9.0;
 
 /// Where last frame's dopesheet was drawn (tests convert key times to screen with it).
 #[derive(Clone, Debug)]
@@ -40,6 +35,8 @@ pub struct SheetLayout {
     pub summary_y: f32,
     /// Each timeline's row, centre line.
     pub rows: Vec<(TimelineId, f32)>,
+    /// Each row's name, as drawn ([`row_names`]).
+    pub names: Vec<String>,
 }
 
 impl SheetLayout {
@@ -65,39 +62,6 @@ impl SheetLayout {
     }
 }
 
-/// Where last frame's curve editor graph was drawn.
-#[derive(Clone, Debug)]
-pub struct CurveLayout {
-    pub rect: Rect,
-    pub start_s: f64,
-    pub end_s: f64,
-    /// Value range shown, bottom to top.
-    pub low: f64,
-    pub high: f64,
-    /// The two Bézier handles of the shown channel, when the curve is a Bézier.
-    pub handles: Option<[Pos2; 2]>,
-}
-
-impl CurveLayout {
-    pub fn screen(&self, time_s: f64, value: f64) -> Pos2 {
-        let fx = ((time_s - self.start_s) / (self.end_s - self.start_s)) as f32;
-        let fy = ((value - self.low) / (self.high - self.low)) as f32;
-        Pos2::new(
-            self.rect.left() + fx * self.rect.width(),
-            self.rect.bottom() - fy * self.rect.height(),
-        )
-    }
-
-    pub fn graph(&self, p: Pos2) -> (f64, f64) {
-        let fx = f64::from((p.x - self.rect.left()) / self.rect.width());
-        let fy = f64::from((self.rect.bottom() - p.y) / self.rect.height());
-        (
-            self.start_s + fx * (self.end_s - self.start_s),
-            self.low + fy * (self.high - self.low),
-        )
-    }
-}
-
 /// What a press in the dopesheet landed on.
 enum Hit {
     Ruler,
@@ -109,7 +73,7 @@ enum Hit {
     Empty,
 }
 
-enum SheetGesture {
+pub(super) enum SheetGesture {
     Scrub,
     Move {
         anchor_s: f64,
@@ -138,11 +102,14 @@ pub struct TimelineState {
     /// Whether playback starts again at the end (default) or stops there.
     pub looping: bool,
     pub onion: OnionOptions,
+    /// Auto-key: every pose edit in animate mode keys the channels it changed at the
+    /// playhead (default off: edits wait for *Set key*).
+    pub auto_key: bool,
     /// Which value channel (x, y; r, g, b, a) the curve editor shows.
     pub curve_channel: usize,
     pub sheet: Option<SheetLayout>,
     pub curve: Option<CurveLayout>,
-    gesture: Option<SheetGesture>,
+    pub(super) gesture: Option<SheetGesture>,
     /// The animation the selection belongs to.
     selection_of: String,
 }
@@ -154,6 +121,7 @@ impl Default for TimelineState {
             clipboard: Vec::new(),
             looping: true,
             onion: OnionOptions::default(),
+            auto_key: false,
             curve_channel: 0,
             sheet: None,
             curve: None,
@@ -163,7 +131,65 @@ impl Default for TimelineState {
     }
 }
 
-fn diamond(center: Pos2, radius: f32, fill: Color32, stroke: Stroke) -> Shape {
+/// The dopesheet's row names: a transform channel's `arm rotate`; an IK drag named after the
+/// handle nearest its rest point at rest (`hand drag`, numbered when several drags share one:
+/// `hand drag 2`), not by its index.
+pub fn row_names(
+    timelines: &[(TimelineId, Vec<f64>)],
+    animation: &crate::anim::Animation,
+    handles: &crate::rig::Handles,
+) -> Vec<String> {
+    let mut per_handle: std::collections::BTreeMap<String, usize> = Default::default();
+    timelines
+        .iter()
+        .map(|(t, _)| match t {
+            TimelineId::Ik { index } => {
+                let Some(at) = animation.ik.get(*index).map(|d| d.at) else {
+                    return t.label();
+                };
+                let Some(handle) = nearest_handle(handles, at) else {
+                    return t.label();
+                };
+                let n = per_handle.entry(handle.clone()).or_default();
+                *n += 1;
+                if *n == 1 {
+                    format!("{handle} drag")
+                } else {
+                    format!("{handle} drag {n}")
+                }
+            }
+            _ => t.label(),
+        })
+        .collect()
+}
+
+/// The bone (its segment) or point nearest `at_px` at rest.
+fn nearest_handle(handles: &crate::rig::Handles, at_px: [f64; 2]) -> Option<String> {
+    let distance = |a: [f64; 2], b: [f64; 2]| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let f = if len2 > 0.0 {
+            (((at_px[0] - a[0]) * dx + (at_px[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (at_px[0] - a[0] - f * dx).hypot(at_px[1] - a[1] - f * dy)
+    };
+    let bones = handles
+        .bones
+        .iter()
+        .map(|b| (distance(b.head, b.tail), &b.name));
+    let points = handles
+        .points
+        .iter()
+        .map(|p| (distance(p.at, p.at), &p.name));
+    bones
+        .chain(points)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, name)| name.clone())
+}
+
+pub(super) fn diamond(center: Pos2, radius: f32, fill: Color32, stroke: Stroke) -> Shape {
     Shape::convex_polygon(
         vec![
             center + egui::vec2(0.0, -radius),
@@ -174,15 +200,6 @@ fn diamond(center: Pos2, radius: f32, fill: Color32, stroke: Stroke) -> Shape {
         fill,
         stroke,
     )
-}
-
-fn channel_name(channels: usize, c: usize) -> String {
-    match (channels, c) {
-        (2, 0) => "x".into(),
-        (2, 1) => "y".into(),
-        (4, k) => ["red", "green", "blue", "alpha"][k.min(3)].into(),
-        _ => format!("channel {c}"),
-    }
 }
 
 impl EditorApp {
@@ -277,9 +294,8 @@ impl EditorApp {
     pub(super) fn animate_panel(&mut self, ui: &mut egui::Ui) {
         let frame_s = self.frame_s();
         ui.horizontal(|ui| {
-            let label = ui.label("Animation");
-            ui.add(egui::TextEdit::singleline(&mut self.animate.animation).desired_width(120.0))
-                .labelled_by(label.id);
+            // Picked, created and renamed in the side panel's list of animations.
+            ui.label(format!("Animation '{}'", self.animate.animation));
             let play = if self.animate.playing {
                 "Pause"
             } else {
@@ -311,9 +327,15 @@ impl EditorApp {
             {
                 self.set_time(t);
             }
-            if ui.button("Set key").clicked() {
+            if ui
+                .button("Set key")
+                .on_hover_text("key the pose shown at the playhead (K)")
+                .clicked()
+            {
                 self.set_key();
             }
+            ui.checkbox(&mut self.timeline.auto_key, "Auto-key")
+                .on_hover_text("key every pose edit at the playhead as it is made");
             if ui.button("Delete key").clicked() {
                 let animation = self.animate.animation.clone();
                 self.apply(Command::DeleteKeys {
@@ -467,6 +489,11 @@ impl EditorApp {
                 .enumerate()
                 .map(|(i, (t, _))| (t.clone(), rect.top() + (i as f32 + 2.5) * ROW_HEIGHT_PT))
                 .collect(),
+            names: row_names(
+                timelines,
+                &crate::document::animation_named(self.doc.state(), &self.animate.animation),
+                &self.doc.state().handles,
+            ),
         };
         self.dopesheet_input(ui, &response, &layout, timelines);
 
@@ -511,8 +538,8 @@ impl EditorApp {
             )
         };
         label(layout.summary_y, "all keys");
-        for (t, y) in &layout.rows {
-            label(*y, &t.label());
+        for ((_, y), name) in layout.rows.iter().zip(&layout.names) {
+            label(*y, name);
             painter.line_segment(
                 [
                     egui::pos2(zero_x, y + ROW_HEIGHT_PT / 2.0),
@@ -733,224 +760,6 @@ impl EditorApp {
                         self.timeline.selection.clear();
                     }
                 }
-            }
-        }
-    }
-
-    /// The curve of the one selected key's outgoing segment: its kind, and for a Bézier the
-    /// graph of one channel with its two handles to drag.
-    fn curve_editor(&mut self, ui: &mut egui::Ui, animation: &Animation) {
-        self.timeline.curve = None;
-        let [key] = self.timeline.selection.as_slice() else {
-            ui.label("Select one key to edit the curve to the next key.");
-            return;
-        };
-        let key = key.clone();
-        let segment = match edit::segment(animation, &key) {
-            Ok(s) => s,
-            Err(e) => {
-                ui.label(e.to_string());
-                return;
-            }
-        };
-        ui.label(format!(
-            "{}: {:.3} s to {:.3} s",
-            key.timeline.label(),
-            segment.start_s,
-            segment.end_s
-        ));
-        let channels = segment.channels();
-        self.timeline.curve_channel = self.timeline.curve_channel.min(channels.saturating_sub(1));
-        ui.horizontal(|ui| {
-            let kind = match segment.curve {
-                Curve::Linear => 0,
-                Curve::Stepped => 1,
-                Curve::Bezier(_) => 2,
-            };
-            let mut chosen = None;
-            if ui.selectable_label(kind == 0, "Linear").clicked() && kind != 0 {
-                chosen = Some(Curve::Linear);
-            }
-            if ui.selectable_label(kind == 1, "Stepped").clicked() && kind != 1 {
-                chosen = Some(Curve::Stepped);
-            }
-            if ui.selectable_label(kind == 2, "Bézier").clicked() && kind != 2 {
-                chosen = Some(Curve::Bezier(segment.linear_bezier()));
-            }
-            if let Some(curve) = chosen {
-                self.apply(Command::SetCurve {
-                    animation: self.animate.animation.clone(),
-                    key: key.clone(),
-                    curve,
-                });
-            }
-            if channels > 1 {
-                egui::ComboBox::from_id_salt("curve channel")
-                    .selected_text(channel_name(channels, self.timeline.curve_channel))
-                    .show_ui(ui, |ui| {
-                        for c in 0..channels {
-                            ui.selectable_value(
-                                &mut self.timeline.curve_channel,
-                                c,
-                                channel_name(channels, c),
-                            );
-                        }
-                    });
-            }
-        });
-        self.curve_graph(ui, &key, segment);
-    }
-
-    fn curve_graph(&mut self, ui: &mut egui::Ui, key: &KeyRef, mut segment: Segment) {
-        let c = self.timeline.curve_channel;
-        // A handle being dragged shows where it is, not where the document has it.
-        if let Some(SheetGesture::CurveHandle {
-            key: k, numbers, ..
-        }) = &self.timeline.gesture
-        {
-            if k == key {
-                segment.curve = Curve::Bezier(numbers.clone());
-            }
-        }
-        let (response, painter) = ui.allocate_painter(
-            egui::vec2(CURVE_GRAPH_PT[0], CURVE_GRAPH_PT[1]),
-            Sense::drag(),
-        );
-        let rect = response.rect.shrink(10.0);
-        let (t0, t1) = (segment.start_s, segment.end_s);
-        let samples: Vec<(f64, f64)> = (0..=64)
-            .map(|i| {
-                let t = t0 + (t1 - t0) * i as f64 / 64.0;
-                (t, segment.value_at(c, t))
-            })
-            .collect();
-        let handles: Option<[(f64, f64); 2]> = match &segment.curve {
-            Curve::Bezier(n) if n.len() >= 4 * (c + 1) => {
-                Some([(n[4 * c], n[4 * c + 1]), (n[4 * c + 2], n[4 * c + 3])])
-            }
-            _ => None,
-        };
-        let values = samples
-            .iter()
-            .map(|s| s.1)
-            .chain(handles.iter().flatten().map(|h| h.1));
-        let (mut low, mut high) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-            (l.min(v), h.max(v))
-        });
-        if high - low < 1e-9 {
-            (low, high) = (low - 1.0, high + 1.0);
-        }
-        let pad = 0.08 * (high - low);
-        let layout = CurveLayout {
-            rect,
-            start_s: t0,
-            end_s: t1,
-            low: low - pad,
-            high: high + pad,
-            handles: None,
-        };
-        painter.rect_filled(response.rect, 2.0, Color32::from_gray(30));
-        let curve: Vec<Pos2> = samples.iter().map(|&(t, v)| layout.screen(t, v)).collect();
-        painter.add(Shape::line(
-            curve,
-            Stroke::new(2.0, Color32::from_rgb(230, 190, 60)),
-        ));
-        let ends = [
-            layout.screen(t0, segment.start.get(c).copied().unwrap_or(0.0)),
-            layout.screen(t1, segment.end.get(c).copied().unwrap_or(0.0)),
-        ];
-        for end in ends {
-            painter.add(diamond(
-                end,
-                5.0,
-                Color32::from_rgb(255, 140, 40),
-                Stroke::NONE,
-            ));
-        }
-        // The value range shown, at the graph's top and bottom.
-        let font = egui::FontId::proportional(10.0);
-        for (value, y, align) in [
-            (
-                layout.high,
-                response.rect.top() + 2.0,
-                egui::Align2::LEFT_TOP,
-            ),
-            (
-                layout.low,
-                response.rect.bottom() - 2.0,
-                egui::Align2::LEFT_BOTTOM,
-            ),
-        ] {
-            painter.text(
-                egui::pos2(response.rect.left() + 3.0, y),
-                align,
-                format!("{value:.2}"),
-                font.clone(),
-                Color32::from_gray(150),
-            );
-        }
-        let handle_pos = handles.map(|h| h.map(|(t, v)| layout.screen(t, v)));
-        if let Some(h) = handle_pos {
-            for (end, handle) in ends.iter().zip(h) {
-                painter.line_segment([*end, handle], Stroke::new(1.0, Color32::from_gray(170)));
-                painter.circle_filled(handle, 4.5, Color32::from_rgb(120, 180, 255));
-            }
-        }
-        let layout = CurveLayout {
-            handles: handle_pos,
-            ..layout
-        };
-        self.curve_input(ui, &response, &layout, key, &segment);
-        self.timeline.curve = Some(layout);
-    }
-
-    fn curve_input(
-        &mut self,
-        ui: &egui::Ui,
-        response: &egui::Response,
-        layout: &CurveLayout,
-        key: &KeyRef,
-        segment: &Segment,
-    ) {
-        let c = self.timeline.curve_channel;
-        let pointer = response.interact_pointer_pos();
-        if response.drag_started_by(egui::PointerButton::Primary) {
-            let origin = ui.input(|i| i.pointer.press_origin()).or(pointer);
-            if let (Some(at), Some(handles), Curve::Bezier(numbers)) =
-                (origin, layout.handles, &segment.curve)
-            {
-                let grabbed = (0..2)
-                    .filter(|&h| handles[h].distance(at) <= HANDLE_PICK_PT)
-                    .min_by(|&a, &b| handles[a].distance(at).total_cmp(&handles[b].distance(at)));
-                if let Some(h) = grabbed {
-                    self.timeline.gesture = Some(SheetGesture::CurveHandle {
-                        key: key.clone(),
-                        at: 4 * c + 2 * h,
-                        numbers: numbers.clone(),
-                    });
-                }
-            }
-        }
-        if let (Some(p), true) = (pointer, response.dragged()) {
-            if let Some(SheetGesture::CurveHandle { at, numbers, .. }) = &mut self.timeline.gesture
-            {
-                let (t, v) = layout.graph(p);
-                if let Some(pair) = numbers.get_mut(*at..*at + 2) {
-                    // Handle times stay in the segment: time must keep running forward.
-                    pair[0] = t.clamp(layout.start_s, layout.end_s);
-                    pair[1] = v;
-                }
-            }
-        }
-        if response.drag_stopped() {
-            if let Some(SheetGesture::CurveHandle { key, numbers, .. }) =
-                self.timeline.gesture.take()
-            {
-                self.apply(Command::SetCurve {
-                    animation: self.animate.animation.clone(),
-                    key,
-                    curve: Curve::Bezier(numbers),
-                });
             }
         }
     }

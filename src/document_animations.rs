@@ -1,0 +1,280 @@
+//! The document's list of animations and auto-keying: [`AnimationEdit`] (add, rename,
+//! duplicate, delete an animation) and [`key_changes`] (key only the channels a pose changed).
+//!
+//! In: the state's animations by name. Out: the animations after the edit, or why it is
+//! refused (an empty name, a name taken, an animation that does not exist); the caller
+//! ([`super::Document::apply`]) keeps the state as it was on a refusal.
+
+use super::{DocumentError, State};
+use crate::anim::edit::put_key;
+use crate::anim::{Animation, Curve, IkTimeline, Key};
+use crate::rig::Pose;
+
+/// One edit of the list of animations (see [`super::Command::Animations`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnimationEdit {
+    /// A new animation with no keys.
+    Add {
+        name: String,
+    },
+    /// Renames an animation; its keys stay.
+    Rename {
+        from: String,
+        to: String,
+    },
+    /// A copy of `from`'s keys under the new name `to`.
+    Duplicate {
+        from: String,
+        to: String,
+    },
+    Delete {
+        name: String,
+    },
+}
+
+/// Checks a new animation's name: not blank, no control characters, not taken.
+fn check_new_name(state: &State, name: &str) -> Result<(), DocumentError> {
+    if name.trim().is_empty() || name.chars().any(char::is_control) || name.trim() != name {
+        return Err(DocumentError::AnimationName(name.to_string()));
+    }
+    if state.animations.contains_key(name) {
+        return Err(DocumentError::AnimationExists(name.to_string()));
+    }
+    Ok(())
+}
+
+fn existing(state: &State, name: &str) -> Result<Animation, DocumentError> {
+    state
+        .animations
+        .get(name)
+        .cloned()
+        .ok_or_else(|| DocumentError::UnknownAnimation(name.to_string()))
+}
+
+/// Applies `edit` to `next` (a copy of the state).
+pub(super) fn apply(next: &mut State, edit: AnimationEdit) -> Result<(), DocumentError> {
+    match edit {
+        AnimationEdit::Add { name } => {
+            check_new_name(next, &name)?;
+            next.animations.insert(name, Animation::default());
+        }
+        AnimationEdit::Rename { from, to } => {
+            let anim = existing(next, &from)?;
+            check_new_name(next, &to)?;
+            next.animations.remove(&from);
+            next.animations.insert(to, anim);
+        }
+        AnimationEdit::Duplicate { from, to } => {
+            let anim = existing(next, &from)?;
+            check_new_name(next, &to)?;
+            next.animations.insert(to, anim);
+        }
+        AnimationEdit::Delete { name } => {
+            existing(next, &name)?;
+            next.animations.remove(&name);
+        }
+    }
+    Ok(())
+}
+
+/// `base` followed by the first of "", " 2", " 3", … that no animation of `state` has.
+pub fn unused_animation_name(state: &State, base: &str) -> String {
+    (1..)
+        .map(|k| {
+            if k == 1 {
+                base.to_string()
+            } else {
+                format!("{base} {k}")
+            }
+        })
+        .find(|n| !state.animations.contains_key(n))
+        .unwrap_or_else(|| base.to_string())
+}
+
+/// Keys at `time_s` each channel where `pose` differs from `before` (the animation's own pose
+/// there): a bone's or point's rotate, translate, scale and shear one by one, and each IK drag
+/// that is new or moved. Returns how many channels were keyed. Keys go in with
+/// [`put_key`], so a key inside a segment splits its curve.
+pub fn key_changes(anim: &mut Animation, time_s: f64, before: &Pose, pose: &Pose) -> usize {
+    let mut keyed = 0;
+    let mut put = |changed: bool, f: &mut dyn FnMut()| {
+        if changed {
+            f();
+            keyed += 1;
+        }
+    };
+    for (name, b) in &pose.bones {
+        let old = before.bones.get(name).cloned().unwrap_or_default();
+        if *b == old {
+            continue;
+        }
+        let t = anim.bones.entry(name.clone()).or_default();
+        put(b.rotate != old.rotate, &mut || {
+            put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate)
+        });
+        put(b.translate != old.translate, &mut || {
+            put_key(
+                t.translate.get_or_insert_with(Vec::new),
+                time_s,
+                b.translate,
+            )
+        });
+        put(b.scale != old.scale, &mut || {
+            put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale)
+        });
+        put(b.shear != old.shear, &mut || {
+            put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear)
+        });
+    }
+    for (name, p) in &pose.points {
+        let old = before.points.get(name).cloned().unwrap_or_default();
+        if *p == old {
+            continue;
+        }
+        let t = anim.points.entry(name.clone()).or_default();
+        put(p.rotate != old.rotate, &mut || {
+            put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate)
+        });
+        put(p.translate != old.translate, &mut || {
+            put_key(
+                t.translate.get_or_insert_with(Vec::new),
+                time_s,
+                p.translate,
+            )
+        });
+        put(p.scale != old.scale, &mut || {
+            put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale)
+        });
+        put(p.shear != old.shear, &mut || {
+            put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear)
+        });
+    }
+    for drag in &pose.ik {
+        let same = |d: &crate::rig::pose::IkDrag| d.at == drag.at && d.weight == drag.weight;
+        if before.ik.iter().any(|d| same(d) && d.to == drag.to) {
+            continue;
+        }
+        keyed += 1;
+        match anim
+            .ik
+            .iter_mut()
+            .find(|t| t.at == drag.at && t.weight == drag.weight)
+        {
+            Some(t) => put_key(&mut t.to, time_s, drag.to),
+            None => anim.ik.push(IkTimeline {
+                at: drag.at,
+                to: vec![Key {
+                    time: time_s,
+                    value: drag.to,
+                    curve: Curve::Linear,
+                }],
+                weight: drag.weight,
+            }),
+        }
+    }
+    keyed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{animation_named, Command, Document};
+    use super::*;
+    use crate::rig::pose::BonePose;
+
+    fn arm_at(rotate: f64, translate: [f64; 2]) -> Pose {
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "arm".into(),
+            BonePose {
+                rotate,
+                translate,
+                ..Default::default()
+            },
+        );
+        pose
+    }
+
+    #[test]
+    fn add_rename_duplicate_delete_and_their_refusals() {
+        let mut doc = Document::new();
+        let edit = |e| Command::Animations(e);
+        doc.apply(edit(AnimationEdit::Add {
+            name: "walk".into(),
+        }))
+        .expect("added");
+        assert!(doc.state().animations["walk"] == Animation::default());
+        doc.apply(Command::SetKey {
+            animation: "walk".into(),
+            time_s: 1.0,
+            pose: arm_at(30.0, [0.0, 0.0]),
+        })
+        .expect("keyed");
+        // Taken, blank and padded names are refused, the document unchanged.
+        for bad in ["walk", "", "  ", " walk2"] {
+            let e = doc.apply(edit(AnimationEdit::Add { name: bad.into() }));
+            assert!(e.is_err(), "{bad:?} accepted");
+        }
+        assert!(doc
+            .apply(edit(AnimationEdit::Rename {
+                from: "run".into(),
+                to: "sprint".into()
+            }))
+            .is_err());
+        doc.apply(edit(AnimationEdit::Duplicate {
+            from: "walk".into(),
+            to: "walk 2".into(),
+        }))
+        .expect("duplicated");
+        assert_eq!(
+            animation_named(doc.state(), "walk 2"),
+            animation_named(doc.state(), "walk")
+        );
+        assert_eq!(unused_animation_name(doc.state(), "walk"), "walk 3");
+        doc.apply(edit(AnimationEdit::Rename {
+            from: "walk".into(),
+            to: "stroll".into(),
+        }))
+        .expect("renamed");
+        let names: Vec<&String> = doc.state().animations.keys().collect();
+        assert_eq!(names, ["stroll", "walk 2"]);
+        doc.apply(edit(AnimationEdit::Delete {
+            name: "stroll".into(),
+        }))
+        .expect("deleted");
+        assert_eq!(doc.state().animations.len(), 1);
+        assert!(doc.undo());
+        assert!(doc.state().animations.contains_key("stroll"));
+    }
+
+    #[test]
+    fn key_changes_keys_only_the_channels_that_moved() {
+        let mut doc = Document::new();
+        doc.apply(Command::SetKey {
+            animation: "wave".into(),
+            time_s: 0.0,
+            pose: arm_at(0.0, [0.0, 0.0]),
+        })
+        .expect("keyed");
+        let before = animation_named(doc.state(), "wave").sample(1.0, false);
+        let after = arm_at(45.0, [0.0, 0.0]);
+        doc.apply(Command::KeyChanges {
+            animation: "wave".into(),
+            time_s: 1.0,
+            before: before.clone(),
+            pose: after,
+        })
+        .expect("auto-keyed");
+        let arm = &animation_named(doc.state(), "wave").bones["arm"];
+        assert_eq!(arm.rotate.as_ref().map(Vec::len), Some(2));
+        assert_eq!(arm.translate.as_ref().map(Vec::len), Some(1));
+        assert_eq!(arm.scale.as_ref().map(Vec::len), Some(1));
+        // Nothing changed: refused, as Set key is.
+        let e = doc.apply(Command::KeyChanges {
+            animation: "wave".into(),
+            time_s: 1.0,
+            before: before.clone(),
+            pose: before,
+        });
+        assert!(matches!(e, Err(DocumentError::NothingToKey(_))), "{e:?}");
+    }
+}
