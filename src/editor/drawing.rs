@@ -123,9 +123,11 @@ impl EditorApp {
             (rect.width() * pixels_per_point).round().max(1.0) as u32,
             (rect.height() * pixels_per_point).round().max(1.0) as u32,
         ];
+        // The parts the tree hides are left out of the draw list.
+        let pose = self.with_hidden_parts(&posed.pose);
         let key = PictureKey {
             scene: Identity::of(scene),
-            pose: posed.pose.clone(),
+            pose: pose.clone(),
             blend: self.render_settings.blend,
             view: placed.view,
             size_px,
@@ -143,7 +145,7 @@ impl EditorApp {
         let zoom = placed.view.zoom * pixels_per_point;
         let pan = placed.view.pan * pixels_per_point;
         let pixmap_from_canvas = tiny_skia::Transform::from_row(zoom, 0.0, 0.0, zoom, pan.x, pan.y);
-        let draws = crate::playback::pose_draws(scene, &posed.positions, &posed.pose);
+        let draws = crate::playback::pose_draws(scene, &posed.positions, &pose);
         scene
             .draw_parts(&mut pixmap, &draws, pixmap_from_canvas)
             .map_err(|e| e.to_string())?;
@@ -303,9 +305,7 @@ impl EditorApp {
         size_px: [u32; 2],
     ) -> Placed {
         let rect = response.rect;
-        let view = *self
-            .view
-            .get_or_insert_with(|| canvas::fit(size_px, rect.size()));
+        let view = self.place_view(size_px, rect.size());
         let placed = Placed {
             view,
             origin: rect.min,

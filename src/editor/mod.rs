@@ -33,6 +33,8 @@ pub mod pose_mode;
 pub mod rig_mode;
 pub mod rig_tools;
 pub mod timeline;
+pub mod tree;
+pub mod view;
 pub mod worker;
 
 #[cfg(test)]
@@ -105,6 +107,8 @@ pub struct EditorApp {
     pub selected: Option<String>,
     /// `None` fits the canvas into the window on the next frame.
     pub view: Option<View>,
+    /// A change of the view (View menu, Home, F, Ctrl+0) for the next frame.
+    pub view_request: Option<view::ViewRequest>,
     /// Where the canvas was drawn last frame (tests convert canvas px to screen with it).
     pub placed: Option<Placed>,
     /// The last message for the user (errors, saves).
@@ -166,6 +170,8 @@ pub struct EditorApp {
     pub paint: paint::PaintSettings,
     /// Animate mode: key selection, clipboard, loop, onion skins, curve editor.
     pub timeline: timeline::TimelineState,
+    /// The tree view: renaming in place, the parts hidden on the canvas.
+    pub tree: tree::TreeState,
 }
 
 impl EditorApp {
@@ -187,6 +193,7 @@ impl EditorApp {
             mode: Mode::Rig,
             selected: None,
             view: None,
+            view_request: None,
             placed: None,
             message: None,
             last_frame_ms: 0.0,
@@ -218,6 +225,7 @@ impl EditorApp {
             colorize: Default::default(),
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),
+            tree: Default::default(),
         }
     }
 
@@ -258,6 +266,7 @@ impl EditorApp {
         self.dropped_files(&ctx);
         // Ctrl+N/O/S first: they take their key events, which no other shortcut then sees.
         self.file_shortcuts(&ctx);
+        self.view_shortcuts(&ctx);
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
         self.autosave(&ctx);
@@ -358,25 +367,33 @@ impl EditorApp {
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             self.file_menu_button(ui);
+            self.view_menu_button(ui);
             if ui
                 .add_enabled(self.can_undo_in_mode(), egui::Button::new("Undo"))
+                .on_hover_text("Ctrl+Z")
                 .clicked()
             {
                 self.undo_in_mode();
             }
             if ui
                 .add_enabled(self.can_redo_in_mode(), egui::Button::new("Redo"))
+                .on_hover_text("Ctrl+Shift+Z")
                 .clicked()
             {
                 self.redo_in_mode();
             }
             ui.separator();
-            ui.selectable_value(&mut self.mode, Mode::Rig, "Rig mode");
-            ui.selectable_value(&mut self.mode, Mode::Pose, "Pose mode");
-            ui.selectable_value(&mut self.mode, Mode::Animate, "Animate mode");
-            ui.selectable_value(&mut self.mode, Mode::Colorize, "Colorize mode");
+            for (mode, label, key) in [
+                (Mode::Rig, "Rig mode", "1"),
+                (Mode::Pose, "Pose mode", "2"),
+                (Mode::Animate, "Animate mode", "3"),
+                (Mode::Colorize, "Colorize mode", "4"),
+            ] {
+                ui.selectable_value(&mut self.mode, mode, label)
+                    .on_hover_text(format!("key {key}"));
+            }
             ui.separator();
-            if ui.button("Help").clicked() {
+            if ui.button("Help").on_hover_text("F1 or ?").clicked() {
                 self.show_help = !self.show_help;
             }
         });
@@ -405,12 +422,14 @@ impl EditorApp {
             Mode::Pose => {
                 self.pose_panel(ui);
                 self.numbers_panel(ui);
+                self.pose_tree(ui);
             }
             Mode::Animate => {
                 self.animation_list(ui);
                 ui.separator();
                 self.pose_panel(ui);
                 self.numbers_panel(ui);
+                self.pose_tree(ui);
             }
             Mode::Colorize => self.colorize_panel(ui),
         });
@@ -517,6 +536,9 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
          Esc or right click cancels); or drag its gizmo's centre / ring / square",
     ),
     ("Mouse wheel", "zoom about the pointer"),
+    ("Home", "zoom to fit the canvas"),
+    ("F", "frame the selected handle"),
+    ("Ctrl+0", "actual size (100 %)"),
     ("Middle drag", "pan"),
     ("Esc", "cancel the gesture, close this help"),
     ("F1 or ?", "this help"),

@@ -156,6 +156,13 @@ impl EditorApp {
         }
     }
 
+    /// The tree view under pose and animate mode's panels.
+    pub(super) fn pose_tree(&mut self, ui: &mut egui::Ui) {
+        ui.separator();
+        ui.heading("Tree");
+        self.tree_view(ui);
+    }
+
     /// Poses `scene` for the static `pose` through [`pose_frame`] into [`PoseMode::posed`]
     /// (kept while the rig, the pose and the blend stay the same).
     pub(super) fn update_posed(&mut self, scene: &Arc<Scene>, pose: &Pose) -> Result<(), String> {

@@ -63,8 +63,11 @@ impl EditorApp {
         weighted: bool,
     ) -> Vec<Shape> {
         let mut shapes = Vec::new();
-        for texture in textures {
-            shapes.push(canvas::image_quad(placed, texture, canvas_px));
+        let hidden = &self.tree.hidden_parts;
+        for (texture, layer) in textures.iter().zip(&self.doc.state().layers) {
+            if !hidden.contains(&layer.name) {
+                shapes.push(canvas::image_quad(placed, texture, canvas_px));
+            }
         }
         let (Some(scene), Some(name)) = (&self.doc.state().rig, &self.selected) else {
             return shapes;
@@ -149,22 +152,11 @@ impl EditorApp {
             self.paint_panel(ui);
         }
         ui.separator();
-        ui.heading("Handles");
-        let names: Vec<String> = self.doc.state().handles.names().map(String::from).collect();
+        ui.heading("Tree");
         egui::ScrollArea::vertical()
-            .max_height(180.0)
-            .show(ui, |ui| {
-                for name in names {
-                    let selected = self.selected.as_deref() == Some(name.as_str());
-                    ui.horizontal(|ui| {
-                        self.lock_box(ui, &name);
-                        if ui.selectable_label(selected, &name).clicked() {
-                            self.rig_mode.rename_to = name.clone();
-                            self.selected = Some(name);
-                        }
-                    });
-                }
-            });
+            .id_salt("tree")
+            .max_height(260.0)
+            .show(ui, |ui| self.tree_view(ui));
         if let Some(name) = self.selected.clone() {
             ui.separator();
             ui.label(format!("Selected: {name}"));

@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 mod animate;
 mod files;
+mod tree_view;
 mod workflow;
 
 /// Frames a background weight build may take before a test gives up (50 ms apart).

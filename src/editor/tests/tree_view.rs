@@ -1,0 +1,152 @@
+//! The tree view and the View menu's keys, driven by input events only.
+
+use super::*;
+use egui_kittest::kittest::NodeT;
+
+/// Scrolls the side panel to the widget labelled `label`, then clicks it.
+fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
+    h.get_by_label(label).scroll_to_me();
+    h.run();
+    h.get_by_label(label).click();
+    h.run();
+}
+
+/// The same view, up to a fraction of a point (the side panel's width settles over the first
+/// frames, and the fit with it).
+fn same_view(a: Option<View>, b: View) -> bool {
+    a.is_some_and(|a| (a.zoom - b.zoom).abs() < 1e-3 && (a.pan - b.pan).length() < 1.0)
+}
+
+/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
+fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
+    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
+}
+
+#[test]
+fn the_tree_selects_with_the_canvas_renames_in_place_and_hides_parts() {
+    let mut h = open_character("tree");
+    // Rig mode: a bone picked in the tree is the canvas's selection.
+    click_label(&mut h, "lantern");
+    assert_eq!(h.state().selected.as_deref(), Some("lantern"));
+    assert!(tree_selected(&h, "lantern"));
+
+    // F2 renames the selected handle in place; Enter commits, the selection follows.
+    h.key_press(Key::F2);
+    h.run();
+    type_into(&mut h, "New name:", "lamp");
+    h.key_press(Key::Enter);
+    h.run();
+    let handles = h.state().doc.state().handles.clone();
+    let lamp = handles.bones.iter().find(|b| b.name == "lamp");
+    assert_eq!(
+        lamp.and_then(|b| b.parent.as_deref()),
+        Some("arm_lower_r"),
+        "{:?}",
+        h.state().message
+    );
+    assert_eq!(h.state().selected.as_deref(), Some("lamp"));
+    assert!(h.query_by_label("lantern").is_none());
+
+    // Rename in place, then Escape: nothing renamed.
+    h.key_press(Key::F2);
+    h.run();
+    type_into(&mut h, "New name:", "torch");
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(h.state().doc.state().handles.names().any(|n| n == "lamp"));
+    assert!(h.query_by_label("New name:").is_none());
+
+    // Pose mode: a click on the chest on the canvas selects it in the tree too. (Renaming
+    // made the rig stale: compute the weights again first.)
+    click_label(&mut h, "Compute weights");
+    wait_for_weights(&mut h);
+    h.key_press(Key::Num2);
+    h.run();
+    click(&mut h, [256.0, 225.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    assert!(tree_selected(&h, "chest"));
+    assert!(!tree_selected(&h, "lamp"));
+
+    // The head part's eye box hides it on the canvas: the picture leaves it out and shows
+    // what is behind it; ticked again, it is back.
+    let on_head = screen(&h, part_point(&h, "head"));
+    let shown = |h: &Harness<'_, EditorApp>| {
+        let picture = h.state().drawing.picture.as_ref().expect("a picture");
+        let head = picture
+            .draws
+            .iter()
+            .find(|d| d.name == "head")
+            .expect("head");
+        (head.visible, picture.pixel_at(on_head))
+    };
+    let before = shown(&h);
+    assert!(before.0);
+    click_label(&mut h, "show head");
+    let hidden = shown(&h);
+    assert!(!hidden.0);
+    assert_ne!(hidden.1, before.1, "the head's pixel did not change");
+    click_label(&mut h, "show head");
+    assert_eq!(shown(&h), before);
+    // Hiding is the view's, not the document's.
+    assert!(!h.state().doc.dirty() || h.state().doc.can_undo());
+}
+
+#[test]
+fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
+    let mut h = open_character("view-keys");
+    h.key_press(Key::Num2);
+    h.run();
+    let fitted = h.state().view.expect("a view");
+    assert!(
+        (fitted.zoom - 1.0).abs() > 0.05,
+        "the test needs a fit ≠ 100 %"
+    );
+
+    // Ctrl+0: one canvas px per point, the point at the area's centre kept there.
+    let area = h.state().drawing.picture.as_ref().expect("a picture").rect;
+    let centre_px = h
+        .state()
+        .placed
+        .expect("placed")
+        .canvas_from_screen(area.center());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Num0);
+    h.run();
+    assert_eq!(h.state().view.expect("a view").zoom, 1.0);
+    let kept = screen(&h, centre_px);
+    assert!(
+        kept.distance(area.center()) < 0.5,
+        "{kept:?} vs {:?}",
+        area.center()
+    );
+
+    // Home: fitted again.
+    h.key_press(Key::Home);
+    h.run();
+    assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
+
+    // F frames the selected bone: its middle at the area's centre, zoomed in on it.
+    click(&mut h, [256.0, 225.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    h.key_press(Key::F);
+    h.run();
+    let view = h.state().view.expect("a view");
+    assert!(
+        view.zoom > 3.0 * fitted.zoom,
+        "zoom {} vs {}",
+        view.zoom,
+        fitted.zoom
+    );
+    let middle = screen(&h, [256.0, 230.0]);
+    assert!(
+        middle.distance(area.center()) < 0.5,
+        "{middle:?} vs {:?}",
+        area.center()
+    );
+
+    // The View menu does the same, its entries showing their keys.
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label_contains("Zoom to fit").click();
+    h.run();
+    assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
+}

@@ -1,0 +1,210 @@
+//! The tree view (rig, pose and animate modes' side panel): skeletons with their bones nested
+//! under their parents, the points, cages and regions, and the parts (slots) front to back.
+//!
+//! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
+//! the parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename`
+//! commands, and which parts the canvas hides (a view setting, not part of the document: the
+//! posed picture drops them from the library's draw list; rig mode leaves their images out).
+
+use super::{EditorApp, Mode};
+use crate::document::Command;
+use eframe::egui::{self, Key};
+use std::collections::BTreeSet;
+
+/// The tree's own state.
+#[derive(Default)]
+pub struct TreeState {
+    /// Parts the canvas does not draw (by name).
+    pub hidden_parts: BTreeSet<String>,
+    /// The handle being renamed in place, and the name typed so far.
+    renaming: Option<(String, String)>,
+    /// The rename field wants the keyboard (it just appeared).
+    focus: bool,
+}
+
+impl EditorApp {
+    /// Selects handle `name`, as a click on the canvas does.
+    pub fn select_handle(&mut self, name: &str) {
+        self.selected = Some(name.to_string());
+        self.rig_mode.rename_to = name.to_string();
+    }
+
+    /// The tree: skeletons, points, cages, regions, parts.
+    pub(super) fn tree_view(&mut self, ui: &mut egui::Ui) {
+        let typing = ui.ctx().text_edit_focused();
+        if !typing && ui.input(|i| super::file_menu::plain_key(i, Key::F2)) {
+            if let Some(name) = self.selected.clone() {
+                self.start_rename(&name);
+            }
+        }
+        let handles = self.doc.state().handles.clone();
+        egui::CollapsingHeader::new("Skeletons")
+            .default_open(true)
+            .show(ui, |ui| {
+                let roots: Vec<String> = handles
+                    .bones
+                    .iter()
+                    .filter(|b| b.parent.is_none())
+                    .map(|b| b.name.clone())
+                    .collect();
+                if roots.is_empty() {
+                    ui.label("No bones yet (the Bone tool draws them).");
+                }
+                for root in roots {
+                    self.bone_subtree(ui, &handles, &root, 0);
+                }
+            });
+        let groups = [
+            (
+                "Points",
+                handles.points.iter().map(|p| p.name.clone()).collect(),
+            ),
+            (
+                "Cages",
+                handles.cages.iter().map(|c| c.name.clone()).collect(),
+            ),
+            (
+                "Regions",
+                handles.regions.iter().map(|r| r.name.clone()).collect(),
+            ),
+        ];
+        for (title, names) in groups {
+            let names: Vec<String> = names;
+            if names.is_empty() {
+                continue;
+            }
+            egui::CollapsingHeader::new(title)
+                .default_open(true)
+                .show(ui, |ui| {
+                    for name in names {
+                        self.handle_row(ui, &name);
+                    }
+                });
+        }
+        self.parts_tree(ui);
+    }
+
+    fn bone_subtree(
+        &mut self,
+        ui: &mut egui::Ui,
+        handles: &crate::rig::Handles,
+        name: &str,
+        depth: usize,
+    ) {
+        // A cycle cannot be saved, but a tree never recurses without end.
+        if depth > handles.bones.len() {
+            return;
+        }
+        ui.horizontal(|ui| {
+            ui.add_space(12.0 * depth as f32);
+            self.handle_row(ui, name);
+        });
+        let children: Vec<String> = handles
+            .bones
+            .iter()
+            .filter(|b| b.parent.as_deref() == Some(name))
+            .map(|b| b.name.clone())
+            .collect();
+        for child in children {
+            self.bone_subtree(ui, handles, &child, depth + 1);
+        }
+    }
+
+    /// One handle: its name to click (select) or double-click (rename); its rename field while
+    /// renamed; rig mode's lock box.
+    fn handle_row(&mut self, ui: &mut egui::Ui, name: &str) {
+        ui.horizontal(|ui| {
+            if self.mode == Mode::Rig {
+                self.lock_box(ui, name);
+            }
+            if let Some((from, to)) = &mut self.tree.renaming {
+                if from == name {
+                    let label = ui.label("New name:");
+                    let field = ui
+                        .add(egui::TextEdit::singleline(to).desired_width(110.0))
+                        .labelled_by(label.id);
+                    if std::mem::take(&mut self.tree.focus) {
+                        field.request_focus();
+                    }
+                    if field.lost_focus() {
+                        let enter = ui.input(|i| i.key_pressed(Key::Enter));
+                        let (from, to) = self.tree.renaming.take().unwrap_or_default();
+                        if enter && to != from {
+                            self.rename_handle(&from, &to);
+                        }
+                    }
+                    return;
+                }
+            }
+            let selected = self.selected.as_deref() == Some(name);
+            let response = ui.selectable_label(selected, name);
+            if response.clicked() {
+                self.select_handle(name);
+            }
+            if response.double_clicked() {
+                self.start_rename(name);
+            }
+        });
+    }
+
+    fn start_rename(&mut self, name: &str) {
+        self.select_handle(name);
+        self.tree.renaming = Some((name.to_string(), name.to_string()));
+        self.tree.focus = true;
+    }
+
+    /// Renames a handle everywhere (the document's `Rename`); the selection follows.
+    pub fn rename_handle(&mut self, from: &str, to: &str) {
+        if self.apply(Command::Rename {
+            from: from.to_string(),
+            to: to.to_string(),
+        }) {
+            if self.selected.as_deref() == Some(from) {
+                self.select_handle(to);
+            }
+            self.message = Some(format!("renamed '{from}' to '{to}'"));
+        }
+    }
+
+    /// The parts front to back (the top one is drawn over the others), each with its eye box.
+    fn parts_tree(&mut self, ui: &mut egui::Ui) {
+        let parts: Vec<String> = self
+            .doc
+            .state()
+            .layers
+            .iter()
+            .rev()
+            .map(|l| l.name.clone())
+            .collect();
+        if parts.is_empty() {
+            return;
+        }
+        egui::CollapsingHeader::new("Parts (front to back)")
+            .default_open(true)
+            .show(ui, |ui| {
+                for part in parts {
+                    let mut shown = !self.tree.hidden_parts.contains(&part);
+                    if ui
+                        .checkbox(&mut shown, format!("show {part}"))
+                        .on_hover_text("show or hide the part on the canvas")
+                        .changed()
+                    {
+                        if shown {
+                            self.tree.hidden_parts.remove(&part);
+                        } else {
+                            self.tree.hidden_parts.insert(part);
+                        }
+                    }
+                }
+            });
+    }
+
+    /// `pose` with the parts hidden in the tree made invisible, for the canvas's picture.
+    pub(super) fn with_hidden_parts(&self, pose: &crate::rig::Pose) -> crate::rig::Pose {
+        let mut pose = pose.clone();
+        for part in &self.tree.hidden_parts {
+            pose.parts.entry(part.clone()).or_default().visible = false;
+        }
+        pose
+    }
+}

@@ -1,0 +1,172 @@
+//! The View menu and its keys: zoom to fit (Home), frame the selection (F), actual size
+//! (Ctrl+0: one canvas px per screen point).
+//!
+//! In: the keys, the menu's clicks, the selected handle (where the canvas shows it) and the
+//! canvas area's size. Out: the canvas's [`View`] (zoom and pan), set on the next frame where
+//! the canvas area is known ([`EditorApp::place_view`]).
+
+use super::canvas::{self, View};
+use super::{EditorApp, Mode};
+use eframe::egui::{self, Key, Modifiers, Vec2};
+
+/// Margin around what a view change fits, screen points.
+const FIT_MARGIN_PT: f32 = 24.0;
+/// The smallest box (canvas px) "frame the selection" zooms to: a point is framed with its
+/// surroundings, not magnified without end.
+const MIN_FRAMED_PX: f64 = 96.0;
+/// The zoom range (screen points per canvas px), as the mouse wheel's.
+const ZOOM_RANGE: (f32, f32) = (0.05, 32.0);
+
+/// A view change waiting for the canvas area's size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewRequest {
+    /// The whole canvas in the area.
+    Fit,
+    /// A box (canvas px, min and max corners) in the area, centred.
+    Frame([f64; 2], [f64; 2]),
+    /// One canvas px per screen point, about the area's centre.
+    ActualSize,
+}
+
+impl EditorApp {
+    /// Home, F and Ctrl+0 (not while typing).
+    pub(super) fn view_shortcuts(&mut self, ctx: &egui::Context) {
+        if ctx.text_edit_focused() || self.mode == Mode::Colorize {
+            return;
+        }
+        let (fit, frame, actual) = ctx.input_mut(|i| {
+            (
+                super::file_menu::plain_key(i, Key::Home),
+                super::file_menu::plain_key(i, Key::F),
+                i.consume_key(Modifiers::COMMAND, Key::Num0),
+            )
+        });
+        if fit {
+            self.view_request = Some(ViewRequest::Fit);
+        }
+        if frame {
+            self.frame_selection();
+        }
+        if actual {
+            self.view_request = Some(ViewRequest::ActualSize);
+        }
+    }
+
+    /// The View menu, each entry with its key.
+    pub(super) fn view_menu_button(&mut self, ui: &mut egui::Ui) {
+        ui.menu_button("View", |ui| {
+            if ui
+                .add(egui::Button::new("Zoom to fit").shortcut_text("Home"))
+                .clicked()
+            {
+                self.view_request = Some(ViewRequest::Fit);
+                ui.close();
+            }
+            if ui
+                .add_enabled(
+                    self.selected.is_some(),
+                    egui::Button::new("Frame selection").shortcut_text("F"),
+                )
+                .clicked()
+            {
+                self.frame_selection();
+                ui.close();
+            }
+            if ui
+                .add(egui::Button::new("Actual size (100 %)").shortcut_text("Ctrl+0"))
+                .clicked()
+            {
+                self.view_request = Some(ViewRequest::ActualSize);
+                ui.close();
+            }
+        });
+    }
+
+    /// Frames the selected handle where the canvas shows it (posed in pose and animate mode);
+    /// with nothing selected, the whole canvas.
+    pub fn frame_selection(&mut self) {
+        let posed = match self.mode {
+            Mode::Pose | Mode::Animate => self.pose_mode.posed.as_ref().map(|p| &p.handles),
+            _ => None,
+        };
+        let handles = posed.unwrap_or(&self.doc.state().handles);
+        let corners = self
+            .selected
+            .as_deref()
+            .map(|name| handle_corners(handles, name))
+            .unwrap_or_default();
+        self.view_request = Some(match bounds(&corners) {
+            Some((min, max)) => ViewRequest::Frame(min, max),
+            None => ViewRequest::Fit,
+        });
+    }
+
+    /// The view to draw with in an area of `area` points showing a canvas of `canvas_px`:
+    /// the pending request applied, or the view as it is (fitted the first time).
+    pub(super) fn place_view(&mut self, canvas_px: [u32; 2], area: Vec2) -> View {
+        let current = self.view.unwrap_or_else(|| canvas::fit(canvas_px, area));
+        let view = match self.view_request.take() {
+            None => current,
+            Some(ViewRequest::Fit) => canvas::fit(canvas_px, area),
+            Some(ViewRequest::ActualSize) => {
+                // The canvas point at the area's centre stays there.
+                let centre = (area / 2.0 - current.pan) / current.zoom;
+                View {
+                    zoom: 1.0,
+                    pan: area / 2.0 - centre,
+                }
+            }
+            Some(ViewRequest::Frame(min, max)) => frame(min, max, area),
+        };
+        self.view = Some(view);
+        view
+    }
+}
+
+/// The view showing the box `min`..`max` (canvas px, grown to [`MIN_FRAMED_PX`]) centred in
+/// an area of `area` points.
+pub fn frame(min: [f64; 2], max: [f64; 2], area: Vec2) -> View {
+    let centre = Vec2::new(
+        ((min[0] + max[0]) / 2.0) as f32,
+        ((min[1] + max[1]) / 2.0) as f32,
+    );
+    let size = Vec2::new(
+        (max[0] - min[0]).max(MIN_FRAMED_PX) as f32,
+        (max[1] - min[1]).max(MIN_FRAMED_PX) as f32,
+    );
+    let zoom = ((area.x - 2.0 * FIT_MARGIN_PT) / size.x)
+        .min((area.y - 2.0 * FIT_MARGIN_PT) / size.y)
+        .clamp(ZOOM_RANGE.0, ZOOM_RANGE.1);
+    View {
+        zoom,
+        pan: area / 2.0 - centre * zoom,
+    }
+}
+
+/// The points that outline handle `name`: a bone's head and tail, a point, a polygon's
+/// vertices.
+fn handle_corners(handles: &crate::rig::Handles, name: &str) -> Vec<[f64; 2]> {
+    if let Some(b) = handles.bones.iter().find(|b| b.name == name) {
+        return vec![b.head, b.tail];
+    }
+    if let Some(p) = handles.points.iter().find(|p| p.name == name) {
+        return vec![p.at];
+    }
+    let cages = handles.cages.iter().map(|c| (&c.name, &c.polygon));
+    let regions = handles.regions.iter().map(|r| (&r.name, &r.polygon));
+    cages
+        .chain(regions)
+        .find(|(n, _)| *n == name)
+        .map(|(_, polygon)| polygon.clone())
+        .unwrap_or_default()
+}
+
+fn bounds(points: &[[f64; 2]]) -> Option<([f64; 2], [f64; 2])> {
+    let first = *points.first()?;
+    Some(points.iter().fold((first, first), |(lo, hi), p| {
+        (
+            [lo[0].min(p[0]), lo[1].min(p[1])],
+            [hi[0].max(p[0]), hi[1].max(p[1])],
+        )
+    }))
+}
