@@ -359,7 +359,9 @@ mod tests {
         fs::write(&target, b"previous").unwrap();
         // A pid above the kernel's largest (4194304) never runs.
         let dead = dir.join(".walk.json.4294967294.0.tmp");
-        let live = dir.join(format!(".walk.json.{}.7.tmp", std::process::id()));
+        // This process's own, with a write number its writes never reach (the other tests'
+        // writes count up from 0 in this process).
+        let live = dir.join(format!(".walk.json.{}.{}.tmp", std::process::id(), u64::MAX));
         let other = dir.join(".other.json.4294967294.0.tmp");
         let unlike = dir.join(".walk.json.12x.0.tmp");
         for p in [&dead, &live, &other, &unlike] {
