@@ -1,0 +1,103 @@
+//! Outputs: Export Spine and Render from the editor.
+
+use super::*;
+
+#[test]
+fn exports_for_spine_from_the_file_menu_function() {
+    let path = character_rig("export");
+    let mut app = EditorApp::new(Document::open(&path).expect("opens"));
+    let dir = path.parent().expect("a folder").join("spine");
+    // The menu's options reach the exporter: Spine 4.3, at most 2 influences per vertex.
+    app.spine_options.version = crate::export::spine::SpineVersion::V4_3;
+    app.spine_options.max_influences = Some(2);
+    let message = app.export_spine(&dir);
+    assert!(message.starts_with("exported"), "{message}");
+    for file in ["character.json", "character.atlas"] {
+        assert!(dir.join(file).is_file(), "{file} missing: {message}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("character.json")).expect("the skeleton"))
+            .expect("JSON");
+    let version = json["skeleton"]["spine"].as_str().expect("a version");
+    assert!(version.starts_with("4.3"), "{version}");
+    // Without current weights there is nothing to export, and nothing is written.
+    app.apply(Command::AddPoint(PointHandle {
+        name: "extra".into(),
+        at: [10.0, 10.0],
+    }));
+    let empty = path.parent().expect("a folder").join("none");
+    let message = app.export_spine(&empty);
+    assert!(message.contains("compute"), "{message}");
+    assert_eq!(std::fs::read_dir(&empty).map(|d| d.count()).unwrap_or(0), 0);
+}
+
+#[test]
+fn renders_the_current_animation_in_the_background() {
+    let path = character_rig("render");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let gif = path.parent().expect("a folder").join("nod.gif");
+    key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 20.0)]);
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("nod").click();
+    h.run();
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Render…").click();
+    h.run();
+    type_into(
+        &mut h,
+        "Render the current animation to (.gif, .png sheet or a folder):",
+        &gif.display().to_string(),
+    );
+    for (field, value) in [
+        ("Frames per second", "8"),
+        ("Scale (output px per canvas px)", "0.5"),
+    ] {
+        type_into(&mut h, field, value);
+        h.key_press(Key::Enter);
+        h.run();
+    }
+    // The button, not the window's title.
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
+        .click();
+    wait_for_render(&mut h, 50);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.starts_with("rendered"), "{message}");
+    let bytes = std::fs::read(&gif).expect("the GIF was written");
+    assert!(bytes.starts_with(b"GIF89a"));
+    // The settings reached the renderer: the GIF's logical screen is the half-scale canvas.
+    let canvas_width = h.state().doc.state().layers[0].image.width();
+    let width = u16::from_le_bytes([bytes[6], bytes[7]]);
+    assert_eq!(u32::from(width), canvas_width.div_ceil(2));
+    // Deleted from the list, "nod" is gone; the animation edited then has no keys yet, and
+    // rendering it says so and writes no file.
+    h.get_by_label("Delete animation").click();
+    h.run();
+    assert!(h.state().doc.state().animations.is_empty());
+    h.get_by_label("animation (no keys yet)");
+    type_into(
+        &mut h,
+        "Render the current animation to (.gif, .png sheet or a folder):",
+        &path.with_file_name("nope.gif").display().to_string(),
+    );
+    // The button, not the window's title.
+    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
+        .click();
+    wait_for_render(&mut h, 20);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("no animation of that name"), "{message}");
+    assert!(!path.with_file_name("nope.gif").exists());
+}
+
+/// Steps frames until the background render ends, sleeping `pause_ms` between them.
+fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
+    for _ in 0..BUILD_FRAMES {
+        h.step();
+        if !h.state().rendering() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(pause_ms));
+    }
+}

@@ -1,0 +1,364 @@
+//! Animate mode's timeline: keys, scrubbing, the dopesheet (select, move, copy, paste, curves,
+//! undo, the keyboard) and playback with onion skins.
+
+use super::*;
+
+#[test]
+fn set_two_keys_and_scrub_the_timeline() {
+    let mut h = open_character("animate");
+    h.key_press(Key::Num3);
+    h.run();
+    assert_eq!(h.state().mode, Mode::Animate);
+    let grip = torso_point(&h);
+    let first = [grip[0] + 20.0, grip[1] - 10.0];
+    drag(&mut h, grip, first);
+    assert_eq!(
+        h.state().edited_pose().ik.len(),
+        1,
+        "{:?}",
+        h.state().message
+    );
+    h.get_by_label("Set key").click();
+    h.run();
+    for _ in 0..24 {
+        h.get_by_label("Next frame").click();
+        h.run();
+    }
+    assert!(
+        (h.state().animate.time_s - 1.0).abs() < 1e-9,
+        "{}",
+        h.state().animate.time_s
+    );
+    // Grab the pin where the first key left it and move it to the other side.
+    let second = [grip[0] - 20.0, grip[1] - 10.0];
+    drag(&mut h, first, second);
+    h.get_by_label("Set key").click();
+    h.run();
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation");
+    assert_eq!(crate::document::key_times(&anim), vec![0.0, 1.0]);
+    for _ in 0..12 {
+        h.get_by_label("Previous frame").click();
+        h.run();
+    }
+    let halfway = h.state().edited_pose();
+    assert_eq!(halfway.ik.len(), 1);
+    assert!(
+        distance(halfway.ik[0].to, [grip[0], grip[1] - 10.0]) < 1.0,
+        "{:?}",
+        halfway.ik[0].to
+    );
+    // The canvas shows that pose: the posed mesh was solved for it.
+    assert_eq!(
+        h.state().pose_mode.posed.as_ref().expect("posed").pose,
+        halfway
+    );
+    // Setting keys is undoable like any edit.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation");
+    assert_eq!(crate::document::key_times(&anim), vec![0.0]);
+}
+
+#[test]
+fn dopesheet_select_move_copy_paste_curve_and_undo() {
+    use crate::anim::edit::{KeyRef, TransformChannel::*};
+    let mut h = open_character("dopesheet");
+    h.key_press(Key::Num3);
+    h.run();
+    // A new animation from the list, renamed "nod".
+    h.get_by_label("New animation").click();
+    h.run();
+    type_into(&mut h, "Rename to:", "nod");
+    h.get_by_label("Rename animation").click();
+    h.run();
+    assert_eq!(h.state().animate.animation, "nod");
+    assert!(h.state().doc.state().animations.contains_key("nod"));
+    // Two keys from the numbers panel: the head (a click on the bone selects it) at 0° at
+    // 0 s and at 20° at 0.5 s.
+    click(&mut h, [256.0, 150.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("head"));
+    for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
+        for _ in 0..frames {
+            h.get_by_label("Next frame").click();
+            h.run();
+        }
+        // 0° is the rest pose's: another number first, so the pose names the head.
+        set_number(&mut h, "Rotation", degrees + 5.0);
+        set_number(&mut h, "Rotation", degrees);
+        h.get_by_label("Set key").click();
+        h.run();
+    }
+    assert_eq!(
+        head_rotate_keys(&h),
+        vec![
+            (0.0, 0.0, serde_json::Value::Null),
+            (0.5, 20.0, serde_json::Value::Null)
+        ],
+        "{:?}",
+        h.state().message
+    );
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+
+    // Select the rotate key at 0.5 s: the playhead goes there.
+    let at = key_on_sheet(&h, Rotate, 0.5);
+    click_screen(&mut h, at);
+    let selected = KeyRef {
+        timeline: head(Rotate),
+        time_s: 0.5,
+    };
+    assert_eq!(h.state().timeline.selection, vec![selected.clone()]);
+    assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
+
+    // Drag it to 0.75 s (a little off: it snaps to the frame); only that channel moves.
+    let sheet = h.state().timeline.sheet.clone().expect("sheet");
+    let to = Pos2::new(
+        sheet.x_of(0.75) + 0.2 * sheet.px_per_s / 24.0,
+        sheet.rows[0].1,
+    );
+    let from = key_on_sheet(&h, Rotate, 0.5);
+    drag_screen(&mut h, from, to);
+    let rotate = head_rotate_keys(&h);
+    assert_eq!(rotate.len(), 2, "{:?}", h.state().message);
+    assert!((rotate[1].0 - 0.75).abs() < 1e-9, "{rotate:?}");
+    assert_eq!(rotate[1].1, 20.0);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+    assert!((h.state().timeline.selection[0].time_s - 0.75).abs() < 1e-9);
+
+    // Copy it, put the playhead at 1 s on the ruler, paste: a 20° key at 1 s.
+    h.get_by_label("Copy keys").click();
+    h.run();
+    let ruler_y = sheet.ruler.center().y;
+    click_screen(&mut h, Pos2::new(sheet.x_of(1.0), ruler_y));
+    assert!(
+        (h.state().animate.time_s - 1.0).abs() < 1e-9,
+        "{}",
+        h.state().animate.time_s
+    );
+    h.get_by_label("Paste keys").click();
+    h.run();
+    let rotate = head_rotate_keys(&h);
+    assert_eq!(rotate.len(), 3, "{:?}", h.state().message);
+    assert!(
+        (rotate[2].0 - 1.0).abs() < 1e-9 && rotate[2].1 == 20.0,
+        "{rotate:?}"
+    );
+
+    // Select the first key and make its segment a Bézier: handles at the thirds.
+    let at = key_on_sheet(&h, Rotate, 0.0);
+    click_screen(&mut h, at);
+    assert_eq!(h.state().timeline.selection.len(), 1);
+    h.get_by_label("Bézier").click();
+    h.run();
+    let curve = head_rotate_keys(&h)[0].2.clone();
+    let numbers: Vec<f64> = serde_json::from_value(curve.clone()).expect("a Bézier: {curve}");
+    let expected = [0.25, 20.0 / 3.0, 0.5, 40.0 / 3.0];
+    assert!(
+        numbers
+            .iter()
+            .zip(expected)
+            .all(|(a, b)| (a - b).abs() < 1e-9),
+        "{numbers:?}"
+    );
+
+    // Drag the first handle down and right: one more undo step, the handle stays in the segment.
+    let layout = h.state().timeline.curve.clone().expect("the curve editor");
+    let [first, _] = layout.handles.expect("Bézier handles");
+    drag_screen(&mut h, first, first + egui::vec2(30.0, 25.0));
+    let dragged: Vec<f64> =
+        serde_json::from_value(head_rotate_keys(&h)[0].2.clone()).expect("still a Bézier");
+    assert!(dragged[0] > numbers[0] + 1e-3, "{dragged:?}");
+    assert!(dragged[1] < numbers[1] - 1e-3, "{dragged:?}");
+    assert!(
+        dragged[0] <= 0.75 && dragged[2..] == numbers[2..],
+        "{dragged:?}"
+    );
+
+    // Undo, step by step, back to the two keys as set.
+    let undo = |h: &mut Harness<'_, EditorApp>| {
+        h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        h.run();
+    };
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h)[0].2, curve);
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h)[0].2, serde_json::Value::Null);
+    undo(&mut h);
+    assert_eq!(head_rotate_keys(&h).len(), 2);
+    undo(&mut h);
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
+
+    // Box-select the column at 0.5 s (all four channels) and delete it with the Delete key.
+    let sheet = h.state().timeline.sheet.clone().expect("sheet");
+    let (top, bottom) = (
+        sheet.rows.first().expect("rows").1 - 8.0,
+        sheet.rows.last().expect("rows").1 + 8.0,
+    );
+    drag_screen(
+        &mut h,
+        Pos2::new(sheet.x_of(0.5) - 10.0, top),
+        Pos2::new(sheet.x_of(0.5) + 10.0, bottom),
+    );
+    assert_eq!(h.state().timeline.selection.len(), 4);
+    h.key_press(Key::Delete);
+    h.run();
+    for channel in [Rotate, Translate, Scale, Shear] {
+        assert_eq!(times_of(&h, channel), vec![0.0]);
+    }
+    assert!(
+        h.state().doc.state().handles.names().any(|n| n == "head"),
+        "Delete took the keys, not a handle"
+    );
+    undo(&mut h);
+    assert_eq!(times_of(&h, Shear), vec![0.0, 0.5]);
+}
+
+#[test]
+fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
+    let path = character_with_nod("playback");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("nod").click();
+    h.run();
+    assert_eq!(h.state().animate.animation, "nod");
+    let fps = h.state().render_settings.fps;
+    let on_frame = |t: f64| ((t * fps) - (t * fps).round()).abs() < 1e-6;
+    // Play (a click; the playing editor asks for frame after frame, so frames are stepped).
+    h.get_by_label("Play").click();
+    h.step();
+    let mut wrapped = false;
+    let mut last = 0.0;
+    for _ in 0..240 {
+        h.step();
+        let t = h.state().animate.time_s;
+        assert!(on_frame(t) && t < 0.5 - 1e-9, "{t}");
+        wrapped |= t < last;
+        last = t;
+    }
+    assert!(wrapped, "playback never looped");
+    // Without looping it stops on the last key.
+    h.get_by_label("Pause").click();
+    h.step();
+    h.run();
+    h.get_by_label("Loop").click();
+    h.run();
+    assert!(!h.state().timeline.looping);
+    h.get_by_label("Play").click();
+    h.step();
+    for _ in 0..240 {
+        h.step();
+        if h.query_by_label("Play").is_some() {
+            break;
+        }
+    }
+    h.run();
+    h.get_by_label("Play");
+    assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
+    // Playing again from the end starts over (Space plays and pauses too).
+    // (The harness' clock moves a quarter second a frame: the press's frame shows the
+    // rewind, the release's frame has played on.)
+    h.key_down(Key::Space);
+    h.step();
+    assert_eq!(h.state().animate.time_s, 0.0);
+    assert!(h.state().animate.playing);
+    h.key_up(Key::Space);
+    h.step();
+    assert!(h.state().animate.time_s > 0.0);
+    h.key_press(Key::Space);
+    h.step();
+    h.run();
+    h.get_by_label("Play");
+
+    // Onion skins: at the end only earlier frames exist; in the middle both sides.
+    let frames_to =
+        |h: &Harness<'_, EditorApp>, t: f64| ((t - h.state().animate.time_s) * fps).round() as i64;
+    let steps = frames_to(&h, 0.5);
+    let button = if steps > 0 {
+        "Next frame"
+    } else {
+        "Previous frame"
+    };
+    for _ in 0..steps.abs() {
+        h.get_by_label(button).click();
+        h.run();
+    }
+    assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
+    h.get_by_label("Onion skin").click();
+    h.run();
+    let scene = h.state().doc.posable().expect("posable").clone();
+    let placed = h.state().placed.expect("placed");
+    let at_end = h.state_mut().onion_shapes(&scene, &placed);
+    for _ in 0..frames_to(&h, 0.25).abs() {
+        h.get_by_label("Previous frame").click();
+        h.run();
+    }
+    assert!((h.state().animate.time_s - 0.25).abs() < 1e-9);
+    let middle = h.state_mut().onion_shapes(&scene, &placed);
+    assert!(!at_end.is_empty());
+    assert_eq!(
+        middle.len(),
+        2 * at_end.len(),
+        "two frames each side vs two before"
+    );
+    h.get_by_label("Onion skin").click();
+    h.run();
+    assert!(h.state_mut().onion_shapes(&scene, &placed).is_empty());
+}
+
+#[test]
+fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
+    use crate::anim::edit::{KeyRef, TransformChannel::*};
+    let mut h = open_character("keyboard");
+    key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 30.0)]);
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("nod").click();
+    h.run();
+    // Click one key, shift-click another: both selected; shift-click again: deselected.
+    let at = key_on_sheet(&h, Rotate, 0.5);
+    click_screen(&mut h, at);
+    let translate = key_on_sheet(&h, Translate, 0.5);
+    // One frame per event: shift down, press, release, shift up.
+    h.event(egui::Event::ModifiersChanged(Modifiers::SHIFT));
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: translate,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::SHIFT,
+        });
+    }
+    h.event(egui::Event::ModifiersChanged(Modifiers::NONE));
+    h.step();
+    h.run();
+    let selection = &h.state().timeline.selection;
+    assert_eq!(selection.len(), 2, "{selection:?}");
+    assert!(selection.contains(&KeyRef {
+        timeline: head(Translate),
+        time_s: 0.5
+    }));
+    assert!(
+        (h.state().animate.time_s - 0.5).abs() < 1e-9,
+        "a plain click moves the playhead to its key"
+    );
+    // Ctrl+C, playhead to 1 s, Ctrl+V: both keys pasted at 1 s.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::C);
+    h.run();
+    assert_eq!(h.state().timeline.clipboard.len(), 2);
+    // A click on the ruler at 1 s moves the playhead there.
+    let sheet = h.state().timeline.sheet.clone().expect("the dopesheet");
+    click_screen(&mut h, Pos2::new(sheet.x_of(1.0), sheet.ruler.center().y));
+    assert!((h.state().animate.time_s - 1.0).abs() < 1e-9);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5, 1.0]);
+    assert_eq!(times_of(&h, Scale), vec![0.0, 0.5], "not copied");
+    assert_eq!(head_rotate_keys(&h)[2].1, 30.0);
+    // The pasted keys are the selection now; Delete removes exactly them.
+    h.key_press(Key::Delete);
+    h.run();
+    assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
+    assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
+}
