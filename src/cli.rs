@@ -23,7 +23,7 @@ use sinew::rig::{Handles, Pose};
 use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
 use sinew::trace::TraceOptions;
-use sinew::weights::{WeightMethod, WeightOptions};
+use sinew::weights::{TwoLevelOptions, WeightMethod, WeightOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -284,6 +284,11 @@ pub struct BuildArgs {
     /// With `--weights rigid`: width of the blend band around joints, px.
     #[arg(long = "blend", value_name = "PX", default_value_t = 0.0)]
     pub rigid_blend_px: f64,
+    /// Two-level weights: solve on a coarse mesh of about N vertices of the same domain, carry
+    /// the weights to the fine mesh and polish them there (faster on large meshes; see
+    /// docs/two-level-weights.md for how far they are from the exact solve).
+    #[arg(long, value_name = "N")]
+    pub coarse_weights: Option<usize>,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq)]
@@ -320,6 +325,10 @@ impl BuildArgs {
             max_influences: self.max_influences,
             monotone: self.monotone,
             rigid_blend_px: self.rigid_blend_px,
+            two_level: self.coarse_weights.map(|n| TwoLevelOptions {
+                coarse_vertices: n,
+                ..TwoLevelOptions::default()
+            }),
             ..WeightOptions::default()
         };
         BuildOptions {

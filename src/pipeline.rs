@@ -252,18 +252,33 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             let embedded =
                 mesh::triangulate_with_handles(&outlines, &geometry, canvas_area, &options.mesh)
                     .map_err(|e| cage_error(&bound, e).unwrap_or_else(mesh_error))?;
-            let colors = options
-                .weights
-                .content_aware
-                .map(|_| vertex_colors(&layer.image, &embedded.domain.vertices));
             let binding = handles.columns_binding(&layer.name);
-            let part = weights::part::bound_part_weights(
-                &embedded,
-                handles,
-                &binding,
-                colors.as_deref(),
-                &options.weights,
-            )
+            let coarse = coarse_weight_mesh(&embedded, &outlines, &geometry, canvas_area, options)
+                .map_err(|e| cage_error(&bound, e).unwrap_or_else(mesh_error))?;
+            let colors = |mesh: &mesh::EmbeddedMesh| {
+                options
+                    .weights
+                    .content_aware
+                    .map(|_| vertex_colors(&layer.image, &mesh.domain.vertices))
+            };
+            let part = match &coarse {
+                Some(coarse) => weights::two_level::two_level_weights(
+                    &embedded,
+                    coarse,
+                    handles,
+                    &binding,
+                    colors(&embedded).as_deref(),
+                    colors(coarse).as_deref(),
+                    &options.weights,
+                ),
+                None => weights::part::bound_part_weights(
+                    &embedded,
+                    handles,
+                    &binding,
+                    colors(&embedded).as_deref(),
+                    &options.weights,
+                ),
+            }
             .map_err(|source| PipelineError::Weights {
                 path: layer.path.clone(),
                 source,
@@ -297,6 +312,45 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
         return Err(PipelineError::HandleOutside(columns[column].clone()));
     }
     Ok((doc, stats))
+}
+
+/// The coarse mesh of the same weight domain that two-level weights solve on
+/// ([`weights::part::TwoLevelOptions`]), or `None` for the exact solve on `fine` (two-level off,
+/// or `fine` not more than [`weights::part::TWO_LEVEL_MIN_RATIO`] times the target). Its
+/// largest triangle area is the domain's area over the target vertex count (a refined
+/// Delaunay mesh has about two triangles per vertex, at about half the largest area each).
+fn coarse_weight_mesh(
+    fine: &mesh::EmbeddedMesh,
+    outlines: &[trace::Outline],
+    geometry: &mesh::HandleGeometry,
+    canvas_area_px2: f64,
+    options: &BuildOptions,
+) -> Result<Option<mesh::EmbeddedMesh>, mesh::MeshError> {
+    let Some(target) = options
+        .weights
+        .two_level
+        .as_ref()
+        .map(|t| t.coarse_vertices)
+    else {
+        return Ok(None);
+    };
+    if fine.domain.vertices.len() <= target.saturating_mul(weights::part::TWO_LEVEL_MIN_RATIO) {
+        return Ok(None);
+    }
+    let area_px2: f64 = fine
+        .domain
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| fine.domain.vertices[v as usize]);
+            0.5 * crate::geom::triangle_area2(a, b, c).abs()
+        })
+        .sum();
+    let coarse = mesh::MeshOptions {
+        max_area_fraction: area_px2 / target.max(1) as f64 / canvas_area_px2,
+        ..options.mesh.clone()
+    };
+    mesh::triangulate_with_handles(outlines, geometry, canvas_area_px2, &coarse).map(Some)
 }
 
 /// A mesh error that concerns a cage, named (the image is not at fault); others back as they are.
