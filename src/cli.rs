@@ -210,9 +210,13 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
-    /// OUT.json beside it).
+    /// OUT.json beside it, which lists each frame's events).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also print the events each frame fires, one JSON object a line:
+    /// {"frame", "frame_time", "event": {"name", "time", "int", "float", "string", ...}}.
+    #[arg(long)]
+    pub events: bool,
 }
 
 /// Parses `WxH` (px).
@@ -683,9 +687,25 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     let frames =
         playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
-    let report =
-        io::sequence::write_sequence(&frames?, args.fps, &args.output, &Default::default())?;
-    println!(
+    let events = playback::render_events(&scene, &animation, &settings)?;
+    let report = io::sequence::write_sequence(
+        &frames?,
+        &events,
+        args.fps,
+        &args.output,
+        &Default::default(),
+    )?;
+    if args.events {
+        let times = playback::frame_times(animation.duration_s(), args.fps)?;
+        for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
+            for event in fired {
+                let line = serde_json::json!({"frame": frame, "frame_time": time, "event": event});
+                println!("{line}");
+            }
+        }
+    }
+    // With --events, stdout holds only the event lines.
+    let summary = format!(
         "{}: {} frames of {}×{} px, {:.2} s",
         args.output.display(),
         report.frame_count,
@@ -693,6 +713,11 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         report.frame_size_px.1,
         report.duration_s
     );
+    if args.events {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     Ok(())
 }
 
@@ -816,6 +841,7 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             ..Default::default()
         };
         let frames = playback::render_animation(&scene, name, animation, &settings, &|| {})?;
+        let events = playback::render_events(&scene, animation, &settings)?;
         render_s += t.elapsed().as_secs_f64();
         frame_count += frames.len();
         let t = Instant::now();
@@ -824,8 +850,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             args.output.join(format!("{name}.png")),
             args.output.join(name),
         ] {
-            let report =
-                io::sequence::write_sequence(&frames, DEMO_FPS, &target, &Default::default())?;
+            let report = io::sequence::write_sequence(
+                &frames,
+                &events,
+                DEMO_FPS,
+                &target,
+                &Default::default(),
+            )?;
             if report.format == io::sequence::SequenceFormat::Folder {
                 written.push(target);
             } else {

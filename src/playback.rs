@@ -111,6 +111,23 @@ pub fn render_animation(
     )?)
 }
 
+/// The events each frame of [`render_animation`] fires, one list per frame
+/// ([`crate::anim::frame_events`] at its frame times, payloads from the rig's definitions; key
+/// times stored as the runtime stores them when `settings` match it).
+pub fn render_events(
+    scene: &Scene,
+    animation: &Animation,
+    settings: &RenderSettings,
+) -> Result<Vec<Vec<crate::anim::FiredEvent>>, PlaybackError> {
+    let times = frame_times(animation.duration_s(), settings.fps)?;
+    Ok(crate::anim::frame_events(
+        animation,
+        &times,
+        &scene.doc.events,
+        settings.sampling.curves,
+    ))
+}
+
 /// The frames of `animation` (named `name`) at `times_s`: with exact curves, through the one
 /// pose path ([`crate::scene::frames`]); with [`CurveEvaluation::SpineRuntime`], as Spine's
 /// runtime plays the default Spine export ([`crate::export::spine::played`]: its curve

@@ -17,6 +17,7 @@
 pub mod check;
 pub mod curve;
 pub mod edit;
+pub mod event;
 pub mod mix;
 pub mod sample;
 pub mod timeline;
@@ -24,6 +25,7 @@ pub mod timeline;
 pub use check::check_animations;
 pub use curve::Curve;
 pub use curve::CurveEvaluation;
+pub use event::{frame_events, EventDef, EventDefs, EventKey, FiredAudio, FiredEvent};
 pub use mix::{mix_poses, sample_mix, Playhead, STEPPED_MIX_THRESHOLD};
 pub use sample::SampleOptions;
 pub use timeline::{
@@ -252,7 +254,7 @@ mod tests {
         let check = |v: serde_json::Value| {
             parse(v)
                 .unwrap()
-                .check_rig("walk", &handles, &parts)
+                .check_rig("walk", &handles, &parts, &EventDefs::new())
                 .map_err(|e| e.to_string())
         };
         let key = json!([{"time": 0, "value": 1}]);
@@ -324,7 +326,8 @@ mod tests {
             ["lift", "walk", "wave"].iter().collect::<Vec<_>>()
         );
         for (name, anim) in &animations {
-            anim.check_rig(name, &handles, &parts).unwrap();
+            anim.check_rig(name, &handles, &parts, &EventDefs::new())
+                .unwrap();
             let duration = anim.duration_s();
             // The end of the cycle runs into its start: no jump when it wraps.
             let end = anim.sample(duration, false);
