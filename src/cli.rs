@@ -809,6 +809,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
     let bad = || format!("{}: bad animation", animations_path.display());
     doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
+    // The events the animations fire (footsteps), when the assets define any.
+    let events_path = args.assets.join("events.json");
+    if events_path.exists() {
+        let events_json: serde_json::Value = read_json(&events_path, "events file")?;
+        doc.events = anim::events_from_json(&events_json)
+            .with_context(|| format!("{}: bad events", events_path.display()))?;
+    }
     doc.check_animations().with_context(bad)?;
     let animations = doc.animations.clone();
     let rig_path = args.output.join("character.json");

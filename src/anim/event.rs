@@ -117,6 +117,8 @@ pub struct FiredAudio {
 /// What is wrong with an event definition (the rig document names it).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum EventDefError {
+    #[error("events: {0}")]
+    Json(String),
     #[error("event '{name}': {field} must be a finite number{range} (got {value:e})")]
     Value {
         name: String,
@@ -235,6 +237,21 @@ fn key_time(time_s: f64, curves: CurveEvaluation) -> f64 {
 
 /// The definitions events are resolved with: name → default payload.
 pub type EventDefs = std::collections::BTreeMap<String, EventDef>;
+
+/// Reads and checks event definitions (an events file, or a rig document's `events`): a JSON
+/// object of name → [`EventDef`].
+pub fn events_from_json(value: &serde_json::Value) -> Result<EventDefs, EventDefError> {
+    if !value.is_object() {
+        return Err(EventDefError::Json(
+            "expected an object: name → event".into(),
+        ));
+    }
+    let defs = EventDefs::deserialize(value).map_err(|e| EventDefError::Json(e.to_string()))?;
+    for (name, def) in &defs {
+        def.check(name)?;
+    }
+    Ok(defs)
+}
 
 impl Animation {
     /// The events fired while the animation's time moves from `after_s` (exclusive; negative:
