@@ -153,6 +153,15 @@ fn check_number(
 
 const WITHIN_LIMIT: &str = " within ±1e6";
 
+/// How a payload field's allowed range reads in messages.
+pub(super) fn range_text(field: &str) -> &'static str {
+    match field {
+        "volume" => " in [0, 1]",
+        "balance" => " in [-1, 1]",
+        _ => WITHIN_LIMIT,
+    }
+}
+
 const VOLUME: Option<(f64, f64, &str)> = Some((0.0, 1.0, " in [0, 1]"));
 const BALANCE: Option<(f64, f64, &str)> = Some((-1.0, 1.0, " in [-1, 1]"));
 
@@ -200,7 +209,6 @@ pub(super) fn check_event_keys(keys: &[EventKey]) -> Result<(), TimelineError> {
                     key,
                     field,
                     value,
-                    range: range.map_or(WITHIN_LIMIT, |(_, _, text)| text),
                 })?;
             }
         }

@@ -244,12 +244,14 @@ pub enum TimelineError {
         got: usize,
         expected: usize,
     },
-    #[error("key {key}: {field} must be a finite number{range} (got {value:e})")]
+    #[error(
+        "key {key}: {field} must be a finite number{} (got {value:e})",
+        super::event::range_text(field)
+    )]
     Payload {
         key: usize,
         field: &'static str,
         value: f64,
-        range: &'static str,
     },
     #[error("key {key} lists part '{name}' twice")]
     DuplicatePart { key: usize, name: String },
