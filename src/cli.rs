@@ -210,9 +210,13 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
-    /// OUT.json beside it).
+    /// OUT.json beside it, which lists each frame's events).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also print the events each frame fires, one JSON object a line:
+    /// {"frame", "frame_time", "event": {"name", "time", "int", "float", "string", ...}}.
+    #[arg(long)]
+    pub events: bool,
 }
 
 /// Parses `WxH` (px).
@@ -692,9 +696,25 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     let frames =
         playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
-    let report =
-        io::sequence::write_sequence(&frames?, args.fps, &args.output, &Default::default())?;
-    println!(
+    let events = playback::render_events(&scene, &animation, &settings)?;
+    let report = io::sequence::write_sequence(
+        &frames?,
+        &events,
+        args.fps,
+        &args.output,
+        &Default::default(),
+    )?;
+    if args.events {
+        let times = playback::frame_times(animation.duration_s(), args.fps)?;
+        for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
+            for event in fired {
+                let line = serde_json::json!({"frame": frame, "frame_time": time, "event": event});
+                println!("{line}");
+            }
+        }
+    }
+    // With --events, stdout holds only the event lines.
+    let summary = format!(
         "{}: {} frames of {}×{} px, {:.2} s",
         args.output.display(),
         report.frame_count,
@@ -702,6 +722,11 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         report.frame_size_px.1,
         report.duration_s
     );
+    if args.events {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     Ok(())
 }
 
@@ -793,6 +818,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
     let bad = || format!("{}: bad animation", animations_path.display());
     doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
+    // The events the animations fire (footsteps), when the assets define any.
+    let events_path = args.assets.join("events.json");
+    if events_path.exists() {
+        let events_json: serde_json::Value = read_json(&events_path, "events file")?;
+        doc.events = anim::events_from_json(&events_json)
+            .with_context(|| format!("{}: bad events", events_path.display()))?;
+    }
     doc.check_animations().with_context(bad)?;
     let animations = doc.animations.clone();
     let rig_path = args.output.join("character.json");
@@ -825,6 +857,7 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             ..Default::default()
         };
         let frames = playback::render_animation(&scene, name, animation, &settings, &|| {})?;
+        let events = playback::render_events(&scene, animation, &settings)?;
         render_s += t.elapsed().as_secs_f64();
         frame_count += frames.len();
         let t = Instant::now();
@@ -833,8 +866,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             args.output.join(format!("{name}.png")),
             args.output.join(name),
         ] {
-            let report =
-                io::sequence::write_sequence(&frames, DEMO_FPS, &target, &Default::default())?;
+            let report = io::sequence::write_sequence(
+                &frames,
+                &events,
+                DEMO_FPS,
+                &target,
+                &Default::default(),
+            )?;
             if report.format == io::sequence::SequenceFormat::Folder {
                 written.push(target);
             } else {
