@@ -135,7 +135,7 @@ impl Default for LayeredLimits {
 pub enum LayeredError {
     #[error("cannot read: {0}")]
     Read(#[from] std::io::Error),
-    #[error("not a {expected} file")]
+    #[error("not {expected}")]
     NotFormat { expected: &'static str },
     #[error("truncated: {what} ends past the end of the file")]
     Truncated { what: String },
@@ -201,7 +201,7 @@ pub fn load_layered(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage,
     };
     let format = LayeredFormat::of(path).ok_or_else(|| {
         wrap(LayeredError::NotFormat {
-            expected: "layered (.psd, .psb, .ora or Spine .json)",
+            expected: "a layered file (.psd, .psb, .ora or Spine .json)",
         })
     })?;
     match format {

@@ -36,9 +36,9 @@ pub fn merged_image(bytes: &[u8]) -> Result<RgbaImage, LayeredError> {
 }
 
 fn open<'a>(bytes: &'a [u8], limits: &LayeredLimits) -> Result<Archive<'a>, LayeredError> {
-    if !bytes.starts_with(b"PK\x03\x04") {
+    if !bytes.starts_with(b"PK") {
         return Err(LayeredError::NotFormat {
-            expected: "OpenRaster (a zip archive)",
+            expected: "an OpenRaster file (a zip archive)",
         });
     }
     let zip =

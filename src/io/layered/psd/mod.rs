@@ -77,7 +77,7 @@ impl Header {
     fn read(r: &mut Reader, limits: &LayeredLimits) -> Result<Self, LayeredError> {
         if r.peek(4) != Some(b"8BPS") {
             return Err(LayeredError::NotFormat {
-                expected: "Photoshop (PSD/PSB)",
+                expected: "a Photoshop file (PSD/PSB)",
             });
         }
         r.skip(4, "signature")?;
