@@ -320,12 +320,11 @@ fn cage_error(handles: &Handles, error: MeshError) -> Result<PipelineError, Mesh
             .to_string()
     };
     match error {
-        MeshError::CageCrossesOutline { cage, edge } => Ok(PipelineError::Cage {
+        MeshError::CageAlongOutline { cage, edge } => Ok(PipelineError::Cage {
             cage: name(cage),
             problem: format!(
-                "its edge {edge} (vertices {edge}–{}) crosses the drawing's outline: a cage \
-                 must enclose the part's outline or lie inside it; move that edge's vertices \
-                 out or in",
+                "its edge {edge} (vertices {edge}–{}) runs along the drawing's outline: move \
+                 that edge's vertices off the outline",
                 (edge + 1) % handles.cages[cage].polygon.len()
             ),
         }),

@@ -722,3 +722,42 @@ fn stretchable_bones_stretch_under_ik() {
         "linear {linear} vs stretch blending {stretch}"
     );
 }
+
+/// A static pose has one answer: pins added where points already are move nothing (each
+/// vertex within 1e-6 px), even after drags that bend the character, and a solver that has
+/// solved other poses gives the same answer as a fresh one.
+#[test]
+fn pins_where_points_already_are_move_nothing() {
+    let mut ik = scene().rig_ik().unwrap();
+    let meshes = scene().skinned_meshes().unwrap();
+    let mut drags = pins();
+    drags.push(drag([256.0, 150.0], [206.0, 175.0]));
+    drags.push(drag([160.0, 330.0], [125.0, 240.0]));
+    let before = ik.solve_pose(&pose_with(drags.clone())).unwrap();
+    let shown = skinned(&meshes, &before.transforms);
+    // Pin three more points of the drawing where they are drawn, one after the other.
+    for (part, vertex) in [(0, 0), (meshes.len() / 2, 3), (meshes.len() - 1, 7)] {
+        let at = meshes[part].rest[vertex];
+        let to = shown[part][vertex];
+        drags.push(drag([at.x, at.y], [to.x, to.y]));
+        let after = ik.solve_pose(&pose_with(drags.clone())).unwrap();
+        let moved = shown
+            .iter()
+            .flatten()
+            .zip(skinned(&meshes, &after.transforms).iter().flatten())
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max);
+        assert!(
+            moved < 1e-6,
+            "a pin where the point is moved the drawing {moved} px"
+        );
+    }
+    let pose = pose_with(drags);
+    ik.solve_pose(&pose_with(pins())).unwrap();
+    let used = ik.solve_pose(&pose).unwrap();
+    let fresh = scene().rig_ik().unwrap().solve_pose(&pose).unwrap();
+    assert_eq!(
+        used.transforms, fresh.transforms,
+        "the answer depends on the history"
+    );
+}

@@ -536,6 +536,46 @@ impl FastIk {
         })
     }
 
+    /// The answer of record for a static pose: `problem`'s drags taken in their order, each
+    /// solved cold only when the answer for the drags before it leaves it unmet.
+    ///
+    /// With rigid columns the problem is not convex, so a cold solve of more constraints may
+    /// settle in another local optimum even where the new constraint is already met: pinning a
+    /// point where it is drawn would move the drawing. Here the answer x_j for the first j drags
+    /// is x_(j−1) when drag j lies within [`SATISFIED_DRAG_PX`] of its target there (x_(j−1)
+    /// meets every constraint of the larger problem, at the same energy), and the cold
+    /// [`FastIk::solve`] of those j drags otherwise; x_0 is the anchor. The answer is a function
+    /// of the problem alone (the drags' order included): a pin added where a point already is
+    /// changes nothing, and the same pins after a reset give the same pose. Drags met at the
+    /// anchor (pins at rest) cost nothing; the worst case, every drag unmet in turn, is one cold
+    /// solve per drag.
+    pub fn solve_static(&mut self, problem: &Problem) -> Result<IkSolution, IkError> {
+        let mut t = stack(&problem.anchor);
+        let mut iterations = 0;
+        for j in 0..problem.drags.len() {
+            if drag_miss_px(&problem.drags[j], &t) <= SATISFIED_DRAG_PX {
+                continue;
+            }
+            self.reset();
+            let first = Problem {
+                drags: problem.drags[..=j].to_vec(),
+                ..problem.clone()
+            };
+            let solution = self.solve(&first)?;
+            iterations += solution.iterations;
+            t = stack(&solution.transforms);
+        }
+        let drag_error_px = hard_misses_px(problem, &t).into_iter().fold(0.0, f64::max);
+        let energy = self.reduced_energy(&t);
+        self.previous = Some(t.clone());
+        Ok(IkSolution {
+            transforms: unstack(&t),
+            iterations,
+            drag_error_px,
+            energy,
+        })
+    }
+
     /// Local/global iterations from `t` with fold-guard rounds; returns the result and how many
     /// iterations ran.
     fn iterate_from(
@@ -815,17 +855,25 @@ impl FastIk {
 /// their energy, px².
 pub const MISS_TIE_PX2: f64 = 1e-4;
 
+/// A drag whose point lies this close to its target under the answer for the drags before it
+/// adds nothing to a static pose ([`FastIk::solve_static`]), px: far below what can be seen,
+/// far above the rounding of a pin placed where the point is drawn.
+pub const SATISFIED_DRAG_PX: f64 = 1e-4;
+
+/// How far `drag`'s point lies from its target under `t`, px.
+fn drag_miss_px(drag: &DragRow, t: &DMatrix<f64>) -> f64 {
+    let row = DVector::from_column_slice(&drag.row);
+    let pos = t.tr_mul(&row);
+    (pos[0] - drag.target[0]).hypot(pos[1] - drag.target[1])
+}
+
 /// How far each hard drag's point lies from its target under `t`, px.
 fn hard_misses_px(problem: &Problem, t: &DMatrix<f64>) -> Vec<f64> {
     problem
         .drags
         .iter()
         .filter(|d| d.weight.is_none())
-        .map(|d| {
-            let row = DVector::from_column_slice(&d.row);
-            let pos = t.tr_mul(&row);
-            (pos[0] - d.target[0]).hypot(pos[1] - d.target[1])
-        })
+        .map(|d| drag_miss_px(d, t))
         .collect()
 }
 

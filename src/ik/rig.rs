@@ -126,12 +126,24 @@ impl RigIk {
     }
 
     /// The skinning transformations of the static pose `pose`, as a fresh solver finds them:
-    /// solved from the forward-kinematics pose, with no warm start and no guarded triangles
-    /// carried over, so the answer depends on the pose alone. The last factorization is reused
-    /// when the problem's structure is the same, which changes the cost, never the answer.
+    /// its drags taken in order from the forward-kinematics pose ([`FastIk::solve_static`]),
+    /// with no warm start and no guarded triangles carried over, so the answer depends on the
+    /// pose alone, and a pin added where a point already is moves nothing. The last
+    /// factorization is reused when the problem's structure is the same, which changes the
+    /// cost, never the answer.
     pub fn solve_pose(&mut self, pose: &Pose) -> Result<IkSolution, IkError> {
-        self.solver.reset();
-        self.transforms(pose)
+        let drags = self.cached_drag_rows(pose)?;
+        let problem = self.problem_with(pose, None, drags)?;
+        if problem.drags.is_empty() {
+            self.solver.reset();
+            return Ok(IkSolution {
+                transforms: problem.anchor,
+                iterations: 0,
+                drag_error_px: 0.0,
+                energy: f64::NAN,
+            });
+        }
+        self.solver.solve_static(&problem)
     }
 
     /// The skinning transformations for `pose`: forward kinematics if it has no drags, the

@@ -116,6 +116,46 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
+/// Writes several files that belong together (a sprite sheet and its JSON; a skeleton, its
+/// atlas and pages): every target is checked first ([`resolve_output`]), then every temporary
+/// is written and synced, and only when all are written are they renamed into place, in the
+/// order given. A failure before the renames (a refused target, a full disk, no permission)
+/// leaves every target as it was and no temporary behind. Give the file that refers to the
+/// others last: the renames are atomic one by one, not as a set, and a reader that sees the
+/// new referring file then sees the new files it refers to. Returns the failing path with
+/// its error.
+pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error)> {
+    let mut targets = Vec::with_capacity(files.len());
+    for (path, _) in files {
+        let target = resolve_output(path, OutputKind::File).map_err(|e| (path.clone(), e))?;
+        remove_stale_temporaries(&target);
+        targets.push(target);
+    }
+    let mut temporaries = Vec::with_capacity(files.len());
+    let written = files
+        .iter()
+        .zip(&targets)
+        .try_for_each(|((path, bytes), target)| {
+            let tmp = temporary_sibling(target);
+            temporaries.push(tmp.clone());
+            write_new(&tmp, bytes).map_err(|e| (path.clone(), e))
+        });
+    if let Err(e) = written {
+        for tmp in &temporaries {
+            // A temporary not yet created has nothing to remove.
+            let _ = fs::remove_file(tmp);
+        }
+        return Err(e);
+    }
+    for (((path, _), target), tmp) in files.iter().zip(&targets).zip(&temporaries) {
+        if let Err(e) = fs::rename(tmp, target) {
+            let _ = fs::remove_file(tmp);
+            return Err((path.clone(), e));
+        }
+    }
+    Ok(())
+}
+
 /// Creates `path` (which must not exist) with `bytes`, synced to disk.
 pub fn write_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut file = fs::OpenOptions::new()
@@ -227,6 +267,37 @@ mod tests {
     }
 
     #[test]
+    fn a_set_is_written_whole_or_not_at_all() {
+        let dir = scratch("set");
+        let (png, json) = (dir.join("sheet.png"), dir.join("sheet.json"));
+        write_set(&[
+            (png.clone(), b"old png".to_vec()),
+            (json.clone(), b"old".to_vec()),
+        ])
+        .unwrap();
+        // The second target cannot be written (a folder where a file goes; a file where a
+        // folder is needed): the first keeps its old content, and no temporary stays.
+        fs::create_dir(dir.join("taken")).unwrap();
+        for bad in [dir.join("taken"), json.join("below")] {
+            let failed = write_set(&[
+                (png.clone(), b"new png".to_vec()),
+                (bad.clone(), b"x".to_vec()),
+            ]);
+            assert_eq!(failed.map_err(|(path, _)| path), Err(bad));
+            assert_eq!(fs::read(&png).unwrap(), b"old png");
+        }
+        assert_eq!(fs::read_dir(&dir).unwrap().count(), 3);
+        write_set(&[
+            (png.clone(), b"new png".to_vec()),
+            (json.clone(), b"new".to_vec()),
+        ])
+        .unwrap();
+        assert_eq!(fs::read(&png).unwrap(), b"new png");
+        assert_eq!(fs::read(&json).unwrap(), b"new");
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn writes_of_one_target_from_two_threads_do_not_mix() {
         let dir = scratch("two");
         let target = dir.join("a.json");
@@ -288,7 +359,9 @@ mod tests {
         fs::write(&target, b"previous").unwrap();
         // A pid above the kernel's largest (4194304) never runs.
         let dead = dir.join(".walk.json.4294967294.0.tmp");
-        let live = dir.join(format!(".walk.json.{}.7.tmp", std::process::id()));
+        // This process's own, with a write number its writes never reach (the other tests'
+        // writes count up from 0 in this process).
+        let live = dir.join(format!(".walk.json.{}.{}.tmp", std::process::id(), u64::MAX));
         let other = dir.join(".other.json.4294967294.0.tmp");
         let unlike = dir.join(".walk.json.12x.0.tmp");
         for p in [&dead, &live, &other, &unlike] {

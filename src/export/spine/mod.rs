@@ -678,50 +678,32 @@ impl SpineExport {
     }
 
     /// Writes every file into `dir` (created if missing; a symbolic link to a folder is
-    /// followed): each goes to a hidden temporary file beside its target first (temporaries a
-    /// killed run left there are removed), and only when all are written are they renamed into
-    /// place, so a failure while writing (disk full, no permission) leaves `dir` without any new
-    /// or half-written file. A target that is a symbolic link is written through (its file is
-    /// replaced); one that is not a regular file is refused before anything is written. The
-    /// renames themselves are atomic one by one, not as a set. Returns the paths written.
+    /// followed) as one set ([`io::atomic::write_set`]): a failure while writing (a refused
+    /// target, disk full, no permission) leaves `dir` without any new or half-written file;
+    /// temporaries a killed run left there are removed. The pages are renamed into place
+    /// first, then the atlas that names them, then the skeleton that names the atlas. Returns
+    /// the paths written.
     pub fn write(&self, dir: &Path) -> Result<Vec<PathBuf>, SpineError> {
-        let fail = |path: &Path| {
-            let path = path.to_path_buf();
-            move |source| SpineError::Write { path, source }
-        };
         let real_dir =
-            io::atomic::resolve_output(dir, io::atomic::OutputKind::Folder).map_err(fail(dir))?;
-        std::fs::create_dir_all(&real_dir).map_err(fail(dir))?;
-        let files = self.files();
-        let mut targets = Vec::with_capacity(files.len());
-        for (file, _) in &files {
-            let path = dir.join(file);
-            let target =
-                io::atomic::resolve_output(&real_dir.join(file), io::atomic::OutputKind::File)
-                    .map_err(fail(&path))?;
-            io::atomic::remove_stale_temporaries(&target);
-            targets.push((path, target));
-        }
-        let mut temporaries = Vec::with_capacity(files.len());
-        let result = (|| {
-            for ((_, bytes), (_, target)) in files.iter().zip(&targets) {
-                let tmp = io::atomic::temporary_sibling(target);
-                temporaries.push(tmp.clone());
-                io::atomic::write_new(&tmp, bytes).map_err(fail(&tmp))?;
-            }
-            Ok(())
-        })();
-        if let Err(e) = result {
-            for tmp in &temporaries {
-                let _ = std::fs::remove_file(tmp);
-            }
-            return Err(e);
-        }
-        let mut written = Vec::with_capacity(files.len());
-        for ((path, target), tmp) in targets.into_iter().zip(&temporaries) {
-            std::fs::rename(tmp, &target).map_err(fail(&path))?;
-            written.push(path);
-        }
-        Ok(written)
+            io::atomic::resolve_output(dir, io::atomic::OutputKind::Folder).map_err(|source| {
+                SpineError::Write {
+                    path: dir.to_path_buf(),
+                    source,
+                }
+            })?;
+        std::fs::create_dir_all(&real_dir).map_err(|source| SpineError::Write {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        // files() lists the skeleton, the atlas, then the pages: written in reverse.
+        let files: Vec<(PathBuf, Vec<u8>)> = self
+            .files()
+            .into_iter()
+            .rev()
+            .map(|(name, bytes)| (dir.join(name), bytes))
+            .collect();
+        io::atomic::write_set(&files)
+            .map_err(|(path, source)| SpineError::Write { path, source })?;
+        Ok(files.into_iter().rev().map(|(path, _)| path).collect())
     }
 }

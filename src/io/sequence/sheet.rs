@@ -27,7 +27,6 @@ use super::folder::digits_for;
 use super::timing::{frame_durations, MS_PER_S};
 use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::geom::pack::{pack_shelves, ShelfLayout};
-use crate::io::atomic::write_atomic;
 use crate::io::image::encode_png;
 use image::RgbaImage;
 use serde::ser::SerializeMap;
@@ -278,8 +277,12 @@ pub fn write_sheet(
         reason: e.to_string(),
     })?;
     let json_path = path.with_extension("json");
-    write_atomic(path, &png).map_err(write_error(path))?;
-    write_atomic(&json_path, sheet.json.as_bytes()).map_err(write_error(&json_path))?;
+    // The JSON names the image: renamed last, after the image it describes.
+    crate::io::atomic::write_set(&[
+        (path.to_path_buf(), png),
+        (json_path.clone(), sheet.json.into_bytes()),
+    ])
+    .map_err(|(failed, e)| write_error(&failed)(e))?;
     let total_ms: u64 = sheet
         .frames
         .iter()

@@ -10,6 +10,8 @@
 //! every triangle meets the angle and area limits. Faces outside the outer rings or inside holes
 //! are dropped (spade decides inside by the winding parity of the constraint rings).
 
+pub mod crossing;
+
 use crate::geom::{point_in_ring, ring_signed_area, triangle_area2, Point};
 use crate::trace::Outline;
 use serde::{Deserialize, Serialize};
@@ -119,10 +121,10 @@ pub enum MeshError {
     #[error("outline edges cross each other")]
     CrossingOutlines,
     #[error(
-        "cage {cage}: its edge {edge} crosses the drawing's outline; a cage must enclose the \
-         part's outline or lie inside it (move that edge's vertices out or in)"
+        "cage {cage}: its edge {edge} runs along the drawing's outline; move that edge's \
+         vertices off the outline"
     )]
-    CageCrossesOutline { cage: usize, edge: usize },
+    CageAlongOutline { cage: usize, edge: usize },
     #[error("cage {first} and cage {second} cross each other: cages must not overlap")]
     CagesCross { first: usize, second: usize },
     #[error("invalid mesh option: {0}")]
@@ -325,9 +327,11 @@ pub fn triangulate_with_handles(
         .iter()
         .map(Vec::as_slice)
         .collect();
-    if let Some(error) = crossing_extension(&rings, &extensions) {
-        return Err(error);
-    }
+    // Where a cage crosses the outline, both rings get the crossing point: the domain is the
+    // union of the shape and the cages' insides.
+    let split = crossing::split_at_crossings(&rings, &extensions)?;
+    let rings: Vec<&[Point]> = split.rings.iter().map(Vec::as_slice).collect();
+    let extensions: Vec<&[Point]> = split.extensions.iter().map(Vec::as_slice).collect();
     let (points, edges) =
         constraint_graph(&rings.iter().chain(&extensions).copied().collect::<Vec<_>>())?;
     let mut conflict = false;
@@ -348,9 +352,16 @@ pub fn triangulate_with_handles(
                 .map_err(|_| MeshError::NonFinite)?;
         }
     }
-    let polygon_edges = geometry
-        .polygons
-        .iter()
+    // A cage's outline is already constrained, split where it crosses the drawing's outline:
+    // its split ring replaces it (the whole edge again would cross the outline a hair away).
+    let polygons = geometry.polygons.iter().map(|poly| {
+        geometry
+            .domain_extensions
+            .iter()
+            .position(|e| e == poly)
+            .map_or(poly.as_slice(), |k| extensions[k])
+    });
+    let polygon_edges = polygons
         .flat_map(|poly| (0..poly.len()).map(move |i| [poly[i], poly[(i + 1) % poly.len()]]));
     for [a, b] in geometry.segments.iter().copied().chain(polygon_edges) {
         let Some((a, b)) = bounds.clip_segment(a, b) else {
@@ -623,41 +634,6 @@ fn constraint_graph(rings: &[&[Point]]) -> Result<ConstraintGraph, MeshError> {
         }
     }
     Ok((points, edges))
-}
-
-/// Which domain extension (cage) crosses an outline ring or another extension: the mesher
-/// would otherwise report it as the image's crossing outlines. A shared vertex is no crossing
-/// (the constraint graph merges it); touching anywhere else is.
-fn crossing_extension(rings: &[&[Point]], extensions: &[&[Point]]) -> Option<MeshError> {
-    let edges = |ring: &[Point]| -> Vec<[Point; 2]> {
-        (0..ring.len())
-            .map(|i| [ring[i], ring[(i + 1) % ring.len()]])
-            .collect()
-    };
-    let crosses = |[a, b]: [Point; 2], [c, d]: [Point; 2]| {
-        let shared = a == c || a == d || b == c || b == d;
-        !shared && crate::geom::segments_touch(a, b, c, d)
-    };
-    let outline: Vec<[Point; 2]> = rings.iter().flat_map(|r| edges(r)).collect();
-    for (cage, ring) in extensions.iter().enumerate() {
-        for (edge, e) in edges(ring).into_iter().enumerate() {
-            if outline.iter().any(|&o| crosses(e, o)) {
-                return Some(MeshError::CageCrossesOutline { cage, edge });
-            }
-        }
-        for (other, ring2) in extensions.iter().enumerate().skip(cage + 1) {
-            if edges(ring)
-                .into_iter()
-                .any(|e| edges(ring2).into_iter().any(|o| crosses(e, o)))
-            {
-                return Some(MeshError::CagesCross {
-                    first: cage,
-                    second: other,
-                });
-            }
-        }
-    }
-    None
 }
 
 /// A ring vertex whose two edges turn by less than this (the sine of the turn) is dropped.
