@@ -42,22 +42,28 @@ impl Art {
             .map(|&i| self.layers[i].path.as_path())
     }
 
-    /// Writes the images of the layers from layered files (atomically, each), creating their
+    /// Writes the images of the layers from layered files as one set (`io::atomic::write_set`:
+    /// all written to temporaries, then renamed; a failure leaves none), creating their
     /// folders. Returns the paths written.
     pub fn write_parts(&self) -> Result<Vec<PathBuf>, ImageError> {
-        let mut written = Vec::with_capacity(self.unwritten.len());
+        let mut files = Vec::with_capacity(self.unwritten.len());
         for &i in &self.unwritten {
             let layer = &self.layers[i];
+            let bytes = io::image::encode_png(&layer.image).map_err(|e| ImageError::Encode {
+                path: layer.path.clone(),
+                reason: e.to_string(),
+            })?;
             if let Some(dir) = layer.path.parent() {
                 std::fs::create_dir_all(dir).map_err(|source| ImageError::Write {
                     path: layer.path.clone(),
                     source,
                 })?;
             }
-            io::save_png(&layer.path, &layer.image)?;
-            written.push(layer.path.clone());
+            files.push((layer.path.clone(), bytes));
         }
-        Ok(written)
+        io::atomic::write_set(&files)
+            .map_err(|(path, source)| ImageError::Write { path, source })?;
+        Ok(files.into_iter().map(|(path, _)| path).collect())
     }
 }
 
