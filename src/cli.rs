@@ -161,7 +161,8 @@ fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
 
 #[derive(Args, Debug)]
 pub struct AutorigArgs {
-    /// Layer images (PNG, all the same size), back to front.
+    /// Layer images (PNG, all the same size) or layered files (.psd, .psb, .ora, or the .json
+    /// of a Spine export script beside its PNGs), back to front.
     #[arg(required = true)]
     pub images: Vec<PathBuf>,
     /// The handles file to write.
@@ -236,7 +237,8 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 #[derive(Args, Debug)]
 pub struct RigArgs {
-    /// Layer images (PNG, all the same size), back to front.
+    /// Layer images (PNG, all the same size) or layered files (.psd, .psb, .ora, or the .json
+    /// of a Spine export script beside its PNGs), back to front.
     #[arg(required = true)]
     pub images: Vec<PathBuf>,
     /// The rig document to write.
@@ -443,7 +445,7 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         args.images.iter().map(PathBuf::as_path),
         [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
-    let layers = pipeline::load_layers(&args.images)?;
+    let layers = load_art(&args.images, &args.output)?.layers;
     let mut options = AutorigOptions {
         template: args.template,
         cage_vertices: args.cage,
@@ -511,7 +513,19 @@ fn rig(args: &RigArgs) -> Result<()> {
             .chain(args.handles.as_deref()),
         [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
-    let layers = pipeline::load_layers(&args.images)?;
+    let art = load_art(&args.images, &args.output)?;
+    // The parts of layered files are written beside the document: none may overwrite an input.
+    check_not_overwriting(
+        args.images
+            .iter()
+            .map(PathBuf::as_path)
+            .chain(args.handles.as_deref()),
+        art.part_paths()
+            .chain([args.output.as_path()])
+            .chain(args.preview.as_deref())
+            .map(Some),
+    )?;
+    let layers = art.layers.clone();
     let handles: Handles = match &args.handles {
         Some(path) => read_json(path, "handles file")?,
         None => Handles::default(),
@@ -525,6 +539,7 @@ fn rig(args: &RigArgs) -> Result<()> {
         }
         None => None,
     };
+    art.write_parts()?;
     doc.save(&args.output)?;
     if let (Some(path), Some(image)) = (&args.preview, preview) {
         io::save_png(path, &image)?;
@@ -533,6 +548,21 @@ fn rig(args: &RigArgs) -> Result<()> {
         report_part(&part.name, s);
     }
     Ok(())
+}
+
+/// Loads PNG layers and layered files (PSD, ORA, a Spine script's JSON) for a command that
+/// writes `output`: layered files' parts go to `OUTPUT.parts/` (see [`sinew::art`]). Prints
+/// the notes on skipped layers.
+fn load_art(images: &[PathBuf], output: &Path) -> Result<sinew::art::Art> {
+    let options = sinew::art::ArtOptions {
+        parts_dir: output.with_extension("parts"),
+        ..Default::default()
+    };
+    let art = sinew::art::load_art(images, &options)?;
+    for note in &art.notes {
+        println!("note: {note}");
+    }
+    Ok(art)
 }
 
 /// [`pipeline::build_rig`] with a bar over the parts; indicatif draws nothing when stderr is

@@ -38,6 +38,8 @@ pub enum PipelineError {
     Image(#[from] ImageError),
     #[error(transparent)]
     Document(#[from] io::DocumentError),
+    #[error(transparent)]
+    Layered(#[from] io::layered::LayeredFileError),
     #[error("{path}: image is {}×{} px, too small to rig (at least {MIN_SPRITE_SIDE_PX}×{MIN_SPRITE_SIDE_PX})", got[0], got[1])]
     TooSmall { path: PathBuf, got: [u32; 2] },
     #[error("no input images")]
@@ -52,7 +54,9 @@ pub enum PipelineError {
         got: [u32; 2],
         canvas: [u32; 2],
     },
-    #[error("{path}: a part named '{name}' already exists (part names come from file names)")]
+    #[error(
+        "{path}: a part named '{name}' already exists (part names come from file and layer names)"
+    )]
     DuplicatePart { path: PathBuf, name: String },
     #[error("{path}: {source}")]
     Trace { path: PathBuf, source: TraceError },
@@ -119,44 +123,51 @@ pub const MIN_SPRITE_SIDE_PX: u32 = 4;
 /// Loads image files as the layers of one canvas, in the given (draw) order.
 pub fn load_layers(paths: &[PathBuf]) -> Result<Vec<Layer>, PipelineError> {
     let mut layers: Vec<Layer> = Vec::with_capacity(paths.len());
-    let mut names = HashSet::new();
     for path in paths {
         let image = io::load_png(path)?;
-        let got = [image.width(), image.height()];
-        if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
-            return Err(PipelineError::TooSmall {
-                path: path.clone(),
-                got,
-            });
-        }
-        if let Some(first) = layers.first() {
-            let canvas = [first.image.width(), first.image.height()];
-            if got != canvas {
-                return Err(PipelineError::SizeMismatch {
-                    path: path.clone(),
-                    got,
-                    canvas,
-                });
-            }
-        }
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        if !names.insert(name.clone()) {
-            return Err(PipelineError::DuplicatePart {
-                path: path.clone(),
-                name,
-            });
-        }
         layers.push(Layer {
             name,
             path: path.clone(),
             image,
         });
     }
-    if layers.is_empty() {
-        return Err(PipelineError::NoImages);
+    checked_layers(layers)
+}
+
+/// `layers` when they can be the parts of one rig: at least one, each at least
+/// [`MIN_SPRITE_SIDE_PX`] on a side, all of the first one's size, names unique.
+pub fn checked_layers(layers: Vec<Layer>) -> Result<Vec<Layer>, PipelineError> {
+    let mut names = HashSet::new();
+    let canvas = match layers.first() {
+        Some(first) => [first.image.width(), first.image.height()],
+        None => return Err(PipelineError::NoImages),
+    };
+    for layer in &layers {
+        let path = &layer.path;
+        let got = [layer.image.width(), layer.image.height()];
+        if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
+            return Err(PipelineError::TooSmall {
+                path: path.clone(),
+                got,
+            });
+        }
+        if got != canvas {
+            return Err(PipelineError::SizeMismatch {
+                path: path.clone(),
+                got,
+                canvas,
+            });
+        }
+        if !names.insert(layer.name.clone()) {
+            return Err(PipelineError::DuplicatePart {
+                path: path.clone(),
+                name: layer.name.clone(),
+            });
+        }
     }
     Ok(layers)
 }
