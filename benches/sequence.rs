@@ -37,6 +37,7 @@ fn sequence(c: &mut Criterion) {
         b.iter(|| {
             let sheet = build_sheet(
                 black_box(&frames),
+                &[],
                 FPS,
                 "demo",
                 "demo.png",

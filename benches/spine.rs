@@ -37,6 +37,7 @@ fn character() -> (Scene, Vec<image::RgbaImage>) {
     let (mut doc, _) = pipeline::build_rig(&layers, &dir, &BuildOptions::default(), &handles)
         .expect("the character rigs");
     doc.animations = serde_json::from_value(read("animations.json")).expect("animations parse");
+    doc.events = sinew::anim::events_from_json(&read("events.json")).expect("events parse");
     let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
     let scene = Scene::new(doc, &images).expect("the scene loads");
     (scene, images)

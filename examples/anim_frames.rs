@@ -54,7 +54,7 @@ fn main() -> Result<()> {
     let animations = sinew::anim::parse_animations(&raw)?;
     let parts: Vec<&str> = scene.doc.parts.iter().map(|p| p.name.as_str()).collect();
     for (anim_name, anim) in &animations {
-        anim.check_rig(anim_name, &scene.doc.handles, &parts)?;
+        anim.check_rig(anim_name, &scene.doc.handles, &parts, &scene.doc.events)?;
     }
     let get = |n: &str| -> Result<&Animation> {
         animations

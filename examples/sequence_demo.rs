@@ -33,7 +33,7 @@ fn main() -> anyhow::Result<()> {
         (&frames, "demo_frames"),
     ] {
         let start = Instant::now();
-        let report = write_sequence(frames, fps, &out.join(name), &options)?;
+        let report = write_sequence(frames, &[], fps, &out.join(name), &options)?;
         let bytes: u64 = report
             .files
             .iter()

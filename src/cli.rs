@@ -23,7 +23,7 @@ use sinew::rig::{Handles, Pose};
 use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
 use sinew::trace::TraceOptions;
-use sinew::weights::{WeightMethod, WeightOptions};
+use sinew::weights::{TwoLevelOptions, WeightMethod, WeightOptions};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -161,7 +161,8 @@ fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
 
 #[derive(Args, Debug)]
 pub struct AutorigArgs {
-    /// Layer images (PNG, all the same size), back to front.
+    /// Layer images (PNG, all the same size) or layered files (.psd, .psb, .ora, or the .json
+    /// of a Spine export script beside its PNGs), back to front.
     #[arg(required = true)]
     pub images: Vec<PathBuf>,
     /// The handles file to write.
@@ -210,9 +211,13 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
-    /// OUT.json beside it).
+    /// OUT.json beside it, which lists each frame's events).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Also print the events each frame fires, one JSON object a line:
+    /// {"frame", "frame_time", "event": {"name", "time", "int", "float", "string", ...}}.
+    #[arg(long)]
+    pub events: bool,
 }
 
 /// Parses `WxH` (px).
@@ -232,7 +237,8 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 #[derive(Args, Debug)]
 pub struct RigArgs {
-    /// Layer images (PNG, all the same size), back to front.
+    /// Layer images (PNG, all the same size) or layered files (.psd, .psb, .ora, or the .json
+    /// of a Spine export script beside its PNGs), back to front.
     #[arg(required = true)]
     pub images: Vec<PathBuf>,
     /// The rig document to write.
@@ -284,6 +290,11 @@ pub struct BuildArgs {
     /// With `--weights rigid`: width of the blend band around joints, px.
     #[arg(long = "blend", value_name = "PX", default_value_t = 0.0)]
     pub rigid_blend_px: f64,
+    /// Two-level weights: solve on a coarse mesh of about N vertices of the same domain, carry
+    /// the weights to the fine mesh and polish them there (faster on large meshes; see
+    /// docs/two-level-weights.md for how far they are from the exact solve).
+    #[arg(long, value_name = "N")]
+    pub coarse_weights: Option<usize>,
 }
 
 #[derive(ValueEnum, Clone, Copy, Debug, Default, PartialEq)]
@@ -320,6 +331,10 @@ impl BuildArgs {
             max_influences: self.max_influences,
             monotone: self.monotone,
             rigid_blend_px: self.rigid_blend_px,
+            two_level: self.coarse_weights.map(|n| TwoLevelOptions {
+                coarse_vertices: n,
+                ..TwoLevelOptions::default()
+            }),
             ..WeightOptions::default()
         };
         BuildOptions {
@@ -430,7 +445,7 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         args.images.iter().map(PathBuf::as_path),
         [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
-    let layers = pipeline::load_layers(&args.images)?;
+    let layers = load_art(&args.images, &args.output)?.layers;
     let mut options = AutorigOptions {
         template: args.template,
         cage_vertices: args.cage,
@@ -498,7 +513,19 @@ fn rig(args: &RigArgs) -> Result<()> {
             .chain(args.handles.as_deref()),
         [Some(args.output.as_path()), args.preview.as_deref()],
     )?;
-    let layers = pipeline::load_layers(&args.images)?;
+    let art = load_art(&args.images, &args.output)?;
+    // The parts of layered files are written beside the document: none may overwrite an input.
+    check_not_overwriting(
+        args.images
+            .iter()
+            .map(PathBuf::as_path)
+            .chain(args.handles.as_deref()),
+        art.part_paths()
+            .chain([args.output.as_path()])
+            .chain(args.preview.as_deref())
+            .map(Some),
+    )?;
+    let layers = art.layers.clone();
     let handles: Handles = match &args.handles {
         Some(path) => read_json(path, "handles file")?,
         None => Handles::default(),
@@ -512,6 +539,7 @@ fn rig(args: &RigArgs) -> Result<()> {
         }
         None => None,
     };
+    art.write_parts()?;
     doc.save(&args.output)?;
     if let (Some(path), Some(image)) = (&args.preview, preview) {
         io::save_png(path, &image)?;
@@ -520,6 +548,21 @@ fn rig(args: &RigArgs) -> Result<()> {
         report_part(&part.name, s);
     }
     Ok(())
+}
+
+/// Loads PNG layers and layered files (PSD, ORA, a Spine script's JSON) for a command that
+/// writes `output`: layered files' parts go to `OUTPUT.parts/` (see [`sinew::art`]). Prints
+/// the notes on skipped layers.
+fn load_art(images: &[PathBuf], output: &Path) -> Result<sinew::art::Art> {
+    let options = sinew::art::ArtOptions {
+        parts_dir: output.with_extension("parts"),
+        ..Default::default()
+    };
+    let art = sinew::art::load_art(images, &options)?;
+    for note in &art.notes {
+        println!("note: {note}");
+    }
+    Ok(art)
 }
 
 /// [`pipeline::build_rig`] with a bar over the parts; indicatif draws nothing when stderr is
@@ -683,9 +726,25 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     let frames =
         playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
-    let report =
-        io::sequence::write_sequence(&frames?, args.fps, &args.output, &Default::default())?;
-    println!(
+    let events = playback::render_events(&scene, &animation, &settings)?;
+    let report = io::sequence::write_sequence(
+        &frames?,
+        &events,
+        args.fps,
+        &args.output,
+        &Default::default(),
+    )?;
+    if args.events {
+        let times = playback::frame_times(animation.duration_s(), args.fps)?;
+        for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
+            for event in fired {
+                let line = serde_json::json!({"frame": frame, "frame_time": time, "event": event});
+                println!("{line}");
+            }
+        }
+    }
+    // With --events, stdout holds only the event lines.
+    let summary = format!(
         "{}: {} frames of {}×{} px, {:.2} s",
         args.output.display(),
         report.frame_count,
@@ -693,6 +752,11 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         report.frame_size_px.1,
         report.duration_s
     );
+    if args.events {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     Ok(())
 }
 
@@ -784,6 +848,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
     let bad = || format!("{}: bad animation", animations_path.display());
     doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
+    // The events the animations fire (footsteps), when the assets define any.
+    let events_path = args.assets.join("events.json");
+    if events_path.exists() {
+        let events_json: serde_json::Value = read_json(&events_path, "events file")?;
+        doc.events = anim::events_from_json(&events_json)
+            .with_context(|| format!("{}: bad events", events_path.display()))?;
+    }
     doc.check_animations().with_context(bad)?;
     let animations = doc.animations.clone();
     let rig_path = args.output.join("character.json");
@@ -816,6 +887,7 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             ..Default::default()
         };
         let frames = playback::render_animation(&scene, name, animation, &settings, &|| {})?;
+        let events = playback::render_events(&scene, animation, &settings)?;
         render_s += t.elapsed().as_secs_f64();
         frame_count += frames.len();
         let t = Instant::now();
@@ -824,8 +896,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
             args.output.join(format!("{name}.png")),
             args.output.join(name),
         ] {
-            let report =
-                io::sequence::write_sequence(&frames, DEMO_FPS, &target, &Default::default())?;
+            let report = io::sequence::write_sequence(
+                &frames,
+                &events,
+                DEMO_FPS,
+                &target,
+                &Default::default(),
+            )?;
             if report.format == io::sequence::SequenceFormat::Folder {
                 written.push(target);
             } else {

@@ -126,6 +126,8 @@ pub struct State {
     /// Animations by name, each checked on its own (names the rig lacks are checked where an
     /// animation is rendered or exported).
     pub animations: BTreeMap<String, Animation>,
+    /// Event definitions the animations fire (kept as read; the editor does not edit them).
+    pub events: crate::anim::EventDefs,
     /// The rig last built from layers, handles and options (meshes, weights, textures).
     pub rig: Option<Arc<Scene>>,
     /// Whether `rig` was built from exactly the current layers, handles and options.
@@ -320,6 +322,7 @@ impl Document {
                 handles: Handles::default(),
                 options: BuildOptions::default(),
                 animations: BTreeMap::new(),
+                events: BTreeMap::new(),
                 rig: None,
                 rig_current: true,
                 pose: Pose::default(),
@@ -367,6 +370,7 @@ impl Document {
             handles: doc.handles.clone(),
             options: doc.options.clone(),
             animations: doc.animations.clone(),
+            events: doc.events.clone(),
             rig_current: weighted,
             locked: doc.locked.iter().cloned().collect(),
             rig: Some(Arc::new(Scene::new(doc, &images)?)),
@@ -559,6 +563,7 @@ fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError
     doc.handles = state.handles.clone();
     doc.options = state.options.clone();
     doc.animations = state.animations.clone();
+    doc.events = state.events.clone();
     doc.locked = state.locked.iter().cloned().collect();
     Ok(doc)
 }

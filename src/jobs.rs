@@ -101,8 +101,10 @@ pub fn render_animation(
     settings.view(doc.canvas)?;
     let scene = Scene::new(doc, images)?;
     let frames = playback::render_animation(&scene, name, &animation, settings, &|| {})?;
+    let events = playback::render_events(&scene, &animation, settings)?;
     Ok(sequence::write_sequence(
         &frames,
+        &events,
         settings.fps,
         output,
         &Default::default(),

@@ -7,6 +7,7 @@
 //! the library knows no shell. The files sinew reads and writes: `docs/formats.md`.
 
 pub mod anim;
+pub mod art;
 pub mod autorig;
 pub mod colorize;
 pub mod document;

@@ -38,6 +38,8 @@ pub enum PipelineError {
     Image(#[from] ImageError),
     #[error(transparent)]
     Document(#[from] io::DocumentError),
+    #[error(transparent)]
+    Layered(#[from] io::layered::LayeredFileError),
     #[error("{path}: image is {}×{} px, too small to rig (at least {MIN_SPRITE_SIDE_PX}×{MIN_SPRITE_SIDE_PX})", got[0], got[1])]
     TooSmall { path: PathBuf, got: [u32; 2] },
     #[error("no input images")]
@@ -52,7 +54,9 @@ pub enum PipelineError {
         got: [u32; 2],
         canvas: [u32; 2],
     },
-    #[error("{path}: a part named '{name}' already exists (part names come from file names)")]
+    #[error(
+        "{path}: a part named '{name}' already exists (part names come from file and layer names)"
+    )]
     DuplicatePart { path: PathBuf, name: String },
     #[error("{path}: {source}")]
     Trace { path: PathBuf, source: TraceError },
@@ -119,44 +123,51 @@ pub const MIN_SPRITE_SIDE_PX: u32 = 4;
 /// Loads image files as the layers of one canvas, in the given (draw) order.
 pub fn load_layers(paths: &[PathBuf]) -> Result<Vec<Layer>, PipelineError> {
     let mut layers: Vec<Layer> = Vec::with_capacity(paths.len());
-    let mut names = HashSet::new();
     for path in paths {
         let image = io::load_png(path)?;
-        let got = [image.width(), image.height()];
-        if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
-            return Err(PipelineError::TooSmall {
-                path: path.clone(),
-                got,
-            });
-        }
-        if let Some(first) = layers.first() {
-            let canvas = [first.image.width(), first.image.height()];
-            if got != canvas {
-                return Err(PipelineError::SizeMismatch {
-                    path: path.clone(),
-                    got,
-                    canvas,
-                });
-            }
-        }
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        if !names.insert(name.clone()) {
-            return Err(PipelineError::DuplicatePart {
-                path: path.clone(),
-                name,
-            });
-        }
         layers.push(Layer {
             name,
             path: path.clone(),
             image,
         });
     }
-    if layers.is_empty() {
-        return Err(PipelineError::NoImages);
+    checked_layers(layers)
+}
+
+/// `layers` when they can be the parts of one rig: at least one, each at least
+/// [`MIN_SPRITE_SIDE_PX`] on a side, all of the first one's size, names unique.
+pub fn checked_layers(layers: Vec<Layer>) -> Result<Vec<Layer>, PipelineError> {
+    let mut names = HashSet::new();
+    let canvas = match layers.first() {
+        Some(first) => [first.image.width(), first.image.height()],
+        None => return Err(PipelineError::NoImages),
+    };
+    for layer in &layers {
+        let path = &layer.path;
+        let got = [layer.image.width(), layer.image.height()];
+        if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
+            return Err(PipelineError::TooSmall {
+                path: path.clone(),
+                got,
+            });
+        }
+        if got != canvas {
+            return Err(PipelineError::SizeMismatch {
+                path: path.clone(),
+                got,
+                canvas,
+            });
+        }
+        if !names.insert(layer.name.clone()) {
+            return Err(PipelineError::DuplicatePart {
+                path: path.clone(),
+                name: layer.name.clone(),
+            });
+        }
     }
     Ok(layers)
 }
@@ -252,18 +263,33 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             let embedded =
                 mesh::triangulate_with_handles(&outlines, &geometry, canvas_area, &options.mesh)
                     .map_err(|e| cage_error(&bound, e).unwrap_or_else(mesh_error))?;
-            let colors = options
-                .weights
-                .content_aware
-                .map(|_| vertex_colors(&layer.image, &embedded.domain.vertices));
             let binding = handles.columns_binding(&layer.name);
-            let part = weights::part::bound_part_weights(
-                &embedded,
-                handles,
-                &binding,
-                colors.as_deref(),
-                &options.weights,
-            )
+            let coarse = coarse_weight_mesh(&embedded, &outlines, &geometry, canvas_area, options)
+                .map_err(|e| cage_error(&bound, e).unwrap_or_else(mesh_error))?;
+            let colors = |mesh: &mesh::EmbeddedMesh| {
+                options
+                    .weights
+                    .content_aware
+                    .map(|_| vertex_colors(&layer.image, &mesh.domain.vertices))
+            };
+            let part = match &coarse {
+                Some(coarse) => weights::two_level::two_level_weights(
+                    &embedded,
+                    coarse,
+                    handles,
+                    &binding,
+                    colors(&embedded).as_deref(),
+                    colors(coarse).as_deref(),
+                    &options.weights,
+                ),
+                None => weights::part::bound_part_weights(
+                    &embedded,
+                    handles,
+                    &binding,
+                    colors(&embedded).as_deref(),
+                    &options.weights,
+                ),
+            }
             .map_err(|source| PipelineError::Weights {
                 path: layer.path.clone(),
                 source,
@@ -297,6 +323,45 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
         return Err(PipelineError::HandleOutside(columns[column].clone()));
     }
     Ok((doc, stats))
+}
+
+/// The coarse mesh of the same weight domain that two-level weights solve on
+/// ([`weights::part::TwoLevelOptions`]), or `None` for the exact solve on `fine` (two-level off,
+/// or `fine` not more than [`weights::part::TWO_LEVEL_MIN_RATIO`] times the target). Its
+/// largest triangle area is the domain's area over the target vertex count (a refined
+/// Delaunay mesh has about two triangles per vertex, at about half the largest area each).
+fn coarse_weight_mesh(
+    fine: &mesh::EmbeddedMesh,
+    outlines: &[trace::Outline],
+    geometry: &mesh::HandleGeometry,
+    canvas_area_px2: f64,
+    options: &BuildOptions,
+) -> Result<Option<mesh::EmbeddedMesh>, mesh::MeshError> {
+    let Some(target) = options
+        .weights
+        .two_level
+        .as_ref()
+        .map(|t| t.coarse_vertices)
+    else {
+        return Ok(None);
+    };
+    if fine.domain.vertices.len() <= target.saturating_mul(weights::part::TWO_LEVEL_MIN_RATIO) {
+        return Ok(None);
+    }
+    let area_px2: f64 = fine
+        .domain
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| fine.domain.vertices[v as usize]);
+            0.5 * crate::geom::triangle_area2(a, b, c).abs()
+        })
+        .sum();
+    let coarse = mesh::MeshOptions {
+        max_area_fraction: area_px2 / target.max(1) as f64 / canvas_area_px2,
+        ..options.mesh.clone()
+    };
+    mesh::triangulate_with_handles(outlines, geometry, canvas_area_px2, &coarse).map(Some)
 }
 
 /// A mesh error that concerns a cage, named (the image is not at fault); others back as they are.

@@ -111,6 +111,23 @@ pub fn render_animation(
     )?)
 }
 
+/// The events each frame of [`render_animation`] fires, one list per frame
+/// ([`crate::anim::frame_events`] at its frame times, payloads from the rig's definitions; key
+/// times stored as the runtime stores them when `settings` match it).
+pub fn render_events(
+    scene: &Scene,
+    animation: &Animation,
+    settings: &RenderSettings,
+) -> Result<Vec<Vec<crate::anim::FiredEvent>>, PlaybackError> {
+    let times = frame_times(animation.duration_s(), settings.fps)?;
+    Ok(crate::anim::frame_events(
+        animation,
+        &times,
+        &scene.doc.events,
+        settings.sampling.curves,
+    ))
+}
+
 /// The frames of `animation` (named `name`) at `times_s`: with exact curves, through the one
 /// pose path ([`crate::scene::frames`]); with [`CurveEvaluation::SpineRuntime`], as Spine's
 /// runtime plays the default Spine export ([`crate::export::spine::played`]: its curve
@@ -395,7 +412,7 @@ pub const BAKE_REPLAY_TOLERANCE_PX: f64 = 1e-3;
 /// Bakes `animation` at `times_s` (ascending; the caller includes the end time if the loop
 /// must close) into an animation with linear keys for every bone, point and cage, computed from
 /// the skinning transformations playback solves — skinning IK included — and no `ik`
-/// timelines. Part looks and draw order are kept as authored. Rotations are unwrapped (each key
+/// timelines. Part looks, draw order and events are kept as authored. Rotations are unwrapped (each key
 /// within 180° of the previous), since runtimes interpolate plain numbers.
 ///
 /// Bone IK constraints stay in the rig and solve again when the baked keys play, so the bones of
@@ -449,6 +466,7 @@ pub fn bake(
     let mut out = keyed_animation(handles, times_s, &baked);
     out.parts = animation.parts.clone();
     out.draw_order = animation.draw_order.clone();
+    out.events = animation.events.clone();
     Ok(out)
 }
 

@@ -41,23 +41,26 @@ pub enum SchemaKind {
     Animations,
     /// The scribbles JSON of `sinew colorize --scribbles`.
     Scribbles,
+    /// An events file: event name → definition, as the rig document's `events`.
+    Events,
 }
 
 /// What is wrong with a schema request.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SchemaError {
-    #[error("no schema named '{0}' (known: handles, rig, pose, animations, scribbles)")]
+    #[error("no schema named '{0}' (known: handles, rig, pose, animations, scribbles, events)")]
     UnknownKind(String),
 }
 
 impl SchemaKind {
     /// Every kind, in the order `docs/formats.md` lists them.
-    pub const ALL: [SchemaKind; 5] = [
+    pub const ALL: [SchemaKind; 6] = [
         SchemaKind::Handles,
         SchemaKind::Rig,
         SchemaKind::Pose,
         SchemaKind::Animations,
         SchemaKind::Scribbles,
+        SchemaKind::Events,
     ];
 
     /// The kind's name on the command line.
@@ -68,6 +71,7 @@ impl SchemaKind {
             SchemaKind::Pose => "pose",
             SchemaKind::Animations => "animations",
             SchemaKind::Scribbles => "scribbles",
+            SchemaKind::Events => "events",
         }
     }
 }
@@ -91,6 +95,7 @@ pub fn schema(kind: SchemaKind) -> Schema {
         SchemaKind::Pose => schemars::schema_for!(Pose),
         SchemaKind::Animations => schemars::schema_for!(Animations),
         SchemaKind::Scribbles => schemars::schema_for!(StrokeFile),
+        SchemaKind::Events => schemars::schema_for!(crate::anim::EventDefs),
     }
 }
 

@@ -238,6 +238,12 @@ fn the_bundled_character_opens_and_poses() {
     for part in &mut scene_doc.parts {
         part.image = assets.join(&part.image).to_string_lossy().into_owned();
     }
+    // With the bundled animations and the events their walk fires.
+    let read = |file: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(assets.join(file)).unwrap()).unwrap()
+    };
+    scene_doc.animations = sinew::anim::animations_from_json(&read("animations.json")).unwrap();
+    scene_doc.events = sinew::anim::events_from_json(&read("events.json")).unwrap();
     let grip = scene_doc.parts[0].mesh.vertices[0];
     let path = dir.join("character.json");
     scene_doc.save(&path).unwrap();
@@ -253,6 +259,13 @@ fn the_bundled_character_opens_and_poses() {
     assert_eq!(doc.state().pose.ik.len(), 1);
     assert!(doc.undo());
     assert!(doc.state().pose.ik.is_empty());
+    // Saving from the editor keeps the events and the keys that fire them.
+    let again = dir.join("again.json");
+    doc.save(&again).unwrap();
+    let saved = sinew::io::RigDocument::load(&again).unwrap();
+    assert_eq!(saved.events, scene_doc.events);
+    assert!(!saved.animations["walk"].events.is_empty());
+    assert_eq!(saved.animations, scene_doc.animations);
 }
 
 #[test]

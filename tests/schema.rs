@@ -73,6 +73,11 @@ fn the_bundled_files_validate() {
         &read_json(&assets.join("animations.json")),
         "assets/character/animations.json",
     );
+    assert_valid(
+        SchemaKind::Events,
+        &read_json(&assets.join("events.json")),
+        "assets/character/events.json",
+    );
     let mut poses = 0;
     for entry in std::fs::read_dir(assets.join("poses")).expect("the poses folder") {
         let path = entry.expect("a folder entry").path();
@@ -193,6 +198,9 @@ fn load(kind: SchemaKind, text: &str) -> Result<(), String> {
                 .map_err(|e| e.to_string())
         }
         SchemaKind::Scribbles => Scribbles::from_json(text, 512, 512, &ScribbleOptions::default())
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        SchemaKind::Events => anim::events_from_json(&value)
             .map(|_| ())
             .map_err(|e| e.to_string()),
     }
@@ -379,6 +387,7 @@ fn the_rig_the_command_writes_for_the_character_validates() {
     );
     assert_valid(SchemaKind::Rig, &written, "the rig `sinew rig` wrote");
     written["animations"] = read_json(&assets.join("animations.json"));
+    written["events"] = read_json(&assets.join("events.json"));
     assert_valid(
         SchemaKind::Rig,
         &written,

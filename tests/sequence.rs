@@ -205,7 +205,7 @@ fn check_sheet(
     options: &SheetOptions,
 ) -> serde_json::Value {
     let path = dir.join(format!("{name}.png"));
-    let report = write_sheet(frames, 30.0, &path, options).unwrap();
+    let report = write_sheet(frames, &[], 30.0, &path, options).unwrap();
     assert_eq!(report.format, SequenceFormat::Sheet);
     let sheet = sinew::io::load_png(&path).unwrap();
     let json: serde_json::Value =
@@ -319,6 +319,7 @@ fn sheet_json_reproduces_every_frame() {
     let first_png = std::fs::read(dir.join("walk.png")).unwrap();
     write_sheet(
         &frames,
+        &[],
         30.0,
         &dir.join("walk.png"),
         &SheetOptions::default(),
@@ -339,7 +340,7 @@ fn folder_holds_numbered_frames() {
     std::fs::write(out.join("frame_0007.png"), b"old").unwrap();
     std::fs::write(out.join("notes.txt"), b"keep").unwrap();
     std::fs::write(out.join("refs/a.txt"), b"keep too").unwrap();
-    let report = write_sequence(&frames, 12.0, &out, &SequenceOptions::default()).unwrap();
+    let report = write_sequence(&frames, &[], 12.0, &out, &SequenceOptions::default()).unwrap();
     assert_eq!(report.format, SequenceFormat::Folder);
     assert_eq!(report.stale_files, vec![out.join("frame_0007.png")]);
     assert!(!out.join("frame_0007.png").exists());
@@ -380,25 +381,28 @@ fn bad_input_gives_one_line_errors_and_no_files() {
     };
 
     let gif = dir.join("a.gif");
-    let e = one_line(write_sequence(&[], 10.0, &gif, &options).unwrap_err());
+    let e = one_line(write_sequence(&[], &[], 10.0, &gif, &options).unwrap_err());
     assert!(matches!(e, SequenceError::NoFrames));
     let mixed = vec![frames[0].clone(), RgbaImage::new(8, 16)];
     for target in ["a.gif", "a.png", "a"] {
-        let e = one_line(write_sequence(&mixed, 10.0, &dir.join(target), &options).unwrap_err());
+        let e =
+            one_line(write_sequence(&mixed, &[], 10.0, &dir.join(target), &options).unwrap_err());
         assert!(
             matches!(e, SequenceError::MismatchedSize { index: 1, .. }),
             "{e}"
         );
     }
-    let e = one_line(write_sequence(&frames, 0.0, &gif, &options).unwrap_err());
+    let e = one_line(write_sequence(&frames, &[], 0.0, &gif, &options).unwrap_err());
     assert!(matches!(e, SequenceError::BadFrameRate { .. }));
-    let e = one_line(write_sequence(&frames, 10.0, &dir.join("a.webm"), &options).unwrap_err());
+    let e =
+        one_line(write_sequence(&frames, &[], 10.0, &dir.join("a.webm"), &options).unwrap_err());
     assert!(matches!(e, SequenceError::UnknownFormat { .. }));
 
     // A file where a folder should be.
     std::fs::write(dir.join("blocker"), b"x").unwrap();
     for target in ["blocker/a.gif", "blocker/a.png", "blocker/frames"] {
-        let e = one_line(write_sequence(&frames, 10.0, &dir.join(target), &options).unwrap_err());
+        let e =
+            one_line(write_sequence(&frames, &[], 10.0, &dir.join(target), &options).unwrap_err());
         assert!(matches!(e, SequenceError::Write { .. }), "{e}");
         assert!(e.to_string().contains("blocker"));
     }
@@ -410,7 +414,7 @@ fn bad_input_gives_one_line_errors_and_no_files() {
         },
         ..SequenceOptions::default()
     };
-    let e = one_line(write_sequence(&frames, 10.0, &dir.join("big.png"), &tiny).unwrap_err());
+    let e = one_line(write_sequence(&frames, &[], 10.0, &dir.join("big.png"), &tiny).unwrap_err());
     assert!(matches!(
         e,
         SequenceError::SheetTooLarge { max_side_px: 8, .. }

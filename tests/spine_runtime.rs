@@ -17,6 +17,7 @@ mod command;
 
 use command::{s, scratch};
 use serde::Deserialize;
+use sinew::anim::{CurveEvaluation, FiredEvent, SampleOptions};
 use sinew::export::spine::bake::bake_times;
 use sinew::export::spine::played::as_played;
 use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
@@ -36,6 +37,8 @@ const SETUP_TOLERANCE_PX: f64 = 0.001;
 const COLOR_TOLERANCE: f64 = 1e-4;
 /// Times sampled per animation, evenly, besides every key time.
 const TIMES_PER_ANIMATION: usize = 60;
+/// Frame rates at which events are stepped through, frame to frame.
+const EVENT_FPS: [f64; 2] = [24.0, 30.0];
 /// Of those, how many go through `sinew pose --vertices` (the rest are compared in-process).
 const CLI_TIMES_PER_ANIMATION: usize = 5;
 
@@ -72,14 +75,32 @@ struct Played {
 struct Oracle {
     setup: Vec<SlotState>,
     animations: BTreeMap<String, Played>,
+    /// Per animation, per requested step, the events the runtime fired.
+    #[serde(default)]
+    events: BTreeMap<String, Vec<Vec<FiredEvent>>>,
     warnings: Vec<String>,
 }
 
+/// A step of an animation's time the runtime is asked to fire events over: (last time, time,
+/// looping).
+type EventStep = (f64, f64, bool);
+
 /// Loads `dir/name.json` + `.atlas` in spine-core and plays it at `times`.
 fn run_oracle(dir: &Path, name: &str, times: &BTreeMap<String, Vec<f64>>) -> Oracle {
+    run_oracle_with_events(dir, name, times, &BTreeMap::new())
+}
+
+/// [`run_oracle`], and the events fired over `steps`.
+fn run_oracle_with_events(
+    dir: &Path,
+    name: &str,
+    times: &BTreeMap<String, Vec<f64>>,
+    steps: &BTreeMap<String, Vec<EventStep>>,
+) -> Oracle {
     let request = dir.join(format!("{name}.request.json"));
     let out = dir.join(format!("{name}.oracle.json"));
-    std::fs::write(&request, serde_json::json!({ "times": times }).to_string()).unwrap();
+    let json = serde_json::json!({ "times": times, "events": steps });
+    std::fs::write(&request, json.to_string()).unwrap();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/spine-check/run.sh");
     let status = Command::new(script)
         .args([
@@ -247,7 +268,50 @@ fn check_rig(
             (name.clone(), times)
         })
         .collect();
-    let oracle = run_oracle(dir, "rig", &times);
+    // Events, stepping from frame to frame as a game loop does, at two frame rates; frame 0
+    // is stepped to from the last frame with the loop wrapping (a one-frame render: from
+    // before the start to the end).
+    let mut steps: BTreeMap<String, Vec<EventStep>> = BTreeMap::new();
+    let mut expected_events: BTreeMap<String, Vec<Vec<FiredEvent>>> = BTreeMap::new();
+    for (name, animation) in &animations {
+        for fps in EVENT_FPS {
+            let settings = sinew::playback::RenderSettings {
+                fps,
+                sampling: SampleOptions {
+                    curves: CurveEvaluation::SpineRuntime,
+                },
+                ..Default::default()
+            };
+            let frame_times = sinew::playback::frame_times(animation.duration_s(), fps).unwrap();
+            let events = sinew::playback::render_events(&scene, animation, &settings).unwrap();
+            let n = frame_times.len();
+            for (k, fired) in events.into_iter().enumerate() {
+                let step = match k {
+                    0 if n == 1 => (-1.0, animation.duration_s(), false),
+                    0 => (frame_times[n - 1], 0.0, true),
+                    _ => (frame_times[k - 1], frame_times[k], false),
+                };
+                steps.entry(name.clone()).or_default().push(step);
+                expected_events.entry(name.clone()).or_default().push(fired);
+            }
+        }
+    }
+    let oracle = run_oracle_with_events(dir, "rig", &times, &steps);
+    let mut fired_count = 0;
+    for (name, expected) in &expected_events {
+        let got = &oracle.events[name];
+        assert_eq!(got.len(), expected.len(), "{name}: event steps");
+        for ((step, got), expected) in steps[name].iter().zip(got).zip(expected) {
+            assert_eq!(got, expected, "{name}: events fired over {step:?}");
+            fired_count += got.len();
+        }
+    }
+    if !doc.events.is_empty() {
+        println!(
+            "{}: {fired_count} events fired by spine-core, all as sinew fires them",
+            rig.display()
+        );
+    }
     // The pages are premultiplied, as the atlas says: no colour channel above alpha.
     let atlas = std::fs::read_to_string(dir.join("rig.atlas")).unwrap();
     assert!(atlas.contains("pma: true\n"), "{atlas}");
@@ -524,11 +588,40 @@ fn generated_rig(dir: &Path) -> PathBuf {
                                      {"time": 0.9, "value": true}]}
             },
             "draw_order": [{"time": 0.3, "value": ["arm", "body", "blob"]},
-                           {"time": 0.75, "value": ["body", "arm", "blob"]}]
+                           {"time": 0.75, "value": ["body", "arm", "blob"]}],
+            // Several at one time, one on a frame time (0.3 s at 30 fps, stored by the runtime
+            // as 0.30000001 s), one at the end (fired as the loop wraps), overrides of each
+            // payload field.
+            "events": [
+                {"time": 0, "name": "step", "string": "left"},
+                {"time": 0.3, "name": "hit", "int": 7, "float": 2.5},
+                {"time": 0.3, "name": "step", "volume": 0.5},
+                {"time": 0.55, "name": "step", "string": "right", "balance": -0.25},
+                {"time": 0.61, "name": "cue"},
+                {"time": 1.0, "name": "hit"}
+            ]
         },
-        "idle": {"bones": {"spine_b": {"rotate": [{"time": 0.5, "value": 12}]}}}
+        "idle": {"bones": {"spine_b": {"rotate": [{"time": 0.5, "value": 12}]}},
+                 "events": [{"time": 0.25, "name": "cue", "string": "blink"}]}
     });
-    with_animations(rig, animations)
+    let rig = with_animations(rig, animations);
+    with_events(
+        rig,
+        serde_json::json!({
+            "step": {"int": 1, "string": "foot", "audio": "sfx/step.ogg", "volume": 0.9},
+            "hit": {"float": 1.25},
+            "cue": {}
+        }),
+    )
+}
+
+/// Writes the event definitions `events` into the rig file at `rig`; returns its path.
+fn with_events(rig: PathBuf, events: serde_json::Value) -> PathBuf {
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc["events"] = events;
+    std::fs::write(&rig, doc.to_string()).unwrap();
+    rig
 }
 
 #[test]

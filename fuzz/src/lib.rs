@@ -68,7 +68,7 @@ pub fn animations(data: &[u8]) {
     };
     let handles = character();
     let parts: Vec<&str> = Vec::new();
-    let _ = anim::check_animations(&animations, &handles, &parts);
+    let _ = anim::check_animations(&animations, &handles, &parts, &Default::default());
     for animation in animations.values() {
         sample(&handles, animation);
     }

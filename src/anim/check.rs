@@ -2,8 +2,10 @@
 //!
 //! In: an [`Animation`] (already checked on its own), the rig's [`Handles`] and its part names.
 //! Out: `Ok` when every name a timeline uses exists in the rig, every cage key has the rig cage's
-//! vertex count, and every draw-order key lists each part exactly once.
+//! vertex count, every draw-order key lists each part exactly once, and every event key names
+//! an event the rig defines.
 
+use super::event::EventDefs;
 use super::timeline::Animation;
 use super::AnimError;
 use crate::rig::Handles;
@@ -16,6 +18,7 @@ impl Animation {
         name: &str,
         handles: &Handles,
         parts: &[&str],
+        events: &EventDefs,
     ) -> Result<(), AnimError> {
         let unknown = |kind: &'static str, what: &str| AnimError::UnknownName {
             animation: name.into(),
@@ -69,6 +72,9 @@ impl Animation {
                 });
             }
         }
+        if let Some(k) = self.events.iter().find(|k| !events.contains_key(&k.name)) {
+            return Err(unknown("event", &k.name));
+        }
         Ok(())
     }
 }
@@ -79,8 +85,9 @@ pub fn check_animations(
     animations: &BTreeMap<String, Animation>,
     handles: &Handles,
     parts: &[&str],
+    events: &EventDefs,
 ) -> Result<(), AnimError> {
     animations
         .iter()
-        .try_for_each(|(name, animation)| animation.check_rig(name, handles, parts))
+        .try_for_each(|(name, animation)| animation.check_rig(name, handles, parts, events))
 }

@@ -17,6 +17,7 @@
 pub mod check;
 pub mod curve;
 pub mod edit;
+pub mod event;
 pub mod mix;
 pub mod sample;
 pub mod timeline;
@@ -24,6 +25,9 @@ pub mod timeline;
 pub use check::check_animations;
 pub use curve::Curve;
 pub use curve::CurveEvaluation;
+pub use event::{
+    events_from_json, frame_events, EventDef, EventDefs, EventKey, FiredAudio, FiredEvent,
+};
 pub use mix::{mix_poses, sample_mix, Playhead, STEPPED_MIX_THRESHOLD};
 pub use sample::SampleOptions;
 pub use timeline::{
@@ -252,7 +256,7 @@ mod tests {
         let check = |v: serde_json::Value| {
             parse(v)
                 .unwrap()
-                .check_rig("walk", &handles, &parts)
+                .check_rig("walk", &handles, &parts, &EventDefs::new())
                 .map_err(|e| e.to_string())
         };
         let key = json!([{"time": 0, "value": 1}]);
@@ -310,6 +314,13 @@ mod tests {
             .collect();
         let raw: std::collections::BTreeMap<String, serde_json::Value> =
             serde_json::from_value(read("animations.json")).unwrap();
+        let events = events_from_json(&read("events.json")).unwrap();
+        assert!(
+            animations_from_json(&read("animations.json")).unwrap()["walk"]
+                .events
+                .iter()
+                .any(|k| k.name == "footstep")
+        );
         let animations = parse_animations(&raw).unwrap();
         assert_eq!(
             animations_from_json(&read("animations.json")),
@@ -324,7 +335,7 @@ mod tests {
             ["lift", "walk", "wave"].iter().collect::<Vec<_>>()
         );
         for (name, anim) in &animations {
-            anim.check_rig(name, &handles, &parts).unwrap();
+            anim.check_rig(name, &handles, &parts, &events).unwrap();
             let duration = anim.duration_s();
             // The end of the cycle runs into its start: no jump when it wraps.
             let end = anim.sample(duration, false);

@@ -199,6 +199,10 @@ pub struct Animation {
     pub draw_order: Option<Vec<StepKey<Vec<String>>>>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ik: Vec<IkTimeline>,
+    /// Events fired at their times (names of the rig document's `events`), in time order;
+    /// several keys may share a time.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<super::event::EventKey>,
 }
 
 /// What is wrong with one timeline (the enclosing [`AnimError`] names it).
@@ -239,6 +243,15 @@ pub enum TimelineError {
         key: usize,
         got: usize,
         expected: usize,
+    },
+    #[error(
+        "key {key}: {field} must be a finite number{} (got {value:e})",
+        super::event::range_text(field)
+    )]
+    Payload {
+        key: usize,
+        field: &'static str,
+        value: f64,
     },
     #[error("key {key} lists part '{name}' twice")]
     DuplicatePart { key: usize, name: String },
@@ -459,6 +472,7 @@ impl Animation {
             }
             check_keys(&drag.to).map_err(fail(format!("ik[{i}].to")))?;
         }
+        super::event::check_event_keys(&self.events).map_err(fail("events".into()))?;
         Ok(())
     }
 
@@ -496,6 +510,7 @@ impl Animation {
         for drag in &self.ik {
             see(last(&drag.to, key2));
         }
+        see(last(&self.events, |k| k.time));
         end
     }
 }
@@ -595,6 +610,11 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                     return Some(fail(format!("draw_order{at}"), reason));
                 }
             }
+            "events" => {
+                if let Err((at, reason)) = probe_keys::<super::event::EventKey>(content) {
+                    return Some(fail(format!("events{at}"), reason));
+                }
+            }
             "ik" => {
                 let Some(drags) = content.as_array() else {
                     return Some(fail(section.clone(), "expected an array of drags".into()));
@@ -613,7 +633,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
             other => {
                 return Some(malformed(format!(
                     "unknown section '{other}' (expected bones, points, cages, parts, \
-                     draw_order or ik)"
+                     draw_order, ik or events)"
                 )))
             }
         }

@@ -104,6 +104,8 @@ mirror!(SchemaKindArg => SchemaKind {
     Animations,
     /// The scribbles JSON of `sinew colorize --scribbles`.
     Scribbles,
+    /// An events file: event name → definition, as the rig document's `events`.
+    Events,
 });
 
 mirror!(ColorWeightsArg => ColorWeights {

@@ -93,8 +93,35 @@ pub fn load_view(path: &Path) -> Option<ViewState> {
 }
 
 impl EditorApp {
-    /// Imports a PNG as a new front layer; a bad file leaves the document as it was.
+    /// Imports a PNG as a new front layer; a bad file leaves the document as it was. A layered
+    /// file (PSD/PSB, ORA, a Spine script's JSON) adds each visible layer as a front layer, its
+    /// image written to `FILE.parts/` beside the file (see [`crate::art`]).
     pub fn import_layer(&mut self, path: &Path) {
+        if crate::art::is_layered(path) {
+            let options = crate::art::ArtOptions {
+                parts_dir: path.with_extension("parts"),
+                ..Default::default()
+            };
+            let loaded = crate::art::load_art(&[path.to_path_buf()], &options)
+                .map_err(|e| e.to_string())
+                .and_then(|art| art.write_parts().map(|_| art).map_err(|e| e.to_string()));
+            match loaded {
+                Ok(art) => {
+                    let added = art
+                        .layers
+                        .into_iter()
+                        .all(|l| self.apply(Command::AddLayer(l)));
+                    if added {
+                        self.view = None;
+                        if !art.notes.is_empty() {
+                            self.message = Some(art.notes.join("; "));
+                        }
+                    }
+                }
+                Err(e) => self.fail(e),
+            }
+            return;
+        }
         let loaded = crate::io::load_png(path);
         match loaded {
             Ok(image) => {

@@ -361,7 +361,11 @@ mod tests {
         let dead = dir.join(".walk.json.4294967294.0.tmp");
         // This process's own, with a write number its writes never reach (the other tests'
         // writes count up from 0 in this process).
-        let live = dir.join(format!(".walk.json.{}.{}.tmp", std::process::id(), u64::MAX));
+        let live = dir.join(format!(
+            ".walk.json.{}.{}.tmp",
+            std::process::id(),
+            u64::MAX
+        ));
         let other = dir.join(".other.json.4294967294.0.tmp");
         let unlike = dir.join(".walk.json.12x.0.tmp");
         for p in [&dead, &live, &other, &unlike] {

@@ -44,6 +44,9 @@ pub struct RigDocument {
     )]
     #[schemars(with = "crate::schema::Animations")]
     pub animations: BTreeMap<String, Animation>,
+    /// Events the animations fire, by name, with their default payloads. Absent when none.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub events: crate::anim::EventDefs,
     /// The options the meshes were built with, so a re-trace reproduces them.
     #[serde(default)]
     pub options: BuildOptions,
@@ -164,6 +167,7 @@ impl RigDocument {
             parts: Vec::new(),
             handles: Handles::default(),
             animations: BTreeMap::new(),
+            events: BTreeMap::new(),
             options: BuildOptions::default(),
             locked: Vec::new(),
         }
@@ -257,7 +261,7 @@ impl RigDocument {
     /// the document must still open; what poses an animation checks it first.
     pub fn check_animations(&self) -> Result<(), AnimError> {
         let parts: Vec<&str> = self.parts.iter().map(|p| p.name.as_str()).collect();
-        crate::anim::check_animations(&self.animations, &self.handles, &parts)
+        crate::anim::check_animations(&self.animations, &self.handles, &parts, &self.events)
     }
 
     /// The image of `part`, resolved against the folder of the document at `doc_path`.
@@ -282,6 +286,9 @@ impl RigDocument {
             .find(|n| !self.handles.names().any(|h| h == n.as_str()))
         {
             return Err(format!("locked handle '{name}' is not a handle"));
+        }
+        for (name, event) in &self.events {
+            event.check(name).map_err(|e| e.to_string())?;
         }
         let mut names = HashSet::new();
         for part in &self.parts {

@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod document;
 pub mod image;
+pub mod layered;
 pub mod outputs;
 pub mod sequence;
 

@@ -60,7 +60,40 @@ pub struct WeightOptions {
     pub monotone: bool,
     /// With method `rigid`: width of the blend band around joints, px. Default 0 (no blend).
     pub rigid_blend_px: f64,
+    /// Two-level weights ([`super::two_level`]): solved on a coarse mesh of the same weight
+    /// domain and carried to the fine mesh. `None` solves on the fine mesh itself (the exact
+    /// solve). Default: None.
+    pub two_level: Option<TwoLevelOptions>,
 }
+
+/// How two-level weights are solved ([`super::two_level`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct TwoLevelOptions {
+    /// About how many vertices the coarse mesh has. Two-level weights are used only where the
+    /// fine mesh has more than [`TWO_LEVEL_MIN_RATIO`] times as many. Default 1000.
+    pub coarse_vertices: usize,
+    /// With bounded biharmonic weights: active-set iterations on the fine mesh from the carried
+    /// weights ([`super::active_set`]), each one numeric factorization per handle; 0 keeps the
+    /// carried weights as they are. Default 4.
+    pub polish_iterations: usize,
+}
+
+impl Default for TwoLevelOptions {
+    fn default() -> Self {
+        TwoLevelOptions {
+            coarse_vertices: 1000,
+            polish_iterations: 4,
+        }
+    }
+}
+
+/// Two-level weights are used only where the fine mesh has more than this many times the
+/// coarse mesh's target vertex count (below it the exact solve costs about as much).
+pub const TWO_LEVEL_MIN_RATIO: usize = 2;
+
+/// The fewest coarse vertices two-level weights accept: fewer cannot carry several handles.
+pub const MIN_COARSE_VERTICES: usize = 50;
 
 impl Default for WeightOptions {
     fn default() -> Self {
@@ -72,6 +105,7 @@ impl Default for WeightOptions {
             min_weight: 1e-6,
             monotone: false,
             rigid_blend_px: 0.0,
+            two_level: None,
         }
     }
 }
@@ -181,6 +215,49 @@ pub fn bound_part_weights(
     colors: Option<&[[f64; 3]]>,
     options: &WeightOptions,
 ) -> Result<PartWeights, WeightError> {
+    check_options(handles, binding, options)?;
+    let solved = domain_weights(embedded, handles, binding, colors, options)?;
+    Ok(shape_rows(embedded, solved, options))
+}
+
+/// Weights over the whole weight domain of `embedded` (every domain vertex, rows summing to
+/// one), before they are sparsified for the drawn mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DomainWeights {
+    pub matrix: WeightMatrix,
+    /// As [`PartWeights::touched`].
+    pub touched: Vec<usize>,
+    /// As [`PartWeights::bound_to_nearest`].
+    pub bound_to_nearest: Vec<usize>,
+    /// As [`PartWeights::unconverged`].
+    pub unconverged: Vec<usize>,
+}
+
+/// The drawn mesh's sparse rows of `solved` (see [`sparse_row`]).
+pub fn shape_rows(
+    embedded: &EmbeddedMesh,
+    solved: DomainWeights,
+    options: &WeightOptions,
+) -> PartWeights {
+    let (_, domain_index) = embedded.shape_mesh();
+    let rows = domain_index
+        .iter()
+        .map(|&i| sparse_row(solved.matrix.row(i), options))
+        .collect();
+    PartWeights {
+        rows,
+        touched: solved.touched,
+        bound_to_nearest: solved.bound_to_nearest,
+        unconverged: solved.unconverged,
+    }
+}
+
+/// The checks of handles, binding flags and options shared by every weight solve.
+pub fn check_options(
+    handles: &Handles,
+    binding: &[bool],
+    options: &WeightOptions,
+) -> Result<(), WeightError> {
     let columns = handle_columns(handles).len();
     if columns == 0 || !binding.iter().any(|&b| b) {
         return Err(WeightError::NoHandles);
@@ -196,27 +273,37 @@ pub fn bound_part_weights(
             "min_weight must lie in [0, 1)".into(),
         ));
     }
+    if options
+        .two_level
+        .as_ref()
+        .is_some_and(|t| t.coarse_vertices < MIN_COARSE_VERTICES)
+    {
+        return Err(WeightError::InvalidOptions(format!(
+            "coarse_vertices must be at least {MIN_COARSE_VERTICES}"
+        )));
+    }
     if options.max_influences == Some(0) {
         return Err(WeightError::InvalidOptions(
             "max_influences must be at least 1".into(),
         ));
     }
+    Ok(())
+}
+
+/// Solves the weights over every vertex of `embedded`'s domain: boundary conditions from the
+/// handles (only the columns in `binding`), pieces without a handle bound to the nearest one,
+/// the method's solve, rows normalized (rows every bound clamped to zero follow the nearest
+/// handle). `colors` as in [`part_weights`].
+pub fn domain_weights(
+    embedded: &EmbeddedMesh,
+    handles: &Handles,
+    binding: &[bool],
+    colors: Option<&[[f64; 3]]>,
+    options: &WeightOptions,
+) -> Result<DomainWeights, WeightError> {
     let mesh = &embedded.domain;
-    let (mut bc, touched) = bound_boundary_conditions(&mesh.vertices, handles, binding);
-    let bound_to_nearest = bind_free_pieces(embedded, handles, binding, &mut bc);
-    let positions: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
-    let domain = match options.content_aware {
-        None => Domain::new(&positions, &mesh.triangles),
-        Some(scale) => {
-            let colors = colors.ok_or(WeightError::ColorCount(0, mesh.vertices.len()))?;
-            content_aware_domain(&positions, colors, scale, &mesh.triangles).map_err(
-                |e| match e {
-                    LiftError::InvalidScale(_) => WeightError::InvalidOptions(e.to_string()),
-                    LiftError::ColorCount(c, n) => WeightError::ColorCount(c, n),
-                },
-            )?
-        }
-    };
+    let (bc, touched, bound_to_nearest) = boundary_conditions(embedded, handles, binding);
+    let domain = weight_domain(mesh, colors, options)?;
     let mut unconverged = Vec::new();
     let mut w = match options.method {
         WeightMethod::Bbw if options.monotone => {
@@ -243,19 +330,57 @@ pub fn bound_part_weights(
             )
         }
     };
-    let empty = w.normalize_rows();
-    fill_empty_rows(&mut w, &empty, mesh, handles, binding);
-    let (_, domain_index) = embedded.shape_mesh();
-    let rows = domain_index
-        .iter()
-        .map(|&i| sparse_row(w.row(i), options))
-        .collect();
-    Ok(PartWeights {
-        rows,
+    normalize_rows(&mut w, mesh, handles, binding);
+    Ok(DomainWeights {
+        matrix: w,
         touched,
         bound_to_nearest,
         unconverged,
     })
+}
+
+/// The handles' boundary conditions on `embedded`'s domain vertices (only the columns in
+/// `binding`), with every piece no handle reaches bound to the nearest handle; also how many
+/// vertices each column fixes and the columns pieces were bound to.
+pub fn boundary_conditions(
+    embedded: &EmbeddedMesh,
+    handles: &Handles,
+    binding: &[bool],
+) -> (BoundaryConditions, Vec<usize>, Vec<usize>) {
+    let (mut bc, touched) = bound_boundary_conditions(&embedded.domain.vertices, handles, binding);
+    let bound_to_nearest = bind_free_pieces(embedded, handles, binding, &mut bc);
+    (bc, touched, bound_to_nearest)
+}
+
+/// The domain the weights are measured in: `mesh` in canvas px, or lifted by its vertices'
+/// `colors` with content-aware weights.
+pub fn weight_domain(
+    mesh: &crate::mesh::Mesh,
+    colors: Option<&[[f64; 3]]>,
+    options: &WeightOptions,
+) -> Result<Domain, WeightError> {
+    let positions: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
+    match options.content_aware {
+        None => Ok(Domain::new(&positions, &mesh.triangles)),
+        Some(scale) => {
+            let colors = colors.ok_or(WeightError::ColorCount(0, mesh.vertices.len()))?;
+            content_aware_domain(&positions, colors, scale, &mesh.triangles).map_err(|e| match e {
+                LiftError::InvalidScale(_) => WeightError::InvalidOptions(e.to_string()),
+                LiftError::ColorCount(c, n) => WeightError::ColorCount(c, n),
+            })
+        }
+    }
+}
+
+/// Rows scaled to sum to one; rows that every bound clamped to zero follow the nearest handle.
+pub fn normalize_rows(
+    w: &mut WeightMatrix,
+    mesh: &crate::mesh::Mesh,
+    handles: &Handles,
+    binding: &[bool],
+) {
+    let empty = w.normalize_rows();
+    fill_empty_rows(w, &empty, mesh, handles, binding);
 }
 
 /// Rows that every handle's bounds clamped to zero follow the nearest handle.

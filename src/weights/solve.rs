@@ -114,7 +114,7 @@ impl WeightMatrix {
             .collect()
     }
 
-    fn from_columns(vertex_count: usize, columns: &[Vec<f64>]) -> Self {
+    pub(super) fn from_columns(vertex_count: usize, columns: &[Vec<f64>]) -> Self {
         let handle_count = columns.len();
         let mut data = vec![0.0; vertex_count * handle_count];
         for (j, col) in columns.iter().enumerate() {
@@ -195,7 +195,7 @@ pub struct BbwReport {
 }
 
 /// Free vertices (not fixed by a handle), in ascending order.
-fn free_vertices(n: usize, bc: &BoundaryConditions) -> Vec<usize> {
+pub(super) fn free_vertices(n: usize, bc: &BoundaryConditions) -> Vec<usize> {
     let mut fixed = vec![false; n];
     for &v in &bc.vertices {
         fixed[v] = true;
@@ -204,7 +204,7 @@ fn free_vertices(n: usize, bc: &BoundaryConditions) -> Vec<usize> {
 }
 
 /// Handle j's full-length weight column with the fixed values in place and zeros elsewhere.
-fn fixed_column(n: usize, bc: &BoundaryConditions, j: usize) -> Vec<f64> {
+pub(super) fn fixed_column(n: usize, bc: &BoundaryConditions, j: usize) -> Vec<f64> {
     let mut w = vec![0.0; n];
     for (k, &v) in bc.vertices.iter().enumerate() {
         w[v] = bc.values[k * bc.handle_count + j];
@@ -214,7 +214,7 @@ fn fixed_column(n: usize, bc: &BoundaryConditions, j: usize) -> Vec<f64> {
 
 /// Fails when some vertex cannot be reached from a fixed vertex through the matrix's pattern
 /// (the mesh's edges): the system would be singular there.
-fn check_reachable(a: &CsMat<f64>, bc: &BoundaryConditions) -> Result<(), SolveError> {
+pub(super) fn check_reachable(a: &CsMat<f64>, bc: &BoundaryConditions) -> Result<(), SolveError> {
     let mut reached = vec![false; a.rows()];
     let mut stack: Vec<usize> = bc.vertices.clone();
     for &v in &stack {

@@ -7,9 +7,12 @@
 //
 //   node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json
 //
-// REQUEST.json: {"times": {"<animation>": [t, ...]}}. OUT.json: {"setup": Snapshot,
+// REQUEST.json: {"times": {"<animation>": [t, ...]}, "events": {"<animation>": [[lastTime,
+// time, loop], ...]}}. OUT.json: {"setup": Snapshot,
 // "animations": {"<name>": {"duration": d, "frames": [{"time": t, "slots": Snapshot}]}},
-// "warnings": [...]}; Snapshot = [{"name", "attachment", "color": [r, g, b, a],
+// "events": {"<name>": [[Event, ...] per step]}, "warnings": [...]}; Event = {"name", "time",
+// "int", "float", "string", "audio": null or {"path", "volume", "balance"}}: what Animation.apply fires moving
+// from lastTime to time; Snapshot = [{"name", "attachment", "color": [r, g, b, a],
 // "vertices": [x0, y0, ...]}] in draw order (vertices only for meshes).
 // Exit status: 0 when loaded (warnings are reported, not fatal), 2 when the runtime refuses it.
 import fs from "node:fs";
@@ -72,6 +75,24 @@ for (const [name, times] of Object.entries(request.times || {})) {
   });
   result.animations[name] = { duration: animation.duration, frames };
 }
+result.events = {};
+for (const [name, steps] of Object.entries(request.events || {})) {
+  const animation = data.findAnimation(name);
+  if (!animation) {
+    console.error(`no animation '${name}' in ${skeletonPath}`);
+    process.exit(2);
+  }
+  result.events[name] = steps.map(([lastTime, time, loop]) => {
+    setupPose();
+    const fired = [];
+    if (v43) animation.apply(skeleton, lastTime, time, loop, fired, 1, spine.MixFrom.setup, false, false, false);
+    else animation.apply(skeleton, lastTime, time, loop, fired, 1, spine.MixBlend.setup, spine.MixDirection.mixIn);
+    return fired.map((e) => ({
+      name: e.data.name, time: e.time, int: e.intValue, float: e.floatValue, string: e.stringValue,
+      audio: e.data.audioPath ? { path: e.data.audioPath, volume: e.volume, balance: e.balance } : null,
+    }));
+  });
+}
 fs.writeFileSync(outPath, JSON.stringify(result));
 
 // What SkeletonJson.js (4.2, or 4.3 where it differs) reads; anything else it ignores without a
@@ -105,6 +126,11 @@ function lint(json, atlas) {
     if (!v43 && k.order !== i) out.push(`ik ${k.name}: order ${k.order} at position ${i}`);
     for (const b of [...k.bones, k.target]) if (!boneIndex.has(b)) out.push(`ik ${k.name}: unknown bone ${b}`);
   });
+  const events = new Set(Object.keys(json.events || {}));
+  for (const [name, e] of Object.entries(json.events || {})) {
+    only(`event ${name}`, e, ["int", "float", "string", "audio", "volume", "balance"]);
+    if ((e.volume !== undefined || e.balance !== undefined) && !e.audio) out.push(`event ${name}: volume or balance without audio (not read)`);
+  }
   const slots = new Map();
   for (const s of json.slots || []) {
     only(`slot ${s.name}`, s, ["name", "bone", "color", "dark", "attachment", "blend", "visible"]);
@@ -186,6 +212,13 @@ function lint(json, atlas) {
     for (const [constraint, keys] of Object.entries(a.ik || {})) {
       if (!constraints.has(constraint)) out.push(`animation ${name}: unknown IK constraint ${constraint}`);
       keysOk(`animation ${name}, ik ${constraint}`, keys, ["mix", "softness", "bendPositive", "compress", "stretch"], 2);
+    }
+    let lastEvent = -Infinity;
+    for (const [i, k] of (a.events || []).entries()) {
+      only(`animation ${name}, events key ${i}`, k, ["time", "name", "int", "float", "string", "volume", "balance"]);
+      if (!events.has(k.name)) out.push(`animation ${name}, events key ${i}: unknown event ${k.name}`);
+      if (!((k.time || 0) >= lastEvent)) out.push(`animation ${name}, events key ${i}: time goes back`);
+      lastEvent = k.time || 0;
     }
     for (const [i, k] of (a.drawOrder || []).entries()) {
       only(`animation ${name}, drawOrder key ${i}`, k, ["time", "offsets"]);

@@ -249,6 +249,41 @@ fn an_empty_canvas_asks_for_images_and_takes_a_dropped_png() {
 }
 
 #[test]
+fn a_dropped_psd_becomes_its_visible_layers() {
+    let dir = scratch("drop-psd");
+    std::fs::create_dir_all(&dir).unwrap();
+    let psd = dir.join("character.psd");
+    let fixture =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/layered/character.psd");
+    std::fs::copy(fixture, &psd).unwrap();
+    let mut h = harness(EditorApp::new(Document::new()));
+    h.run();
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(psd.clone())));
+    h.run();
+    let names: Vec<String> = h
+        .state()
+        .doc
+        .state()
+        .layers
+        .iter()
+        .map(|l| l.name.clone())
+        .collect();
+    assert_eq!(
+        names,
+        ["torso", "arm_l/upper", "arm_l/hand", "head", "leaf"],
+        "{:?}",
+        h.state().message
+    );
+    // Hidden layers are not parts: the status bar says so.
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("'sketch' is hidden"), "{message}");
+    assert!(dir.join("character.parts/arm_l/hand.png").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn export_spine_from_its_window_refuses_to_write_over_the_document() {
     let mut h = open_character("export-window");
     let path = h.state().doc.path.clone().expect("a file");

@@ -14,6 +14,7 @@
 //! - [`atlas`]: trimmed regions packed into pages, premultiplied, and the atlas text;
 //! - [`timelines`]: sinew timelines as native Spine timelines with their curves;
 //! - [`constraints`]: one- and two-bone IK constraints as Spine IK constraints;
+//! - [`events`]: event definitions and event keys as Spine events;
 //! - [`bake`]: what Spine cannot express, sampled at `bake_fps` through the one pose path.
 //!
 //! Spine facts relied on are in `docs/spine-format.md` (the "spine-format.md §N" cited in these
@@ -24,6 +25,7 @@ pub mod atlas;
 pub mod bake;
 pub mod constraints;
 pub mod decimate;
+pub mod events;
 pub mod frame;
 pub mod mesh;
 pub mod played;
@@ -346,6 +348,9 @@ pub fn export_spine(
             return Err(SpineError::DuplicateConstraint(constraint.name.clone()));
         }
     }
+    for event in doc.events.keys() {
+        check_name("event", event, false)?;
+    }
     let exported_ik = constraints::exported(&doc.handles);
     let frame = SpineFrame::for_canvas(doc.canvas);
     let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
@@ -474,6 +479,12 @@ pub fn export_spine(
         }
         if let Some(d) = draw_order {
             a.insert("drawOrder".into(), d);
+        }
+        if !animation.events.is_empty() {
+            a.insert(
+                "events".into(),
+                events::event_timeline(&animation.events, &doc.events),
+            );
         }
         animations_json.insert(anim_name.clone(), Value::Object(a));
         baked_report.push((
@@ -625,6 +636,9 @@ fn skeleton_json(
     });
     if !ik.is_empty() {
         out[constraints::block_key(options.version)] = Value::from(ik);
+    }
+    if !doc.events.is_empty() {
+        out["events"] = events::event_defs_json(&doc.events);
     }
     // serde_json writes f64 as the shortest text that reads back exactly: lossless, and the
     // same bytes for the same rig. Compact: the weighted vertex arrays are long.

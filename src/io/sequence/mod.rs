@@ -35,6 +35,8 @@ use std::path::{Path, PathBuf};
 pub enum SequenceError {
     #[error("no frames to write")]
     NoFrames,
+    #[error("{events} lists of frame events for {frames} frames")]
+    EventFrames { frames: usize, events: usize },
     #[error("frame {index} has no pixels ({width}×{height} px)")]
     EmptyFrame {
         index: usize,
@@ -137,9 +139,11 @@ pub fn format_for_path(path: &Path) -> Result<SequenceFormat, SequenceError> {
 }
 
 /// Writes `frames` (straight alpha, `fps` frames per second) to `path` in the format its
-/// extension asks for (see [`format_for_path`]).
+/// extension asks for (see [`format_for_path`]). `events` (empty, or one list per frame: what
+/// each frame fires) go into a sprite sheet's JSON; a GIF or a folder has no place for them.
 pub fn write_sequence(
     frames: &[RgbaImage],
+    events: &[Vec<crate::anim::FiredEvent>],
     fps: f64,
     path: &Path,
     options: &SequenceOptions,
@@ -147,7 +151,7 @@ pub fn write_sequence(
     match format_for_path(path)? {
         SequenceFormat::Folder => write_folder(frames, fps, path),
         SequenceFormat::Gif => write_gif(frames, fps, path, &options.gif),
-        SequenceFormat::Sheet => write_sheet(frames, fps, path, &options.sheet),
+        SequenceFormat::Sheet => write_sheet(frames, events, fps, path, &options.sheet),
     }
 }
 

@@ -9,7 +9,8 @@
 //! ```json
 //! { "frames": { "NAME_0000.png": { "frame": {"x","y","w","h"}, "rotated": false,
 //!                                   "trimmed": true, "spriteSourceSize": {"x","y","w","h"},
-//!                                   "sourceSize": {"w","h"}, "duration": 42 }, … },
+//!                                   "sourceSize": {"w","h"}, "duration": 42,
+//!                                   "events": [ … ] }, … },
 //!   "animations": { "NAME": ["NAME_0000.png", …] },
 //!   "meta": { "app": "sinew", "version": "…", "image": "NAME.png", "format": "RGBA8888",
 //!             "size": {"w","h"}, "scale": "1",
@@ -22,10 +23,16 @@
 //! so use [`FrameNaming::Index`] for it; with the default names, Phaser users call
 //! `anims.generateFrameNames(key, {prefix: "NAME_", suffix: ".png", zeroPad: 4, end: N-1})`.
 //! Frames with identical trimmed pixels share one rectangle (TexturePacker's "alias").
+//! `events` (sinew's; importers ignore it) lists the animation's events the frame fires
+//! ([`crate::anim::frame_events`]: those after the previous frame's time up to its own; frame 0
+//! also those after the last frame, fired as the loop wraps), each
+//! `{"name", "time", "int", "float", "string", "audio"?, "volume", "balance"}`; it is left out
+//! for a frame that fires none.
 
 use super::folder::digits_for;
 use super::timing::{frame_durations, MS_PER_S};
 use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
+use crate::anim::FiredEvent;
 use crate::geom::pack::{pack_shelves, ShelfLayout};
 use crate::io::image::encode_png;
 use image::RgbaImage;
@@ -113,6 +120,9 @@ pub struct FrameEntry {
     pub source_size: PxSize,
     /// How long the frame shows, ms.
     pub duration: u32,
+    /// The events the frame fires (see the module doc); left out when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<FiredEvent>,
 }
 
 /// A built sheet: the image and the frame map.
@@ -126,9 +136,11 @@ pub struct Sheet {
 }
 
 /// Builds the sheet of `frames` at `fps`; `name` names the animation (and prefixes frame names),
-/// `image_file` is the sheet's file name written as `meta.image`.
+/// `image_file` is the sheet's file name written as `meta.image`. `events[i]` are the events
+/// frame `i` fires (empty, or one list per frame).
 pub fn build_sheet(
     frames: &[RgbaImage],
+    events: &[Vec<FiredEvent>],
     fps: f64,
     name: &str,
     image_file: &str,
@@ -136,6 +148,12 @@ pub fn build_sheet(
 ) -> Result<Sheet, SequenceError> {
     let (width, height) = check_frames(frames)?;
     check_fps(fps)?;
+    if !(events.is_empty() || events.len() == frames.len()) {
+        return Err(SequenceError::EventFrames {
+            frames: frames.len(),
+            events: events.len(),
+        });
+    }
     let full = PxRect {
         x: 0,
         y: 0,
@@ -215,6 +233,7 @@ pub fn build_sheet(
                     h: height,
                 },
                 duration: durations[i],
+                events: events.get(i).cloned().unwrap_or_default(),
             };
             (frame_name, entry)
         })
@@ -256,9 +275,11 @@ pub fn build_sheet(
     })
 }
 
-/// Writes the sheet `path` (`NAME.png`) and its frame map `NAME.json`.
+/// Writes the sheet `path` (`NAME.png`) and its frame map `NAME.json` (with `events`, see
+/// [`build_sheet`]).
 pub fn write_sheet(
     frames: &[RgbaImage],
+    events: &[Vec<FiredEvent>],
     fps: f64,
     path: &Path,
     options: &SheetOptions,
@@ -271,7 +292,7 @@ pub fn write_sheet(
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let sheet = build_sheet(frames, fps, &name, &image_file, options)?;
+    let sheet = build_sheet(frames, events, fps, &name, &image_file, options)?;
     let png = encode_png(&sheet.image).map_err(|e| SequenceError::Encode {
         path: path.into(),
         reason: e.to_string(),

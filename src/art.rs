@@ -1,0 +1,173 @@
+//! The art a rig is made from: PNG layers (each covering the whole canvas) and layered files
+//! (PSD/PSB, OpenRaster, a Spine script's JSON + trimmed PNGs, see [`crate::io::layered`]),
+//! in any mix, as the pipeline's [`Layer`]s.
+//!
+//! In: paths in draw order (back to front) and the folder where a layered file's parts will be
+//! written ([`ArtOptions::parts_dir`]). Out: [`Art`]: one [`Layer`] per PNG and per visible pixel
+//! layer of a layered file (named by its group path, `arm_l/hand`, its image the layer placed
+//! on the canvas with its opacity), the notes a person should read (skipped layers), and which
+//! layers still have to be written ([`Art::write_parts`]) before a document may refer to them.
+//! Hidden layers do not become parts (a note says so). Layers are expanded to the canvas here
+//! because every later stage takes canvas-sized part images.
+
+use crate::io::layered::{self, LayeredFormat, LayeredLimits};
+use crate::io::{self, ImageError};
+use crate::pipeline::{checked_layers, Layer, PipelineError};
+use std::path::{Path, PathBuf};
+
+/// Where layered files' parts go, and the limits their reading obeys.
+#[derive(Clone, Debug, Default)]
+pub struct ArtOptions {
+    /// Folder for the part images of layered files: `PARTS_DIR/arm_l/hand.png`. The command
+    /// line uses `RIG.parts` beside the rig document it writes.
+    pub parts_dir: PathBuf,
+    pub limits: LayeredLimits,
+}
+
+/// Layers ready for the pipeline.
+#[derive(Clone, Debug)]
+pub struct Art {
+    pub layers: Vec<Layer>,
+    /// One line each: what was skipped or drawn differently, naming the layer and file.
+    pub notes: Vec<String>,
+    /// Indices into `layers` of the images to write (those from layered files).
+    pub unwritten: Vec<usize>,
+}
+
+impl Art {
+    /// The files [`Art::write_parts`] will write.
+    pub fn part_paths(&self) -> impl Iterator<Item = &Path> {
+        self.unwritten
+            .iter()
+            .map(|&i| self.layers[i].path.as_path())
+    }
+
+    /// Writes the images of the layers from layered files as one set (`io::atomic::write_set`:
+    /// all written to temporaries, then renamed; a failure leaves none), creating their
+    /// folders. Returns the paths written.
+    pub fn write_parts(&self) -> Result<Vec<PathBuf>, ImageError> {
+        let mut files = Vec::with_capacity(self.unwritten.len());
+        for &i in &self.unwritten {
+            let layer = &self.layers[i];
+            let bytes = io::image::encode_png(&layer.image).map_err(|e| ImageError::Encode {
+                path: layer.path.clone(),
+                reason: e.to_string(),
+            })?;
+            if let Some(dir) = layer.path.parent() {
+                std::fs::create_dir_all(dir).map_err(|source| ImageError::Write {
+                    path: layer.path.clone(),
+                    source,
+                })?;
+            }
+            files.push((layer.path.clone(), bytes));
+        }
+        io::atomic::write_set(&files)
+            .map_err(|(path, source)| ImageError::Write { path, source })?;
+        Ok(files.into_iter().map(|(path, _)| path).collect())
+    }
+}
+
+/// Whether `path` names a layered file by its extension (`.psd`, `.psb`, `.ora`, `.json`).
+pub fn is_layered(path: &Path) -> bool {
+    LayeredFormat::of(path).is_some()
+}
+
+/// The image file of the part at `layer_path` (`arm_l/hand`) under `parts_dir`: each name of
+/// the path made a safe file name (characters other than letters, digits, `-`, `_`, `.` and
+/// space become `_`; `.` and `..` become `_`).
+pub fn part_image_path(parts_dir: &Path, layer_path: &str) -> PathBuf {
+    let mut out = parts_dir.to_path_buf();
+    let names: Vec<String> = layer_path
+        .split('/')
+        .map(|name| {
+            let safe: String = name
+                .chars()
+                .map(|c| {
+                    if c.is_alphanumeric() || "-_. ".contains(c) {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            match safe.trim() {
+                "" | "." | ".." => "_".to_string(),
+                s => s.to_string(),
+            }
+        })
+        .collect();
+    for (i, name) in names.iter().enumerate() {
+        if i + 1 == names.len() {
+            out.push(format!("{name}.png"));
+        } else {
+            out.push(name);
+        }
+    }
+    out
+}
+
+/// Loads PNG layers and layered files as the layers of one canvas (see the module docs).
+pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, PipelineError> {
+    let mut layers = Vec::new();
+    let mut notes = Vec::new();
+    let mut unwritten = Vec::new();
+    for path in paths {
+        if !is_layered(path) {
+            layers.push(Layer {
+                name: path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                path: path.clone(),
+                image: io::load_png(path)?,
+            });
+            continue;
+        }
+        let file = layered::load_layered(path, &options.limits)?;
+        let shown = path.display();
+        notes.extend(file.warnings.iter().map(|w| format!("{shown}: {w}")));
+        for l in &file.layers {
+            if !l.visible {
+                notes.push(format!("{shown}: layer '{}' is hidden; not a part", l.path));
+                continue;
+            }
+            let image = layered::canvas_image(l, file.canvas_px);
+            if image.pixels().all(|p| p[3] == 0) {
+                notes.push(format!(
+                    "{shown}: layer '{}' lies outside the canvas; not a part",
+                    l.path
+                ));
+                continue;
+            }
+            unwritten.push(layers.len());
+            layers.push(Layer {
+                name: l.path.clone(),
+                path: part_image_path(&options.parts_dir, &l.path),
+                image,
+            });
+        }
+    }
+    Ok(Art {
+        layers: checked_layers(layers)?,
+        notes,
+        unwritten,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn part_paths_are_safe_file_names() {
+        let dir = Path::new("rig.parts");
+        assert_eq!(
+            part_image_path(dir, "arm_l/hand"),
+            dir.join("arm_l").join("hand.png")
+        );
+        assert_eq!(
+            part_image_path(dir, "../x:y/.."),
+            dir.join("_").join("x_y").join("_.png")
+        );
+    }
+}

@@ -1,0 +1,225 @@
+//! Trimmed PNGs with their positions, as Spine's export scripts write them (PhotoshopToSpine,
+//! GimpToSpine, the Krita and Affinity scripts): a skeleton JSON whose slots hold region
+//! attachments (centre `x`, `y` and `width`, `height`, Spine units = px, y up, relative to
+//! their bone) next to a folder of trimmed PNGs.
+//!
+//! In: the JSON's path (the PNGs are found under `skeleton.images`, relative to the JSON's
+//! folder, named after each attachment's `path` or name). Out: the raw layers for
+//! [`build_layers`], back to front in slot order, on the canvas that bounds them all (the
+//! scripts do not record the document's size). Slots with no setup attachment are hidden
+//! layers. Bones may translate; bones or attachments that rotate or scale are refused, as are
+//! attachments other than regions (skipped with a warning).
+
+use super::tree::{build_layers, RawLayer, RawNode};
+use super::{check_size, read_limited, BlendMode, LayeredError, LayeredImage, LayeredLimits};
+use image::codecs::png::PngDecoder;
+use image::{DynamicImage, ImageDecoder};
+use serde_json::Value;
+use std::collections::HashMap;
+use std::io::Cursor;
+use std::path::Path;
+
+fn bad(reason: impl Into<String>) -> LayeredError {
+    LayeredError::Malformed(reason.into())
+}
+
+/// Reads a Spine skeleton JSON of region attachments and the PNGs it names.
+pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, LayeredError> {
+    let bytes = read_limited(path, limits)?;
+    let json: Value = serde_json::from_slice(&bytes)
+        .map_err(|e| bad(format!("not a Spine skeleton JSON: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let images = json
+        .pointer("/skeleton/images")
+        .and_then(Value::as_str)
+        .unwrap_or("");
+    let images = dir.join(images);
+    let bones = bone_positions(&json)?;
+    let skin = default_skin(&json)?;
+    let slots = json
+        .get("slots")
+        .and_then(Value::as_array)
+        .ok_or_else(|| bad("no \"slots\" array: not a Spine skeleton"))?;
+    let mut warnings = Vec::new();
+    struct Placed {
+        name: String,
+        visible: bool,
+        center: [f64; 2],
+        image: image::RgbaImage,
+    }
+    let mut placed = Vec::new();
+    let mut total_px = 0;
+    for slot in slots {
+        let slot_name = slot.get("name").and_then(Value::as_str).unwrap_or("");
+        let bone = slot.get("bone").and_then(Value::as_str).unwrap_or("root");
+        let bone_at = *bones
+            .get(bone)
+            .ok_or_else(|| bad(format!("slot '{slot_name}': unknown bone '{bone}'")))?;
+        let Some(attachments) = skin.get(slot_name).and_then(Value::as_object) else {
+            continue;
+        };
+        let setup = slot.get("attachment").and_then(Value::as_str);
+        let (name, att) = match setup.and_then(|s| attachments.get_key_value(s)) {
+            Some(found) => found,
+            None => match attachments.iter().next() {
+                Some(first) => first,
+                None => continue,
+            },
+        };
+        let visible = setup == Some(name.as_str());
+        let kind = att.get("type").and_then(Value::as_str).unwrap_or("region");
+        if kind != "region" {
+            warnings.push(format!(
+                "attachment '{name}': {kind} attachments are not read; skipped"
+            ));
+            continue;
+        }
+        let f = |k: &str, default: f64| att.get(k).and_then(Value::as_f64).unwrap_or(default);
+        if f("rotation", 0.0) != 0.0 || f("scaleX", 1.0) != 1.0 || f("scaleY", 1.0) != 1.0 {
+            return Err(LayeredError::Unsupported(format!(
+                "attachment '{name}' is rotated or scaled; sinew reads unrotated, unscaled regions"
+            )));
+        }
+        let file = att.get("path").and_then(Value::as_str).unwrap_or(name);
+        let png = images.join(format!("{file}.png"));
+        let image = load_png(&png, limits, &mut total_px)?;
+        let (w, h) = (
+            f("width", image.width() as f64),
+            f("height", image.height() as f64),
+        );
+        if (w - image.width() as f64).abs() > 0.5 || (h - image.height() as f64).abs() > 0.5 {
+            warnings.push(format!(
+                "attachment '{name}': {w}×{h} in the JSON but {}×{} px in {}; placed by its centre",
+                image.width(),
+                image.height(),
+                png.display()
+            ));
+        }
+        placed.push(Placed {
+            name: name.clone(),
+            visible,
+            center: [bone_at[0] + f("x", 0.0), bone_at[1] + f("y", 0.0)],
+            image,
+        });
+    }
+    // Top-left corners in y-down px: the scripts write centres either exactly (Photoshop:
+    // `left + width / 2`) or floored (GIMP: `left + floor(width / 2)`); flooring the corner
+    // plus half a pixel recovers the integer corner from both.
+    let corner = |p: &Placed| {
+        let (w, h) = (p.image.width() as f64, p.image.height() as f64);
+        [
+            (p.center[0] - w / 2.0 + 0.5).floor(),
+            (-p.center[1] - h / 2.0 + 0.5).floor(),
+        ]
+    };
+    let left = placed
+        .iter()
+        .map(|p| corner(p)[0])
+        .fold(f64::INFINITY, f64::min);
+    let top = placed
+        .iter()
+        .map(|p| corner(p)[1])
+        .fold(f64::INFINITY, f64::min);
+    let mut size = [0u32; 2];
+    let mut nodes = Vec::new();
+    for p in placed {
+        let [l, t] = corner(&p);
+        let offset_px = [(l - left) as i32, (t - top) as i32];
+        size[0] = size[0].max(offset_px[0] as u32 + p.image.width());
+        size[1] = size[1].max(offset_px[1] as u32 + p.image.height());
+        nodes.push(RawNode::Layer(RawLayer {
+            name: p.name,
+            offset_px,
+            image: p.image,
+            opacity: 1.0,
+            visible: p.visible,
+            blend: BlendMode::Normal,
+            clipped: false,
+        }));
+    }
+    if nodes.is_empty() {
+        return Err(LayeredError::NoLayers);
+    }
+    check_size("the canvas", size.map(u64::from), &mut 0, limits)?;
+    build_layers(size, nodes, warnings, limits)
+}
+
+/// Each bone's world position (the sum of its and its parents' `x`, `y`).
+fn bone_positions(json: &Value) -> Result<HashMap<String, [f64; 2]>, LayeredError> {
+    let mut at: HashMap<String, [f64; 2]> = HashMap::new();
+    let bones = json
+        .get("bones")
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
+    // Spine lists parents before children.
+    for bone in &bones {
+        let name = bone
+            .get("name")
+            .and_then(Value::as_str)
+            .ok_or_else(|| bad("a bone without a name"))?;
+        let f = |k: &str, d: f64| bone.get(k).and_then(Value::as_f64).unwrap_or(d);
+        if f("rotation", 0.0) != 0.0 || f("scaleX", 1.0) != 1.0 || f("scaleY", 1.0) != 1.0 {
+            return Err(LayeredError::Unsupported(format!(
+                "bone '{name}' is rotated or scaled; sinew reads bones that only translate"
+            )));
+        }
+        let base = match bone.get("parent").and_then(Value::as_str) {
+            Some(p) => *at
+                .get(p)
+                .ok_or_else(|| bad(format!("bone '{name}': parent '{p}' not listed before it")))?,
+            None => [0.0, 0.0],
+        };
+        at.insert(
+            name.to_string(),
+            [base[0] + f("x", 0.0), base[1] + f("y", 0.0)],
+        );
+    }
+    at.entry("root".into()).or_insert([0.0, 0.0]);
+    Ok(at)
+}
+
+/// The default skin's slot → attachments map (Spine 3.8+'s array of skins or the older
+/// object of skins).
+fn default_skin(json: &Value) -> Result<serde_json::Map<String, Value>, LayeredError> {
+    let skins = json
+        .get("skins")
+        .ok_or_else(|| bad("no \"skins\": not a Spine skeleton"))?;
+    let found = match skins {
+        Value::Array(list) => list
+            .iter()
+            .find(|s| s.get("name").and_then(Value::as_str) == Some("default"))
+            .or(list.first())
+            .and_then(|s| s.get("attachments")),
+        Value::Object(map) => map.get("default").or(map.values().next()),
+        _ => None,
+    };
+    found
+        .and_then(Value::as_object)
+        .cloned()
+        .ok_or_else(|| bad("no skin with attachments"))
+}
+
+fn load_png(
+    path: &Path,
+    limits: &LayeredLimits,
+    total_px: &mut u64,
+) -> Result<image::RgbaImage, LayeredError> {
+    let entry = |reason: String| LayeredError::Entry {
+        entry: path.display().to_string(),
+        reason,
+    };
+    let bytes = read_limited(path, limits).map_err(|e| entry(e.to_string()))?;
+    let decoder = PngDecoder::new(Cursor::new(&bytes))
+        .map_err(|e| entry(format!("cannot decode PNG: {e}")))?;
+    let (w, h) = decoder.dimensions();
+    check_size(
+        &path.display().to_string(),
+        [w as u64, h as u64],
+        total_px,
+        limits,
+    )?;
+    Ok(DynamicImage::from_decoder(decoder)
+        .map_err(|e| entry(format!("cannot decode PNG: {e}")))?
+        .into_rgba8())
+}

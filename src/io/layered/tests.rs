@@ -1,0 +1,282 @@
+//! Unit tests of the layered readers on small files built here byte by byte (what the art
+//! tools of tests/layered.rs do not write: masks, clipping, deep nesting, zip bombs).
+
+use super::*;
+use std::io::Write;
+
+/// A test layer mask: rectangle (top, left, bottom, right), value per mask pixel, default
+/// outside.
+type TestMask = ([i32; 4], fn(u32, u32) -> u8, u8);
+
+/// A layer of a test PSD: raw channels.
+struct L {
+    name: &'static str,
+    /// top, left, bottom, right.
+    rect: [i32; 4],
+    pixel: fn(u32, u32) -> [u8; 4],
+    mask: Option<TestMask>,
+    clipped: bool,
+    hidden: bool,
+    /// `lsct` divider type (1 group start, 3 group end).
+    section: Option<u32>,
+}
+
+fn layer(name: &'static str, rect: [i32; 4], pixel: fn(u32, u32) -> [u8; 4]) -> L {
+    L {
+        name,
+        rect,
+        pixel,
+        mask: None,
+        clipped: false,
+        hidden: false,
+        section: None,
+    }
+}
+
+fn divider(name: &'static str, kind: u32) -> L {
+    L {
+        section: Some(kind),
+        ..layer(name, [0, 0, 0, 0], |_, _| [0; 4])
+    }
+}
+
+fn be32(v: &mut Vec<u8>, x: u32) {
+    v.extend_from_slice(&x.to_be_bytes());
+}
+
+fn size(rect: [i32; 4]) -> (u32, u32) {
+    ((rect[3] - rect[1]) as u32, (rect[2] - rect[0]) as u32)
+}
+
+/// An 8-bit RGB PSD of `w`×`h` with `layers` bottom first, all channels raw.
+fn psd(w: u32, h: u32, layers: &[L]) -> Vec<u8> {
+    let mut info = Vec::new();
+    info.extend_from_slice(&(layers.len() as i16).to_be_bytes());
+    let mut data = Vec::new();
+    for l in layers {
+        for v in l.rect {
+            info.extend_from_slice(&v.to_be_bytes());
+        }
+        let (lw, lh) = size(l.rect);
+        let mut channels: Vec<(i16, Vec<u8>)> = (0..4)
+            .map(|c| {
+                let id = if c == 3 { -1 } else { c as i16 };
+                let mut plane = Vec::new();
+                for y in 0..lh {
+                    for x in 0..lw {
+                        plane.push((l.pixel)(x, y)[c]);
+                    }
+                }
+                (id, plane)
+            })
+            .collect();
+        if let Some((rect, value, _)) = l.mask {
+            let (mw, mh) = size(rect);
+            let plane = (0..mh)
+                .flat_map(|y| (0..mw).map(move |x| value(x, y)))
+                .collect();
+            channels.push((-2, plane));
+        }
+        info.extend_from_slice(&(channels.len() as u16).to_be_bytes());
+        for (id, plane) in &channels {
+            info.extend_from_slice(&id.to_be_bytes());
+            be32(&mut info, plane.len() as u32 + 2);
+            data.extend_from_slice(&[0, 0]);
+            data.extend_from_slice(plane);
+        }
+        info.extend_from_slice(b"8BIMnorm");
+        info.extend_from_slice(&[255, l.clipped as u8, if l.hidden { 2 } else { 0 }, 0]);
+        let mut extra = Vec::new();
+        match l.mask {
+            Some((rect, _, default)) => {
+                be32(&mut extra, 20);
+                for v in rect {
+                    extra.extend_from_slice(&v.to_be_bytes());
+                }
+                extra.extend_from_slice(&[default, 0, 0, 0]);
+            }
+            None => be32(&mut extra, 0),
+        }
+        be32(&mut extra, 0);
+        let name = l.name.as_bytes();
+        extra.push(name.len() as u8);
+        extra.extend_from_slice(name);
+        extra.extend(std::iter::repeat_n(0u8, (4 - (name.len() + 1) % 4) % 4));
+        if let Some(kind) = l.section {
+            extra.extend_from_slice(b"8BIMlsct");
+            be32(&mut extra, 4);
+            be32(&mut extra, kind);
+        }
+        be32(&mut info, extra.len() as u32);
+        info.extend_from_slice(&extra);
+    }
+    info.extend_from_slice(&data);
+    let mut out = Vec::new();
+    out.extend_from_slice(b"8BPS\0\x01\0\0\0\0\0\0\0\x03");
+    be32(&mut out, h);
+    be32(&mut out, w);
+    out.extend_from_slice(&[0, 8, 0, 3]);
+    be32(&mut out, 0);
+    be32(&mut out, 0);
+    be32(&mut out, info.len() as u32 + 8);
+    be32(&mut out, info.len() as u32);
+    out.extend_from_slice(&info);
+    be32(&mut out, 0);
+    out.extend_from_slice(&[0, 0]);
+    out.extend(std::iter::repeat_n(0u8, (w * h * 3) as usize));
+    out
+}
+
+const RED: fn(u32, u32) -> [u8; 4] = |_, _| [255, 0, 0, 255];
+const BLUE: fn(u32, u32) -> [u8; 4] = |_, _| [0, 0, 255, 255];
+
+#[test]
+fn psd_masks_clipping_and_trimming() {
+    let left_half: fn(u32, u32) -> [u8; 4] = |x, _| [255, 0, 0, if x < 4 { 255 } else { 0 }];
+    let masked = L {
+        mask: Some(([0, 0, 8, 8], |_, y| if y < 4 { 0 } else { 255 }, 0)),
+        ..layer("masked", [0, 0, 8, 8], BLUE)
+    };
+    let shade = L {
+        clipped: true,
+        ..layer("shade", [0, 0, 8, 8], BLUE)
+    };
+    let bytes = psd(
+        8,
+        8,
+        &[layer("base", [0, 0, 8, 8], left_half), shade, masked],
+    );
+    let img = psd::parse(&bytes, &LayeredLimits::default()).unwrap();
+    let names: Vec<_> = img.layers.iter().map(|l| l.path.as_str()).collect();
+    assert_eq!(names, ["base", "shade", "masked"]);
+    // Trimmed to the opaque half; the clipped layer to its base's pixels; the mask to its rows.
+    assert_eq!(img.layers[0].image.dimensions(), (4, 8));
+    assert_eq!(img.layers[1].image.dimensions(), (4, 8));
+    assert_eq!(img.layers[2].image.dimensions(), (8, 4));
+    assert_eq!(img.layers[2].offset_px, [0, 4]);
+}
+
+#[test]
+fn psd_groups_give_paths_and_deep_nesting_is_refused() {
+    let groups = |depth: usize| {
+        let mut layers = Vec::new();
+        for _ in 0..depth {
+            layers.push(divider("</Layer group>", 3));
+        }
+        layers.push(layer("leaf", [1, 1, 5, 5], RED));
+        layers.push(L {
+            hidden: true,
+            ..layer("ghost", [1, 1, 5, 5], RED)
+        });
+        for _ in 0..depth {
+            layers.push(divider("g", 1));
+        }
+        psd(8, 8, &layers)
+    };
+    let img = psd::parse(&groups(3), &LayeredLimits::default()).unwrap();
+    assert_eq!(img.layers[0].path, "g/g/g/leaf");
+    assert!(img.layers[0].visible && !img.layers[1].visible);
+    let e = psd::parse(&groups(64), &LayeredLimits::default()).unwrap_err();
+    assert!(matches!(e, LayeredError::TooDeep { .. }), "{e}");
+}
+
+#[test]
+fn psd_empty_and_off_canvas_layers() {
+    let bytes = psd(
+        8,
+        8,
+        &[
+            layer("empty", [0, 0, 0, 0], RED),
+            layer("away", [100, 100, 104, 104], RED),
+            layer("body", [0, 0, 4, 4], RED),
+        ],
+    );
+    let img = psd::parse(&bytes, &LayeredLimits::default()).unwrap();
+    assert_eq!(img.warnings, ["layer 'empty': empty layer; skipped"]);
+    // Off the canvas but kept, at its place: the caller decides (sinew rig drops it).
+    assert_eq!(img.layers[0].offset_px, [100, 100]);
+    let only_empty = psd(8, 8, &[layer("empty", [0, 0, 0, 0], RED)]);
+    assert!(matches!(
+        psd::parse(&only_empty, &LayeredLimits::default()),
+        Err(LayeredError::NoLayers)
+    ));
+}
+
+/// An ORA zip of `entries` (deflated).
+fn ora_zip(entries: &[(&str, &[u8])]) -> Vec<u8> {
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    for (name, bytes) in entries {
+        zip.start_file(*name, options).unwrap();
+        zip.write_all(bytes).unwrap();
+    }
+    zip.finish().unwrap().into_inner()
+}
+
+fn png(w: u32, h: u32) -> Vec<u8> {
+    crate::io::image::encode_png(&image::RgbaImage::from_pixel(
+        w,
+        h,
+        image::Rgba([9, 9, 9, 255]),
+    ))
+    .unwrap()
+}
+
+#[test]
+fn ora_stacks_merge_and_refusals() {
+    let dot = png(2, 2);
+    let stack = br#"<image w="10" h="10"><stack>
+        <stack name="arm [merge]" x="1" y="1">
+          <layer name="a" src="a.png" x="0" y="0"/>
+          <layer name="b" src="a.png" x="3" y="3" opacity="0.5"/>
+        </stack>
+        <layer name="body" src="a.png" x="5" y="6" visibility="hidden"/>
+      </stack></image>"#;
+    let bytes = ora_zip(&[
+        ("mimetype", b"image/openraster"),
+        ("stack.xml", stack),
+        ("a.png", &dot),
+    ]);
+    let img = ora::parse(&bytes, &LayeredLimits::default()).unwrap();
+    let names: Vec<_> = img
+        .layers
+        .iter()
+        .map(|l| (l.path.as_str(), l.visible))
+        .collect();
+    // First in stack.xml is the top: back to front it comes last.
+    assert_eq!(names, [("body", false), ("arm", true)]);
+    // The merged group spans both children, offset by the stack's x/y.
+    assert_eq!(img.layers[1].offset_px, [1, 1]);
+    assert_eq!(img.layers[1].image.dimensions(), (5, 5));
+
+    let e = ora::parse(&ora_zip(&[("a.png", &dot)]), &LayeredLimits::default()).unwrap_err();
+    assert!(e.to_string().contains("stack.xml: missing"), "{e}");
+
+    let deep = format!(
+        r#"<image w="4" h="4">{}<layer src="a.png"/>{}</image>"#,
+        "<stack>".repeat(65),
+        "</stack>".repeat(65)
+    );
+    let e = ora::parse(
+        &ora_zip(&[("stack.xml", deep.as_bytes()), ("a.png", &dot)]),
+        &LayeredLimits::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, LayeredError::TooDeep { .. }), "{e}");
+
+    // A zip bomb: 8 MiB of zeros deflate to a few kB; the entry limit stops the read.
+    let zeros = vec![0u8; 8 << 20];
+    let bomb = ora_zip(&[("stack.xml", &zeros)]);
+    assert!(bomb.len() < 100_000);
+    let limits = LayeredLimits {
+        max_entry_bytes: 1 << 20,
+        ..LayeredLimits::default()
+    };
+    let e = ora::parse(&bomb, &limits).unwrap_err();
+    assert!(e.to_string().contains("max_entry_bytes"), "{e}");
+    assert!(matches!(
+        ora::parse(b"PK\x03\x04garbage", &limits),
+        Err(LayeredError::Zip(_))
+    ));
+}

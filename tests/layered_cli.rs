@@ -1,0 +1,117 @@
+//! `sinew rig` and `sinew autorig` on layered files written by real tools
+//! (tests/fixtures/layered, see tools/layered-fixtures/run.sh): the rest pose of the rig
+//! renders the tool's own flattened image; bad files are refused with one line, exit code 2,
+//! and nothing written.
+
+mod command;
+
+use command::{assert_bad_input, s, scratch, sinew};
+use image::RgbaImage;
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/layered")
+        .join(name)
+}
+
+fn ok(args: &[&str]) -> String {
+    let out = sinew(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// PSNR (dB) of premultiplied RGBA over the canvas.
+fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
+    assert_eq!(a.dimensions(), b.dimensions());
+    let pre = |p: &image::Rgba<u8>, c: usize| {
+        if c == 3 {
+            p[3] as f64
+        } else {
+            p[c] as f64 * p[3] as f64 / 255.0
+        }
+    };
+    let (mut se, mut n) = (0.0, 0.0);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        for c in 0..4 {
+            se += (pre(p, c) - pre(q, c)).powi(2);
+            n += 1.0;
+        }
+    }
+    10.0 * (255.0f64.powi(2) / (se / n).max(1e-12)).log10()
+}
+
+/// Autorig, rig with the proposed handles, draw the rest pose: it is the tool's flattening.
+fn rest_pose_matches(file: &str, reference: &RgbaImage, name: &str) {
+    let dir = scratch(name);
+    let (handles, rig, rest) = (
+        dir.join("handles.json"),
+        dir.join("rig.json"),
+        dir.join("rest.png"),
+    );
+    let art = fixture(file);
+    ok(&["autorig", s(&art), "-o", s(&handles)]);
+    let report = ok(&["rig", s(&art), "--handles", s(&handles), "-o", s(&rig)]);
+    assert!(
+        report.contains("layer 'sketch' is hidden; not a part"),
+        "{report}"
+    );
+    ok(&["pose", s(&rig), "-o", s(&rest)]);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    let parts: Vec<&str> = doc["parts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        parts,
+        ["torso", "arm_l/upper", "arm_l/hand", "head", "leaf"]
+    );
+    assert!(dir.join("rig.parts/arm_l/hand.png").is_file());
+    let rest = image::open(&rest).unwrap().into_rgba8();
+    let db = psnr(&rest, reference);
+    println!("{file}: rest pose vs the tool's flattened image: PSNR {db:.1} dB");
+    assert!(db >= 40.0, "{file}: PSNR {db:.1} dB");
+}
+
+#[test]
+fn psd_rig_rest_pose_renders_psd_tools_composite() {
+    let reference = image::open(fixture("character.composite.png"))
+        .unwrap()
+        .into_rgba8();
+    rest_pose_matches("character.psd", &reference, "psd");
+}
+
+#[test]
+fn krita_ora_rig_rest_pose_renders_kritas_merged_image() {
+    let bytes = std::fs::read(fixture("krita.ora")).unwrap();
+    let reference = sinew::io::layered::ora::merged_image(&bytes).unwrap();
+    rest_pose_matches("krita.ora", &reference, "ora");
+}
+
+#[test]
+fn bad_layered_files_are_refused_and_nothing_is_written() {
+    let dir = scratch("bad");
+    let rig = dir.join("rig.json");
+    let cut = dir.join("cut.psd");
+    let bytes = std::fs::read(fixture("character.psd")).unwrap();
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).unwrap();
+    assert_bad_input(&["rig", s(&cut), "-o", s(&rig)], "truncated");
+    assert_bad_input(&["rig", s(&fixture("deep16.psd")), "-o", s(&rig)], "16-bit");
+    assert_bad_input(&["rig", s(&fixture("cmyk.psd")), "-o", s(&rig)], "CMYK");
+    let no_stack = dir.join("empty.ora");
+    std::fs::write(&no_stack, b"PK\x05\x06\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0").unwrap();
+    assert_bad_input(&["autorig", s(&no_stack), "-o", s(&rig)], "stack.xml");
+    let entries: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert_eq!(entries.len(), 2, "{entries:?}");
+}
