@@ -10,7 +10,6 @@ use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer};
 use sinew::rig::{Bone, Handles, PointHandle};
 use sinew::weights::{Domain, WeightOptions};
-use std::path::Path;
 use std::time::Instant;
 
 /// The quality bars. The issue asks for max |Δw| ≤ 0.03; the active-set polish does not reach
@@ -22,18 +21,7 @@ const EXACT: f64 = 1e-9;
 const COARSE_VERTICES: usize = 1000;
 
 fn character() -> (Vec<Layer>, Handles) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/character");
-    let list: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("layers.json")).unwrap()).unwrap();
-    let paths: Vec<_> = list["layers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|n| dir.join(format!("{}.png", n.as_str().unwrap())))
-        .collect();
-    let handles: Handles =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("handles.json")).unwrap()).unwrap();
-    (pipeline::load_layers(&paths).unwrap(), handles)
+    common::character_layers()
 }
 
 /// The critter at 512² with a spine of two bones and eight point handles.

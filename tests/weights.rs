@@ -10,25 +10,13 @@ use sinew::pipeline::{self, Layer, Scene};
 use sinew::rig::pose::{rotation, BonePose, PointPose};
 use sinew::rig::{handle_columns, Bone, Handles, PointHandle, Pose};
 use sinew::weights::WeightOptions;
-use std::path::Path;
 
 mod common;
 
 const SUM_TOLERANCE: f64 = 1e-9;
 
 fn character() -> (Vec<Layer>, Handles) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/character");
-    let list: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("layers.json")).unwrap()).unwrap();
-    let paths: Vec<_> = list["layers"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|n| dir.join(format!("{}.png", n.as_str().unwrap())))
-        .collect();
-    let handles: Handles =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("handles.json")).unwrap()).unwrap();
-    (pipeline::load_layers(&paths).unwrap(), handles)
+    common::character_layers()
 }
 
 fn rig(layers: &[Layer], handles: &Handles, options: &BuildOptions) -> RigDocument {

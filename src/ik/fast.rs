@@ -525,15 +525,7 @@ impl FastIk {
                 self.iterate_from(problem, stack(&problem.anchor), limit)?
             }
         };
-        let drag_error_px = hard_misses_px(problem, &t).into_iter().fold(0.0, f64::max);
-        let energy = self.reduced_energy(&t);
-        self.previous = Some(t.clone());
-        Ok(IkSolution {
-            transforms: unstack(&t),
-            iterations,
-            drag_error_px,
-            energy,
-        })
+        Ok(self.finish(problem, t, iterations))
     }
 
     /// The answer of record for a static pose: `problem`'s drags taken in their order, each
@@ -565,15 +557,22 @@ impl FastIk {
             iterations += solution.iterations;
             t = stack(&solution.transforms);
         }
+        Ok(self.finish(problem, t, iterations))
+    }
+
+    /// `t` as the solution of `problem` (its largest hard-drag miss and its energy), kept as
+    /// the next solve's warm start.
+    fn finish(&mut self, problem: &Problem, t: DMatrix<f64>, iterations: usize) -> IkSolution {
         let drag_error_px = hard_misses_px(problem, &t).into_iter().fold(0.0, f64::max);
         let energy = self.reduced_energy(&t);
-        self.previous = Some(t.clone());
-        Ok(IkSolution {
-            transforms: unstack(&t),
+        let transforms = unstack(&t);
+        self.previous = Some(t);
+        IkSolution {
+            transforms,
             iterations,
             drag_error_px,
             energy,
-        })
+        }
     }
 
     /// Local/global iterations from `t` with fold-guard rounds; returns the result and how many

@@ -198,10 +198,9 @@ pub fn character_scene() -> sinew::pipeline::Scene {
     sinew::pipeline::Scene::new(doc, &images).expect("a scene")
 }
 
-/// The bundled character's rig document (no animations) and its part images, as
-/// [`character_scene`] builds them.
-pub fn character_rig() -> (sinew::io::RigDocument, Vec<RgbaImage>) {
-    use sinew::pipeline::{self, Layer};
+/// The bundled character's layers and handles, as the assets hold them.
+pub fn character_layers() -> (Vec<sinew::pipeline::Layer>, sinew::rig::Handles) {
+    use sinew::pipeline;
     let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
     let list: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
@@ -213,12 +212,20 @@ pub fn character_rig() -> (sinew::io::RigDocument, Vec<RgbaImage>) {
         .iter()
         .map(|n| assets.join(format!("{}.png", n.as_str().expect("a layer name"))))
         .collect();
-    let layers: Vec<Layer> = pipeline::load_layers(&paths).expect("layers load");
+    let layers = pipeline::load_layers(&paths).expect("layers load");
     let handles: sinew::rig::Handles = serde_json::from_str(
         &std::fs::read_to_string(assets.join("handles.json")).expect("handles.json"),
     )
     .expect("handles.json parses");
-    let (doc, _) = pipeline::build_rig(
+    (layers, handles)
+}
+
+/// The bundled character's rig document (no animations) and its part images, as
+/// [`character_scene`] builds them.
+pub fn character_rig() -> (sinew::io::RigDocument, Vec<RgbaImage>) {
+    let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
+    let (layers, handles) = character_layers();
+    let (doc, _) = sinew::pipeline::build_rig(
         &layers,
         &assets,
         &sinew::io::BuildOptions::default(),
