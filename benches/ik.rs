@@ -87,7 +87,7 @@ fn problem(mesh: &SkinnedMesh, drag_to: [f64; 2]) -> Problem {
     };
     let pin = |k: usize| DragRow {
         row: row(k),
-        target: [mesh.rest[k].x, mesh.rest[k].y],
+        target: mesh.rest[k],
         weight: None,
     };
     Problem {
@@ -98,7 +98,7 @@ fn problem(mesh: &SkinnedMesh, drag_to: [f64; 2]) -> Problem {
             pin(SIDE * SIDE - 1),
             DragRow {
                 row: row(SIDE / 2),
-                target: drag_to,
+                target: sinew::geom::Point::new(drag_to[0], drag_to[1]),
                 weight: None,
             },
         ],

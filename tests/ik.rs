@@ -150,7 +150,7 @@ fn mesh_drags(meshes: &[SkinnedMesh], drags: &[IkDrag]) -> Vec<MeshDrag> {
                 mesh,
                 triangle,
                 barycentric,
-                target: d.to,
+                target: Point::new(d.to[0], d.to[1]),
             }
         })
         .collect()

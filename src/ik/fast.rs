@@ -38,6 +38,7 @@ use super::fold::FoldCheck;
 use super::rigid::CoupledStep;
 use super::subspace::Subspace;
 use super::{IkError, IkOptions};
+use crate::geom::Point;
 use crate::rig::pose::Affine;
 use nalgebra::{DMatrix, DVector, Matrix2, Vector2};
 
@@ -58,7 +59,7 @@ pub enum ColumnDofs {
     /// `pivot` (rest canvas px, e.g. the bone's head: only the solver's conditioning depends on
     /// it); `scale`: it may also scale uniformly (a bone allowed to stretch). Solved by the
     /// coupled step of [`super::rigid`].
-    Rigid { pivot: [f64; 2], scale: bool },
+    Rigid { pivot: Point, scale: bool },
 }
 
 /// The point `at` (rest canvas px) moves with `child` and with `parent` alike.
@@ -66,7 +67,7 @@ pub enum ColumnDofs {
 pub struct Joint {
     pub child: usize,
     pub parent: usize,
-    pub at: [f64; 2],
+    pub at: Point,
 }
 
 /// A skinned material point and where it must go.
@@ -74,7 +75,7 @@ pub struct Joint {
 pub struct DragRow {
     /// The point's skinning row (3m): its position is row · T.
     pub row: Vec<f64>,
-    pub target: [f64; 2],
+    pub target: Point,
     /// `None`: a hard constraint; `Some(w)`: a soft one, relative to one handle's stiffness.
     pub weight: Option<f64>,
 }
@@ -389,7 +390,7 @@ impl FastIk {
         let mut hard: Vec<Vec<f64>> = Vec::new();
         for joint in &problem.joints {
             let mut row = vec![0.0; dim];
-            let h = [joint.at[0], joint.at[1], 1.0];
+            let h = [joint.at.x, joint.at.y, 1.0];
             for k in 0..3 {
                 row[3 * joint.child + k] += h[k];
                 row[3 * joint.parent + k] -= h[k];
@@ -641,8 +642,7 @@ impl FastIk {
         let mut transforms = solution.transforms;
         for (t, c) in transforms.iter_mut().zip(&problem.columns) {
             if let ColumnDofs::Rigid { pivot, scale } = c {
-                let pivot = nalgebra::Point2::new(pivot[0], pivot[1]);
-                let moved = t.apply(pivot);
+                let moved = t.apply(*pivot);
                 let mut linear = nearest_rotation(&t.linear);
                 if *scale {
                     linear *= ((linear.transpose() * t.linear).trace() * 0.5).max(0.0);
@@ -738,7 +738,7 @@ impl FastIk {
             target += pull;
         }
         let mut targets = Vec::with_capacity(system.e_t.nrows());
-        targets.extend(problem.joints.iter().map(|_| [0.0, 0.0]));
+        targets.extend(problem.joints.iter().map(|_| Point::origin()));
         for drag in &problem.drags {
             match drag.weight {
                 None => targets.push(drag.target),
@@ -863,7 +863,7 @@ pub const SATISFIED_DRAG_PX: f64 = 1e-4;
 fn drag_miss_px(drag: &DragRow, t: &DMatrix<f64>) -> f64 {
     let row = DVector::from_column_slice(&drag.row);
     let pos = t.tr_mul(&row);
-    (pos[0] - drag.target[0]).hypot(pos[1] - drag.target[1])
+    (pos[0] - drag.target.x).hypot(pos[1] - drag.target.y)
 }
 
 /// How far each hard drag's point lies from its target under `t`, px.

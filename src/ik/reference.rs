@@ -20,7 +20,7 @@ pub struct MeshDrag {
     pub mesh: usize,
     pub triangle: usize,
     pub barycentric: [f64; 3],
-    pub target: [f64; 2],
+    pub target: Point,
 }
 
 /// Penalty on a drag's squared distance, relative to the largest Laplacian diagonal.
@@ -111,8 +111,8 @@ fn deform_one(
         }
         for d in drags {
             for (a, &v) in mesh.triangles[d.triangle].iter().enumerate() {
-                rhs[v as usize] += omega * d.barycentric[a] * d.target[0];
-                rhs[n + v as usize] += omega * d.barycentric[a] * d.target[1];
+                rhs[v as usize] += omega * d.barycentric[a] * d.target.x;
+                rhs[n + v as usize] += omega * d.barycentric[a] * d.target.y;
             }
         }
         factor.solve_in_place(&mut rhs);

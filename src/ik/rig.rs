@@ -184,7 +184,7 @@ impl RigIk {
                 match self.gripped.get(&key) {
                     Some(row) => Ok(DragRow {
                         row: row.clone(),
-                        target: drag.to,
+                        target: Point::new(drag.to[0], drag.to[1]),
                         weight: drag.weight,
                     }),
                     _ => {
@@ -225,7 +225,7 @@ impl RigIk {
             if !keyed(i) {
                 columns.push(match options.bones {
                     BoneDofs::Rigid | BoneDofs::Uniform => ColumnDofs::Rigid {
-                        pivot: bone.head,
+                        pivot: Point::new(bone.head[0], bone.head[1]),
                         scale: options.bones == BoneDofs::Uniform
                             || options.stretch.contains(&bone.name),
                     },
@@ -237,7 +237,7 @@ impl RigIk {
                     joints.push(Joint {
                         child: i,
                         parent: p,
-                        at: bone.head,
+                        at: Point::new(bone.head[0], bone.head[1]),
                     });
                 }
                 continue;
@@ -367,7 +367,7 @@ impl RigIk {
         }
         Ok(DragRow {
             row,
-            target: drag.to,
+            target: Point::new(drag.to[0], drag.to[1]),
             weight: drag.weight,
         })
     }

@@ -24,6 +24,7 @@
 
 use super::fast::{ColumnDofs, Joint};
 use super::IkError;
+use crate::geom::Point;
 use nalgebra::{DMatrix, DVector};
 
 /// Largest turn of a rigid column in one step, rad: steps that would turn a column further are
@@ -49,7 +50,7 @@ enum Param {
     /// keeps the pivot where that column puts it.
     Similarity {
         offset: usize,
-        pivot: [f64; 2],
+        pivot: Point,
         scale: bool,
         joined: Option<usize>,
     },
@@ -198,14 +199,14 @@ impl CoupledStep {
                 ) => {
                     // Where the parent puts the joint, the pivot's own offset cancelling.
                     for c in 0..2 {
-                        q[(3 * j + 2, c)] += pivot[0] * q[(3 * parent, c)]
-                            + pivot[1] * q[(3 * parent + 1, c)]
+                        q[(3 * j + 2, c)] += pivot.x * q[(3 * parent, c)]
+                            + pivot.y * q[(3 * parent + 1, c)]
                             + q[(3 * parent + 2, c)];
                     }
                 }
                 (Param::Similarity { pivot, .. }, _) => {
-                    q[(3 * j + 2, 0)] += pivot[0];
-                    q[(3 * j + 2, 1)] += pivot[1];
+                    q[(3 * j + 2, 0)] += pivot.x;
+                    q[(3 * j + 2, 1)] += pivot.y;
                 }
                 (_, Some(&(_, parent, map))) => {
                     for c in 0..2 {
@@ -247,10 +248,11 @@ impl CoupledStep {
                 }
                 Param::Similarity {
                     offset: o,
-                    pivot: [cx, cy],
+                    pivot,
                     scale,
                     joined,
                 } => {
+                    let (cx, cy) = (pivot.x, pivot.y);
                     let (l00, l01, l10, l11) = (
                         t[(3 * j, 0)],
                         t[(3 * j + 1, 0)],
@@ -481,10 +483,11 @@ fn fill_column(
         }
         Param::Similarity {
             offset: o,
-            pivot: [cx, cy],
+            pivot,
             joined,
             ..
         } => {
+            let (cx, cy) = (pivot.x, pivot.y);
             // L = [[a, −b], [b, a]]; the translation's −L c part.
             p[(3 * j, o)] = 1.0;
             p[(3 * j + 1, o + 1)] = -1.0;
