@@ -234,8 +234,18 @@ impl EditorApp {
             ui.selectable_value(&mut self.paint.mode, BrushMode::Subtract, "Subtract");
             ui.selectable_value(&mut self.paint.mode, BrushMode::Smooth, "Smooth");
         });
-        ui.add(egui::Slider::new(&mut self.paint.options.radius_px, 2.0..=200.0).text("radius px"));
-        ui.add(egui::Slider::new(&mut self.paint.options.strength, 0.01..=1.0).text("strength"));
+        // Labelled number fields (typed or dragged), as the numbers panel's.
+        let options = &mut self.paint.options;
+        for (text, value, range, speed) in [
+            ("Brush radius px:", &mut options.radius_px, 2.0..=200.0, 0.5),
+            ("Brush strength:", &mut options.strength, 0.01..=1.0, 0.01),
+        ] {
+            ui.horizontal(|ui| {
+                let label = ui.label(text);
+                ui.add(egui::DragValue::new(value).range(range).speed(speed))
+                    .labelled_by(label.id);
+            });
+        }
         match &self.selected {
             Some(name) => ui.label(format!("Painting {name}'s weights")),
             None => ui.label("Select a handle to paint its weights"),

@@ -204,8 +204,10 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     h.run();
     h.get_by_label("Subtract");
     assert_eq!(h.state().paint.mode, crate::weights::BrushMode::Add);
-    h.state_mut().paint.options.radius_px = 24.0;
-    h.state_mut().paint.options.strength = 0.5;
+    set_number(&mut h, "Brush radius px:", 24.0);
+    set_number(&mut h, "Brush strength:", 0.5);
+    assert_eq!(h.state().paint.options.radius_px, 24.0);
+    assert_eq!(h.state().paint.options.strength, 0.5);
 
     // One stroke across the hip–chest joint. While it runs, the canvas shows a preview; the
     // document changes once, at release, to exactly that preview.
