@@ -85,6 +85,10 @@ pub struct EditArgs {
     /// Scribbles to draw on the line art (the JSON of `sinew colorize --scribbles`).
     #[arg(long, requires = "line_art")]
     pub scribbles: Option<PathBuf>,
+    /// Append every frame's times to this file (tab-separated, ms: the editor's own code, the
+    /// whole frame with the GL draw, the interval since the frame before), for benchmarks.
+    #[arg(long)]
+    pub frame_log: Option<PathBuf>,
 }
 
 #[cfg(feature = "editor")]
@@ -423,6 +427,7 @@ fn edit(args: &EditArgs) -> Result<()> {
         screenshot: args.screenshot.clone(),
         line_art: args.line_art.clone(),
         scribbles: args.scribbles.clone(),
+        frame_log: args.frame_log.clone(),
     })
 }
 
@@ -723,17 +728,18 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     {
         bar.set_style(style);
     }
-    let frames =
-        playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
-    bar.finish_and_clear();
-    let events = playback::render_events(&scene, &animation, &settings)?;
-    let report = io::sequence::write_sequence(
-        &frames?,
-        &events,
-        args.fps,
+    // Drawn and written a chunk of frames at a time: any length renders in bounded memory.
+    let written = playback::write_animation(
+        &scene,
+        &args.anim,
+        &animation,
+        &settings,
         &args.output,
         &Default::default(),
-    )?;
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    let (report, events) = written?;
     if args.events {
         let times = playback::frame_times(animation.duration_s(), args.fps)?;
         for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
