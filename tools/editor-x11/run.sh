@@ -43,10 +43,11 @@ before="$(ik_count "$rig")"
 start_x11
 start_editor "$rig" --mode animate
 
-# Drag the belly (window point 800, 430 shows it in animate mode at the fitted view) up and
-# right, in steps, as a hand does; then K keys the pose, Ctrl+S saves.
-xdotool mousemove $(at 800 430) sleep 0.3 mousedown 1 sleep 0.3
-for k in 1 2 3 4 5 6; do xdotool mousemove $(at $((800 + 5 * k)) $((430 - 4 * k))) sleep 0.15; done
+# Drag the belly (window point 830, 430 shows it in animate mode at the fitted view, right of
+# the spine's bones: a drag that starts on a bone turns the bone) up and right, in steps, as a
+# hand does; then K keys the pose, Ctrl+S saves.
+xdotool mousemove $(at 830 430) sleep 0.3 mousedown 1 sleep 0.3
+for k in 1 2 3 4 5 6; do xdotool mousemove $(at $((830 + 5 * k)) $((430 - 4 * k))) sleep 0.15; done
 xdotool mouseup 1 sleep 1
 xdotool key --clearmodifiers k sleep 1
 xdotool key --clearmodifiers ctrl+s
