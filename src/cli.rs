@@ -801,10 +801,15 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
     Ok(serde_json::to_string(&Posed { parts })? + "\n")
 }
 
-/// The bundled character's layer list.
+/// The bundled character's layer list: layers in draw order, other attachments of their slots
+/// (image name → slot), skins.
 #[derive(serde::Deserialize)]
 struct LayerList {
     layers: Vec<String>,
+    #[serde(default)]
+    attachments: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    skins: io::Skins,
 }
 
 fn demo(args: &DemoArgs) -> Result<()> {
@@ -829,6 +834,7 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let paths: Vec<PathBuf> = list
         .layers
         .iter()
+        .chain(list.attachments.keys())
         .map(|name| args.assets.join(format!("{name}.png")))
         .collect();
     std::fs::create_dir_all(&args.output)
@@ -844,6 +850,8 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let rig_s = t.elapsed().as_secs_f64();
 
     let mut doc = doc;
+    doc.set_slots(&list.attachments, list.skins.clone())
+        .map_err(|reason| anyhow::anyhow!("{}: {reason}", list_path.display()))?;
     let animations_path = args.assets.join("animations.json");
     let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
     let bad = || format!("{}: bad animation", animations_path.display());

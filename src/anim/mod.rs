@@ -14,6 +14,7 @@
 //! - [`mix`]: the crossfade from one animation into another;
 //! - [`edit`]: keys edited per timeline (move, copy and paste, delete, curves).
 
+pub mod attachment;
 pub mod check;
 pub mod curve;
 pub mod edit;
@@ -75,6 +76,22 @@ pub enum AnimError {
         key: usize,
         missing: String,
     },
+    #[error(
+        "animation '{animation}', parts.{slot}.attachment: key {key} shows '{attachment}', which \
+         slot '{slot}' does not have (its attachments: {known})"
+    )]
+    UnknownAttachment {
+        animation: String,
+        slot: String,
+        key: usize,
+        attachment: String,
+        known: String,
+    },
+    #[error(
+        "animation '{animation}', parts.{slot}: keys both 'visible' and 'attachment' (one \
+         timeline shows or hides a slot: key 'attachment' null to hide it)"
+    )]
+    VisibleAndAttachment { animation: String, slot: String },
 }
 
 #[cfg(test)]

@@ -167,6 +167,11 @@ pub struct PartTimelines {
     pub color: Option<Vec<Key<Rgba>>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub visible: Option<Vec<StepKey<bool>>>,
+    /// Which attachment the slot shows (a part of the slot by name; the slot's own name: its
+    /// default as the skins resolve it), or `null`: none. Stepped, as Spine's attachment
+    /// timeline; an animation keys either this or `visible` of a slot.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attachment: Option<Vec<StepKey<Option<String>>>>,
 }
 
 /// A keyed skinning-IK drag: the material point at rest position `at` (canvas px) goes to the
