@@ -210,6 +210,10 @@ pub struct RenderArgs {
     /// Play curves as this runtime does instead of exactly (see README, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
+    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// combine skins, a later one overriding an earlier one on the same slot.
+    #[arg(long = "skin", value_name = "NAME")]
+    pub skins: Vec<String>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
     /// OUT.json beside it, which lists each frame's events).
     #[arg(short, long)]
@@ -372,6 +376,10 @@ pub struct PoseArgs {
     /// With --anim: sample curves as this runtime plays them instead of exactly.
     #[arg(long, value_enum, requires = "anim")]
     pub match_runtime: Option<RuntimeMatch>,
+    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// combine skins, a later one overriding an earlier one on the same slot.
+    #[arg(long = "skin", value_name = "NAME")]
+    pub skins: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -634,7 +642,8 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
-    let scene = Scene::load(&args.rig)?;
+    let mut scene = Scene::load(&args.rig)?;
+    scene.set_skins(&args.skins)?;
     let images = part_images(&args.rig, &scene.doc);
     check_outputs(
         [Some(args.rig.as_path()), args.pose.as_deref()]
@@ -646,6 +655,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
     let (pose, transforms) = match (&args.pose, &args.anim) {
         (Some(path), _) => {
             let pose: Pose = read_json(path, "pose file")?;
+            scene.doc.check_pose_attachments(&pose)?;
             let transforms = scene.handle_transforms(&pose)?;
             (pose, transforms)
         }
@@ -683,7 +693,8 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    let scene = Scene::load(&args.rig)?;
+    let mut scene = Scene::load(&args.rig)?;
+    scene.set_skins(&args.skins)?;
     // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
     let files = match io::sequence::format_for_path(&args.output)? {
         io::sequence::SequenceFormat::Folder => vec![],
@@ -871,11 +882,20 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 
     let t = Instant::now();
     let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
-    let scene = Scene::new(doc.clone(), &images)?;
+    let mut scene = Scene::new(doc.clone(), &images)?;
     let rest = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
     let rest_s = t.elapsed().as_secs_f64();
     let rest_path = args.output.join("rest.png");
     io::save_png(&rest_path, &rest)?;
+    // Each skin at rest too (`rest_SKIN.png`); the animations play in the default skin.
+    for skin in doc.skins.keys() {
+        scene.set_skins(std::slice::from_ref(skin))?;
+        let image = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
+        let path = args.output.join(format!("rest_{skin}.png"));
+        io::save_png(&path, &image)?;
+        written.push(path);
+    }
+    scene.set_skins(&[])?;
     let preview_path = args.output.join("mesh.png");
     io::save_png(&preview_path, &preview_image(&scene)?)?;
     written.extend([rest_path, preview_path]);

@@ -454,6 +454,7 @@ mod tests {
                             value: false,
                         },
                     ]),
+                    attachment: None,
                 },
             )]
             .into(),

@@ -196,7 +196,8 @@ pub enum SpineError {
 /// One exported part.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExportedPart {
-    /// Slot, attachment and atlas region name: the part's name.
+    /// Attachment and atlas region name: the part's name (its slot: the part's own name, or its
+    /// `slot` field when it is another attachment of a slot).
     pub name: String,
     pub mesh: MeshAttachment,
 }
