@@ -27,10 +27,11 @@ impl Animation {
                 if doc.shown_part(slot, Some(attachment), &[]).is_none() {
                     return Err(AnimError::UnknownAttachment {
                         animation: name.into(),
-                        slot: slot.clone(),
-                        key,
-                        attachment: attachment.clone(),
-                        known: doc.attachment_names(slot).join(", "),
+                        place: format!(
+                            "parts.{slot}.attachment: key {key} shows '{attachment}', which \
+                             slot '{slot}' does not have (its attachments: {})",
+                            doc.attachment_names(slot).join(", ")
+                        ),
                     });
                 }
             }

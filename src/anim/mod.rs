@@ -76,17 +76,10 @@ pub enum AnimError {
         key: usize,
         missing: String,
     },
-    #[error(
-        "animation '{animation}', parts.{slot}.attachment: key {key} shows '{attachment}', which \
-         slot '{slot}' does not have (its attachments: {known})"
-    )]
-    UnknownAttachment {
-        animation: String,
-        slot: String,
-        key: usize,
-        attachment: String,
-        known: String,
-    },
+    /// `place`: `parts.SLOT.attachment: key K shows 'NAME', which slot 'SLOT' does not have (its
+    /// attachments: …)` (one string, so the error stays small).
+    #[error("animation '{animation}', {place}")]
+    UnknownAttachment { animation: String, place: String },
     #[error(
         "animation '{animation}', parts.{slot}: keys both 'visible' and 'attachment' (one \
          timeline shows or hides a slot: key 'attachment' null to hide it)"
