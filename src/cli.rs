@@ -254,8 +254,22 @@ pub struct RigArgs {
     /// The handles file (bones, points, cages, regions); with it, weights are computed.
     #[arg(long)]
     pub handles: Option<PathBuf>,
+    /// Make layer PART another attachment of layer SLOT's slot (repeatable; see docs/formats.md,
+    /// "Rig document": `slot`).
+    #[arg(long = "attachment", value_name = "PART=SLOT", value_parser = parse_attachment)]
+    pub attachments: Vec<(String, String)>,
     #[command(flatten)]
     pub build: BuildArgs,
+}
+
+/// Parses `PART=SLOT`.
+fn parse_attachment(text: &str) -> Result<(String, String), String> {
+    match text.split_once('=') {
+        Some((part, slot)) if !part.is_empty() && !slot.is_empty() => {
+            Ok((part.to_string(), slot.to_string()))
+        }
+        _ => Err(format!("'{text}' is not PART=SLOT")),
+    }
 }
 
 /// Tracing and meshing parameters; each defaults to the library's default.
@@ -538,8 +552,21 @@ fn rig(args: &RigArgs) -> Result<()> {
         Some(path) => read_json(path, "handles file")?,
         None => Handles::default(),
     };
+    // Attachments name layers: checked before any work.
+    let attachments: std::collections::BTreeMap<String, String> =
+        args.attachments.iter().cloned().collect();
+    if let Some(name) = attachments
+        .iter()
+        .flat_map(|(part, slot)| [part, slot])
+        .find(|n| !layers.iter().any(|l| &l.name == *n))
+    {
+        bail!("--attachment: '{name}' is not a layer of the rig");
+    }
     let doc_dir = parent_dir(&args.output);
-    let (doc, stats) = rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
+    let (mut doc, stats) =
+        rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
+    doc.set_slots(&attachments, io::Skins::new())
+        .map_err(|reason| anyhow!("--attachment: {reason}"))?;
     let preview = match &args.preview {
         Some(_) => {
             let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();

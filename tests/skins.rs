@@ -1,7 +1,7 @@
 //! Slots with several attachments, skins and attachment keys through the binary: what `sinew
 //! pose` and `sinew render` draw with `--skin` and at times around attachment keys, and bad
 //! input (an attachment key or a pose naming an attachment the slot lacks, a skin naming a
-//! missing slot, an unknown `--skin`) refused in one line with exit code 2 and no output.
+//! missing slot, an unknown `--skin`, a bad `sinew rig --attachment`) refused in one line with exit code 2 and no output.
 
 mod command;
 mod common;
@@ -34,6 +34,8 @@ fn rig(dir: &Path) -> (Value, PathBuf) {
         s(&dir.join("critter_blue.png")),
         "--handles",
         s(&handles),
+        "--attachment",
+        "critter_blue=critter",
         "-o",
         s(&rig),
     ]);
@@ -43,7 +45,7 @@ fn rig(dir: &Path) -> (Value, PathBuf) {
         String::from_utf8_lossy(&out.stderr)
     );
     let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
-    doc["parts"][1]["slot"] = json!("critter");
+    assert_eq!(doc["parts"][1]["slot"], json!("critter"));
     doc["skins"] = json!({"blue": {"critter": "critter_blue"}});
     doc["animations"] = json!({"swap": {
         "bones": {"a": {"rotate": [{"time": 0, "value": 0}, {"time": 1, "value": 0}]}},
@@ -186,6 +188,31 @@ fn missing_attachments_slots_and_skins_are_refused_in_one_line() {
         &["pose", s(&rig), "--pose", s(&file), "-o", s(&png)],
         "the pose shows attachment 'ghost' in slot 'critter'",
     );
-    assert!(!png.exists() && !gif.exists() && !export.exists());
+    // `sinew rig --attachment` names layers, and a slot that is a slot.
+    let out_rig = dir.join("new.json");
+    let critter = dir.join("critter.png");
+    let blue = dir.join("critter_blue.png");
+    for (attachment, message) in [
+        (
+            "ghost=critter",
+            "--attachment: 'ghost' is not a layer of the rig",
+        ),
+        ("critter_blue", "is not PART=SLOT"),
+        ("critter=critter", "names itself as its slot"),
+    ] {
+        assert_bad_input(
+            &[
+                "rig",
+                s(&critter),
+                s(&blue),
+                "--attachment",
+                attachment,
+                "-o",
+                s(&out_rig),
+            ],
+            message,
+        );
+    }
+    assert!(!png.exists() && !gif.exists() && !export.exists() && !out_rig.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
