@@ -339,32 +339,38 @@ pub fn draw_pose(
 }
 
 /// The parts at `positions` (one list per part, canvas px) as `pose` shows them, back to
-/// front: its draw order (the document's otherwise), each part's tint and visibility. What
+/// front: its draw order of slots (the document's otherwise), each slot's tint and visibility,
+/// and the part each slot shows (its attachment, through the scene's skins). What
 /// [`draw_pose`] draws, for every consumer that draws a pose (the editor's canvas too).
 pub fn pose_draws<'a>(
     scene: &Scene,
     positions: &'a [Vec<crate::geom::Point>],
     pose: &Pose,
 ) -> Vec<render::PartDraw<'a>> {
-    let parts = &scene.doc.parts;
-    let order: Vec<usize> = match &pose.draw_order {
+    let doc = &scene.doc;
+    // Slots back to front; each draws the part its attachment and the skins choose.
+    let slots: Vec<&str> = match &pose.draw_order {
         Some(names) => names
             .iter()
-            .filter_map(|n| parts.iter().position(|p| &p.name == n))
+            .map(String::as_str)
+            .filter(|n| doc.parts.iter().any(|p| p.slot.is_none() && p.name == *n))
             .collect(),
-        None => (0..parts.len()).collect(),
+        None => doc.slot_names(),
     };
-    order
+    slots
         .into_iter()
-        .map(|i| {
+        .filter_map(|slot| {
+            let state = pose.parts.get(slot);
+            let attachment = state.and_then(|s| s.attachment.as_deref());
+            let i = doc.shown_part(slot, attachment, scene.skins())?;
             let mut draw =
                 render::PartDraw::new(i, positions.get(i).map(Vec::as_slice).unwrap_or_default());
-            if let Some(state) = pose.parts.get(&parts[i].name) {
+            if let Some(state) = state {
                 let [r, g, b, a] = state.color.map(|c| c as f32);
                 draw.tint = render::Tint { r, g, b, a };
                 draw.visible = state.visible;
             }
-            draw
+            Some(draw)
         })
         .collect()
 }

@@ -8,7 +8,7 @@
 //   node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json
 //
 // REQUEST.json: {"times": {"<animation>": [t, ...]}, "events": {"<animation>": [[lastTime,
-// time, loop], ...]}}. OUT.json: {"setup": Snapshot,
+// time, loop], ...]}, "skins": ["<skin>", ...]} (skins combined in order; none: the default). OUT.json: {"setup": Snapshot,
 // "animations": {"<name>": {"duration": d, "frames": [{"time": t, "slots": Snapshot}]}},
 // "events": {"<name>": [[Event, ...] per step]}, "warnings": [...]}; Event = {"name", "time",
 // "int", "float", "string", "audio": null or {"path", "volume", "balance"}}: what Animation.apply fires moving
@@ -40,6 +40,19 @@ try {
   process.exit(2);
 }
 const skeleton = new spine.Skeleton(data);
+// Skins combined in order (a later one overrides an earlier one on a slot), as a game does.
+if ((request.skins || []).length > 0) {
+  const combined = new spine.Skin("combined");
+  for (const name of request.skins) {
+    const skin = data.findSkin(name);
+    if (!skin) {
+      console.error(`no skin '${name}' in ${skeletonPath}`);
+      process.exit(2);
+    }
+    combined.addSkin(skin);
+  }
+  skeleton.setSkin(combined);
+}
 
 function snapshot() {
   skeleton.updateWorldTransform(spine.Physics.none);
