@@ -17,6 +17,10 @@ pub enum SolveError {
     Assembly(String),
 }
 
+/// Diagonal shifts (relative to the largest diagonal entry) tried in turn by
+/// [`SharedPattern::factor_regularized`].
+pub const REGULARIZATION_STEPS: [f64; 3] = [1e-13, 1e-11, 1e-9];
+
 /// A Cholesky factorization of the principal sub-matrix A[keep, keep] of a symmetric matrix.
 pub struct SubmatrixCholesky {
     llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
@@ -211,6 +215,33 @@ impl SharedPattern {
 
     pub fn is_empty(&self) -> bool {
         self.diagonal.is_empty()
+    }
+
+    /// [`SharedPattern::factor`], retried with the diagonal raised by
+    /// [`REGULARIZATION_STEPS`] × the largest diagonal entry when rounding makes a pivot
+    /// vanish: a positive semi-definite matrix assembled from a mesh with near-degenerate
+    /// triangles (angles under a degree, vertex masses many orders below their neighbors')
+    /// can lose definiteness in floating point although it has none to lose in exact
+    /// arithmetic. The shift changes the solution by about that relative amount.
+    pub fn factor_regularized(&self, values: &[f64]) -> Result<PatternCholesky<'_>, SolveError> {
+        if let Ok(f) = self.factor(values) {
+            return Ok(f);
+        }
+        let largest = self
+            .diagonal
+            .iter()
+            .map(|&d| values[d].abs())
+            .fold(0.0, f64::max);
+        for step in REGULARIZATION_STEPS {
+            let mut shifted = values.to_vec();
+            for &d in &self.diagonal {
+                shifted[d] += step * largest;
+            }
+            if let Ok(f) = self.factor(&shifted) {
+                return Ok(f);
+            }
+        }
+        Err(SolveError::NotPositiveDefinite)
     }
 
     /// Factors the matrix with this pattern and the given values (numeric phase only,
