@@ -367,6 +367,33 @@ mod tests {
     use super::*;
     use sprs::TriMat;
 
+    /// A positive semi-definite matrix that is singular: the plain factorization fails, the
+    /// regularized one shifts the diagonal by a tiny relative amount and succeeds, and an
+    /// indefinite matrix still fails.
+    #[test]
+    fn regularized_factorization_shifts_only_what_rounding_needs() {
+        let matrix = |off: f64| {
+            let mut t = TriMat::new((2, 2));
+            t.add_triplet(0, 0, 1.0);
+            t.add_triplet(1, 1, 1.0);
+            t.add_triplet(0, 1, off);
+            t.add_triplet(1, 0, off);
+            t.to_csr::<usize>()
+        };
+        let singular = SharedPattern::new(&matrix(1.0), &[0, 1]).unwrap();
+        assert!(singular.factor(&singular.values).is_err());
+        let f = singular.factor_regularized(&singular.values).unwrap();
+        // Solves (A + εI) x = (1, 1) with x ≈ (0.5, 0.5).
+        let mut x = vec![1.0, 1.0];
+        f.solve_in_place(&mut x);
+        assert!(
+            (x[0] - 0.5).abs() < 1e-6 && (x[1] - 0.5).abs() < 1e-6,
+            "{x:?}"
+        );
+        let indefinite = SharedPattern::new(&matrix(2.0), &[0, 1]).unwrap();
+        assert!(indefinite.factor_regularized(&indefinite.values).is_err());
+    }
+
     #[test]
     fn solves_a_principal_submatrix() {
         // A tridiagonal SPD matrix; keep indices 0, 2, 3.
