@@ -7,16 +7,21 @@
 //!
 //! Matching: the template's extremities (humanoid: head, two hands, two feet; quadruped: head,
 //! tail, four feet) are assigned to leaves of the axis tree by exhaustive search over the
-//! candidate leaves. An assignment fixes the template's inner joints as tree medians (the
-//! humanoid's pelvis is where the paths between the feet and the head meet, its chest where
-//! the hands and the head meet), and must respect the template graph: chest strictly between
-//! pelvis and head, no arm path through the pelvis, no leg path through the chest. Among the
-//! valid assignments the one with the best score wins: extremities where the template expects
-//! them in the drawing's box (head up, feet down, `_l` limbs on the right of the screen: the
-//! character's left, facing the viewer) and left/right limbs of similar length. Bones then
-//! follow the tree paths between the joints, split at the limbs' bends (elbows, knees) and kept
-//! straight and inside; axis branches the template does not name (ears, a tail on a humanoid,
-//! a held prop) become extra bones hanging from the named bone they leave.
+//! candidate leaves. The axis is computed without merging nearby junctions, so that limbs
+//! leaving a round torso keep their own joints. An assignment fixes the template's inner
+//! joints as tree medians: the humanoid's pelvis is where the paths between the feet and the
+//! head meet, each arm's shoulder where its hand's path meets the spine (pelvis to head), and
+//! the chest is the higher shoulder; shoulders must lie strictly above the pelvis and off the
+//! legs' paths. A head drawn apart from the body is no leaf of the body's axis: the highest
+//! node of the piece then ends the spine (the head gets its own bone as a separate piece,
+//! [`super::budget`]). Among the valid assignments the one with the best score wins:
+//! extremities where the template expects them in the drawing's box (head up, feet down, `_l`
+//! limbs on the right of the screen: the character's left, facing the viewer) and left/right
+//! limbs of similar length. Bones then follow the tree paths between the joints: hip and chest
+//! along the spine, a neck and a head split where the path widens into the skull, two bones per
+//! limb split at the limbs' bends (elbows, knees), a quadruped's tail in up to three bones, all
+//! kept straight and inside; axis branches the template does not name (ears, a tail on a
+//! humanoid, a held prop) become extra bones hanging from the named bone they leave.
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
