@@ -635,8 +635,9 @@ fn report_part(name: &str, r: &PartReport) {
         s.vertices, s.triangles, s.min_angle_deg
     );
     if !r.bound_to_nearest.is_empty() {
-        println!(
-            "  pieces no handle touches follow the nearest handle: {}",
+        eprintln!(
+            "sinew: warning: part '{name}': {} mesh vertices lie on pieces no handle reaches: they follow the nearest handle rigidly ({})",
+            r.bound_vertices,
             r.bound_to_nearest.join(", ")
         );
     }

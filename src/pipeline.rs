@@ -115,6 +115,8 @@ pub struct PartReport {
     pub unconverged: Vec<String>,
     /// Handles that pieces no handle touches were bound to rigidly.
     pub bound_to_nearest: Vec<String>,
+    /// How many mesh vertices those pieces have.
+    pub bound_vertices: usize,
 }
 
 /// Images narrower or lower than this (px) are too small to trace and rig.
@@ -300,6 +302,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             let name = |j: &usize| columns[*j].clone();
             notes.unconverged = part.unconverged.iter().map(name).collect();
             notes.bound_to_nearest = part.bound_to_nearest.iter().map(name).collect();
+            notes.bound_vertices = part.bound_vertices;
             let weights = WeightsDoc {
                 handles: columns.clone(),
                 rows: part.rows,

@@ -429,7 +429,8 @@ fn humanoid_template_names_and_parents_the_characters_limbs() {
     let expected_parents = [
         ("hip", None),
         ("chest", Some("hip")),
-        ("head", Some("chest")),
+        ("neck", Some("chest")),
+        ("head", Some("neck")),
         ("arm_upper_l", Some("chest")),
         ("arm_lower_l", Some("arm_upper_l")),
         ("arm_upper_r", Some("chest")),
@@ -485,7 +486,8 @@ fn quadruped_template_finds_head_tail_and_four_legs() {
     for (name, parent) in [
         ("hip", None),
         ("chest", Some("hip")),
-        ("head", Some("chest")),
+        ("neck", Some("chest")),
+        ("head", Some("neck")),
         ("tail_1", Some("hip")),
         ("leg_front_upper_l", Some("chest")),
         ("leg_front_upper_r", Some("chest")),
@@ -934,4 +936,179 @@ fn proposed_rig_over_the_character_matches_golden() {
         "autorig",
         common::golden::premultiplied_tolerance,
     );
+}
+
+// ---------------------------------------------------------------- the evaluation set
+
+/// A character of the evaluation set (`tests/fixtures/autorig-eval`, drawn by
+/// `tools/autorig-eval/make_set.py`): its sprite, kind, bone budget and reference joints.
+struct EvalCharacter {
+    image: RgbaImage,
+    budget: [usize; 2],
+    template: Option<Template>,
+    joints: Vec<(String, Point)>,
+}
+
+fn eval_character(name: &str) -> EvalCharacter {
+    let dir = root().join("tests/fixtures/autorig-eval");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap())
+            .unwrap();
+    let template = match meta["kind"].as_str().unwrap() {
+        "humanoid" => Some(Template::Humanoid),
+        "quadruped" => Some(Template::Quadruped),
+        _ => None,
+    };
+    let budget = [0, 1].map(|k| meta["budget"][k].as_u64().unwrap() as usize);
+    let joints = meta["joints"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, v)| {
+            let xy = [0, 1].map(|i| v[i].as_f64().unwrap());
+            (k.clone(), Point::new(xy[0], xy[1]))
+        })
+        .collect();
+    EvalCharacter {
+        image: load(&dir.join(format!("{name}.png"))),
+        budget,
+        template,
+        joints,
+    }
+}
+
+fn propose_for(c: &EvalCharacter) -> Handles {
+    let options = AutorigOptions {
+        template: c.template,
+        ..AutorigOptions::default()
+    };
+    propose(&[("sprite", &c.image)], &options)
+}
+
+/// The height of the opaque pixels' box, px.
+fn opaque_height(image: &RgbaImage) -> f64 {
+    let rows: Vec<u32> = image
+        .enumerate_pixels()
+        .filter(|(_, _, p)| p[3] > 0)
+        .map(|(_, y, _)| y)
+        .collect();
+    let (lo, hi) = (rows.iter().min().unwrap(), rows.iter().max().unwrap());
+    (hi - lo + 1) as f64
+}
+
+/// A handful of the evaluation set (the whole set runs through tools/autorig-eval/score.py):
+/// a stick figure with juggling balls (four pieces), a cartoon with a detached head, a dog, a
+/// dragon and a sword. Every bone inside, every piece with a bone, the count within the
+/// budget, no bone shorter than the default fraction of the size, and the median distance
+/// from a reference joint to the nearest bone end under 8 % of the height.
+#[test]
+fn evaluation_characters_get_rigs_an_animator_keeps() {
+    for name in ["stick_juggler", "detached_head", "dog", "dragon", "sword"] {
+        let c = eval_character(name);
+        let h = propose_for(&c);
+        dump(name, &c.image, &h);
+        let shape = traced(&c.image);
+        assert_bones_inside(&h, &shape, name);
+        let n = h.bones.len();
+        assert!(
+            (c.budget[0]..=c.budget[1]).contains(&n),
+            "{name}: {n} bones, budget {:?}",
+            c.budget
+        );
+        let size = sinew::autorig::budget::size_px(&shape);
+        let shortest = sinew::autorig::SkeletonOptions::default().min_bone_fraction * size;
+        for b in &h.bones {
+            let len = (pt(b.tail) - pt(b.head)).norm();
+            assert!(len >= shortest, "{name}: bone {} is {len:.1} px", b.name);
+        }
+        for (k, outline) in shape.outlines.iter().enumerate() {
+            let reached = h.bones.iter().any(|b| {
+                let m = (pt(b.head).coords + pt(b.tail).coords) * 0.5;
+                point_in_ring(Point::from(m), &outline.outer)
+            });
+            assert!(reached, "{name}: piece {k} has no bone");
+        }
+        let height = opaque_height(&c.image);
+        let mut errors: Vec<f64> = c
+            .joints
+            .iter()
+            .map(|(_, j)| nearest_bone_end(&h, *j) / height)
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        let median = errors[errors.len() / 2];
+        assert!(median < 0.08, "{name}: median joint error {median:.3}");
+    }
+}
+
+#[test]
+fn humanoid_limbs_join_the_spine_and_the_head_hangs_from_a_neck() {
+    let c = eval_character("chibi");
+    let h = propose_for(&c);
+    let by_name: HashMap<&str, &sinew::rig::Bone> =
+        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    assert_eq!(by_name["neck"].parent.as_deref(), Some("chest"));
+    assert_eq!(by_name["head"].parent.as_deref(), Some("neck"));
+    // Each upper limb starts within its limb's width of the spine bone it hangs from.
+    for (limb, parent) in [
+        ("arm_upper_l", "chest"),
+        ("arm_upper_r", "chest"),
+        ("leg_upper_l", "hip"),
+        ("leg_upper_r", "hip"),
+    ] {
+        let (b, p) = (by_name[limb], by_name[parent]);
+        assert_eq!(b.parent.as_deref(), Some(parent), "{limb}");
+        let gap = sinew::geom::segment_distance(pt(b.head), pt(p.head), pt(p.tail)).0;
+        assert!(gap < 60.0, "{limb} starts {gap:.1} px from {parent}");
+    }
+}
+
+#[test]
+fn proposed_rigs_over_two_evaluation_characters_match_golden() {
+    for (name, golden) in [
+        ("stick_juggler", "autorig_juggler"),
+        ("dragon", "autorig_dragon"),
+    ] {
+        let c = eval_character(name);
+        let h = propose_for(&c);
+        let actual = sinew::autorig::draw_preview(&[&c.image], &h).unwrap();
+        common::golden::check(
+            golden,
+            &actual,
+            "autorig",
+            common::golden::premultiplied_tolerance,
+        );
+    }
+}
+
+/// Handles that reach only the body of a character whose head is drawn apart: `sinew rig`
+/// builds the rig, the head following the nearest bone, with a one-line warning.
+#[cfg(feature = "cli")]
+#[test]
+fn rig_binds_pieces_no_handle_reaches_with_a_one_line_warning() {
+    let dir = scratch("autorig-unreached");
+    let sprite = root().join("tests/fixtures/autorig-eval/detached_head.png");
+    let handles = dir.join("handles.json");
+    std::fs::write(
+        &handles,
+        r#"{"bones": [{"name": "body", "head": [256, 315], "tail": [256, 250]}]}"#,
+    )
+    .unwrap();
+    let rig = dir.join("rig.json");
+    let out = sinew(&[
+        "rig",
+        sprite.to_str().unwrap(),
+        "--handles",
+        handles.to_str().unwrap(),
+        "-o",
+        rig.to_str().unwrap(),
+    ]);
+    ok(&out, "rig");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let warnings: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("pieces no handle reaches"))
+        .collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(warnings[0].contains("mesh vertices") && warnings[0].contains("body"));
+    assert!(rig.exists());
 }

@@ -14,6 +14,7 @@
 //! - `cage_vertices`: a containing cage of the union ([`cage`]); `point_count`: point handles by
 //!   geodesic farthest-point sampling ([`points`]). [`preview`] draws the result.
 
+pub mod budget;
 pub mod cage;
 pub mod layers;
 pub mod medial;
@@ -86,8 +87,6 @@ pub enum AutorigError {
     NoShape(f64),
     #[error(transparent)]
     Medial(#[from] MedialError),
-    #[error("the drawing does not match the {0:?} template (no assignment of its limbs to the shape's extremities fits)")]
-    TemplateMismatch(Template),
     #[error("cage: {0}")]
     Cage(#[from] CageError),
     #[error("the proposed handles are invalid: {0}")]
@@ -105,9 +104,20 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
     }
     let so = &options.skeleton;
     let positive = so.bend_ratio.is_finite() && so.bend_ratio > 0.0;
+    let fraction_ok = |f: f64| f.is_finite() && (0.0..=1.0).contains(&f);
     if !(positive && so.min_bone_px.is_finite() && so.min_bone_px >= 0.0) {
         return Err(AutorigError::InvalidOptions(
             "bend_ratio must be positive and min_bone_px at least 0".into(),
+        ));
+    }
+    if !(fraction_ok(so.min_bone_fraction) && fraction_ok(so.prop_branch_fraction)) {
+        return Err(AutorigError::InvalidOptions(
+            "min_bone_fraction and prop_branch_fraction must lie in [0, 1]".into(),
+        ));
+    }
+    if so.prop_max_bones == 0 {
+        return Err(AutorigError::InvalidOptions(
+            "prop_max_bones must be at least 1".into(),
         ));
     }
     if so.max_bones == Some(0) {
@@ -121,12 +131,34 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
         .ok_or(AutorigError::NoShape(options.trace.min_area_px2))?;
     let mut notes = Vec::new();
     let mut bind: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    let min_bone_px = budget::min_bone_length_px(so, &silhouette);
+    let so = &SkeletonOptions {
+        min_bone_px,
+        ..so.clone()
+    };
 
     let mut bones = if layers.len() == 1 || options.template.is_some() {
-        let axis = medial::medial_axis(&silhouette, &options.medial)?;
+        let medial_options = match options.template {
+            // Limbs leaving a round torso meet within its radius: merged, the arms' and the
+            // legs' junctions would be one, and the template could not tell chest from pelvis.
+            Some(_) => MedialOptions {
+                junction_merge_ratio: 0.0,
+                ..options.medial.clone()
+            },
+            None => options.medial.clone(),
+        };
+        let axis = medial::medial_axis(&silhouette, &medial_options)?;
         match options.template {
-            Some(t) => template::fit_template(&axis, &silhouette, t, so)
-                .ok_or(AutorigError::TemplateMismatch(t))?,
+            Some(t) => match template::fit_template(&axis, &silhouette, t, so) {
+                Some(bones) => bones,
+                None => {
+                    notes.push(format!(
+                        "the drawing does not match the {t:?} template (no assignment of its \
+                         limbs to the shape's extremities fits): bones from the medial axis"
+                    ));
+                    skeleton::medial_skeleton(&axis, &silhouette, so)
+                }
+            },
             None => skeleton::medial_skeleton(&axis, &silhouette, so),
         }
     } else {
@@ -160,7 +192,16 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
             bones.push(b);
         }
     }
-    skeleton::limit_bones(&mut bones, so.max_bones, &silhouette);
+    let added = budget::rig_free_pieces(&mut bones, &silhouette, min_bone_px);
+    if added > 0 {
+        notes.push(format!(
+            "{added} separate pieces got a bone each (piece_N), parented to the nearest bone"
+        ));
+    }
+    budget::keep_inside(&mut bones, &silhouette, min_bone_px);
+    budget::drop_short_bones(&mut bones, &silhouette, min_bone_px);
+    let max_bones = budget::bone_budget(so, options.template);
+    skeleton::limit_bones(&mut bones, Some(max_bones), &silhouette);
     let bones = name_bones(bones);
     bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
 

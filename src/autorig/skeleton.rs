@@ -30,9 +30,19 @@ pub struct SkeletonOptions {
     pub bend_ratio: f64,
     /// Paths and bones shorter than this make no bone of their own, px. Default 6.
     pub min_bone_px: f64,
+    /// ... nor those shorter than this fraction of the character's size (the larger side of
+    /// its box), whichever is longer: no junk bones at junctions. Default 0.03.
+    pub min_bone_fraction: f64,
     /// At most this many bones (bends are merged first, then the shortest leaf bones
-    /// dropped). Default: no limit.
+    /// dropped). Default: the template's budget (humanoid 20, quadruped 25; 25 without a
+    /// template, see [`super::budget`]).
     pub max_bones: Option<usize>,
+    /// Without a template, a piece whose axis has no side branch longer than this fraction
+    /// of its longest path is a prop (a sword, a bottle, a flag): bones along that path
+    /// only, at most `prop_max_bones`. Default 0.25.
+    pub prop_branch_fraction: f64,
+    /// At most this many bones for a prop. Default 3.
+    pub prop_max_bones: usize,
 }
 
 impl Default for SkeletonOptions {
@@ -40,7 +50,10 @@ impl Default for SkeletonOptions {
         SkeletonOptions {
             bend_ratio: 0.12,
             min_bone_px: 6.0,
+            min_bone_fraction: 0.03,
             max_bones: None,
+            prop_branch_fraction: 0.25,
+            prop_max_bones: 3,
         }
     }
 }
@@ -317,9 +330,67 @@ pub fn medial_skeleton(
             .then(a.0.cmp(&b.0))
     });
     for (root, tree) in &pieces {
-        builder.grow(tree, *root, &tree.children[*root], None);
+        match prop_path(axis, tree, options.prop_branch_fraction) {
+            Some(path) => {
+                let first = builder.bones.len();
+                builder.path_bones(&path, None);
+                let mut prop: Vec<ProtoBone> = builder.bones.split_off(first);
+                for b in &mut prop {
+                    b.parent = b.parent.map(|p| p - first);
+                }
+                limit_bones(&mut prop, Some(options.prop_max_bones), shape);
+                for mut b in prop {
+                    b.parent = b.parent.map(|p| p + first);
+                    builder.bones.push(b);
+                }
+            }
+            None => builder.grow(tree, *root, &tree.children[*root], None),
+        }
     }
     builder.bones
+}
+
+/// The longest path of a piece of the axis (from its lower end, larger y, to the other) when
+/// no side branch is longer than `fraction` of it: the piece is a prop. None otherwise.
+fn prop_path(axis: &AxisGraph, piece: &NodeTree, fraction: f64) -> Option<Vec<usize>> {
+    let far = |tree: &NodeTree| {
+        let mut dist = vec![0.0; axis.nodes.len()];
+        for &v in &tree.order {
+            if let Some(p) = tree.parent[v] {
+                dist[v] = dist[p] + (axis.nodes[v].pos - axis.nodes[p].pos).norm();
+            }
+        }
+        let end = *tree
+            .order
+            .iter()
+            .max_by(|&&a, &&b| dist[a].total_cmp(&dist[b]).then(b.cmp(&a)))?;
+        Some((end, dist))
+    };
+    let (a, _) = far(piece)?;
+    let from_a = NodeTree::new(axis, a);
+    let (b, dist) = far(&from_a)?;
+    let main = from_a.path_down(a, b)?;
+    if main.len() < 2 {
+        return None;
+    }
+    let mut on_main = vec![false; axis.nodes.len()];
+    main.iter().for_each(|&v| on_main[v] = true);
+    let mut side = vec![0.0f64; axis.nodes.len()];
+    let mut longest_side = 0.0f64;
+    for &v in &from_a.order {
+        if let (Some(p), false) = (from_a.parent[v], on_main[v]) {
+            side[v] = side[p] + (axis.nodes[v].pos - axis.nodes[p].pos).norm();
+            longest_side = longest_side.max(side[v]);
+        }
+    }
+    if longest_side >= fraction * dist[b] {
+        return None;
+    }
+    let mut path = main;
+    if axis.nodes[path[0]].pos.y < axis.nodes[path[path.len() - 1]].pos.y {
+        path.reverse();
+    }
+    Some(path)
 }
 
 /// Reduces `bones` to at most `max` (if given): first merges a bone into its only child where

@@ -7,20 +7,25 @@
 //!
 //! Matching: the template's extremities (humanoid: head, two hands, two feet; quadruped: head,
 //! tail, four feet) are assigned to leaves of the axis tree by exhaustive search over the
-//! candidate leaves. An assignment fixes the template's inner joints as tree medians (the
-//! humanoid's pelvis is where the paths between the feet and the head meet, its chest where
-//! the hands and the head meet), and must respect the template graph: chest strictly between
-//! pelvis and head, no arm path through the pelvis, no leg path through the chest. Among the
-//! valid assignments the one with the best score wins: extremities where the template expects
-//! them in the drawing's box (head up, feet down, `_l` limbs on the right of the screen: the
-//! character's left, facing the viewer) and left/right limbs of similar length. Bones then
-//! follow the tree paths between the joints, split at the limbs' bends (elbows, knees) and kept
-//! straight and inside; axis branches the template does not name (ears, a tail on a humanoid,
-//! a held prop) become extra bones hanging from the named bone they leave.
+//! candidate leaves. The axis is computed without merging nearby junctions, so that limbs
+//! leaving a round torso keep their own joints. An assignment fixes the template's inner
+//! joints as tree medians: the humanoid's pelvis is where the paths between the feet and the
+//! head meet, each arm's shoulder where its hand's path meets the spine (pelvis to head), and
+//! the chest is the higher shoulder; shoulders must lie strictly above the pelvis and off the
+//! legs' paths. A head drawn apart from the body is no leaf of the body's axis: the highest
+//! node of the piece then ends the spine (the head gets its own bone as a separate piece,
+//! [`super::budget`]). Among the valid assignments the one with the best score wins:
+//! extremities where the template expects them in the drawing's box (head up, feet down, `_l`
+//! limbs on the right of the screen: the character's left, facing the viewer) and left/right
+//! limbs of similar length. Bones then follow the tree paths between the joints: hip and chest
+//! along the spine, a neck and a head split where the path widens into the skull, two bones per
+//! limb split at the limbs' bends (elbows, knees), a quadruped's tail in up to three bones, all
+//! kept straight and inside; axis branches the template does not name (ears, a tail on a
+//! humanoid, a held prop) become extra bones hanging from the named bone they leave.
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
-use super::skeleton::{BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
+use super::skeleton::{polyline_length, BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
 use crate::geom::{point_segment_distance, Point};
 use serde::{Deserialize, Serialize};
 
@@ -180,8 +185,9 @@ pub fn fit_template(
     let leaves = most_extreme(&leaves, |v| frame.unit(pos(v)), MAX_CANDIDATE_LEAVES);
     match template {
         Template::Humanoid => {
-            let fit = fit_humanoid(&leaves, &lca, &frame, &pos)?;
-            Some(build_humanoid(axis, shape, options, &fit))
+            let fit = fit_humanoid(&leaves, &tree.order, &lca, &frame, &pos)?;
+            let chest = fit.chest(&lca);
+            Some(build_humanoid(axis, shape, options, &fit, chest))
         }
         Template::Quadruped => {
             let thickness: Vec<(usize, f64)> = leaves
@@ -211,44 +217,91 @@ fn most_extreme(leaves: &[usize], unit: impl Fn(usize) -> (f64, f64), keep: usiz
     kept
 }
 
-/// (pelvis, chest, head, hands [l, r], feet [l, r]): axis nodes.
-type HumanoidFit = (usize, usize, usize, [usize; 2], [usize; 2]);
+/// A humanoid fit (axis nodes): where the legs meet the spine (pelvis), head, hands [l, r],
+/// feet [l, r], and where each arm meets the spine (its shoulder joint, in the order of the
+/// hands); the chest is the shoulder joint nearer the head.
+struct HumanoidFit {
+    pelvis: usize,
+    head: usize,
+    hands: [usize; 2],
+    feet: [usize; 2],
+    shoulders: [usize; 2],
+}
+
+impl HumanoidFit {
+    fn chest(&self, lca: &Lca) -> usize {
+        let [a, b] = self.shoulders;
+        if lca.dist(self.pelvis, a) >= lca.dist(self.pelvis, b) {
+            a
+        } else {
+            b
+        }
+    }
+}
 
 fn fit_humanoid(
     leaves: &[usize],
+    nodes: &[usize],
     lca: &Lca,
     frame: &Frame,
     pos: &dyn Fn(usize) -> Point,
 ) -> Option<HumanoidFit> {
     let mut best: Option<(f64, HumanoidFit)> = None;
     let u = |v: usize| frame.unit(pos(v));
-    for &head in leaves {
+    // The head is a leaf, or (a head drawn apart, rigged as a piece of its own) the highest
+    // node of the piece, where the spine then ends.
+    let mut heads = leaves.to_vec();
+    if let Some(&top) = nodes
+        .iter()
+        .min_by(|&&a, &&b| pos(a).y.total_cmp(&pos(b).y).then(a.cmp(&b)))
+    {
+        if !heads.contains(&top) {
+            heads.push(top);
+        }
+    }
+    for &head in &heads {
+        let head_leaf = leaves.contains(&head);
         for &fl in leaves {
             for &fr in leaves {
                 if fl == head || fr == head || fl == fr || pos(fl).x <= pos(fr).x {
                     continue;
                 }
                 let pelvis = lca.median(fl, fr, head);
+                if pelvis == head {
+                    continue;
+                }
                 for &hl in leaves {
                     for &hr in leaves {
                         let distinct = [head, fl, fr].iter().all(|&v| v != hl && v != hr);
                         if !distinct || hl == hr || pos(hl).x <= pos(hr).x {
                             continue;
                         }
-                        let chest = lca.median(hl, hr, head);
-                        let valid = chest != pelvis
-                            && lca.on_path(chest, pelvis, head)
-                            && lca.on_path(chest, pelvis, hl)
-                            && lca.on_path(chest, pelvis, hr)
-                            && lca.on_path(pelvis, chest, fl)
-                            && lca.on_path(pelvis, chest, fr);
+                        // Each arm leaves the spine (pelvis to head) strictly above the pelvis
+                        // and below the head; no leg passes through a shoulder.
+                        let shoulders = [hl, hr].map(|h| lca.median(h, pelvis, head));
+                        let valid = shoulders.iter().all(|&s| {
+                            s != pelvis
+                                && (s != head || !head_leaf)
+                                && !lca.on_path(s, pelvis, fl)
+                                && !lca.on_path(s, pelvis, fr)
+                        });
                         if !valid {
                             continue;
                         }
-                        let (arm_l, arm_r) = (lca.dist(chest, hl), lca.dist(chest, hr));
+                        let fit = HumanoidFit {
+                            pelvis,
+                            head,
+                            hands: [hl, hr],
+                            feet: [fl, fr],
+                            shoulders,
+                        };
+                        let chest = fit.chest(lca);
+                        let (arm_l, arm_r) =
+                            (lca.dist(shoulders[0], hl), lca.dist(shoulders[1], hr));
                         let (leg_l, leg_r) = (lca.dist(pelvis, fl), lca.dist(pelvis, fr));
                         let spine = lca.dist(pelvis, chest);
                         let mut score = 2.0 * u(head).1
+                            + if head_leaf { 0.0 } else { 1.0 }
                             + 2.0 * (1.0 - u(fl).1)
                             + 2.0 * (1.0 - u(fr).1)
                             + (arm_l - arm_r).abs() / (arm_l + arm_r).max(1e-9)
@@ -266,7 +319,7 @@ fn fit_humanoid(
                             score += 4.0;
                         }
                         if best.as_ref().is_none_or(|b| score < b.0) {
-                            best = Some((score, (pelvis, chest, head, [hl, hr], [fl, fr])));
+                            best = Some((score, fit));
                         }
                     }
                 }
@@ -417,6 +470,32 @@ impl<'a> NamedBuilder<'a> {
         self.bones_along(&path, 0, &ends, names, parent).0
     }
 
+    /// A neck and a head bone from `from` (the chest joint) to `to` (the head's leaf): the
+    /// head starts where the path widens again past its narrowest stretch (the base of the
+    /// skull, [`limb_end`]), else half way. A neck shorter than `min_bone_px` makes one head
+    /// bone.
+    fn neck_and_head(&mut self, from: usize, to: usize, parent: Option<usize>) {
+        let path = self.path(from, to);
+        if path.len() < 2 {
+            return;
+        }
+        let axis = self.builder.axis;
+        let points = self.points(&path);
+        let radii: Vec<f64> = path.iter().map(|&v| axis.nodes[v].radius_px).collect();
+        let base = limb_end(&radii);
+        let base = if base + 1 >= path.len() {
+            half_index(&points)
+        } else {
+            base
+        };
+        let neck_px = polyline_length(&points[..=base]);
+        if neck_px < self.builder.options.min_bone_px || base == 0 {
+            self.bones_along(&path, 0, &[path.len() - 1], &["head"], parent);
+            return;
+        }
+        self.bones_along(&path, 0, &[base, path.len() - 1], &["neck", "head"], parent);
+    }
+
     /// An upper and a lower limb bone from `from` down to `to`: the limb starts where the path
     /// leaves the thick joint (the stretch before belongs to `parent`), bends at its elbow or
     /// knee (the bend, else half way), and the lower bone is at most `lower_limb_ratio` times
@@ -480,6 +559,9 @@ impl<'a> NamedBuilder<'a> {
     }
 }
 
+/// A quadruped's tail bones, root first.
+const TAIL_NAMES: [&str; 3] = ["tail_1", "tail_2", "tail_3"];
+
 /// Default for [`NamedBuilder::limb_radius_ratio`].
 const LIMB_RADIUS_RATIO: f64 = 0.5;
 /// Default for [`NamedBuilder::lower_limb_ratio`].
@@ -503,17 +585,20 @@ fn build_humanoid(
     shape: &Shape,
     options: &SkeletonOptions,
     fit: &HumanoidFit,
+    chest: usize,
 ) -> Vec<ProtoBone> {
-    let &(pelvis, chest, head, hands, feet) = fit;
-    let tree = NodeTree::new(axis, pelvis);
+    let tree = NodeTree::new(axis, fit.pelvis);
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
-    let spine = nb.even_chain(pelvis, chest, &["hip", "chest"], None);
+    let spine = nb.even_chain(fit.pelvis, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
-    nb.even_chain(chest, head, &["head"], chest_bone);
-    nb.limb(chest, hands[0], ["arm_upper_l", "arm_lower_l"], chest_bone);
-    nb.limb(chest, hands[1], ["arm_upper_r", "arm_lower_r"], chest_bone);
-    nb.limb(pelvis, feet[0], ["leg_upper_l", "leg_lower_l"], hip);
-    nb.limb(pelvis, feet[1], ["leg_upper_r", "leg_lower_r"], hip);
+    if chest != fit.head {
+        nb.neck_and_head(chest, fit.head, chest_bone);
+    }
+    let [sl, sr] = fit.shoulders;
+    nb.limb(sl, fit.hands[0], ["arm_upper_l", "arm_lower_l"], chest_bone);
+    nb.limb(sr, fit.hands[1], ["arm_upper_r", "arm_lower_r"], chest_bone);
+    nb.limb(fit.pelvis, fit.feet[0], ["leg_upper_l", "leg_lower_l"], hip);
+    nb.limb(fit.pelvis, fit.feet[1], ["leg_upper_r", "leg_lower_r"], hip);
     nb.extras()
 }
 
@@ -655,8 +740,11 @@ fn build_quadruped(
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
     let spine = nb.even_chain(pelvis, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
-    nb.even_chain(chest, fit.head, &["head"], chest_bone);
-    nb.even_chain(pelvis, fit.tail, &["tail_1", "tail_2"], hip);
+    nb.neck_and_head(chest, fit.head, chest_bone);
+    // A tail of up to three bones, each at least twice the shortest bone.
+    let tail_px = polyline_length(&nb.points(&nb.path(pelvis, fit.tail)));
+    let tail_bones = ((tail_px / (2.0 * options.min_bone_px)) as usize).clamp(1, 3);
+    nb.even_chain(pelvis, fit.tail, &TAIL_NAMES[..tail_bones], hip);
     let names = [
         ["leg_front_upper_l", "leg_front_lower_l"],
         ["leg_front_upper_r", "leg_front_lower_r"],

@@ -44,6 +44,12 @@ pub fn triangle_area(l2: [f64; 3]) -> f64 {
     0.25 * s.max(0.0).sqrt()
 }
 
+/// Whether a triangle (squared edge lengths) is degenerate: it contributes nothing to the
+/// stiffness, so it joins none of its vertices for the solve.
+pub fn is_degenerate(l2: [f64; 3]) -> bool {
+    corner_cotangents(l2).is_none()
+}
+
 /// Cotangents of the angles at corners 0, 1, 2, or `None` for a degenerate triangle.
 fn corner_cotangents(l2: [f64; 3]) -> Option<[f64; 3]> {
     let area = triangle_area(l2);

@@ -5,11 +5,14 @@
 //! Out: [`PartWeights`]: for each vertex of the drawn mesh ([`EmbeddedMesh::shape_mesh`]) its
 //! non-zero weights as (column, weight), rows summing to one, at most `max_influences` each.
 //!
-//! Pieces of the domain that no handle touches (a part with no bone inside it, a stray island)
-//! cannot be solved for; they follow the handle nearest to them rigidly, as cutout tools bind
-//! an unweighted attachment to one bone.
+//! Pieces of the domain that no handle touches (a part with no bone inside it, a stray island,
+//! a detached head) cannot be solved for; they follow the handle nearest to them (measured
+//! across the gap: the smallest distance from any of their vertices) rigidly, as cutout tools
+//! bind an unweighted attachment to one bone. Pieces are those the solve sees: vertices joined
+//! by non-degenerate triangles only (a degenerate triangle adds nothing to the stiffness, so a
+//! piece hanging on by slivers, or a vertex of slivers only, is a piece of its own).
 
-use super::boundary::{bound_boundary_conditions, centroid, nearest_column};
+use super::boundary::{bound_boundary_conditions, distance_to_column, nearest_column};
 use super::lift::{content_aware_domain, LiftError};
 use super::monotone::{monotone_bounded_biharmonic_weights, MonotoneOptions};
 use super::solve::{
@@ -20,6 +23,7 @@ use super::sparse::SolveError;
 use crate::mesh::EmbeddedMesh;
 use crate::rig::{handle_columns, Handles};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// Which energy the weights minimize.
 #[derive(
@@ -119,6 +123,8 @@ pub struct PartWeights {
     pub touched: Vec<usize>,
     /// Columns that pieces without a handle were bound to rigidly.
     pub bound_to_nearest: Vec<usize>,
+    /// How many domain vertices those pieces have.
+    pub bound_vertices: usize,
     /// Columns whose bounded solve stopped at its iteration limit before its tolerances.
     pub unconverged: Vec<usize>,
 }
@@ -160,37 +166,64 @@ fn pieces(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<usize> {
     (0..vertex_count).map(|i| root(&mut parent, i)).collect()
 }
 
+/// The pieces the solve sees: a piece index per vertex, vertices joined by the triangles that
+/// are not degenerate ([`super::laplacian::is_degenerate`]) in `vertices` (canvas px).
+fn solved_pieces(vertices: &[crate::geom::Point], triangles: &[[u32; 3]]) -> Vec<usize> {
+    let points: Vec<[f64; 2]> = vertices.iter().map(|p| [p.x, p.y]).collect();
+    let l2 = super::laplacian::squared_edge_lengths(&points, triangles);
+    let solid: Vec<[u32; 3]> = triangles
+        .iter()
+        .zip(&l2)
+        .filter(|(_, l)| !super::laplacian::is_degenerate(**l))
+        .map(|(t, _)| *t)
+        .collect();
+    pieces(vertices.len(), &solid)
+}
+
 /// Fixes every vertex of every piece that has no fixed vertex to the column nearest to the
-/// piece's centroid; returns those columns.
+/// piece (the smallest distance from any of its vertices); returns those columns and how
+/// many vertices they took.
 fn bind_free_pieces(
     embedded: &EmbeddedMesh,
     handles: &Handles,
     binding: &[bool],
     bc: &mut BoundaryConditions,
-) -> Vec<usize> {
+) -> (Vec<usize>, usize) {
     let vertices = &embedded.domain.vertices;
-    let piece = pieces(vertices.len(), &embedded.domain.triangles);
+    let piece = solved_pieces(vertices, &embedded.domain.triangles);
     let mut has_fixed = vec![false; vertices.len()];
     for &v in &bc.vertices {
         has_fixed[piece[v]] = true;
     }
-    let mut bound = Vec::new();
-    let mut roots: Vec<usize> = piece.clone();
-    roots.sort_unstable();
-    roots.dedup();
-    for r in roots {
-        if has_fixed[r] {
-            continue;
+    let mut members: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (i, &r) in piece.iter().enumerate() {
+        if !has_fixed[r] {
+            members.entry(r).or_default().push(i);
         }
-        let members: Vec<usize> = (0..vertices.len()).filter(|&i| piece[i] == r).collect();
-        let c = centroid(members.iter().map(|&i| vertices[i]));
-        let nearest = nearest_column(c, handles, binding);
-        for i in members {
+    }
+    let mut bound = Vec::new();
+    let mut count = 0;
+    for members in members.values() {
+        let nearest = (0..binding.len())
+            .filter(|&c| binding[c])
+            .map(|c| {
+                let d = members
+                    .iter()
+                    .map(|&i| distance_to_column(vertices[i], handles, c))
+                    .fold(f64::INFINITY, f64::min);
+                (c, d)
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+            .map_or(0, |(c, _)| c);
+        for &i in members {
             bc.fix_to_handle(i, nearest);
         }
-        bound.push(nearest);
+        count += members.len();
+        if !bound.contains(&nearest) {
+            bound.push(nearest);
+        }
     }
-    bound
+    (bound, count)
 }
 
 /// Computes one part's weights. `colors` (premultiplied RGB in [0, 1], one per domain vertex)
@@ -229,6 +262,8 @@ pub struct DomainWeights {
     pub touched: Vec<usize>,
     /// As [`PartWeights::bound_to_nearest`].
     pub bound_to_nearest: Vec<usize>,
+    /// As [`PartWeights::bound_vertices`].
+    pub bound_vertices: usize,
     /// As [`PartWeights::unconverged`].
     pub unconverged: Vec<usize>,
 }
@@ -248,6 +283,7 @@ pub fn shape_rows(
         rows,
         touched: solved.touched,
         bound_to_nearest: solved.bound_to_nearest,
+        bound_vertices: solved.bound_vertices,
         unconverged: solved.unconverged,
     }
 }
@@ -302,7 +338,8 @@ pub fn domain_weights(
     options: &WeightOptions,
 ) -> Result<DomainWeights, WeightError> {
     let mesh = &embedded.domain;
-    let (bc, touched, bound_to_nearest) = boundary_conditions(embedded, handles, binding);
+    let (bc, touched, (bound_to_nearest, bound_vertices)) =
+        boundary_conditions(embedded, handles, binding);
     let domain = weight_domain(mesh, colors, options)?;
     let mut unconverged = Vec::new();
     let mut w = match options.method {
@@ -335,18 +372,19 @@ pub fn domain_weights(
         matrix: w,
         touched,
         bound_to_nearest,
+        bound_vertices,
         unconverged,
     })
 }
 
 /// The handles' boundary conditions on `embedded`'s domain vertices (only the columns in
 /// `binding`), with every piece no handle reaches bound to the nearest handle; also how many
-/// vertices each column fixes and the columns pieces were bound to.
+/// vertices each column fixes, and the columns pieces were bound to with how many vertices.
 pub fn boundary_conditions(
     embedded: &EmbeddedMesh,
     handles: &Handles,
     binding: &[bool],
-) -> (BoundaryConditions, Vec<usize>, Vec<usize>) {
+) -> (BoundaryConditions, Vec<usize>, (Vec<usize>, usize)) {
     let (mut bc, touched) = bound_boundary_conditions(&embedded.domain.vertices, handles, binding);
     let bound_to_nearest = bind_free_pieces(embedded, handles, binding, &mut bc);
     (bc, touched, bound_to_nearest)
@@ -446,6 +484,53 @@ mod tests {
         assert!((row[0].1 + row[1].1 - 1.0).abs() < 1e-15);
         let all = sparse_row(&[0.1, 0.5, 0.0, 0.4], &WeightOptions::default());
         assert_eq!(all.iter().map(|e| e.0).collect::<Vec<_>>(), vec![0, 1, 3]);
+    }
+
+    /// Two triangles joined only by a degenerate (flat) one, a bone on the first: the second
+    /// is a piece the solve cannot reach (a flat triangle adds no stiffness), so it follows
+    /// the bone rigidly instead of failing the solve as unreachable.
+    #[test]
+    fn a_piece_joined_by_a_flat_triangle_follows_the_nearest_handle() {
+        use crate::geom::Point;
+        use crate::mesh::Mesh;
+        use crate::rig::Bone;
+        let p = |x: f64, y: f64| Point::new(x, y);
+        let domain = Mesh {
+            vertices: vec![
+                p(0.0, 0.0),
+                p(10.0, 0.0),
+                p(0.0, 10.0),
+                p(20.0, 0.0),
+                p(30.0, 0.0),
+                p(20.0, 10.0),
+                p(15.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [3, 4, 5], [1, 6, 3]],
+        };
+        let embedded = EmbeddedMesh {
+            in_shape: vec![true; 3],
+            domain,
+        };
+        let handles = Handles {
+            bones: vec![Bone {
+                name: "a".into(),
+                parent: None,
+                head: [0.0, 0.0],
+                tail: [0.0, 10.0],
+            }],
+            ..Default::default()
+        };
+        for method in [WeightMethod::Harmonic, WeightMethod::Bbw] {
+            let options = WeightOptions {
+                method,
+                ..Default::default()
+            };
+            let w = part_weights(&embedded, &handles, None, &options).expect("weights");
+            assert_eq!(w.bound_to_nearest, vec![0]);
+            // The far triangle and the flat triangle's middle vertex.
+            assert_eq!(w.bound_vertices, 4);
+            assert!(w.rows.iter().all(|r| r == &vec![(0, 1.0)]));
+        }
     }
 
     #[test]

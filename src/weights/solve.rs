@@ -293,7 +293,7 @@ pub fn bounded_biharmonic_weights(
     check_reachable(&q, bc)?;
     let free = free_vertices(n, bc);
     let pattern = SharedPattern::new(&q, &free)?;
-    let unconstrained = pattern.factor(&pattern.values)?;
+    let unconstrained = pattern.factor_regularized(&pattern.values)?;
     // Per handle: the weight column, the iterations taken and whether they converged.
     type HandleSolve = (Vec<f64>, usize, bool);
     let results: Vec<Result<HandleSolve, SolveError>> = (0..bc.handle_count)

@@ -17,6 +17,10 @@ pub enum SolveError {
     Assembly(String),
 }
 
+/// Diagonal shifts (relative to the largest diagonal entry) tried in turn by
+/// [`SharedPattern::factor_regularized`].
+pub const REGULARIZATION_STEPS: [f64; 3] = [1e-13, 1e-11, 1e-9];
+
 /// A Cholesky factorization of the principal sub-matrix A[keep, keep] of a symmetric matrix.
 pub struct SubmatrixCholesky {
     llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
@@ -213,6 +217,33 @@ impl SharedPattern {
         self.diagonal.is_empty()
     }
 
+    /// [`SharedPattern::factor`], retried with the diagonal raised by
+    /// [`REGULARIZATION_STEPS`] × the largest diagonal entry when rounding makes a pivot
+    /// vanish: a positive semi-definite matrix assembled from a mesh with near-degenerate
+    /// triangles (angles under a degree, vertex masses many orders below their neighbors')
+    /// can lose definiteness in floating point although it has none to lose in exact
+    /// arithmetic. The shift changes the solution by about that relative amount.
+    pub fn factor_regularized(&self, values: &[f64]) -> Result<PatternCholesky<'_>, SolveError> {
+        if let Ok(f) = self.factor(values) {
+            return Ok(f);
+        }
+        let largest = self
+            .diagonal
+            .iter()
+            .map(|&d| values[d].abs())
+            .fold(0.0, f64::max);
+        for step in REGULARIZATION_STEPS {
+            let mut shifted = values.to_vec();
+            for &d in &self.diagonal {
+                shifted[d] += step * largest;
+            }
+            if let Ok(f) = self.factor(&shifted) {
+                return Ok(f);
+            }
+        }
+        Err(SolveError::NotPositiveDefinite)
+    }
+
     /// Factors the matrix with this pattern and the given values (numeric phase only,
     /// sequential: callers run handles in parallel).
     pub fn factor(&self, values: &[f64]) -> Result<PatternCholesky<'_>, SolveError> {
@@ -335,6 +366,33 @@ pub fn sandwich_diagonal(a: &CsMat<f64>, d: &[f64]) -> CsMat<f64> {
 mod tests {
     use super::*;
     use sprs::TriMat;
+
+    /// A positive semi-definite matrix that is singular: the plain factorization fails, the
+    /// regularized one shifts the diagonal by a tiny relative amount and succeeds, and an
+    /// indefinite matrix still fails.
+    #[test]
+    fn regularized_factorization_shifts_only_what_rounding_needs() {
+        let matrix = |off: f64| {
+            let mut t = TriMat::new((2, 2));
+            t.add_triplet(0, 0, 1.0);
+            t.add_triplet(1, 1, 1.0);
+            t.add_triplet(0, 1, off);
+            t.add_triplet(1, 0, off);
+            t.to_csr::<usize>()
+        };
+        let singular = SharedPattern::new(&matrix(1.0), &[0, 1]).unwrap();
+        assert!(singular.factor(&singular.values).is_err());
+        let f = singular.factor_regularized(&singular.values).unwrap();
+        // Solves (A + εI) x = (1, 1) with x ≈ (0.5, 0.5).
+        let mut x = vec![1.0, 1.0];
+        f.solve_in_place(&mut x);
+        assert!(
+            (x[0] - 0.5).abs() < 1e-6 && (x[1] - 0.5).abs() < 1e-6,
+            "{x:?}"
+        );
+        let indefinite = SharedPattern::new(&matrix(2.0), &[0, 1]).unwrap();
+        assert!(indefinite.factor_regularized(&indefinite.values).is_err());
+    }
 
     #[test]
     fn solves_a_principal_submatrix() {

@@ -72,6 +72,7 @@ pub fn two_level_weights(
             matrix,
             touched,
             bound_to_nearest: solved.bound_to_nearest,
+            bound_vertices: solved.bound_vertices,
             unconverged: solved.unconverged,
         },
         options,
