@@ -16,6 +16,7 @@
 
 pub mod check;
 pub mod curve;
+pub mod deform;
 pub mod edit;
 pub mod event;
 pub mod mix;
@@ -62,6 +63,17 @@ pub enum AnimError {
     CageSize {
         animation: String,
         cage: String,
+        key: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "animation '{animation}', deform.{part}: key {key} has {got} offsets but the part's mesh \
+         has {expected} vertices"
+    )]
+    DeformSize {
+        animation: String,
+        part: String,
         key: usize,
         got: usize,
         expected: usize,

@@ -261,7 +261,13 @@ impl RigDocument {
     /// the document must still open; what poses an animation checks it first.
     pub fn check_animations(&self) -> Result<(), AnimError> {
         let parts: Vec<&str> = self.parts.iter().map(|p| p.name.as_str()).collect();
-        crate::anim::check_animations(&self.animations, &self.handles, &parts, &self.events)
+        crate::anim::check_animations(&self.animations, &self.handles, &parts, &self.events)?;
+        let sizes: Vec<(&str, usize)> = self
+            .parts
+            .iter()
+            .map(|p| (p.name.as_str(), p.mesh.vertices.len()))
+            .collect();
+        crate::anim::deform::check_deform_sizes(&self.animations, &sizes)
     }
 
     /// The image of `part`, resolved against the folder of the document at `doc_path`.

@@ -66,6 +66,14 @@ pub fn sample_path(
     animation: &Animation,
     times: &[f64],
 ) -> Result<Vec<(Pose, Vec<Affine>)>, PipelineError> {
+    // The runtime simulates physics constraints itself: what is baked is the motion without.
+    let unphysical;
+    let scene = if scene.doc.handles.physics.is_empty() {
+        scene
+    } else {
+        unphysical = scene.without_physics();
+        &unphysical
+    };
     let frames = crate::scene::frames(scene, animation, times, PlayOptions::default())?;
     Ok(frames
         .into_iter()
