@@ -80,6 +80,8 @@ fn bundled_animations_match_golden_at_fixed_times() {
         ("walk", [0.25, 0.6]),
         ("wave", [0.4, 1.1]),
         ("lift", [0.5, 1.0]),
+        // The belly squash (deform keys) on landing, and the tail's physics mid-hop.
+        ("hop", [0.4, 0.67]),
     ] {
         let animation = &animations[name];
         for t in times_s {
