@@ -344,7 +344,7 @@ mod tests {
         );
         assert_eq!(
             animations.keys().collect::<Vec<_>>(),
-            ["lift", "walk", "wave"].iter().collect::<Vec<_>>()
+            ["hop", "lift", "walk", "wave"].iter().collect::<Vec<_>>()
         );
         for (name, anim) in &animations {
             anim.check_rig(name, &handles, &parts, &events).unwrap();

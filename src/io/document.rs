@@ -446,7 +446,7 @@ mod tests {
         let bundled: serde_json::Value = serde_json::from_str(&text).unwrap();
         // The animations file on its own.
         let parsed = crate::anim::animations_from_json(&bundled).unwrap();
-        assert_eq!(parsed.len(), 3);
+        assert_eq!(parsed.len(), 4);
         assert!(same_json(&serde_json::to_value(&parsed).unwrap(), &bundled));
         // In a rig document: load, save, load.
         let mut v = serde_json::to_value(sample()).unwrap();

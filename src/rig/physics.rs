@@ -435,3 +435,80 @@ impl PhysicsState {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn constraint() -> PhysicsConstraint {
+        serde_json::from_value(serde_json::json!({"name": "p", "bone": "b", "x": 1})).unwrap()
+    }
+
+    fn bone_at(x: f64) -> SpineWorld {
+        SpineWorld {
+            a: 1.0,
+            b: 0.0,
+            c: 0.0,
+            d: 1.0,
+            world_x: x,
+            world_y: 0.0,
+        }
+    }
+
+    #[test]
+    fn defaults_are_spine_cores() {
+        let c = constraint();
+        assert_eq!(
+            (c.limit, c.fps, c.inertia, c.strength, c.damping, c.mass, c.mix),
+            (5000.0, 60.0, 1.0, 100.0, 1.0, 1.0, 1.0)
+        );
+        assert_eq!((c.y, c.rotate, c.scale_x, c.shear_x), (0.0, 0.0, 0.0, 0.0));
+        let mut nan = c.clone();
+        nan.gravity = f64::NAN;
+        assert_eq!(nan.check().unwrap_err(), "gravity is NaN, not a finite number");
+    }
+
+    #[test]
+    fn a_jump_is_held_back_then_sprung_back_as_spine_core_steps_it() {
+        let c = constraint();
+        let step = c.step_s();
+        let mut state = PhysicsState::default();
+        // The first update only records where the bone is.
+        let mut bone = bone_at(0.0);
+        state.update(&c, 10.0, &mut bone, 0.0, PhysicsMode::Update);
+        assert_eq!(bone.world_x, 0.0);
+        // The bone jumps 10 px in one step: inertia 1 holds it back entirely (offset −10), then
+        // one spring step (strength 100, mass 1, undamped) by hand, as PhysicsConstraint.ts:
+        // v += (0 − (−10)·100)·t; offset += v·t.
+        let mut bone = bone_at(10.0);
+        state.update(&c, 10.0, &mut bone, step, PhysicsMode::Update);
+        let v = 10.0 * 100.0 * step;
+        let offset = -10.0 + v * step;
+        assert!((bone.world_x - (10.0 + offset)).abs() < 1e-12, "{}", bone.world_x);
+        // Between updates: the same offset, no step.
+        let mut posed = bone_at(10.0);
+        state.clone().update(&c, 10.0, &mut posed, step, PhysicsMode::Pose);
+        assert_eq!(posed.world_x, bone.world_x);
+        // Damped, it settles back on the pose.
+        let mut damped = c.clone();
+        damped.damping = 0.5;
+        let mut state = PhysicsState::default();
+        for k in 0..600 {
+            let mut bone = bone_at(if k == 0 { 0.0 } else { 10.0 });
+            state.update(&damped, 10.0, &mut bone, k as f64 * step, PhysicsMode::Update);
+            if k == 599 {
+                assert!((bone.world_x - 10.0).abs() < 1e-6, "{}", bone.world_x);
+            }
+        }
+    }
+
+    #[test]
+    fn canvas_frames_round_trip_through_spines_axes() {
+        let frame = crate::rig::pose::bone_rest_frame([3.0, 4.0], [13.0, -6.0]);
+        let spine = SpineWorld::from_canvas(&frame);
+        // 45° up on screen: counter-clockwise in Spine's y-up axes too.
+        assert!((spine.c.atan2(spine.a).to_degrees() - 45.0).abs() < 1e-12);
+        assert!((spine.a * spine.d - spine.b * spine.c - 1.0).abs() < 1e-12);
+        assert_eq!(spine.to_canvas(), frame);
+    }
+}
