@@ -87,6 +87,8 @@ pub struct ColorizeEditor {
     saved_strokes: Option<Arc<Vec<ScribbleStroke>>>,
     pub tool: ColorizeTool,
     pub color: [u8; 3],
+    /// The "Color hex:" field's text while it is edited (`#rrggbb`).
+    color_hex: String,
     /// Brush diameter, image px.
     pub width_px: f32,
     pub view_mode: ColorizeView,
@@ -117,6 +119,7 @@ impl Default for ColorizeEditor {
             saved_strokes: None,
             tool: ColorizeTool::Brush,
             color: DEFAULT_COLOR,
+            color_hex: String::new(),
             width_px: DEFAULT_BRUSH_PX,
             view_mode: ColorizeView::Result,
             opacity: 1.0,
@@ -449,20 +452,21 @@ impl EditorApp {
     /// The File menu's colorize entries.
     pub(super) fn colorize_file_menu(&mut self, ui: &mut egui::Ui) {
         ui.separator();
-        ui.label("Line-art PNG to colorize:");
-        ui.text_edit_singleline(&mut self.colorize.lineart_path);
+        labelled_text_field(
+            ui,
+            "Line-art PNG to colorize:",
+            &mut self.colorize.lineart_path,
+        );
         if ui.button("Open line art").clicked() {
             let path = PathBuf::from(&self.colorize.lineart_path);
             self.open_lineart(&path);
         }
-        ui.label("Colorized PNG:");
-        ui.text_edit_singleline(&mut self.colorize.save_path);
+        labelled_text_field(ui, "Colorized PNG:", &mut self.colorize.save_path);
         if ui.button("Save colorized PNG").clicked() {
             let path = PathBuf::from(&self.colorize.save_path);
             self.message = Some(self.save_colorized(&path));
         }
-        ui.label("Scribbles JSON:");
-        ui.text_edit_singleline(&mut self.colorize.scribbles_path);
+        labelled_text_field(ui, "Scribbles JSON:", &mut self.colorize.scribbles_path);
         ui.horizontal(|ui| {
             if ui.button("Save scribbles").clicked() {
                 let path = PathBuf::from(&self.colorize.scribbles_path);
@@ -491,6 +495,21 @@ impl EditorApp {
         ui.horizontal(|ui| {
             ui.label("Color");
             ui.color_edit_button_srgb(&mut c.color);
+            // Typed as #rrggbb; taken once it parses, shown as the colour otherwise.
+            let label = ui.label("Color hex:");
+            let field = ui
+                .add(egui::TextEdit::singleline(&mut c.color_hex).desired_width(70.0))
+                .labelled_by(label.id);
+            if field.changed() {
+                if let Some(color) = crate::colorize::scribbles::parse_hex_color(c.color_hex.trim())
+                {
+                    c.color = color;
+                    c.tool = ColorizeTool::Brush;
+                }
+            }
+            if !field.has_focus() {
+                c.color_hex = format!("#{}", crate::colorize::scribbles::hex(c.color));
+            }
         });
         ui.horizontal_wrapped(|ui| {
             for swatch in SWATCHES {
@@ -500,7 +519,15 @@ impl EditorApp {
                 }
             }
         });
-        ui.add(egui::Slider::new(&mut c.width_px, 1.0..=64.0).text("brush px"));
+        ui.horizontal(|ui| {
+            let label = ui.label("Brush px:");
+            ui.add(
+                egui::DragValue::new(&mut c.width_px)
+                    .range(1.0..=64.0)
+                    .speed(0.25),
+            )
+            .labelled_by(label.id);
+        });
         ui.separator();
         ui.horizontal(|ui| {
             ui.selectable_value(&mut c.view_mode, ColorizeView::Result, "Result");
@@ -786,7 +813,14 @@ fn is_png(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("png"))
 }
 
-/// A small square of `color` (framed when `selected`) that picks it.
+/// A label and a one-line text field it names (found by the label's text).
+fn labelled_text_field(ui: &mut egui::Ui, text: &str, value: &mut String) {
+    let label = ui.label(text);
+    ui.text_edit_singleline(value).labelled_by(label.id);
+}
+
+/// A small square of `color` (framed when `selected`) that picks it; named "Swatch #rrggbb"
+/// for screen readers and tests.
 fn swatch_button(ui: &mut egui::Ui, color: [u8; 3], selected: bool) -> egui::Response {
     let fill = Color32::from_rgb(color[0], color[1], color[2]);
     let frame = if selected {
@@ -794,13 +828,17 @@ fn swatch_button(ui: &mut egui::Ui, color: [u8; 3], selected: bool) -> egui::Res
     } else {
         egui::Stroke::new(1.0, Color32::from_gray(90))
     };
-    ui.add(
+    let response = ui.add(
         egui::Button::new("")
             .fill(fill)
             .stroke(frame)
             .min_size(egui::vec2(18.0, 18.0)),
-    )
-    .on_hover_text(format!("#{}", crate::colorize::scribbles::hex(color)))
+    );
+    let name = format!("Swatch #{}", crate::colorize::scribbles::hex(color));
+    response.widget_info(|| {
+        egui::WidgetInfo::selected(egui::WidgetType::Button, true, selected, name.clone())
+    });
+    response.on_hover_text(&name[7..])
 }
 
 /// A scribble as the brush painted it: its path at its width, round joins and caps.

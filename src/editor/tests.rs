@@ -166,6 +166,23 @@ fn never_rigged_bar(dir: &Path) -> Harness<'static, EditorApp> {
     h
 }
 
+/// Opens the File menu, types `text` into its field `label` and closes the menu again.
+fn type_in_file_menu(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
+    h.get_by_label("File").click();
+    h.run();
+    type_into(h, label, text);
+    assert_eq!(h.get_by_label(label).value().as_deref(), Some(text));
+    // The first Escape leaves the field, the second closes the menu.
+    h.key_press(Key::Escape);
+    h.run();
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(
+        h.query_by_label(label).is_none(),
+        "the File menu stayed open"
+    );
+}
+
 /// Presses the window's close button, as eframe reports it; true when the editor cancelled
 /// the close.
 fn press_close_button(h: &mut Harness<'_, EditorApp>) -> bool {

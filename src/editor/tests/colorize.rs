@@ -90,10 +90,17 @@ fn colorize_two_scribbles_then_undo_one() {
 
     // The background's scribble along the top margin, the circle's across its middle.
     let (background, circle) = (&s.strokes[0].points, &s.strokes[1].points);
-    h.state_mut().colorize.width_px = 4.0;
-    h.state_mut().colorize.color = PALETTE[10];
+    set_number(&mut h, "Brush px:", 4.0);
+    assert_eq!(h.state().colorize.width_px, 4.0);
+    let hex = |color: [u8; 3]| format!("#{}", crate::colorize::scribbles::hex(color));
+    type_into(&mut h, "Color hex:", &hex(PALETTE[10]));
+    h.key_press(Key::Enter);
+    h.run();
+    assert_eq!(h.state().colorize.color, PALETTE[10]);
     drag(&mut h, background[0], background[1]);
-    h.state_mut().colorize.color = PALETTE[0];
+    type_into(&mut h, "Color hex:", &hex(PALETTE[0]));
+    h.key_press(Key::Enter);
+    h.run();
     drag(&mut h, circle[0], circle[1]);
     let session = h.state().colorize.session.as_ref().expect("a session");
     assert_eq!(session.strokes().len(), 2, "{:?}", h.state().message);
@@ -220,7 +227,16 @@ fn colorize_scribbles_save_load_and_autosave() {
     assert_eq!(stroke_count(&h), Some(1));
 
     // Cleared strokes are autosaved as none, whatever the path field holds.
-    h.state_mut().colorize.scribbles_path = String::new();
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Scribbles JSON:").click();
+    h.run();
+    h.key_press_modifiers(Modifiers::COMMAND, Key::A);
+    h.key_press(Key::Backspace);
+    h.run();
+    assert_eq!(h.state().colorize.scribbles_path, "");
+    h.key_press(Key::Escape);
+    h.run();
     assert!(h.state_mut().apply_colorize(SessionCommand::Clear));
     h.state_mut().autosave_scribbles();
     let text = std::fs::read_to_string(&autosaved).expect("autosaved");

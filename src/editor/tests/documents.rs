@@ -77,7 +77,7 @@ fn closing_with_unsaved_changes_asks_first() {
     let png = dir.join("bar.png");
     let png_bytes = std::fs::read(&png).expect("bar.png");
     // The File menu's path field holds the imported PNG: Save must not write over it.
-    h.state_mut().open_path = png.display().to_string();
+    type_in_file_menu(&mut h, "Rig or PNG path:", &png.display().to_string());
     assert!(press_close_button(&mut h), "the close was not cancelled");
     assert_eq!(h.state().closing(), Closing::Asking);
     h.get_by_label(
@@ -89,6 +89,12 @@ fn closing_with_unsaved_changes_asks_first() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains(".json file name"), "{message}");
     assert_eq!(std::fs::read(&png).expect("bar.png"), png_bytes);
+    // It asks for the path in a "Save as" window (over the menu bar); Escape dismisses it.
+    h.get_by_label("Save as");
+    h.get_by_label("Path:");
+    h.key_press(Key::Escape);
+    h.run();
+    assert!(h.query_by_label("Path:").is_none());
 
     // Keys and drops do not reach the document behind the dialog; Escape cancels it.
     h.state_mut().request_close();
@@ -111,7 +117,7 @@ fn closing_with_unsaved_changes_asks_first() {
     // With a file name, the save runs off the UI thread and the window closes once it is
     // written.
     let path = dir.join("bar.json");
-    h.state_mut().open_path = path.display().to_string();
+    type_in_file_menu(&mut h, "Rig or PNG path:", &path.display().to_string());
     assert!(press_close_button(&mut h));
     h.get_by_label(&format!(
         "Save the changes to {} before closing?",
