@@ -465,7 +465,10 @@ mod tests {
         assert_eq!((c.y, c.rotate, c.scale_x, c.shear_x), (0.0, 0.0, 0.0, 0.0));
         let mut nan = c.clone();
         nan.gravity = f64::NAN;
-        assert_eq!(nan.check().unwrap_err(), "gravity is NaN, not a finite number");
+        assert_eq!(
+            nan.check().unwrap_err(),
+            "gravity is NaN, not a finite number"
+        );
     }
 
     #[test]
@@ -484,10 +487,16 @@ mod tests {
         state.update(&c, 10.0, &mut bone, step, PhysicsMode::Update);
         let v = 10.0 * 100.0 * step;
         let offset = -10.0 + v * step;
-        assert!((bone.world_x - (10.0 + offset)).abs() < 1e-12, "{}", bone.world_x);
+        assert!(
+            (bone.world_x - (10.0 + offset)).abs() < 1e-12,
+            "{}",
+            bone.world_x
+        );
         // Between updates: the same offset, no step.
         let mut posed = bone_at(10.0);
-        state.clone().update(&c, 10.0, &mut posed, step, PhysicsMode::Pose);
+        state
+            .clone()
+            .update(&c, 10.0, &mut posed, step, PhysicsMode::Pose);
         assert_eq!(posed.world_x, bone.world_x);
         // Damped, it settles back on the pose.
         let mut damped = c.clone();
@@ -495,7 +504,13 @@ mod tests {
         let mut state = PhysicsState::default();
         for k in 0..600 {
             let mut bone = bone_at(if k == 0 { 0.0 } else { 10.0 });
-            state.update(&damped, 10.0, &mut bone, k as f64 * step, PhysicsMode::Update);
+            state.update(
+                &damped,
+                10.0,
+                &mut bone,
+                k as f64 * step,
+                PhysicsMode::Update,
+            );
             if k == 599 {
                 assert!((bone.world_x - 10.0).abs() < 1e-6, "{}", bone.world_x);
             }

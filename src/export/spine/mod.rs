@@ -656,7 +656,7 @@ fn skeleton_json(
             "height": num(hi[1] - lo[1]),
             "images": "./",
             "fps": num(options.bake_fps),
-            "hash": content_hash(name, &bones, &ik, &attachments, &animations),
+            "hash": content_hash(name, &bones, &ik, &physics, &attachments, &animations),
         },
         "bones": bones,
         "slots": slots,
@@ -682,16 +682,21 @@ fn content_hash(
     name: &str,
     bones: &[Value],
     ik: &[Value],
+    physics: &[Value],
     attachments: &Map<String, Value>,
     animations: &Map<String, Value>,
 ) -> String {
-    let text = format!(
+    let mut text = format!(
         "{name}{}{}{}{}",
         Value::from(bones.to_vec()),
         Value::from(ik.to_vec()),
         Value::Object(attachments.clone()),
         Value::Object(animations.clone())
     );
+    // Left out when empty: the hashes of rigs without physics stay as they were.
+    if !physics.is_empty() {
+        text += &Value::from(physics.to_vec()).to_string();
+    }
     let mut h: u64 = 0xcbf29ce484222325;
     for b in text.bytes() {
         h ^= u64::from(b);
