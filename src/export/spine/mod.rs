@@ -181,11 +181,6 @@ pub enum SpineError {
     },
     #[error("the transformation of '{0}' is singular")]
     Singular(String),
-    #[error(
-        "physics constraints export to Spine 4.2 only (4.1 has none, 4.3 changed the model), \
-         not {0}"
-    )]
-    PhysicsVersion(&'static str),
     #[error("two IK constraints are named '{0}'; Spine needs unique constraint names")]
     DuplicateConstraint(String),
     #[error(transparent)]
@@ -283,7 +278,9 @@ pub fn plan_bake(
     // Where a handle's transformation is compared when deciding what to bake.
     let corners = crate::playback::rest_corners(doc);
     let times = bake::bake_times(animation.duration_s(), options.bake_fps);
-    let samples = bake::sample_path(scene, animation, &times).map_err(SpineError::Pose)?;
+    let native_physics = physics::native(options.version);
+    let samples =
+        bake::sample_path(scene, animation, &times, native_physics).map_err(SpineError::Pose)?;
     let mut baked = bake::bones_to_bake(
         options.bake,
         &spine_handles,
@@ -364,7 +361,7 @@ pub fn export_spine(
     for c in &doc.handles.physics {
         check_name("physics constraint", &c.name, false)?;
     }
-    let physics = physics::physics_entries(&doc.handles, exported_ik.len(), options.version)?;
+    let physics = physics::physics_entries(&doc.handles, exported_ik.len(), options.version);
     let frame = SpineFrame::for_canvas(doc.canvas);
     let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
     let columns = handle_columns(&doc.handles);

@@ -6,29 +6,26 @@
 //! `strength`, `damping`, `mass`, `wind`, `gravity`, `mix`), all carried over unchanged since
 //! sinew simulates spine-core 4.2's model (`crate::rig::physics`) in Spine's axes. `order`
 //! follows the IK constraints', as sinew applies physics after bone IK. Spine 4.1 has no
-//! physics and 4.3 changed the model (it interpolates between steps), so only 4.2 exports
-//! them.
+//! physics and 4.3 changed the model (it interpolates between steps), so for those the
+//! constraints are not written and their motion is baked into keys instead ([`super::bake`]).
 
 use super::timelines::num;
-use super::SpineError;
 use super::SpineVersion;
 use crate::rig::Handles;
 use serde_json::{json, Value};
 
-/// The `physics` entries of `handles`, updated after `ik_count` IK constraints; an error for a
-/// version without (this) physics model when there are any.
-pub fn physics_entries(
-    handles: &Handles,
-    ik_count: usize,
-    version: SpineVersion,
-) -> Result<Vec<Value>, SpineError> {
-    if handles.physics.is_empty() {
-        return Ok(Vec::new());
+/// Whether `version`'s runtime simulates sinew's physics model (4.2's) itself.
+pub fn native(version: SpineVersion) -> bool {
+    version == SpineVersion::V4_2
+}
+
+/// The `physics` entries of `handles`, updated after `ik_count` IK constraints; none for a
+/// version without this physics model (the bake carries the motion there).
+pub fn physics_entries(handles: &Handles, ik_count: usize, version: SpineVersion) -> Vec<Value> {
+    if handles.physics.is_empty() || !native(version) {
+        return Vec::new();
     }
-    if version != SpineVersion::V4_2 {
-        return Err(SpineError::PhysicsVersion(version.version_string()));
-    }
-    Ok(handles
+    handles
         .physics
         .iter()
         .enumerate()
@@ -53,5 +50,5 @@ pub fn physics_entries(
                 "mix": num(c.mix),
             })
         })
-        .collect())
+        .collect()
 }

@@ -122,8 +122,13 @@ pub fn as_played(
         .into_iter()
         .filter(|c| !switched_off.contains(c))
         .collect();
+    let mut handles = constraints::with_constraints(&doc.handles, &solved);
+    if !super::physics::native(options.version) {
+        // Not simulated by that runtime: baked into keys instead.
+        handles.physics.clear();
+    }
     Ok(AsPlayed {
         animation: played,
-        handles: constraints::with_constraints(&doc.handles, &solved),
+        handles,
     })
 }
