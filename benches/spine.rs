@@ -26,16 +26,27 @@ fn character() -> (Scene, Vec<image::RgbaImage>) {
         serde_json::from_str(&std::fs::read_to_string(dir.join(file)).expect("bundled file"))
             .expect("bundled JSON")
     };
-    let paths: Vec<PathBuf> = read("layers.json")["layers"]
+    let list = read("layers.json");
+    // The layers, then the other attachments of their slots.
+    let attachments: std::collections::BTreeMap<String, String> =
+        serde_json::from_value(list["attachments"].clone()).unwrap_or_default();
+    let paths: Vec<PathBuf> = list["layers"]
         .as_array()
         .expect("a layer list")
         .iter()
-        .map(|n| dir.join(format!("{}.png", n.as_str().expect("a layer name"))))
+        .map(|n| n.as_str().expect("a layer name").to_string())
+        .chain(attachments.keys().cloned())
+        .map(|n| dir.join(format!("{n}.png")))
         .collect();
     let layers = pipeline::load_layers(&paths).expect("bundled layers load");
     let handles: Handles = serde_json::from_value(read("handles.json")).expect("handles parse");
     let (mut doc, _) = pipeline::build_rig(&layers, &dir, &BuildOptions::default(), &handles)
         .expect("the character rigs");
+    doc.set_slots(
+        &attachments,
+        serde_json::from_value(list["skins"].clone()).unwrap_or_default(),
+    )
+    .expect("the character's slots");
     doc.animations = serde_json::from_value(read("animations.json")).expect("animations parse");
     doc.events = sinew::anim::events_from_json(&read("events.json")).expect("events parse");
     let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();

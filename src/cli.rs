@@ -85,6 +85,10 @@ pub struct EditArgs {
     /// Scribbles to draw on the line art (the JSON of `sinew colorize --scribbles`).
     #[arg(long, requires = "line_art")]
     pub scribbles: Option<PathBuf>,
+    /// Append every frame's times to this file (tab-separated, ms: the editor's own code, the
+    /// whole frame with the GL draw, the interval since the frame before), for benchmarks.
+    #[arg(long)]
+    pub frame_log: Option<PathBuf>,
 }
 
 #[cfg(feature = "editor")]
@@ -210,6 +214,10 @@ pub struct RenderArgs {
     /// Play curves as this runtime does instead of exactly (see README, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
+    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// combine skins, a later one overriding an earlier one on the same slot.
+    #[arg(long = "skin", value_name = "NAME")]
+    pub skins: Vec<String>,
     /// Where to write: a folder (no extension), OUT.gif, or OUT.png (a sprite sheet, with
     /// OUT.json beside it, which lists each frame's events).
     #[arg(short, long)]
@@ -250,8 +258,22 @@ pub struct RigArgs {
     /// The handles file (bones, points, cages, regions); with it, weights are computed.
     #[arg(long)]
     pub handles: Option<PathBuf>,
+    /// Make layer PART another attachment of layer SLOT's slot (repeatable; see docs/formats.md,
+    /// "Rig document": `slot`).
+    #[arg(long = "attachment", value_name = "PART=SLOT", value_parser = parse_attachment)]
+    pub attachments: Vec<(String, String)>,
     #[command(flatten)]
     pub build: BuildArgs,
+}
+
+/// Parses `PART=SLOT`.
+fn parse_attachment(text: &str) -> Result<(String, String), String> {
+    match text.split_once('=') {
+        Some((part, slot)) if !part.is_empty() && !slot.is_empty() => {
+            Ok((part.to_string(), slot.to_string()))
+        }
+        _ => Err(format!("'{text}' is not PART=SLOT")),
+    }
 }
 
 /// Tracing and meshing parameters; each defaults to the library's default.
@@ -372,6 +394,10 @@ pub struct PoseArgs {
     /// With --anim: sample curves as this runtime plays them instead of exactly.
     #[arg(long, value_enum, requires = "anim")]
     pub match_runtime: Option<RuntimeMatch>,
+    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// combine skins, a later one overriding an earlier one on the same slot.
+    #[arg(long = "skin", value_name = "NAME")]
+    pub skins: Vec<String>,
 }
 
 #[derive(Args, Debug)]
@@ -423,6 +449,7 @@ fn edit(args: &EditArgs) -> Result<()> {
         screenshot: args.screenshot.clone(),
         line_art: args.line_art.clone(),
         scribbles: args.scribbles.clone(),
+        frame_log: args.frame_log.clone(),
     })
 }
 
@@ -530,8 +557,21 @@ fn rig(args: &RigArgs) -> Result<()> {
         Some(path) => read_json(path, "handles file")?,
         None => Handles::default(),
     };
+    // Attachments name layers: checked before any work.
+    let attachments: std::collections::BTreeMap<String, String> =
+        args.attachments.iter().cloned().collect();
+    if let Some(name) = attachments
+        .iter()
+        .flat_map(|(part, slot)| [part, slot])
+        .find(|n| !layers.iter().any(|l| &l.name == *n))
+    {
+        bail!("--attachment: '{name}' is not a layer of the rig");
+    }
     let doc_dir = parent_dir(&args.output);
-    let (doc, stats) = rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
+    let (mut doc, stats) =
+        rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
+    doc.set_slots(&attachments, io::Skins::new())
+        .map_err(|reason| anyhow!("--attachment: {reason}"))?;
     let preview = match &args.preview {
         Some(_) => {
             let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
@@ -634,7 +674,8 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
-    let scene = Scene::load(&args.rig)?;
+    let mut scene = Scene::load(&args.rig)?;
+    scene.set_skins(&args.skins)?;
     let images = part_images(&args.rig, &scene.doc);
     check_outputs(
         [Some(args.rig.as_path()), args.pose.as_deref()]
@@ -646,6 +687,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
     let (pose, transforms) = match (&args.pose, &args.anim) {
         (Some(path), _) => {
             let pose: Pose = read_json(path, "pose file")?;
+            scene.doc.check_pose_attachments(&pose)?;
             let transforms = scene.handle_transforms(&pose)?;
             (pose, transforms)
         }
@@ -683,7 +725,8 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    let scene = Scene::load(&args.rig)?;
+    let mut scene = Scene::load(&args.rig)?;
+    scene.set_skins(&args.skins)?;
     // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
     let files = match io::sequence::format_for_path(&args.output)? {
         io::sequence::SequenceFormat::Folder => vec![],
@@ -723,17 +766,18 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
     {
         bar.set_style(style);
     }
-    let frames =
-        playback::render_animation(&scene, &args.anim, &animation, &settings, &|| bar.inc(1));
-    bar.finish_and_clear();
-    let events = playback::render_events(&scene, &animation, &settings)?;
-    let report = io::sequence::write_sequence(
-        &frames?,
-        &events,
-        args.fps,
+    // Drawn and written a chunk of frames at a time: any length renders in bounded memory.
+    let written = playback::write_animation(
+        &scene,
+        &args.anim,
+        &animation,
+        &settings,
         &args.output,
         &Default::default(),
-    )?;
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    let (report, events) = written?;
     if args.events {
         let times = playback::frame_times(animation.duration_s(), args.fps)?;
         for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
@@ -801,10 +845,15 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
     Ok(serde_json::to_string(&Posed { parts })? + "\n")
 }
 
-/// The bundled character's layer list.
+/// The bundled character's layer list: layers in draw order, other attachments of their slots
+/// (image name → slot), skins.
 #[derive(serde::Deserialize)]
 struct LayerList {
     layers: Vec<String>,
+    #[serde(default)]
+    attachments: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    skins: io::Skins,
 }
 
 fn demo(args: &DemoArgs) -> Result<()> {
@@ -829,6 +878,7 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let paths: Vec<PathBuf> = list
         .layers
         .iter()
+        .chain(list.attachments.keys())
         .map(|name| args.assets.join(format!("{name}.png")))
         .collect();
     std::fs::create_dir_all(&args.output)
@@ -844,6 +894,8 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let rig_s = t.elapsed().as_secs_f64();
 
     let mut doc = doc;
+    doc.set_slots(&list.attachments, list.skins.clone())
+        .map_err(|reason| anyhow::anyhow!("{}: {reason}", list_path.display()))?;
     let animations_path = args.assets.join("animations.json");
     let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
     let bad = || format!("{}: bad animation", animations_path.display());
@@ -863,11 +915,20 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 
     let t = Instant::now();
     let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
-    let scene = Scene::new(doc.clone(), &images)?;
+    let mut scene = Scene::new(doc.clone(), &images)?;
     let rest = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
     let rest_s = t.elapsed().as_secs_f64();
     let rest_path = args.output.join("rest.png");
     io::save_png(&rest_path, &rest)?;
+    // Each skin at rest too (`rest_SKIN.png`); the animations play in the default skin.
+    for skin in doc.skins.keys() {
+        scene.set_skins(std::slice::from_ref(skin))?;
+        let image = render::rgba_from_pixmap(&scene.render(&scene.rest_positions())?);
+        let path = args.output.join(format!("rest_{skin}.png"));
+        io::save_png(&path, &image)?;
+        written.push(path);
+    }
+    scene.set_skins(&[])?;
     let preview_path = args.output.join("mesh.png");
     io::save_png(&preview_path, &preview_image(&scene)?)?;
     written.extend([rest_path, preview_path]);

@@ -100,15 +100,16 @@ pub fn render_animation(
     // Settings are checked before the scene is built: a bad scale fails at once.
     settings.view(doc.canvas)?;
     let scene = Scene::new(doc, images)?;
-    let frames = playback::render_animation(&scene, name, &animation, settings, &|| {})?;
-    let events = playback::render_events(&scene, &animation, settings)?;
-    Ok(sequence::write_sequence(
-        &frames,
-        &events,
-        settings.fps,
+    let (report, _events) = playback::write_animation(
+        &scene,
+        name,
+        &animation,
+        settings,
         output,
         &Default::default(),
-    )?)
+        &|| {},
+    )?;
+    Ok(report)
 }
 
 /// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with

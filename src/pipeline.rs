@@ -327,6 +327,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
         });
         doc.parts.push(PartDoc {
             name: layer.name.clone(),
+            slot: None,
             image: relative_path(doc_dir, &layer.path),
             mesh: MeshDoc::from(&mesh),
             weights,
@@ -498,6 +499,8 @@ pub struct Scene {
     parts: std::sync::Arc<Vec<RenderPart>>,
     /// The skinning-IK precomputation, made the first time a pose has drags.
     ik: std::sync::OnceLock<Result<RigIk, crate::ik::IkError>>,
+    /// The skins drawn, combined in order (see [`crate::io::slots`]); none: each slot's own part.
+    skins: Vec<String>,
 }
 
 impl Scene {
@@ -547,6 +550,7 @@ impl Scene {
             doc,
             parts: std::sync::Arc::new(parts),
             ik: std::sync::OnceLock::new(),
+            skins: Vec::new(),
         })
     }
 
@@ -573,6 +577,7 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            skins: self.skins.clone(),
         })
     }
 
@@ -596,6 +601,7 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            skins: self.skins.clone(),
         }
     }
 
@@ -608,7 +614,21 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            skins: self.skins.clone(),
         }
+    }
+
+    /// Draws `skins` from now on, combined in order (a later skin overrides an earlier one on
+    /// the same slot); empty: every slot shows its own part. Fails on a skin the rig lacks.
+    pub fn set_skins(&mut self, skins: &[String]) -> Result<(), io::SlotError> {
+        self.doc.check_skins(skins)?;
+        self.skins = skins.to_vec();
+        Ok(())
+    }
+
+    /// The skins drawn (see [`Scene::set_skins`]).
+    pub fn skins(&self) -> &[String] {
+        &self.skins
     }
 
     /// Every part's rest vertex positions.
@@ -663,12 +683,14 @@ impl Scene {
         self.positions_from_transforms(&transforms, pose, blend)
     }
 
-    /// The rig's meshes as the skinning IK sees them: parts with weights, back to front, their
-    /// weights mapped onto the rig's handle columns.
+    /// The rig's meshes as the skinning IK sees them: slots' own parts with weights, back to
+    /// front, their weights mapped onto the rig's handle columns.
     pub fn skinned_meshes(&self) -> Result<Vec<SkinnedMesh>, PipelineError> {
         let columns = handle_columns(&self.doc.handles);
         let mut meshes = Vec::new();
-        for part in &self.doc.parts {
+        // A slot's other attachments are not solved: the solve is the same whichever skin or
+        // attachment is drawn (they follow the handles as skinned).
+        for part in self.doc.parts.iter().filter(|p| p.slot.is_none()) {
             let Some(weights) = &part.weights else {
                 continue;
             };
@@ -798,8 +820,8 @@ impl Scene {
         Ok(out)
     }
 
-    /// Draws every part at `positions` (one list per part, canvas px) onto a transparent canvas
-    /// of the rig's size.
+    /// Draws every slot's part (as the skins choose it) at `positions` (one list per part,
+    /// canvas px) onto a transparent canvas of the rig's size.
     pub fn render(&self, positions: &[Vec<Point>]) -> Result<tiny_skia::Pixmap, PipelineError> {
         let [w, h] = self.doc.canvas;
         let mut canvas =
@@ -808,7 +830,8 @@ impl Scene {
         Ok(canvas)
     }
 
-    /// Draws every part at `positions` onto `canvas` through `canvas_from_world`.
+    /// Draws every slot's part (as the skins choose it) at `positions` onto `canvas` through
+    /// `canvas_from_world`.
     pub fn draw(
         &self,
         canvas: &mut tiny_skia::Pixmap,
@@ -816,7 +839,14 @@ impl Scene {
         canvas_from_world: tiny_skia::Transform,
     ) -> Result<(), PipelineError> {
         let mut draws = Vec::with_capacity(self.doc.parts.len());
-        for (i, part) in self.doc.parts.iter().enumerate() {
+        // Each slot's part as the skins choose it, in the document's order.
+        let shown = self
+            .doc
+            .slot_names()
+            .into_iter()
+            .filter_map(|slot| self.doc.shown_part(slot, None, &self.skins));
+        for i in shown {
+            let part = &self.doc.parts[i];
             let expected = part.mesh.vertices.len();
             let part_positions = positions.get(i).map(Vec::as_slice).unwrap_or_default();
             if part_positions.len() != expected {

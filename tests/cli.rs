@@ -420,6 +420,7 @@ fn demo_writes_rig_animations_gifs_and_sheets_and_render_and_pose_play_them() {
     for name in [
         "character.json",
         "rest.png",
+        "rest_pail.png",
         "walk.gif",
         "walk.png",
         "walk.json",

@@ -1,6 +1,7 @@
 //! Golden-image tests: the bundled character, rigged from its layers and handles with default
 //! options, rendered at rest, in the bundled poses (`assets/character/poses/`) and in its
-//! bundled animations at fixed times, compared with the reviewed PNGs in `golden/`.
+//! bundled animations at fixed times, and in its second skin, compared with the reviewed PNGs in
+//! `golden/`.
 //!
 //! Tolerance: on premultiplied RGBA8 (what compositing shows; the color of invisible pixels
 //! is not compared), the largest channel difference must be at most 2 and the PSNR at least
@@ -77,14 +78,15 @@ fn bundled_animations_match_golden_at_fixed_times() {
     .expect("animations.json parses");
     let animations = sinew::anim::parse_animations(&animations).expect("the animations check");
     for (name, times_s) in [
-        ("walk", [0.25, 0.6]),
-        ("wave", [0.4, 1.1]),
-        ("lift", [0.5, 1.0]),
+        ("walk", &[0.25, 0.6][..]),
+        // 0.4 s and 1.1 s: the open hand (attachment keys); 0.6 s: the slot's own closed hand.
+        ("wave", &[0.4, 0.6, 1.1]),
+        ("lift", &[0.5, 1.0]),
         // The belly squash (deform keys) on landing, and the tail's physics mid-hop.
-        ("hop", [0.4, 0.67]),
+        ("hop", &[0.4, 0.67]),
     ] {
         let animation = &animations[name];
-        for t in times_s {
+        for &t in times_s {
             // What `sinew pose --anim NAME --time T` and every frame of `sinew render` show.
             let frame =
                 sinew::playback::play(scene(), name, animation, &[t], true, &Default::default())
@@ -103,6 +105,20 @@ fn bundled_animations_match_golden_at_fixed_times() {
             );
         }
     }
+}
+
+#[test]
+fn skin_swap_matches_golden() {
+    // The `pail` skin swaps the lantern for a pail (another attachment of the `bag` slot), at
+    // rest and in the crouch pose; without a skin the same scene draws the lantern (`rest`).
+    let mut pail = common::character_scene();
+    pail.set_skins(&["pail".to_string()])
+        .expect("the demo has a pail skin");
+    check_golden("skin_pail_rest", &render_pose_in(&pail, &Pose::default()));
+    check_golden(
+        "skin_pail_crouch",
+        &render_pose_in(&pail, &load_pose("crouch")),
+    );
 }
 
 #[test]

@@ -359,14 +359,15 @@ fn the_rig_the_command_writes_for_the_character_validates() {
     let assets = root().join("assets/character");
     let dir = command::scratch("character");
     let layers = read_json(&assets.join("layers.json"));
+    // The layers, then the other attachments of their slots.
+    let attachments = layers["attachments"].as_object().expect("attachments");
     let images: Vec<String> = layers["layers"]
         .as_array()
         .expect("a layer list")
         .iter()
-        .map(|n| {
-            let name = n.as_str().expect("a layer name");
-            assets.join(format!("{name}.png")).display().to_string()
-        })
+        .map(|n| n.as_str().expect("a layer name"))
+        .chain(attachments.keys().map(String::as_str))
+        .map(|name| assets.join(format!("{name}.png")).display().to_string())
         .collect();
     let rig = dir.join("character.json");
     let handles = assets.join("handles.json");
@@ -383,9 +384,24 @@ fn the_rig_the_command_writes_for_the_character_validates() {
     let mut written = read_json(&rig);
     assert_eq!(
         written["parts"].as_array().map(Vec::len),
-        layers["layers"].as_array().map(Vec::len)
+        Some(images.len())
     );
     assert_valid(SchemaKind::Rig, &written, "the rig `sinew rig` wrote");
+    // Its slots and skins, as `sinew demo` sets them.
+    for part in written["parts"].as_array_mut().expect("parts") {
+        if let Some(slot) = part["name"].as_str().and_then(|n| attachments.get(n)) {
+            part["slot"] = slot.clone();
+        }
+    }
+    written["skins"] = layers["skins"].clone();
+    assert_valid(SchemaKind::Rig, &written, "the rig with slots and skins");
+    let mut wrong = written.clone();
+    wrong["skins"]["pail"]["bag"] = serde_json::json!(["bag_pail"]);
+    assert_invalid(
+        SchemaKind::Rig,
+        &wrong,
+        "a skin's attachment that is not a name",
+    );
     written["animations"] = read_json(&assets.join("animations.json"));
     written["events"] = read_json(&assets.join("events.json"));
     assert_valid(

@@ -381,7 +381,8 @@ fn bad_input_gives_one_line_errors_and_no_files() {
     };
 
     let gif = dir.join("a.gif");
-    let e = one_line(write_sequence(&[], &[], 10.0, &gif, &options).unwrap_err());
+    let e =
+        one_line(write_sequence(&Vec::<RgbaImage>::new(), &[], 10.0, &gif, &options).unwrap_err());
     assert!(matches!(e, SequenceError::NoFrames));
     let mixed = vec![frames[0].clone(), RgbaImage::new(8, 16)];
     for target in ["a.gif", "a.png", "a"] {
@@ -500,4 +501,100 @@ fn palette_beats_neuquant() {
         let (ours, neuquant) = palette_psnr_vs_neuquant(&frames);
         assert!(ours > neuquant, "{ours:.2} dB vs NeuQuant {neuquant:.2} dB");
     }
+}
+
+/// Frames drawn on demand (as a render draws them), counting what the writers ask for.
+struct OnDemand {
+    frames: Vec<RgbaImage>,
+    largest_draw: std::sync::atomic::AtomicUsize,
+    drawn: std::sync::atomic::AtomicUsize,
+}
+
+impl sinew::io::sequence::FrameSource for OnDemand {
+    fn frame_count(&self) -> usize {
+        self.frames.len()
+    }
+
+    fn frame_size_px(&self) -> (u32, u32) {
+        self.frames[0].dimensions()
+    }
+
+    fn draw(
+        &self,
+        range: std::ops::Range<usize>,
+    ) -> Result<Vec<std::borrow::Cow<'_, RgbaImage>>, SequenceError> {
+        use std::sync::atomic::Ordering::Relaxed;
+        self.largest_draw.fetch_max(range.len(), Relaxed);
+        self.drawn.fetch_add(range.len(), Relaxed);
+        // Fresh copies, as a render makes them.
+        Ok(self.frames[range]
+            .iter()
+            .map(|f| std::borrow::Cow::Owned(f.clone()))
+            .collect())
+    }
+}
+
+#[test]
+fn frames_drawn_on_demand_are_written_a_chunk_at_a_time_with_the_same_bytes() {
+    use sinew::io::sequence::STREAM_CHUNK_FRAMES;
+    use std::sync::atomic::Ordering::Relaxed;
+    let dir = temp_dir("stream");
+    let frames = synthetic_animation(48, 2 * STREAM_CHUNK_FRAMES + 5);
+    let count = frames.len();
+    let source = OnDemand {
+        frames: frames.clone(),
+        largest_draw: 0.into(),
+        drawn: 0.into(),
+    };
+    let options = SequenceOptions::default();
+    for target in ["walk.gif", "walk.png", "walk"] {
+        let (streamed, held) = (
+            dir.join("streamed").join(target),
+            dir.join("held").join(target),
+        );
+        source.drawn.store(0, Relaxed);
+        for side in ["streamed", "held"] {
+            std::fs::create_dir_all(dir.join(side)).unwrap();
+        }
+        write_sequence(&source, &[], 24.0, &streamed, &options).unwrap();
+        write_sequence(&frames, &[], 24.0, &held, &options).unwrap();
+        // A GIF reads the frames twice but keeps what it drew (they fit its budget).
+        assert_eq!(source.drawn.load(Relaxed), count, "{target}");
+        let files = |p: &Path| -> Vec<(String, Vec<u8>)> {
+            let mut paths: Vec<PathBuf> = if p.is_dir() {
+                std::fs::read_dir(p)
+                    .unwrap()
+                    .map(|e| e.unwrap().path())
+                    .collect()
+            } else {
+                vec![p.to_path_buf(), p.with_extension("json")]
+                    .into_iter()
+                    .filter(|f| f.exists())
+                    .collect()
+            };
+            paths.sort();
+            paths
+                .iter()
+                .map(|f| {
+                    let name = f.file_name().unwrap().to_string_lossy().into_owned();
+                    (name, std::fs::read(f).unwrap())
+                })
+                .collect()
+        };
+        assert_eq!(files(&streamed), files(&held), "{target}");
+    }
+    assert!(source.largest_draw.load(Relaxed) <= STREAM_CHUNK_FRAMES);
+
+    // With no room to keep frames, a GIF draws them again for its second pass: same bytes.
+    source.drawn.store(0, Relaxed);
+    let tight = GifOptions {
+        keep_frames_mib: 0,
+        ..GifOptions::default()
+    };
+    assert_eq!(
+        encode_gif(&source, 24.0, &tight).unwrap(),
+        encode_gif(&frames, 24.0, &GifOptions::default()).unwrap()
+    );
+    assert_eq!(source.drawn.load(Relaxed), 2 * count);
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -87,7 +87,7 @@ type EventStep = (f64, f64, bool);
 
 /// Loads `dir/name.json` + `.atlas` in spine-core and plays it at `times`.
 fn run_oracle(dir: &Path, name: &str, times: &BTreeMap<String, Vec<f64>>) -> Oracle {
-    run_oracle_with_events(dir, name, times, &BTreeMap::new())
+    run_oracle_with_events(dir, name, times, &BTreeMap::new(), &[])
 }
 
 /// [`run_oracle`], and the events fired over `steps`.
@@ -96,10 +96,11 @@ fn run_oracle_with_events(
     name: &str,
     times: &BTreeMap<String, Vec<f64>>,
     steps: &BTreeMap<String, Vec<EventStep>>,
+    skins: &[String],
 ) -> Oracle {
     let request = dir.join(format!("{name}.request.json"));
     let out = dir.join(format!("{name}.oracle.json"));
-    let json = serde_json::json!({ "times": times, "events": steps });
+    let json = serde_json::json!({ "times": times, "events": steps, "skins": skins });
     std::fs::write(&request, json.to_string()).unwrap();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/spine-check/run.sh");
     let status = Command::new(script)
@@ -132,7 +133,10 @@ fn deviation(
         let Some(vertices) = &slot.vertices else {
             continue;
         };
-        let part = doc.parts.iter().position(|p| p.name == slot.name).unwrap();
+        // The runtime names the attachment it draws: the part (a slot's own part or another
+        // of its attachments).
+        let shown = slot.attachment.as_deref().unwrap_or(&slot.name);
+        let part = doc.parts.iter().position(|p| p.name == shown).unwrap();
         let mesh = &export.parts[part].mesh;
         assert_eq!(
             vertices.len(),
@@ -211,10 +215,23 @@ fn check_rig(
     options: &SpineOptions,
     compare: Compare,
 ) -> (f64, f64) {
+    check_rig_in_skins(rig, dir, flags, options, compare, &[])
+}
+
+/// [`check_rig`] with `skins` active (combined in order) in the runtime and in sinew.
+fn check_rig_in_skins(
+    rig: &Path,
+    dir: &Path,
+    flags: &[&str],
+    options: &SpineOptions,
+    compare: Compare,
+    skins: &[String],
+) -> (f64, f64) {
     let mut args = vec!["export", "spine", s(rig), "-o", s(dir), "--name", "rig"];
     args.extend_from_slice(flags);
     sinew(&args);
-    let scene = Scene::load(rig).unwrap();
+    let mut scene = Scene::load(rig).unwrap();
+    scene.set_skins(skins).unwrap();
     let doc = scene.doc.clone();
     let images: Vec<_> = doc
         .parts
@@ -296,7 +313,7 @@ fn check_rig(
             }
         }
     }
-    let oracle = run_oracle_with_events(dir, "rig", &times, &steps);
+    let oracle = run_oracle_with_events(dir, "rig", &times, &steps, skins);
     let mut fired_count = 0;
     for (name, expected) in &expected_events {
         let got = &oracle.events[name];
@@ -347,6 +364,7 @@ fn check_rig(
         && options.bake_tolerance_px == defaults.bake_tolerance_px
         && options.root_bone == defaults.root_bone;
     let (mut worst_runtime, mut worst_exact) = (0.0_f64, 0.0_f64);
+    let mut swaps_checked = 0;
     for (name, animation) in &animations {
         let played = &oracle.animations[name];
         let as_played = as_played(&scene, name, animation, options).unwrap();
@@ -383,17 +401,26 @@ fn check_rig(
             let order: Vec<&str> = frame.slots.iter().map(|s| s.name.as_str()).collect();
             let expected: Vec<&str> = match &pose.draw_order {
                 Some(o) => o.iter().map(String::as_str).collect(),
-                None => doc.parts.iter().map(|p| p.name.as_str()).collect(),
+                None => doc.slot_names(),
             };
             assert_eq!(order, expected, "{name} at {t} s: draw order");
             for slot in &frame.slots {
                 let state = pose.parts.get(&slot.name).cloned().unwrap_or_default();
+                // The attachment sinew draws there: the slot's key through the skins.
+                let drawn = state
+                    .visible
+                    .then(|| doc.shown_part(&slot.name, state.attachment.as_deref(), skins))
+                    .flatten()
+                    .map(|i| doc.parts[i].name.as_str());
                 assert_eq!(
-                    slot.attachment.is_some(),
-                    state.visible,
-                    "{name} {t} {}",
+                    slot.attachment.as_deref(),
+                    drawn,
+                    "{name} {t} {}: attachment (skins {skins:?})",
                     slot.name
                 );
+                if drawn.is_some_and(|d| d != slot.name) {
+                    swaps_checked += 1;
+                }
                 for (a, b) in slot.color.iter().zip(state.color) {
                     assert!(
                         (a - b).abs() <= COLOR_TOLERANCE,
@@ -409,7 +436,7 @@ fn check_rig(
             {
                 let v = dir.join("v.json");
                 let time = format!("{t}");
-                sinew(&[
+                let mut args = vec![
                     "pose",
                     s(rig),
                     "--anim",
@@ -420,7 +447,11 @@ fn check_rig(
                     "spine",
                     "--vertices",
                     s(&v),
-                ]);
+                ];
+                for skin in skins {
+                    args.extend(["--skin", skin.as_str()]);
+                }
+                sinew(&args);
                 #[derive(Deserialize)]
                 struct Part {
                     vertices: Vec<[f64; 2]>,
@@ -443,6 +474,13 @@ fn check_rig(
                 );
             }
         }
+    }
+    if doc.has_attachments() {
+        println!(
+            "{} in skins {skins:?}: {swaps_checked} slot states showing another attachment than \
+             the slot's own, drawn as spine-core draws them",
+            rig.display()
+        );
     }
     let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
     println!("{flags:?}: baked {:?}", export.baked);
@@ -470,6 +508,35 @@ fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
         &defaults,
         Compare::RuntimeMode,
     );
+    // Every skin of the demo, on its own and over the default: the swapped prop is drawn
+    // where the runtime draws it, and the hand swap of `wave` switches at the same times.
+    let doc = RigDocument::load(&rig).unwrap();
+    assert!(!doc.skins.is_empty(), "the demo has a second skin");
+    for skin in doc.skins.keys() {
+        check_rig_in_skins(
+            &rig,
+            &dir.join(format!("export-{skin}")),
+            &[],
+            &defaults,
+            Compare::RuntimeMode,
+            std::slice::from_ref(skin),
+        );
+    }
+    // The 4.3 layout in the 4.3 runtime: the skins and attachment keys load and play the same.
+    let v43 = SpineOptions {
+        version: SpineVersion::V4_3,
+        ..SpineOptions::default()
+    };
+    for skins in [vec![], doc.skins.keys().cloned().collect()] {
+        check_rig_in_skins(
+            &rig,
+            &dir.join(format!("export-43-{}", skins.len())),
+            &["--spine-version", "4.3"],
+            &v43,
+            Compare::RuntimeMode,
+            &skins,
+        );
+    }
     // The runtime's polyline does differ from the exact curves: the mode is not idle.
     assert!(
         exact > ANIMATION_TOLERANCE_PX,

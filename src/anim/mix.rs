@@ -151,6 +151,11 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
         let part = PartPose {
             color,
             visible: if stepped_to_new { b.visible } else { a.visible },
+            attachment: if stepped_to_new {
+                b.attachment
+            } else {
+                a.attachment
+            },
         };
         out.parts.insert(name.clone(), part);
     }
@@ -288,6 +293,7 @@ mod tests {
             PartPose {
                 visible: false,
                 color: [0.0, 0.0, 0.0, 1.0],
+                attachment: None,
             },
         );
         from.ik.push(IkDrag {

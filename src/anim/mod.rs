@@ -14,6 +14,7 @@
 //! - [`mix`]: the crossfade from one animation into another;
 //! - [`edit`]: keys edited per timeline (move, copy and paste, delete, curves).
 
+pub mod attachment;
 pub mod check;
 pub mod curve;
 pub mod deform;
@@ -87,6 +88,15 @@ pub enum AnimError {
         key: usize,
         missing: String,
     },
+    /// `place`: `parts.SLOT.attachment: key K shows 'NAME', which slot 'SLOT' does not have (its
+    /// attachments: …)` (one string, so the error stays small).
+    #[error("animation '{animation}', {place}")]
+    UnknownAttachment { animation: String, place: String },
+    #[error(
+        "animation '{animation}', parts.{slot}: keys both 'visible' and 'attachment' (one \
+         timeline shows or hides a slot: key 'attachment' null to hide it)"
+    )]
+    VisibleAndAttachment { animation: String, slot: String },
 }
 
 #[cfg(test)]

@@ -280,6 +280,17 @@ impl Animation {
                 part.visible = v;
                 keyed = true;
             }
+            if let Some(shown) = timelines
+                .attachment
+                .as_deref()
+                .and_then(|k| sample_steps(k, t))
+            {
+                match shown {
+                    Some(name) => part.attachment = Some(name),
+                    None => part.visible = false,
+                }
+                keyed = true;
+            }
             if keyed {
                 pose.parts.insert(name.clone(), part);
             }
@@ -448,6 +459,7 @@ mod tests {
                             value: false,
                         },
                     ]),
+                    attachment: None,
                 },
             )]
             .into(),

@@ -167,6 +167,11 @@ pub struct PartTimelines {
     pub color: Option<Vec<Key<Rgba>>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub visible: Option<Vec<StepKey<bool>>>,
+    /// Which attachment the slot shows (a part of the slot by name; the slot's own name: its
+    /// default as the skins resolve it), or `null`: none. Stepped, as Spine's attachment
+    /// timeline; an animation keys either this or `visible` of a slot.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attachment: Option<Vec<StepKey<Option<String>>>>,
 }
 
 /// A keyed skinning-IK drag: the material point at rest position `at` (canvas px) goes to the
@@ -461,6 +466,9 @@ impl Animation {
             if let Some(keys) = &t.visible {
                 check_step_keys(keys).map_err(fail(format!("parts.{part}.visible")))?;
             }
+            if let Some(keys) = &t.attachment {
+                check_step_keys(keys).map_err(fail(format!("parts.{part}.attachment")))?;
+            }
         }
         if let Some(keys) = &self.draw_order {
             check_draw_order_keys(keys).map_err(fail("draw_order".into()))?;
@@ -510,6 +518,7 @@ impl Animation {
         for t in self.parts.values() {
             see(t.color.as_deref().map_or(0.0, |k| last(k, |k| k.time)));
             see(t.visible.as_deref().map_or(0.0, |k| last(k, |k| k.time)));
+            see(t.attachment.as_deref().map_or(0.0, |k| last(k, |k| k.time)));
         }
         if let Some(keys) = &self.draw_order {
             see(last(keys, |k| k.time));
@@ -584,11 +593,12 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                             }
                             ("parts", "color") => probe_keys::<Key<Rgba>>(keys),
                             ("parts", "visible") => probe_keys::<StepKey<bool>>(keys),
+                            ("parts", "attachment") => probe_keys::<StepKey<Option<String>>>(keys),
                             _ => {
                                 let expected = match section.as_str() {
                                     "bones" => "rotate, translate, scale or shear",
                                     "points" => "translate, rotate, scale or shear",
-                                    _ => "color or visible",
+                                    _ => "color, visible or attachment",
                                 };
                                 return Some(fail(
                                     path,

@@ -1,6 +1,9 @@
-//! Pose mode: drag any point of the drawing and the skinning IK moves the whole shape;
-//! shift-click pins a point where it is shown; every drag stays as a pin of the pose. The FK
-//! gizmo and G/R/S pose the selected bone or point.
+//! Pose mode: drag any point of the drawing and the skinning IK moves the whole shape; the
+//! first drag also pins the grabbed skeleton's root where it is ([`implicit_root_pin`]), so a
+//! limb bends rather than the whole character sliding; shift-click pins a point where it is
+//! shown; every drag stays as a pin of the pose. A drag that starts on a bone's line rotates
+//! the bone about its head (as in Spine); the FK gizmo and G/R/S pose the selected bone or
+//! point.
 //!
 //! In: the pose edited (the document's, or animate mode's at the playhead), pointer and keys.
 //! Out: `SetPose` commands (or animate mode's unkeyed pose), and the posed vertices the canvas
@@ -268,12 +271,23 @@ impl EditorApp {
                 let index = match existing {
                     Some(i) => Some(i),
                     None => grab(self, at).map(|(rest, shown)| {
+                        // The first drag also holds the grabbed skeleton's root (a pin after
+                        // it, drawn as one), so a limb bends instead of the whole character
+                        // following.
+                        let first = pose.ik.is_empty();
                         pose.ik.push(IkDrag {
                             at: rest,
                             to: shown,
                             weight: None,
                         });
-                        pose.ik.len() - 1
+                        let index = pose.ik.len() - 1;
+                        let posed = self.pose_mode.posed.as_ref().filter(|_| first);
+                        if let Some(pin) =
+                            posed.and_then(|p| implicit_root_pin(scene, rest, &p.transforms))
+                        {
+                            pose.ik.push(pin);
+                        }
+                        index
                     }),
                 };
                 if let Some(index) = index {
@@ -368,7 +382,35 @@ impl EditorApp {
         if self.gesture.is_some() {
             return false;
         }
-        let (Some(name), Some(target)) = (self.selected.clone(), self.fk_target(scene)) else {
+        let press = if response.drag_started_by(egui::PointerButton::Primary) {
+            ctx.input(|i| i.pointer.press_origin())
+        } else {
+            None
+        };
+        // The selected handle's gizmo first; else a drag that starts on a bone's line rotates
+        // that bone about its head, where it joins its parent (Spine's default).
+        let gizmo_hit = press.and_then(|at| {
+            let target = self.fk_target(scene)?;
+            Some((gizmo::hit(&placed, &target, at)?, at))
+        });
+        // Pins and drags lie over the bones: grabbing one moves it (see `pose_gestures`).
+        let on_pin = |at: Pos2| {
+            self.edited_pose()
+                .ik
+                .iter()
+                .any(|d| placed.screen_from_canvas(d.to).distance(at) <= canvas::PICK_RADIUS_PT)
+        };
+        if let (None, Some(at)) = (gizmo_hit, press.filter(|&at| !on_pin(at))) {
+            let bone = self.pose_mode.posed.as_ref().and_then(|posed| {
+                canvas::pick(&placed, &posed.handles, at)
+                    .filter(|name| handles.bones.iter().any(|b| &b.name == name))
+            });
+            if let Some(bone) = bone {
+                self.selected = Some(bone);
+                return self.start_fk(handles, &placed, gizmo::FkKind::Rotate, at, false);
+            }
+        }
+        let (Some(_), Some(_)) = (self.selected.as_ref(), self.fk_target(scene)) else {
             return false;
         };
         let typing = ctx.text_edit_focused();
@@ -390,18 +432,29 @@ impl EditorApp {
             })
             .map(|(_, kind)| kind)
         });
-        let pressed = if response.drag_started_by(egui::PointerButton::Primary) {
-            ctx.input(|i| i.pointer.press_origin())
-                .and_then(|at| Some((gizmo::hit(&placed, &target, at)?, at)))
-        } else {
-            None
-        };
-        let (kind, at, modal) = match (key, hover, pressed) {
+        let (kind, at, modal) = match (key, hover, gizmo_hit) {
             (Some(kind), Some(at), _) => (kind, at, true),
             (_, _, Some((kind, at))) => (kind, at, false),
             _ => return false,
         };
-        let Some(shown) = self.pose_mode.posed.as_ref().map(|p| p.transforms.clone()) else {
+        self.start_fk(handles, &placed, kind, at, modal)
+    }
+
+    /// Starts an FK gesture of `kind` on the selected handle at `at` (screen points); `modal`
+    /// when a key started it (it follows the pointer until a click). Returns whether it took
+    /// the pointer.
+    fn start_fk(
+        &mut self,
+        handles: &crate::rig::Handles,
+        placed: &Placed,
+        kind: gizmo::FkKind,
+        at: Pos2,
+        modal: bool,
+    ) -> bool {
+        let (Some(name), Some(shown)) = (
+            self.selected.clone(),
+            self.pose_mode.posed.as_ref().map(|p| p.transforms.clone()),
+        ) else {
             return false;
         };
         match gizmo::FkGesture::start(
@@ -496,6 +549,43 @@ pub fn rest_point_under(
         }
     }
     None
+}
+
+/// The pin a first drag of the drawing adds, as Spine holds a skeleton's root: at the head of
+/// the root of the bone that weighs the rest point `at` (canvas px) most, where `transforms`
+/// show it. `None` when that bone is a root itself (grabbing the root moves the whole
+/// skeleton), when no bone weighs the point, or when the rig cannot say.
+pub fn implicit_root_pin(
+    scene: &Scene,
+    at: [f64; 2],
+    transforms: &[crate::rig::Affine],
+) -> Option<IkDrag> {
+    let ik = scene.rig_ik().ok()?;
+    let grip = ik
+        .drag_row(&IkDrag {
+            at,
+            to: at,
+            weight: None,
+        })
+        .ok()?;
+    let bones = &scene.doc.handles.bones;
+    // Bones are the rig's first weight columns; a column's weight is its row's third entry.
+    let (grabbed, _) = bones
+        .iter()
+        .enumerate()
+        .map(|(j, bone)| (bone, grip.row.get(3 * j + 2).copied().unwrap_or(0.0)))
+        .filter(|(_, w)| *w > 0.0)
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let root = scene.doc.handles.root_bone(&grabbed.name)?;
+    if root.name == grabbed.name {
+        return None;
+    }
+    let shown = shown_position(scene, root.head, transforms).ok()?;
+    Some(IkDrag {
+        at: root.head,
+        to: shown,
+        weight: None,
+    })
 }
 
 /// Where the rest point `at` is shown under `transforms`: the skinning IK's own grip of it

@@ -114,9 +114,61 @@ fn wait_for_weights(h: &mut Harness<'_, EditorApp>) {
     assert!(!h.state().computing(), "weights took too long");
 }
 
-/// A point well inside the torso at rest, canvas px.
+/// A point well inside the torso at rest and away from the bones (a drag there moves the
+/// drawing), canvas px.
 fn torso_point(h: &Harness<'_, EditorApp>) -> [f64; 2] {
-    part_point(h, "torso")
+    off_bone_point(h, "torso")
+}
+
+/// A rest vertex of part `name` that lies on the drawing but away from every bone's line
+/// (more than twice the pick radius on screen), the one nearest the part's centroid: a drag
+/// there moves the drawing, not a bone.
+fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
+    let scene = h.state().doc.posable().expect("posable").clone();
+    let zoom = f64::from(h.state().placed.expect("drawn").view.zoom);
+    let clear_px = 2.0 * f64::from(canvas::PICK_RADIUS_PT) / zoom;
+    let part = scene
+        .doc
+        .parts
+        .iter()
+        .find(|p| p.name == name)
+        .expect("part");
+    let from_bones = |p: [f64; 2]| {
+        let pt = |q: [f64; 2]| crate::geom::Point::new(q[0], q[1]);
+        scene
+            .doc
+            .handles
+            .bones
+            .iter()
+            .map(|b| crate::geom::segment_distance(pt(p), pt(b.head), pt(b.tail)).0)
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Interior vertices only (a vertex of the outline may sit on the drawing's edge).
+    let boundary: std::collections::HashSet<u32> = part
+        .mesh
+        .triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .fold(std::collections::HashMap::new(), |mut m, (a, b)| {
+            *m.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            m
+        })
+        .into_iter()
+        .filter(|(_, n)| *n == 1)
+        .flat_map(|((a, b), _)| [a, b])
+        .collect();
+    // The one nearest the part's centroid.
+    let v = &part.mesh.vertices;
+    let n = v.len() as f64;
+    let c = v
+        .iter()
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    (0..v.len() as u32)
+        .filter(|i| !boundary.contains(i))
+        .map(|i| v[i as usize])
+        .filter(|&p| from_bones(p) > clear_px)
+        .min_by(|&a, &b| distance(a, c).total_cmp(&distance(b, c)))
+        .expect("a vertex away from the bones")
 }
 
 /// Steps frames (up to 5 s) until `done` says the background work is.

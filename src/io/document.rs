@@ -54,6 +54,10 @@ pub struct RigDocument {
     /// keeps them (a cage locks all its columns). Absent when none is locked.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub locked: Vec<String>,
+    /// Skins by name: slot → the attachment it shows instead of its own part (see
+    /// [`super::slots`]). Absent when none.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub skins: super::slots::Skins,
 }
 
 /// How the document's meshes were built.
@@ -72,6 +76,10 @@ pub struct BuildOptions {
 #[serde(deny_unknown_fields)]
 pub struct PartDoc {
     pub name: String,
+    /// The slot this part is another attachment of: the name of a part without `slot` (see
+    /// [`super::slots`]). Absent: the part is a slot, and its own default attachment.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slot: Option<String>,
     /// Path of the image, relative to the document's folder.
     pub image: String,
     pub mesh: MeshDoc,
@@ -170,6 +178,7 @@ impl RigDocument {
             events: BTreeMap::new(),
             options: BuildOptions::default(),
             locked: Vec::new(),
+            skins: BTreeMap::new(),
         }
     }
 
@@ -260,8 +269,11 @@ impl RigDocument {
     /// [`RigDocument::validate`]: an edited rig may drop a handle an animation still names, and
     /// the document must still open; what poses an animation checks it first.
     pub fn check_animations(&self) -> Result<(), AnimError> {
-        let parts: Vec<&str> = self.parts.iter().map(|p| p.name.as_str()).collect();
-        crate::anim::check_animations(&self.animations, &self.handles, &parts, &self.events)?;
+        let slots = self.slot_names();
+        crate::anim::check_animations(&self.animations, &self.handles, &slots, &self.events)?;
+        self.animations
+            .iter()
+            .try_for_each(|(name, animation)| animation.check_attachments(name, self))?;
         let sizes: Vec<(&str, usize)> = self
             .parts
             .iter()
@@ -303,7 +315,7 @@ impl RigDocument {
             }
             validate_part(part).map_err(|e| format!("part '{}': {e}", part.name))?;
         }
-        Ok(())
+        super::slots::validate_slots(self)
     }
 }
 
@@ -398,6 +410,7 @@ mod tests {
         let mut doc = RigDocument::new([4, 4]);
         doc.parts.push(PartDoc {
             name: "body".into(),
+            slot: None,
             image: "body.png".into(),
             mesh: MeshDoc {
                 vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],

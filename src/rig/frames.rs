@@ -153,6 +153,10 @@ pub struct PartPose {
     /// RGBA multiplier, each channel in [0, 1].
     pub color: [f64; 4],
     pub visible: bool,
+    /// The attachment the slot shows (a part of the slot, by name); absent or the slot's own
+    /// name: its default, as the active skins resolve it (see [`crate::io::slots`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub attachment: Option<String>,
 }
 
 impl Default for PartPose {
@@ -160,6 +164,7 @@ impl Default for PartPose {
         PartPose {
             color: [1.0, 1.0, 1.0, 1.0],
             visible: true,
+            attachment: None,
         }
     }
 }

@@ -223,6 +223,19 @@ fn check_reach<'a>(
 pub const MIN_BONE_LENGTH_PX: f64 = 1e-6;
 
 impl Handles {
+    /// The root of bone `name`'s skeleton: the ancestor with no parent (the bone itself when
+    /// it has none). `None` when no bone has that name or the parents loop (an invalid rig).
+    pub fn root_bone(&self, name: &str) -> Option<&Bone> {
+        let mut bone = self.bones.iter().find(|b| b.name == name)?;
+        for _ in 0..self.bones.len() {
+            match &bone.parent {
+                None => return Some(bone),
+                Some(parent) => bone = self.bones.iter().find(|b| &b.name == parent)?,
+            }
+        }
+        None
+    }
+
     pub fn is_empty(&self) -> bool {
         self.bones.is_empty()
             && self.points.is_empty()
@@ -609,6 +622,26 @@ mod tests {
             h.names().collect::<Vec<_>>(),
             ["hip", "chest", "arm_l", "nose", "belly", "hand"]
         );
+    }
+
+    #[test]
+    fn a_bones_root_is_its_first_ancestor_without_parent() {
+        let mut h = Handles {
+            bones: vec![
+                bone("hip", None),
+                bone("chest", Some("hip")),
+                bone("arm", Some("chest")),
+                bone("prop", None),
+            ],
+            ..Default::default()
+        };
+        let root = |h: &Handles, name: &str| h.root_bone(name).map(|b| b.name.clone());
+        assert_eq!(root(&h, "arm").as_deref(), Some("hip"));
+        assert_eq!(root(&h, "hip").as_deref(), Some("hip"));
+        assert_eq!(root(&h, "prop").as_deref(), Some("prop"));
+        assert_eq!(root(&h, "nose"), None);
+        h.bones[0].parent = Some("arm".into());
+        assert_eq!(root(&h, "arm"), None, "a parent loop has no root");
     }
 
     #[test]

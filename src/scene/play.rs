@@ -162,43 +162,52 @@ impl<'a> Playhead<'a> {
     }
 }
 
-/// The frames of `animation` at `times_s` (any order). Without momentum they are solved in
-/// parallel; with it, in order of time on one simulation. Either way each frame is what
-/// [`Playhead::frame`] gives for its time alone.
+/// The frames of `animation` at `times_s` (any order); see [`Playhead::frames`].
 pub fn frames(
     scene: &Scene,
     animation: &Animation,
     times_s: &[f64],
     options: PlayOptions,
 ) -> Result<Vec<Frame>, PipelineError> {
-    let mut head = Playhead::new(scene, animation, options);
-    if head.has_momentum() || head.has_physics() {
-        let mut order: Vec<usize> = (0..times_s.len()).collect();
-        order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
-        let mut out: Vec<Option<Frame>> = vec![None; times_s.len()];
-        for k in order {
-            out[k] = Some(head.frame(times_s[k])?);
+    Playhead::new(scene, animation, options).frames(times_s)
+}
+
+impl Playhead<'_> {
+    /// The frames at `times_s` (any order). Without momentum they are solved in parallel;
+    /// with it, in order of time on this playhead's simulation (so asking for consecutive runs
+    /// of times simulates once forward). Either way each frame is what [`Playhead::frame`]
+    /// gives for its time alone.
+    pub fn frames(&mut self, times_s: &[f64]) -> Result<Vec<Frame>, PipelineError> {
+        if self.has_momentum() || self.has_physics() {
+            let mut order: Vec<usize> = (0..times_s.len()).collect();
+            order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
+            let mut out: Vec<Option<Frame>> = vec![None; times_s.len()];
+            for k in order {
+                out[k] = Some(self.frame(times_s[k])?);
+            }
+            return Ok(out.into_iter().flatten().collect());
         }
-        return Ok(out.into_iter().flatten().collect());
+        let (scene, animation, options) = (self.scene, self.animation, self.options);
+        if !animation.ik.is_empty() {
+            // Made here, outside the thread pool: the precomputation runs rayon work of its
+            // own, and a worker that steals a frame while initializing the shared cell would
+            // wait on itself.
+            scene.rig_ik()?;
+        }
+        times_s
+            .par_iter()
+            .map_init(
+                || None,
+                |ik, &time_s| {
+                    let pose = animation.sample_with(time_s, options.looping, &options.sampling);
+                    let transforms = scene.handle_transforms_with(ik, &pose)?;
+                    Ok(Frame {
+                        time_s,
+                        pose,
+                        transforms,
+                    })
+                },
+            )
+            .collect()
     }
-    if !animation.ik.is_empty() {
-        // Made here, outside the thread pool: the precomputation runs rayon work of its own, and
-        // a worker that steals a frame while initializing the shared cell would wait on itself.
-        scene.rig_ik()?;
-    }
-    times_s
-        .par_iter()
-        .map_init(
-            || None,
-            |ik, &time_s| {
-                let pose = animation.sample_with(time_s, options.looping, &options.sampling);
-                let transforms = scene.handle_transforms_with(ik, &pose)?;
-                Ok(Frame {
-                    time_s,
-                    pose,
-                    transforms,
-                })
-            },
-        )
-        .collect()
 }

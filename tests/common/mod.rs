@@ -224,14 +224,29 @@ pub fn character_layers() -> (Vec<sinew::pipeline::Layer>, sinew::rig::Handles) 
 /// [`character_scene`] builds them.
 pub fn character_rig() -> (sinew::io::RigDocument, Vec<RgbaImage>) {
     let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
-    let (layers, handles) = character_layers();
-    let (doc, _) = sinew::pipeline::build_rig(
+    let (mut layers, handles) = character_layers();
+    // The other attachments of its slots (after the layers) and its skins, as `sinew demo` rigs them.
+    let list: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
+    )
+    .expect("layers.json parses");
+    let attachments: std::collections::BTreeMap<String, String> =
+        serde_json::from_value(list["attachments"].clone()).unwrap_or_default();
+    let skins: sinew::io::Skins = serde_json::from_value(list["skins"].clone()).unwrap_or_default();
+    let paths: Vec<std::path::PathBuf> = attachments
+        .keys()
+        .map(|n| assets.join(format!("{n}.png")))
+        .collect();
+    layers.extend(sinew::pipeline::load_layers(&paths).expect("attachments load"));
+    let (mut doc, _) = sinew::pipeline::build_rig(
         &layers,
         &assets,
         &sinew::io::BuildOptions::default(),
         &handles,
     )
     .expect("the character rigs");
+    doc.set_slots(&attachments, skins)
+        .expect("the character's slots and skins");
     let images: Vec<RgbaImage> = layers.into_iter().map(|l| l.image).collect();
     (doc, images)
 }

@@ -8,7 +8,7 @@
 //   node check.mjs SKELETON.json SKELETON.atlas REQUEST.json OUT.json
 //
 // REQUEST.json: {"times": {"<animation>": [t, ...]}, "events": {"<animation>": [[lastTime,
-// time, loop], ...]}}. OUT.json: {"setup": Snapshot,
+// time, loop], ...]}, "skins": ["<skin>", ...]} (skins combined in order; none: the default). OUT.json: {"setup": Snapshot,
 // "animations": {"<name>": {"duration": d, "frames": [{"time": t, "slots": Snapshot}]}},
 // "events": {"<name>": [[Event, ...] per step]}, "warnings": [...]}; Event = {"name", "time",
 // "int", "float", "string", "audio": null or {"path", "volume", "balance"}}: what Animation.apply fires moving
@@ -39,7 +39,24 @@ try {
   console.error(`spine-core refused ${skeletonPath}: ${e.message}`);
   process.exit(2);
 }
-let skeleton = new spine.Skeleton(data);
+// Skins combined in order (a later one overrides an earlier one on a slot), as a game does.
+function makeSkeleton() {
+  const made = new spine.Skeleton(data);
+  if ((request.skins || []).length > 0) {
+    const combined = new spine.Skin("combined");
+    for (const name of request.skins) {
+      const skin = data.findSkin(name);
+      if (!skin) {
+        console.error(`no skin '${name}' in ${skeletonPath}`);
+        process.exit(2);
+      }
+      combined.addSkin(skin);
+    }
+    made.setSkin(combined);
+  }
+  return made;
+}
+let skeleton = makeSkeleton();
 
 // `physics` false: the world transforms as the last update left them (physics applied).
 function snapshot(update = true) {
@@ -67,7 +84,7 @@ const setupPose = () => (v43 ? skeleton.setupPose() : skeleton.setToSetupPose())
 const UPDATE_HZ = 60;
 const hasPhysics = !v43 && (data.physicsConstraints || []).length > 0;
 function simulated(applyAt, time) {
-  skeleton = new spine.Skeleton(data);
+  skeleton = makeSkeleton();
   const step = 1 / UPDATE_HZ;
   const whole = Math.max(Math.floor(time / step + 1e-9), 0);
   for (let k = 0; k <= whole; k++) {
@@ -80,7 +97,7 @@ function simulated(applyAt, time) {
     skeleton.updateWorldTransform(spine.Physics.pose);
   }
   const out = snapshot(false);
-  skeleton = new spine.Skeleton(data);
+  skeleton = makeSkeleton();
   return out;
 }
 setupPose();

@@ -272,3 +272,45 @@ fn a_pin_after_a_drag_leaves_the_drawing_where_it_is() {
         "a pin after a drag moved the drawing by {moved} px"
     );
 }
+
+#[test]
+fn a_drag_on_a_bone_turns_it_and_a_first_drag_of_the_drawing_holds_the_skeletons_root() {
+    let mut h = open_character("bone-drag");
+    h.key_press(Key::Num2);
+    h.run();
+    // The chest bone runs up from its head at (256, 262): a drag from its line turns it
+    // about the head, as Spine's pose tool does; the drag selects it.
+    let head = [256.0, 262.0];
+    drag(&mut h, [256.0, 215.0], [300.0, 230.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    let pose = h.state().doc.state().pose.clone();
+    let rotate = pose.bones["chest"].rotate;
+    assert!(rotate < -30.0, "turned {rotate}°");
+    assert!(pose.ik.is_empty(), "{:?}", pose.ik);
+    assert!(distance(shown_head(&h, "chest"), head) < 1e-6);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(h.state().doc.state().pose.bones.is_empty());
+
+    // A drag of the lower leg's drawing with no pins bends the leg: the skeleton's root (the
+    // hip's head) is pinned where it is shown, and the pin is part of the pose.
+    let hip = shown_head(&h, "hip");
+    let from = off_bone_point(&h, "leg_lower_l");
+    let to = [from[0] + 40.0, from[1] - 30.0];
+    drag(&mut h, from, to);
+    let ik = h.state().doc.state().pose.ik.clone();
+    assert_eq!(ik.len(), 2, "{:?}", h.state().message);
+    assert!(distance(ik[0].to, to) < 1e-3, "the drag comes first");
+    assert_eq!(ik[1].at, [256.0, 318.0], "the pin is at the hip's head");
+    assert!(distance(ik[1].to, hip) < 1e-6);
+    assert!(
+        distance(shown_head(&h, "hip"), hip) < 0.5,
+        "the hip moved to {:?}",
+        shown_head(&h, "hip")
+    );
+    let foot = shown_head(&h, "leg_lower_l");
+    assert!(
+        distance(foot, [296.0, 392.0]) > 5.0,
+        "the knee stayed at {foot:?}"
+    );
+}

@@ -53,6 +53,7 @@ fn rig_weigh_pose_undo_through_the_ui() {
     assert_eq!(h.state().selected, None);
     let grip = torso_point(&h);
     drag(&mut h, grip, [grip[0] + 25.0, grip[1] - 15.0]);
+    // The torso's middle is the root bone's own: the drag holds no other point.
     let pose = &h.state().doc.state().pose;
     assert_eq!(pose.ik.len(), 1, "{:?}", h.state().message);
     assert!(distance(pose.ik[0].at, grip) < 1.0);

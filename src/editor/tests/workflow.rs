@@ -59,8 +59,9 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     // Animate: drag the bar's end up and key it at 0 s; at 1 s drag it down and key it.
     h.key_press(Key::Num3);
     h.run();
-    let (up, down) = ([80.0, 14.0], [80.0, 34.0]);
-    drag(&mut h, [80.0, 24.0], up);
+    // (Gripped below the bones' line: a drag that starts on a bone turns the bone.)
+    let (up, down) = ([80.0, 22.0], [80.0, 42.0]);
+    drag(&mut h, [80.0, 32.0], up);
     h.get_by_label("Set key").click();
     h.run();
     press_times(&mut h, "Next frame", 24);

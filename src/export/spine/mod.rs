@@ -34,6 +34,7 @@ pub mod mesh;
 pub mod physics;
 pub mod played;
 pub mod skeleton;
+pub mod skins;
 pub mod timelines;
 
 pub use atlas::AtlasOptions;
@@ -199,7 +200,8 @@ pub enum SpineError {
 /// One exported part.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExportedPart {
-    /// Slot, attachment and atlas region name: the part's name.
+    /// Attachment and atlas region name: the part's name (its slot: the part's own name, or its
+    /// `slot` field when it is another attachment of a slot).
     pub name: String,
     pub mesh: MeshAttachment,
 }
@@ -436,7 +438,8 @@ pub fn export_spine(
     // Animations: native timelines, and baked keys for what they cannot express.
     doc.check_animations()?;
     let animations = &doc.animations;
-    let part_names: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
+    // Draw order keys and slot timelines name slots.
+    let part_names: Vec<String> = doc.slot_names().into_iter().map(String::from).collect();
     let mut animations_json = Map::new();
     let mut baked_report = Vec::new();
     for (anim_name, animation) in animations {
@@ -611,12 +614,7 @@ fn skeleton_json(
         })
         .collect();
     let root = &skeleton.bones[0].name;
-    let slots: Vec<Value> = parts
-        .iter()
-        .map(|p| json!({"name": p.name, "bone": root, "attachment": p.name}))
-        .collect();
-    let mut attachments = Map::new();
-    for part in parts {
+    let mesh_json = |part: &ExportedPart| {
         let m = &part.mesh;
         let region = atlas.regions.iter().find(|r| r.name == part.name);
         let mut vertices = Vec::new();
@@ -626,7 +624,7 @@ fn skeleton_json(
                 vertices.extend([json!(i.bone), num(i.bind[0]), num(i.bind[1]), num(i.weight)]);
             }
         }
-        let mesh = json!({
+        json!({
             "type": "mesh",
             "uvs": m.uvs.iter().flat_map(|uv| [num(uv[0]), num(uv[1])]).collect::<Vec<_>>(),
             "triangles": m.triangles,
@@ -635,9 +633,9 @@ fn skeleton_json(
             "edges": m.edges,
             "width": region.map_or(0, |r| r.width),
             "height": region.map_or(0, |r| r.height),
-        });
-        attachments.insert(part.name.clone(), json!({ part.name.clone(): mesh }));
-    }
+        })
+    };
+    let (slots, skins) = skins::slots_and_skins(doc, parts, root, &mesh_json);
     // Update order = file order, as sinew applies them.
     let ik: Vec<Value> = exported_ik
         .iter()
@@ -653,11 +651,11 @@ fn skeleton_json(
             "height": num(hi[1] - lo[1]),
             "images": "./",
             "fps": num(options.bake_fps),
-            "hash": content_hash(name, &bones, &ik, &physics, &attachments, &animations),
+            "hash": content_hash(name, &bones, &ik, &physics, &skins, &animations),
         },
         "bones": bones,
         "slots": slots,
-        "skins": [{"name": "default", "attachments": attachments}],
+        "skins": skins,
         "animations": animations,
     });
     if !ik.is_empty() {
@@ -680,14 +678,18 @@ fn content_hash(
     bones: &[Value],
     ik: &[Value],
     physics: &[Value],
-    attachments: &Map<String, Value>,
+    skins: &[Value],
     animations: &Map<String, Value>,
 ) -> String {
     let mut text = format!(
         "{name}{}{}{}{}",
         Value::from(bones.to_vec()),
         Value::from(ik.to_vec()),
-        Value::Object(attachments.clone()),
+        // The default skin's attachments alone when it is the only skin (as before skins).
+        match skins {
+            [only] => only["attachments"].clone(),
+            _ => Value::from(skins.to_vec()),
+        },
         Value::Object(animations.clone())
     );
     // Left out when empty: the hashes of rigs without physics stay as they were.

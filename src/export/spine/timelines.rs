@@ -265,6 +265,14 @@ pub fn native_timelines(
                 .collect();
             m.insert("attachment".into(), Value::Array(keys));
         }
+        // Names as authored: the slot's own name is the placeholder each skin fills.
+        if let Some(keys) = &t.attachment {
+            let keys: Vec<Value> = steps_with_start(keys)
+                .iter()
+                .map(|k| key_object(k.time, vec![("name", json!(k.value))], None))
+                .collect();
+            m.insert("attachment".into(), Value::Array(keys));
+        }
         if !m.is_empty() {
             slots.insert(name.clone(), Value::Object(m));
         }

@@ -14,12 +14,12 @@
 //! subfolders are moved over right after it. A temporary folder left by a killed run is tidied by
 //! the next run into the same folder (its frames removed, anything else moved back).
 
-use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
+use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
+use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::io::atomic::{
     resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind,
 };
 use crate::io::image::encode_png;
-use image::RgbaImage;
 use rayon::prelude::*;
 use std::fs;
 use std::path::Path;
@@ -49,13 +49,14 @@ pub fn is_frame_name(name: &str) -> bool {
 /// Writes `frames` into the folder `dir` as numbered PNGs, replacing the render there (see the
 /// module doc). `dir` may be a symbolic link to a folder (the folder it names is replaced); an
 /// existing `dir` that is not a folder is refused.
-pub fn write_folder(
-    frames: &[RgbaImage],
+pub fn write_folder<S: FrameSource + ?Sized>(
+    frames: &S,
     fps: f64,
     dir: &Path,
 ) -> Result<SequenceReport, SequenceError> {
-    let size = check_frames(frames)?;
+    let size = first_frame_size(frames)?;
     check_fps(fps)?;
+    let count = frames.frame_count();
     let target = resolve_output(dir, OutputKind::Folder).map_err(write_error(dir))?;
     if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
         fs::create_dir_all(parent).map_err(write_error(parent))?;
@@ -63,13 +64,11 @@ pub fn write_folder(
     for stale in stale_temporaries(&target) {
         tidy_stale_folder(&stale, &target);
     }
-    let digits = digits_for(frames.len());
-    let names: Vec<String> = (0..frames.len())
-        .map(|i| frame_file_name(i, digits))
-        .collect();
+    let digits = digits_for(count);
+    let names: Vec<String> = (0..count).map(|i| frame_file_name(i, digits)).collect();
     let staging = temporary_sibling(&target);
     fs::create_dir(&staging).map_err(write_error(&staging))?;
-    let result = fill_and_swap(frames, &names, &staging, &target);
+    let result = fill_and_swap(frames, size, &names, &staging, &target);
     if result.is_err() {
         // Before the swap the staging folder holds only new frames and links; after a failed
         // swap the same. Nothing of the user's is in it.
@@ -79,9 +78,9 @@ pub fn write_folder(
     Ok(SequenceReport {
         format: SequenceFormat::Folder,
         files: names.iter().map(|n| dir.join(n)).collect(),
-        frame_count: frames.len(),
+        frame_count: count,
         frame_size_px: size,
-        duration_s: frames.len() as f64 / fps,
+        duration_s: count as f64 / fps,
         palette_colours: None,
         sheet_size_px: None,
         stale_files: removed.iter().map(|n| dir.join(n)).collect(),
@@ -90,27 +89,33 @@ pub fn write_folder(
 
 /// Writes the frames into `staging`, puts it in `target`'s place and returns the names of the
 /// previous render's frames that the new one has no file for (removed with it), sorted.
-fn fill_and_swap(
-    frames: &[RgbaImage],
+fn fill_and_swap<S: FrameSource + ?Sized>(
+    frames: &S,
+    size: (u32, u32),
     names: &[String],
     staging: &Path,
     target: &Path,
 ) -> Result<Vec<String>, SequenceError> {
-    // PNG compression dominates; frames are independent. Results are gathered in frame order so
-    // the error reported (the first frame's) does not depend on scheduling.
-    let results: Vec<Result<(), SequenceError>> = frames
-        .par_iter()
-        .zip(names)
-        .map(|(frame, name)| {
-            let path = staging.join(name);
-            let bytes = encode_png(frame).map_err(|e| SequenceError::Encode {
-                path: path.clone(),
-                reason: e.to_string(),
-            })?;
-            write_new(&path, &bytes).map_err(write_error(&path))
-        })
-        .collect();
-    results.into_iter().collect::<Result<(), _>>()?;
+    // A chunk at a time (bounded memory). PNG compression dominates; frames are independent.
+    // Results are gathered in frame order so the error reported (the first frame's) does not
+    // depend on scheduling.
+    for range in chunks(frames.frame_count()) {
+        let drawn = frames.draw(range.clone())?;
+        check_chunk(&drawn, range.start, size)?;
+        let results: Vec<Result<(), SequenceError>> = drawn
+            .par_iter()
+            .zip(&names[range])
+            .map(|(frame, name)| {
+                let path = staging.join(name);
+                let bytes = encode_png(frame).map_err(|e| SequenceError::Encode {
+                    path: path.clone(),
+                    reason: e.to_string(),
+                })?;
+                write_new(&path, &bytes).map_err(write_error(&path))
+            })
+            .collect();
+        results.into_iter().collect::<Result<(), _>>()?;
+    }
     if !target.exists() {
         fs::rename(staging, target).map_err(write_error(target))?;
         return Ok(Vec::new());

@@ -1,7 +1,8 @@
 //! Animated GIF: one global palette, 1-bit transparency, delays from the frame rate, looping.
 //!
-//! In: straight-alpha RGBA8 frames of one size, frames per second, [`GifOptions`]. Out: GIF89a
-//! bytes (or a file, written atomically) that loop forever.
+//! In: straight-alpha RGBA8 frames of one size (a [`FrameSource`], pulled a chunk at a time),
+//! frames per second, [`GifOptions`]. Out: GIF89a bytes (or a file, written atomically) that
+//! loop forever.
 //!
 //! - Palette: one for all frames, so colours do not flicker between frames ([`super::palette`]:
 //!   Wu's quantizer + k-means over the pooled histogram; exact when the colours fit).
@@ -20,8 +21,9 @@
 //!   its visible pixels, which saves the transparent margins' bytes.
 
 use super::palette::{pack_rgb, quantize, Histogram};
+use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
 use super::timing::{frame_durations, GIF_TICKS_PER_S};
-use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
+use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::io::atomic::write_atomic;
 use ::gif::{DisposalMethod, Encoder, Frame, Repeat};
 use image::RgbaImage;
@@ -52,6 +54,10 @@ pub struct GifOptions {
     pub alpha_threshold: u8,
     /// Palette entries at most, transparent entry included (2–256; default 256).
     pub palette_size: u16,
+    /// Frames drawn on demand (a render, not frames in memory) that the two passes share at
+    /// most, MiB: below, the second pass encodes the frames the first drew; above, it draws
+    /// them again, so memory stays bounded whatever the length. Default 256.
+    pub keep_frames_mib: u64,
 }
 
 impl Default for GifOptions {
@@ -59,6 +65,7 @@ impl Default for GifOptions {
         GifOptions {
             alpha_threshold: DEFAULT_ALPHA_THRESHOLD,
             palette_size: MAX_PALETTE_SIZE,
+            keep_frames_mib: DEFAULT_KEEP_FRAMES_MIB,
         }
     }
 }
@@ -71,15 +78,22 @@ pub struct EncodedGif {
     pub palette_colours: usize,
     /// Delay of each frame, 1/100 s.
     pub delays_cs: Vec<u16>,
+    /// The frames' size, px.
+    pub size_px: (u32, u32),
 }
 
-/// Encodes `frames` (straight alpha) at `fps` as a looping GIF.
-pub fn encode_gif(
-    frames: &[RgbaImage],
+/// Default of [`GifOptions::keep_frames_mib`].
+pub const DEFAULT_KEEP_FRAMES_MIB: u64 = 256;
+
+/// Encodes `frames` (straight alpha) at `fps` as a looping GIF. Two passes over the frames,
+/// a chunk at a time: the pooled colour histogram, then each frame mapped to the palette and
+/// compressed.
+pub fn encode_gif<S: FrameSource + ?Sized>(
+    frames: &S,
     fps: f64,
     options: &GifOptions,
 ) -> Result<EncodedGif, SequenceError> {
-    let (width, height) = check_frames(frames)?;
+    let (width, height) = first_frame_size(frames)?;
     check_fps(fps)?;
     if fps > MAX_GIF_FPS {
         return Err(SequenceError::GifFrameRateTooHigh {
@@ -103,18 +117,34 @@ pub fn encode_gif(
     }
     let threshold = options.alpha_threshold;
     let visible = |px: &image::Rgba<u8>| px[3] >= threshold;
+    let count = frames.frame_count();
 
-    let histogram = Histogram::from_frames(
-        frames
-            .iter()
-            .map(|f| {
-                f.pixels()
-                    .filter(|p| visible(p))
-                    .map(|p| pack_rgb(p[0], p[1], p[2]))
-                    .collect()
-            })
-            .collect(),
-    );
+    // Pass 1: the histogram of every frame's visible colours, pooled chunk by chunk.
+    let frame_bytes = u64::from(width) * u64::from(height) * 4;
+    let keep = !frames.in_memory()
+        && (count as u64).saturating_mul(frame_bytes)
+            <= options.keep_frames_mib.saturating_mul(1024 * 1024);
+    let mut kept: Vec<RgbaImage> = Vec::new();
+    let mut histogram = Histogram::default();
+    for range in chunks(count) {
+        let drawn = frames.draw(range.clone())?;
+        check_chunk(&drawn, range.start, (width, height))?;
+        let part = Histogram::from_frames(
+            drawn
+                .par_iter()
+                .map(|f| {
+                    f.pixels()
+                        .filter(|p| visible(p))
+                        .map(|p| pack_rgb(p[0], p[1], p[2]))
+                        .collect()
+                })
+                .collect(),
+        );
+        histogram = histogram.merge(&part);
+        if keep {
+            kept.extend(drawn.into_iter().map(Cow::into_owned));
+        }
+    }
     // Entry 0 is always reserved for transparency, even in a fully opaque animation: that costs
     // one colour at most and keeps the index layout the same for every input.
     let quantized = quantize(&histogram, usize::from(options.palette_size) - 1);
@@ -128,51 +158,68 @@ pub fn encode_gif(
         index_of[colour as usize] = i + 1;
     }
 
-    let delays_cs: Vec<u16> = frame_durations(frames.len(), fps, GIF_TICKS_PER_S)
+    let delays_cs: Vec<u16> = frame_durations(count, fps, GIF_TICKS_PER_S)
         .into_iter()
         .map(|d| d.min(u32::from(u16::MAX)) as u16)
         .collect();
 
-    // Index mapping, cropping and LZW compression are independent per frame: done in parallel,
-    // then written in order, so the bytes do not depend on the thread count.
-    let encoded_frames: Vec<Frame<'static>> = frames
-        .par_iter()
-        .zip(&delays_cs)
-        .map(|(frame, &delay)| {
-            let indices: Vec<u8> = frame
-                .pixels()
-                .map(|p| {
-                    if visible(p) {
-                        index_of[pack_rgb(p[0], p[1], p[2]) as usize]
-                    } else {
-                        TRANSPARENT_INDEX
-                    }
-                })
-                .collect();
-            let (left, top, w, h) = visible_box(&indices, width, height);
-            let cropped: Vec<u8> = (top..top + h)
-                .flat_map(|y| {
-                    let row = (y * width) as usize;
-                    indices[row + left as usize..row + (left + w) as usize]
-                        .iter()
-                        .copied()
-                })
-                .collect();
-            let mut gif_frame = Frame {
-                delay,
-                dispose: DisposalMethod::Background,
-                transparent: Some(TRANSPARENT_INDEX),
-                left: left as u16,
-                top: top as u16,
-                width: w as u16,
-                height: h as u16,
-                buffer: Cow::Owned(cropped),
-                ..Frame::default()
-            };
-            gif_frame.make_lzw_pre_encoded();
-            gif_frame
-        })
-        .collect();
+    // Pass 2: index mapping, cropping and LZW compression are independent per frame: done in
+    // parallel, then written in order, so the bytes do not depend on the thread count.
+    let encode_frame = |frame: &RgbaImage, delay: u16| {
+        let indices: Vec<u8> = frame
+            .pixels()
+            .map(|p| {
+                if visible(p) {
+                    index_of[pack_rgb(p[0], p[1], p[2]) as usize]
+                } else {
+                    TRANSPARENT_INDEX
+                }
+            })
+            .collect();
+        let (left, top, w, h) = visible_box(&indices, width, height);
+        let cropped: Vec<u8> = (top..top + h)
+            .flat_map(|y| {
+                let row = (y * width) as usize;
+                indices[row + left as usize..row + (left + w) as usize]
+                    .iter()
+                    .copied()
+            })
+            .collect();
+        let mut gif_frame = Frame {
+            delay,
+            dispose: DisposalMethod::Background,
+            transparent: Some(TRANSPARENT_INDEX),
+            left: left as u16,
+            top: top as u16,
+            width: w as u16,
+            height: h as u16,
+            buffer: Cow::Owned(cropped),
+            ..Frame::default()
+        };
+        gif_frame.make_lzw_pre_encoded();
+        gif_frame
+    };
+    let mut encoded_frames: Vec<Frame<'static>> = Vec::with_capacity(count);
+    for range in chunks(count) {
+        let delays = &delays_cs[range.clone()];
+        if keep {
+            encoded_frames.par_extend(
+                kept[range]
+                    .par_iter()
+                    .zip(delays)
+                    .map(|(f, &d)| encode_frame(f, d)),
+            );
+        } else {
+            let drawn = frames.draw(range.clone())?;
+            check_chunk(&drawn, range.start, (width, height))?;
+            encoded_frames.par_extend(
+                drawn
+                    .par_iter()
+                    .zip(delays)
+                    .map(|(f, &d)| encode_frame(f, d)),
+            );
+        }
+    }
 
     let mut bytes = Vec::new();
     let encode = |e: ::gif::EncodingError| encode_error(e.to_string());
@@ -192,6 +239,7 @@ pub fn encode_gif(
         bytes,
         palette_colours: quantized.palette.len(),
         delays_cs,
+        size_px: (width, height),
     })
 }
 
@@ -229,8 +277,8 @@ fn visible_box(indices: &[u8], width: u32, height: u32) -> (u32, u32, u32, u32) 
 }
 
 /// Encodes `frames` as a GIF and writes it to `path` atomically.
-pub fn write_gif(
-    frames: &[RgbaImage],
+pub fn write_gif<S: FrameSource + ?Sized>(
+    frames: &S,
     fps: f64,
     path: &Path,
     options: &GifOptions,
@@ -247,8 +295,8 @@ pub fn write_gif(
     Ok(SequenceReport {
         format: SequenceFormat::Gif,
         files: vec![path.into()],
-        frame_count: frames.len(),
-        frame_size_px: frames[0].dimensions(),
+        frame_count: gif.delays_cs.len(),
+        frame_size_px: gif.size_px,
         duration_s: total_cs as f64 / f64::from(GIF_TICKS_PER_S),
         palette_colours: Some(gif.palette_colours),
         sheet_size_px: None,

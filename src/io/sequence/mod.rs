@@ -2,7 +2,9 @@
 //!
 //! In: a sequence of frames, all the same size, as straight-alpha RGBA8 images (what
 //! `render::rgba_from_pixmap` makes of the renderer's premultiplied pixmaps), and the frame rate
-//! in frames per second. Out, chosen by the target path:
+//! in frames per second. The frames come from a [`FrameSource`]: frames in memory, or an
+//! animation drawn as the writers pull it, a chunk at a time, so a render of any length is
+//! written in bounded memory. Out, chosen by the target path:
 //!
 //! - an existing folder, or a path without extension: numbered PNGs `frame_0000.png`, … ([`folder`]);
 //! - `NAME.gif`: an animated GIF looping forever, one global palette ([`gif`]);
@@ -18,6 +20,7 @@ pub mod folder;
 pub mod gif;
 pub mod palette;
 pub mod sheet;
+pub mod source;
 pub mod synthetic;
 pub mod timing;
 
@@ -25,8 +28,8 @@ pub use background::{composite_over_background, parse_rgba_hex};
 pub use folder::write_folder;
 pub use gif::{encode_gif, write_gif, GifOptions};
 pub use sheet::{build_sheet, write_sheet, FrameNaming, SheetOptions};
+pub use source::{FrameSource, STREAM_CHUNK_FRAMES};
 
-use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -78,6 +81,9 @@ pub enum SequenceError {
     Encode { path: PathBuf, reason: String },
     #[error("bad colour {text:?}: expected #rrggbb or #rrggbbaa")]
     BadColour { text: String },
+    /// Drawing the frames failed (posing or rendering them as they were asked for).
+    #[error("{0}")]
+    Draw(String),
 }
 
 /// The kind of file(s) a target path asks for.
@@ -141,8 +147,8 @@ pub fn format_for_path(path: &Path) -> Result<SequenceFormat, SequenceError> {
 /// Writes `frames` (straight alpha, `fps` frames per second) to `path` in the format its
 /// extension asks for (see [`format_for_path`]). `events` (empty, or one list per frame: what
 /// each frame fires) go into a sprite sheet's JSON; a GIF or a folder has no place for them.
-pub fn write_sequence(
-    frames: &[RgbaImage],
+pub fn write_sequence<S: FrameSource + ?Sized>(
+    frames: &S,
     events: &[Vec<crate::anim::FiredEvent>],
     fps: f64,
     path: &Path,
@@ -153,33 +159,6 @@ pub fn write_sequence(
         SequenceFormat::Gif => write_gif(frames, fps, path, &options.gif),
         SequenceFormat::Sheet => write_sheet(frames, events, fps, path, &options.sheet),
     }
-}
-
-/// Checks that there is at least one frame, that every frame has pixels and that all share
-/// frame 0's size, which it returns (px).
-pub fn check_frames(frames: &[RgbaImage]) -> Result<(u32, u32), SequenceError> {
-    let first = frames.first().ok_or(SequenceError::NoFrames)?;
-    let (expected_width, expected_height) = first.dimensions();
-    for (index, frame) in frames.iter().enumerate() {
-        let (width, height) = frame.dimensions();
-        if width == 0 || height == 0 {
-            return Err(SequenceError::EmptyFrame {
-                index,
-                width,
-                height,
-            });
-        }
-        if (width, height) != (expected_width, expected_height) {
-            return Err(SequenceError::MismatchedSize {
-                index,
-                width,
-                height,
-                expected_width,
-                expected_height,
-            });
-        }
-    }
-    Ok((expected_width, expected_height))
 }
 
 /// Checks the frame rate: positive and finite.
@@ -240,24 +219,7 @@ mod tests {
     }
 
     #[test]
-    fn frames_are_checked() {
-        assert!(matches!(check_frames(&[]), Err(SequenceError::NoFrames)));
-        let a = RgbaImage::new(4, 3);
-        assert_eq!(check_frames(&[a.clone(), a.clone()]).unwrap(), (4, 3));
-        let err = check_frames(&[a.clone(), RgbaImage::new(3, 4)]).unwrap_err();
-        assert!(matches!(
-            err,
-            SequenceError::MismatchedSize {
-                index: 1,
-                width: 3,
-                height: 4,
-                ..
-            }
-        ));
-        assert!(matches!(
-            check_frames(&[RgbaImage::new(0, 3)]),
-            Err(SequenceError::EmptyFrame { index: 0, .. })
-        ));
+    fn frame_rates_are_checked() {
         for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
             assert!(matches!(
                 check_fps(bad),

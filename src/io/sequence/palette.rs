@@ -71,6 +71,31 @@ impl Histogram {
     pub fn is_empty(&self) -> bool {
         self.colours.is_empty()
     }
+
+    /// The histogram of both histograms' pixels (counts of a colour in both add up): what
+    /// [`Histogram::from_frames`] gives for their frames together.
+    pub fn merge(&self, other: &Histogram) -> Histogram {
+        let mut a = self
+            .colours
+            .iter()
+            .copied()
+            .zip(self.counts.iter().copied())
+            .peekable();
+        let mut b = other
+            .colours
+            .iter()
+            .copied()
+            .zip(other.counts.iter().copied())
+            .peekable();
+        let merged = std::iter::from_fn(|| match (a.peek(), b.peek()) {
+            (Some(x), Some(y)) if x.0 <= y.0 => a.next(),
+            (Some(_), Some(_)) => b.next(),
+            (Some(_), None) => a.next(),
+            (None, _) => b.next(),
+        });
+        let (colours, counts) = run_lengths(merged);
+        Histogram { colours, counts }
+    }
 }
 
 /// Merges equal neighbours of a colour-sorted list, adding their counts.
@@ -507,6 +532,17 @@ mod tests {
         let h = Histogram::from_frames(vec![vec![5, 3, 5], vec![3, 9], vec![]]);
         assert_eq!(h.colours, vec![3, 5, 9]);
         assert_eq!(h.counts, vec![2, 2, 1]);
+    }
+
+    #[test]
+    fn merged_histograms_are_the_pooled_one() {
+        let frames = vec![vec![5, 3, 5], vec![3, 9], vec![], vec![1, 9, 9, 12]];
+        let whole = Histogram::from_frames(frames.clone());
+        let merged = Histogram::from_frames(frames[..2].to_vec())
+            .merge(&Histogram::from_frames(frames[2..].to_vec()));
+        assert_eq!(merged, whole);
+        assert_eq!(Histogram::default().merge(&whole), whole);
+        assert_eq!(whole.merge(&Histogram::default()), whole);
     }
 
     #[test]

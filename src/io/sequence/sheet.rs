@@ -1,8 +1,9 @@
 //! Sprite sheet: every frame trimmed and shelf-packed into one PNG, plus a JSON frame map in
 //! TexturePacker's "JSON hash" layout (read by Phaser, PixiJS and most engine importers).
 //!
-//! In: straight-alpha RGBA8 frames of one size, frames per second, the sheet's path `NAME.png`,
-//! [`SheetOptions`]. Out: `NAME.png` (straight-alpha RGBA8) and `NAME.json` beside it, each
+//! In: straight-alpha RGBA8 frames of one size (a [`FrameSource`], pulled a chunk at a time:
+//! only the distinct trimmed frames are kept, which is what the sheet holds), frames per
+//! second, the sheet's path `NAME.png`, [`SheetOptions`]. Out: `NAME.png` (straight-alpha RGBA8) and `NAME.json` beside it, each
 //! written atomically, the PNG first. Sheet coordinates: px, origin top-left, y down.
 //!
 //! The JSON, in this key order:
@@ -30,12 +31,14 @@
 //! for a frame that fires none.
 
 use super::folder::digits_for;
+use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
 use super::timing::{frame_durations, MS_PER_S};
-use super::{check_fps, check_frames, write_error, SequenceError, SequenceFormat, SequenceReport};
+use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::anim::FiredEvent;
 use crate::geom::pack::{pack_shelves, ShelfLayout};
 use crate::io::image::encode_png;
 use image::RgbaImage;
+use rayon::prelude::*;
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Serialize, Serializer};
 use std::collections::{BTreeMap, HashMap};
@@ -138,19 +141,20 @@ pub struct Sheet {
 /// Builds the sheet of `frames` at `fps`; `name` names the animation (and prefixes frame names),
 /// `image_file` is the sheet's file name written as `meta.image`. `events[i]` are the events
 /// frame `i` fires (empty, or one list per frame).
-pub fn build_sheet(
-    frames: &[RgbaImage],
+pub fn build_sheet<S: FrameSource + ?Sized>(
+    frames: &S,
     events: &[Vec<FiredEvent>],
     fps: f64,
     name: &str,
     image_file: &str,
     options: &SheetOptions,
 ) -> Result<Sheet, SequenceError> {
-    let (width, height) = check_frames(frames)?;
+    let (width, height) = first_frame_size(frames)?;
     check_fps(fps)?;
-    if !(events.is_empty() || events.len() == frames.len()) {
+    let count = frames.frame_count();
+    if !(events.is_empty() || events.len() == count) {
         return Err(SequenceError::EventFrames {
-            frames: frames.len(),
+            frames: count,
             events: events.len(),
         });
     }
@@ -160,56 +164,66 @@ pub fn build_sheet(
         w: width,
         h: height,
     };
-    let sources: Vec<PxRect> = frames
-        .iter()
-        .map(|f| if options.trim { visible_rect(f) } else { full })
-        .collect();
 
-    // Which stored region each frame uses: the first frame with the same pixels.
-    let mut region_of_frame = Vec::with_capacity(frames.len());
-    let mut regions: Vec<usize> = Vec::new(); // frame index whose pixels each region holds
+    // One pass, a chunk at a time: each frame's box, and which stored region it uses (the
+    // first frame with the same pixels). Only the regions are kept: what the sheet holds.
+    let mut sources: Vec<PxRect> = Vec::with_capacity(count);
+    let mut region_of_frame = Vec::with_capacity(count);
+    let mut regions: Vec<RgbaImage> = Vec::new();
     let mut by_hash: HashMap<u64, Vec<usize>> = HashMap::new();
-    for (i, (frame, src)) in frames.iter().zip(&sources).enumerate() {
-        if !options.dedupe {
+    let max_area = u64::from(options.max_side_px).pow(2);
+    let mut area = 0u64;
+    for range in chunks(count) {
+        let drawn = frames.draw(range.clone())?;
+        check_chunk(&drawn, range.start, (width, height))?;
+        let boxes: Vec<PxRect> = drawn
+            .par_iter()
+            .map(|f| if options.trim { visible_rect(f) } else { full })
+            .collect();
+        for (frame, src) in drawn.iter().zip(boxes) {
+            sources.push(src);
+            let hash = options.dedupe.then(|| pixels_hash(frame, &src));
+            let same = hash.and_then(|hash| {
+                by_hash.get(&hash)?.iter().copied().find(|&r| {
+                    let region = &regions[r];
+                    same_pixels(region, &whole(region), frame, &src)
+                })
+            });
+            if let Some(r) = same {
+                region_of_frame.push(r);
+                continue;
+            }
+            if let Some(hash) = hash {
+                by_hash.entry(hash).or_default().push(regions.len());
+            }
             region_of_frame.push(regions.len());
-            regions.push(i);
-            continue;
+            regions
+                .push(image::imageops::crop_imm(&**frame, src.x, src.y, src.w, src.h).to_image());
+            area += u64::from(src.w) * u64::from(src.h);
         }
-        let hash = pixels_hash(frame, src);
-        let candidates = by_hash.entry(hash).or_default();
-        let same = candidates.iter().copied().find(|&r| {
-            let j = regions[r];
-            same_pixels(&frames[j], &sources[j], frame, src)
-        });
-        match same {
-            Some(r) => region_of_frame.push(r),
-            None => {
-                candidates.push(regions.len());
-                region_of_frame.push(regions.len());
-                regions.push(i);
-            }
+        // Regions that cannot fit are refused before more frames are drawn.
+        if area > max_area {
+            pack(
+                &region_sizes(&regions),
+                options.padding_px,
+                options.max_side_px,
+            )?;
         }
     }
 
-    let sizes: Vec<(u32, u32)> = regions
-        .iter()
-        .map(|&i| (sources[i].w, sources[i].h))
-        .collect();
-    let packing = pack(&sizes, options.padding_px, options.max_side_px)?;
+    let packing = pack(
+        &region_sizes(&regions),
+        options.padding_px,
+        options.max_side_px,
+    )?;
     let mut image = RgbaImage::new(packing.width, packing.height);
-    for (&i, &(x, y)) in regions.iter().zip(&packing.positions) {
-        let src = sources[i];
-        for row in 0..src.h {
-            for col in 0..src.w {
-                let px = *frames[i].get_pixel(src.x + col, src.y + row);
-                image.put_pixel(x + col, y + row, px);
-            }
-        }
+    for (region, &(x, y)) in regions.iter().zip(&packing.positions) {
+        image::imageops::replace(&mut image, region, i64::from(x), i64::from(y));
     }
 
-    let digits = digits_for(frames.len());
-    let durations = frame_durations(frames.len(), fps, MS_PER_S);
-    let entries: Vec<(String, FrameEntry)> = (0..frames.len())
+    let digits = digits_for(count);
+    let durations = frame_durations(count, fps, MS_PER_S);
+    let entries: Vec<(String, FrameEntry)> = (0..count)
         .map(|i| {
             let frame_name = match options.naming {
                 FrameNaming::Prefixed => format!("{name}_{i:0digits$}.png"),
@@ -258,7 +272,7 @@ pub fn build_sheet(
             frame_tags: vec![FrameTag {
                 name,
                 from: 0,
-                to: frames.len() - 1,
+                to: count - 1,
                 direction: "forward",
             }],
         },
@@ -277,8 +291,8 @@ pub fn build_sheet(
 
 /// Writes the sheet `path` (`NAME.png`) and its frame map `NAME.json` (with `events`, see
 /// [`build_sheet`]).
-pub fn write_sheet(
-    frames: &[RgbaImage],
+pub fn write_sheet<S: FrameSource + ?Sized>(
+    frames: &S,
     events: &[Vec<FiredEvent>],
     fps: f64,
     path: &Path,
@@ -312,8 +326,11 @@ pub fn write_sheet(
     Ok(SequenceReport {
         format: SequenceFormat::Sheet,
         files: vec![path.into(), json_path],
-        frame_count: frames.len(),
-        frame_size_px: frames[0].dimensions(),
+        frame_count: sheet.frames.len(),
+        frame_size_px: (
+            sheet.frames[0].1.source_size.w,
+            sheet.frames[0].1.source_size.h,
+        ),
         duration_s: total_ms as f64 / f64::from(MS_PER_S),
         palette_colours: None,
         sheet_size_px: Some(sheet.image.dimensions()),
@@ -357,6 +374,21 @@ fn region_rows<'a>(frame: &'a RgbaImage, r: &PxRect) -> impl Iterator<Item = &'a
         let start = y as usize * stride + x;
         &frame.as_raw()[start..start + w]
     })
+}
+
+/// The whole of `image` as a box.
+fn whole(image: &RgbaImage) -> PxRect {
+    PxRect {
+        x: 0,
+        y: 0,
+        w: image.width(),
+        h: image.height(),
+    }
+}
+
+/// Each stored region's size, px.
+fn region_sizes(regions: &[RgbaImage]) -> Vec<(u32, u32)> {
+    regions.iter().map(|r| r.dimensions()).collect()
 }
 
 fn pixels_hash(frame: &RgbaImage, r: &PxRect) -> u64 {

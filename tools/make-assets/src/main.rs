@@ -3,7 +3,9 @@
 //! Reads `assets/character/layers.json` (relative to this crate's manifest directory),
 //! renders every `assets/character/src/<layer>.svg` onto the shared canvas into
 //! `assets/character/<layer>.png` (RGBA, straight alpha, antialiased), and composites all
-//! layers back to front (source-over) into `assets/character/flat.png`.
+//! layers back to front (source-over) into `assets/character/flat.png`. The `attachments` of
+//! `layers.json` (other images a layer's slot can show) get their PNGs but stay out of the
+//! composite.
 //!
 //! Output is deterministic: same inputs, same bytes.
 //!
@@ -28,6 +30,8 @@ struct Manifest {
     width: u32,
     height: u32,
     layers: Vec<String>,
+    /// Other attachments of the layers' slots (name → slot): rendered, not composited.
+    attachments: Vec<String>,
 }
 
 fn read_manifest(path: &Path) -> Result<Manifest> {
@@ -47,7 +51,16 @@ fn read_manifest(path: &Path) -> Result<Manifest> {
         .iter()
         .map(|l| l.as_str().map(str::to_owned).ok_or("layers.json: layer names must be strings"))
         .collect::<std::result::Result<Vec<_>, _>>()?;
-    Ok(Manifest { width: dim(0)?, height: dim(1)?, layers })
+    let attachments = match v.get("attachments") {
+        None => Vec::new(),
+        Some(a) => a
+            .as_object()
+            .ok_or("layers.json: \"attachments\" must map names to slots")?
+            .keys()
+            .cloned()
+            .collect(),
+    };
+    Ok(Manifest { width: dim(0)?, height: dim(1)?, layers, attachments })
 }
 
 fn render_layer(svg_path: &Path, width: u32, height: u32) -> Result<Pixmap> {
@@ -82,6 +95,13 @@ fn main() -> Result<()> {
         fs::write(&out, layer.encode_png()?)?;
         println!("wrote {}", out.display());
         flat.draw_pixmap(0, 0, layer.as_ref(), &PixmapPaint::default(), Transform::identity(), None);
+    }
+    // Attachments swap in for a layer: their own PNGs, not part of the composite.
+    for name in &manifest.attachments {
+        let layer = render_layer(&dir.join("src").join(format!("{name}.svg")), w, h)?;
+        let out = dir.join(format!("{name}.png"));
+        fs::write(&out, layer.encode_png()?)?;
+        println!("wrote {}", out.display());
     }
     let out = dir.join("flat.png");
     fs::write(&out, flat.encode_png()?)?;

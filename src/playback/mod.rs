@@ -12,7 +12,7 @@
 //! [`bake`] turns an animation into plain keys (bones, points, cages at every frame time) from
 //! the transformations playback solves: what a runtime that knows no skinning IK can play.
 
-use crate::anim::{Animation, CurveEvaluation, SampleOptions};
+use crate::anim::{Animation, SampleOptions};
 use crate::pipeline::{PipelineError, Scene};
 use crate::render;
 use crate::rig::{Handles, Pose};
@@ -20,6 +20,9 @@ use crate::scene::{Frame, PlayOptions};
 use crate::skin::Blend;
 use image::RgbaImage;
 use rayon::prelude::*;
+
+mod stream;
+pub use stream::{write_animation, AnimationFrames};
 
 /// Frame rates above this are refused: nothing plays them, and a typo (`--fps 2400`) would
 /// otherwise render for minutes.
@@ -33,8 +36,9 @@ pub const MIN_FPS: f64 = 0.1;
 pub const MAX_FRAMES: f64 = 100_000.0;
 /// Largest output frame side, px.
 pub const MAX_FRAME_SIDE_PX: u32 = 16_384;
-/// Most memory a render may hold in frames (they are all kept until written), bytes: 8 GiB,
-/// a third of the reference machine's memory (a 20 s 1080p render at 30 fps takes 5 GiB).
+/// Most memory [`render_animation`] may hold in frames (it returns them all), bytes: 8 GiB,
+/// a third of the reference machine's memory. Renders written to files stream instead
+/// ([`write_animation`]) and have no such cap.
 pub const MAX_RENDER_BYTES: f64 = 8.0 * 1024.0 * 1024.0 * 1024.0;
 
 /// Where frames are drawn: an output of `size_px`, the canvas scaled by `scale` about its
@@ -88,9 +92,11 @@ impl RenderSettings {
     }
 }
 
-/// Plays `animation` (named `name`) on `scene` as `settings` say: the frames at
-/// [`frame_times`]`(duration, fps)`, posed by [`play`] (so a frame is the same at any frame
-/// rate) and drawn by [`draw_pose`]. `on_frame` is called once per frame drawn (progress).
+/// Plays `animation` (named `name`) on `scene` as `settings` say, all frames in memory: the
+/// frames of [`AnimationFrames`] (at [`frame_times`]`(duration, fps)`, posed as [`play`] poses
+/// them, so a frame is the same at any frame rate, and drawn by [`draw_pose`]). `on_frame` is
+/// called once per frame drawn (progress). To write a render to files, [`write_animation`]
+/// streams it instead.
 pub fn render_animation(
     scene: &Scene,
     name: &str,
@@ -98,17 +104,10 @@ pub fn render_animation(
     settings: &RenderSettings,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<Vec<RgbaImage>, RenderAnimationError> {
-    let view = settings.view(scene.doc.canvas)?;
-    let times = frame_times(animation.duration_s(), settings.fps)?;
-    check_render_memory(times.len(), &view)?;
-    let frames = play(scene, name, animation, &times, true, &settings.sampling)?;
-    Ok(render_frames(
-        scene,
-        &frames,
-        settings.blend,
-        &view,
-        on_frame,
-    )?)
+    let frames = AnimationFrames::new(scene, name, animation, settings, on_frame)?;
+    let count = frames.times_s().len();
+    check_render_memory(count, &settings.view(scene.doc.canvas)?)?;
+    frames.render(0..count)
 }
 
 /// The events each frame of [`render_animation`] fires, one list per frame
@@ -140,23 +139,7 @@ pub fn play(
     looping: bool,
     sampling: &SampleOptions,
 ) -> Result<Vec<Frame>, RenderAnimationError> {
-    match sampling.curves {
-        CurveEvaluation::Exact => {
-            let options = PlayOptions {
-                sampling: *sampling,
-                looping,
-            };
-            Ok(crate::scene::frames(scene, animation, times_s, options)?)
-        }
-        CurveEvaluation::SpineRuntime => {
-            let options = crate::export::spine::SpineOptions::default();
-            let played = crate::export::spine::played::as_played(scene, name, animation, &options)?;
-            Ok(times_s
-                .iter()
-                .map(|&t| played.frame(t, looping))
-                .collect::<Result<_, _>>()?)
-        }
-    }
+    stream::Player::new(scene, name, animation, sampling, looping)?.frames(times_s)
 }
 
 /// Why [`render_animation`] failed: its settings, or posing and drawing the rig.
@@ -168,6 +151,8 @@ pub enum RenderAnimationError {
     Pipeline(#[from] PipelineError),
     #[error(transparent)]
     Runtime(#[from] crate::export::spine::SpineError),
+    #[error(transparent)]
+    Sequence(#[from] crate::io::sequence::SequenceError),
 }
 
 /// The smallest side the scaled canvas may have, px: a scale that draws it smaller renders
@@ -354,32 +339,38 @@ pub fn draw_pose(
 }
 
 /// The parts at `positions` (one list per part, canvas px) as `pose` shows them, back to
-/// front: its draw order (the document's otherwise), each part's tint and visibility. What
+/// front: its draw order of slots (the document's otherwise), each slot's tint and visibility,
+/// and the part each slot shows (its attachment, through the scene's skins). What
 /// [`draw_pose`] draws, for every consumer that draws a pose (the editor's canvas too).
 pub fn pose_draws<'a>(
     scene: &Scene,
     positions: &'a [Vec<crate::geom::Point>],
     pose: &Pose,
 ) -> Vec<render::PartDraw<'a>> {
-    let parts = &scene.doc.parts;
-    let order: Vec<usize> = match &pose.draw_order {
+    let doc = &scene.doc;
+    // Slots back to front; each draws the part its attachment and the skins choose.
+    let slots: Vec<&str> = match &pose.draw_order {
         Some(names) => names
             .iter()
-            .filter_map(|n| parts.iter().position(|p| &p.name == n))
+            .map(String::as_str)
+            .filter(|n| doc.parts.iter().any(|p| p.slot.is_none() && p.name == *n))
             .collect(),
-        None => (0..parts.len()).collect(),
+        None => doc.slot_names(),
     };
-    order
+    slots
         .into_iter()
-        .map(|i| {
+        .filter_map(|slot| {
+            let state = pose.parts.get(slot);
+            let attachment = state.and_then(|s| s.attachment.as_deref());
+            let i = doc.shown_part(slot, attachment, scene.skins())?;
             let mut draw =
                 render::PartDraw::new(i, positions.get(i).map(Vec::as_slice).unwrap_or_default());
-            if let Some(state) = pose.parts.get(&parts[i].name) {
+            if let Some(state) = state {
                 let [r, g, b, a] = state.color.map(|c| c as f32);
                 draw.tint = render::Tint { r, g, b, a };
                 draw.visible = state.visible;
             }
-            draw
+            Some(draw)
         })
         .collect()
 }
