@@ -187,7 +187,7 @@ pub enum Command {
     },
     SetOptions(BuildOptions),
     /// Installs a rig built by [`compute_rig`] from the current inputs.
-    SetRig(Arc<Scene>, RigInputsKey),
+    SetRig(Arc<Scene>, Box<RigInputsKey>),
     SetPose(Pose),
     /// Keys `pose` into `animation` at `time_s` (creating the animation): every bone and point
     /// the pose names gets rotate, translate, scale and shear keys, every IK drag a key of the
@@ -768,7 +768,7 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::SetOptions(options) => next.options = options,
         Command::SetRig(scene, key) => {
-            if key != rig_inputs_of(state).key() {
+            if *key != rig_inputs_of(state).key() {
                 return Err(DocumentError::OutdatedRig);
             }
             next.rig = Some(scene);

@@ -7,7 +7,7 @@
 //!   and draws any vertex positions.
 //! - [`keep_locked_weights`]: a rebuilt document keeps the locked handles' previous weights.
 
-use crate::geom::Point;
+use crate::geom::{Point, Vec2};
 use crate::ik::{RigIk, SkinnedMesh};
 use crate::io::{self, BuildOptions, ImageError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
 use crate::mesh::{self, HandleGeometry, MeshError, MeshStats};
@@ -46,6 +46,21 @@ pub enum PipelineError {
     NoImages,
     #[error("cancelled")]
     Cancelled,
+    #[error(
+        "the pose deforms part '{part}' with {got} offsets but its mesh has {expected} vertices"
+    )]
+    DeformSize {
+        part: String,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "physics constraints cannot be combined with the skinning IK's momentum yet (turn \
+         momentum off, or remove the physics constraints)"
+    )]
+    PhysicsWithMomentum,
+    #[error("the pose deforms part '{0}', which the rig does not have")]
+    DeformUnknownPart(String),
     #[error("momentum is simulated from the animation's start: time {0:e} s lies outside [0, {max}] s", max = crate::scene::MAX_SIMULATED_S)]
     SimulatedTime(f64),
     #[error("{path}: image is {got:?} px but the canvas (from the first image) is {canvas:?} px; all layers must share one canvas")]
@@ -593,6 +608,19 @@ impl Scene {
         }
     }
 
+    /// This scene without its physics constraints, textures shared: what the Spine export bakes
+    /// from (the runtime simulates physics itself).
+    pub fn without_physics(&self) -> Scene {
+        let mut doc = self.doc.clone();
+        doc.handles.physics.clear();
+        Scene {
+            doc,
+            parts: self.parts.clone(),
+            ik: std::sync::OnceLock::new(),
+            skins: self.skins.clone(),
+        }
+    }
+
     /// Draws `skins` from now on, combined in order (a later skin overrides an earlier one on
     /// the same slot); empty: every slot shows its own part. Fails on a skin the rig lacks.
     pub fn set_skins(&mut self, skins: &[String]) -> Result<(), io::SlotError> {
@@ -744,6 +772,13 @@ impl Scene {
             Blend::Linear | Blend::Dqs => Vec::new(),
         };
         let columns = handle_columns(&self.doc.handles);
+        if let Some(part) = pose
+            .deform
+            .keys()
+            .find(|name| !self.doc.parts.iter().any(|p| &p.name == *name))
+        {
+            return Err(PipelineError::DeformUnknownPart(part.clone()));
+        }
         let mut out = self.rest_positions();
         for (part, positions) in self.doc.parts.iter().zip(out.iter_mut()) {
             let Some(weights) = &part.weights else {
@@ -756,7 +791,21 @@ impl Scene {
                 .iter()
                 .map(|&j| stretches.get(j).copied().flatten())
                 .collect();
-            let rest = positions.clone();
+            let mut rest = positions.clone();
+            if let Some(offsets) = pose.deform.get(&part.name) {
+                if offsets.len() != rest.len() {
+                    return Err(PipelineError::DeformSize {
+                        part: part.name.clone(),
+                        got: offsets.len(),
+                        expected: rest.len(),
+                    });
+                }
+                // Deform offsets move the rest mesh before skinning (crate::anim::deform).
+                for (p, o) in rest.iter_mut().zip(offsets) {
+                    *p += Vec2::new(o[0], o[1]);
+                }
+                *positions = rest.clone();
+            }
             let skin_weights = SkinWeights::from_rows(&weights.rows);
             match blend {
                 Blend::Stretch => stretchable_blend(

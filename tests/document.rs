@@ -156,7 +156,7 @@ fn a_rig_built_for_older_inputs_is_refused() {
     assert!(matches!(
         doc.apply(Command::SetRig(
             std::sync::Arc::new(scene),
-            stale_inputs.key()
+            Box::new(stale_inputs.key())
         )),
         Err(DocumentError::OutdatedRig)
     ));

@@ -82,6 +82,8 @@ fn bundled_animations_match_golden_at_fixed_times() {
         // 0.4 s and 1.1 s: the open hand (attachment keys); 0.6 s: the slot's own closed hand.
         ("wave", &[0.4, 0.6, 1.1]),
         ("lift", &[0.5, 1.0]),
+        // The belly squash (deform keys) on landing, and the tail's physics mid-hop.
+        ("hop", &[0.4, 0.67]),
     ] {
         let animation = &animations[name];
         for &t in times_s {

@@ -911,3 +911,74 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Physics over time: the demo's tail (a Spine 4.2 physics constraint on `tail_4`) while it
+/// hops (bones and a belly squash by deform keys), at 60 Hz for 2 s — past the animation's end,
+/// where only the tail still moves — in spine-core updated as a game updates it, against
+/// `sinew pose --match-runtime spine` (in-process, the same function) within 0.01 px. The
+/// physics must matter (the tail away from its pose without physics) and so must the deform.
+#[test]
+fn physics_and_deform_keys_play_in_spine_core_as_sinew_simulates_them() {
+    const PHYSICS_HZ: f64 = 60.0;
+    const PHYSICS_SECONDS: f64 = 2.0;
+    let dir = scratch("physics");
+    sinew(&["demo", "-o", s(&dir)]);
+    let rig = dir.join("character.json");
+    let out = dir.join("export");
+    sinew(&["export", "spine", s(&rig), "-o", s(&out), "--name", "rig"]);
+    let scene = Scene::load(&rig).unwrap();
+    let doc = scene.doc.clone();
+    assert!(!doc.handles.physics.is_empty() && !doc.animations["hop"].deform.is_empty());
+    let images: Vec<_> = doc
+        .parts
+        .iter()
+        .map(|p| io::load_png(&RigDocument::image_path(&rig, p)).unwrap())
+        .collect();
+    let options = SpineOptions::default();
+    let export = export_spine(&scene, &images, "rig", &options).unwrap();
+    let n = (PHYSICS_SECONDS * PHYSICS_HZ) as usize;
+    let times: Vec<f64> = (0..=n).map(|k| k as f64 / PHYSICS_HZ).collect();
+    let oracle = run_oracle(&out, "rig", &BTreeMap::from([("hop".to_string(), times)]));
+    assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
+    let animation = &doc.animations["hop"];
+    let played = as_played(&scene, "hop", animation, &options).unwrap();
+    let no_physics = scene.without_physics();
+    let tail = doc.parts.iter().position(|p| p.name == "tail").unwrap();
+    let torso = doc.parts.iter().position(|p| p.name == "torso").unwrap();
+    let (mut worst, mut physics_px, mut deform_px) = (0.0_f64, 0.0_f64, 0.0_f64);
+    for frame in &oracle.animations["hop"].frames {
+        let t = frame.time;
+        let f = played.frame(t, false).unwrap();
+        let sinew = scene
+            .positions_from_transforms(&f.transforms, &f.pose, Blend::Linear)
+            .unwrap();
+        let d = deviation(&export, &doc, &frame.slots, &sinew);
+        assert!(d <= ANIMATION_TOLERANCE_PX, "hop at {t} s: {d} px");
+        worst = worst.max(d);
+        let still = no_physics.pose_positions(&f.pose).unwrap();
+        for (a, b) in sinew[tail].iter().zip(&still[tail]) {
+            physics_px = physics_px.max((a - b).norm());
+        }
+        let mut undeformed = f.pose.clone();
+        undeformed.deform.clear();
+        let flat = scene
+            .positions_from_transforms(&f.transforms, &undeformed, Blend::Linear)
+            .unwrap();
+        for (a, b) in sinew[torso].iter().zip(&flat[torso]) {
+            deform_px = deform_px.max((a - b).norm());
+        }
+    }
+    println!(
+        "hop, {n} updates at {PHYSICS_HZ} Hz: runtime vs sinew max {worst:.2e} px; physics moves \
+         the tail up to {physics_px:.1} px, the squash the torso up to {deform_px:.1} px"
+    );
+    assert!(
+        physics_px > 5.0,
+        "physics moved the tail only {physics_px} px"
+    );
+    assert!(
+        deform_px > 5.0,
+        "the squash moved the torso only {deform_px} px"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -6,9 +6,9 @@
 //! The mix weight alpha = elapsed / duration, clamped to [0, 1], runs linearly as in Spine. A
 //! field one side leaves at rest blends with its rest value. Bone and point rotations blend along
 //! the shortest arc (Spine's rule: the difference is wrapped into (−180°, 180°]); translations,
-//! scales, shears, colors, cage vertices and IK targets blend linearly. Values that cannot blend —
-//! visibility, draw order, IK drags or cages present on one side only, cages whose vertex counts
-//! differ — switch from the old animation's to the new one's when alpha reaches
+//! scales, shears, colors, cage vertices, deform offsets (none on one side: zero) and IK targets
+//! blend linearly. Values that cannot blend — visibility, draw order, IK drags or cages present
+//! on one side only, cages whose vertex counts differ — switch from the old animation's to the new one's when alpha reaches
 //! [`STEPPED_MIX_THRESHOLD`]. (Spine's default thresholds are 0: the new animation's attachments
 //! and draw order apply at once. Half way keeps a short mix from popping at its very start.) At
 //! alpha 0 the result is exactly the old pose and at alpha 1 exactly the new one.
@@ -121,6 +121,23 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
         if let Some(polygon) = polygon {
             out.cages.insert(name.clone(), CagePose { polygon });
         }
+    }
+
+    // Deform offsets fade from and to none (zero offsets) on the side without them.
+    let deform_names: BTreeSet<&String> = from.deform.keys().chain(to.deform.keys()).collect();
+    for name in deform_names {
+        let (a, b) = (from.deform.get(name), to.deform.get(name));
+        let n = a.or(b).map_or(0, Vec::len);
+        let none = vec![[0.0, 0.0]; n];
+        let (a, b) = (a.unwrap_or(&none), b.unwrap_or(&none));
+        let offsets = if a.len() == b.len() {
+            a.iter().zip(b).map(|(&p, &q)| lerp2(p, q, alpha)).collect()
+        } else if stepped_to_new {
+            b.clone()
+        } else {
+            a.clone()
+        };
+        out.deform.insert(name.clone(), offsets);
     }
 
     let part_names: BTreeSet<&String> = from.parts.keys().chain(to.parts.keys()).collect();

@@ -17,6 +17,7 @@
 pub mod attachment;
 pub mod check;
 pub mod curve;
+pub mod deform;
 pub mod edit;
 pub mod event;
 pub mod mix;
@@ -63,6 +64,17 @@ pub enum AnimError {
     CageSize {
         animation: String,
         cage: String,
+        key: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error(
+        "animation '{animation}', deform.{part}: key {key} has {got} offsets but the part's mesh \
+         has {expected} vertices"
+    )]
+    DeformSize {
+        animation: String,
+        part: String,
         key: usize,
         got: usize,
         expected: usize,
@@ -342,7 +354,7 @@ mod tests {
         );
         assert_eq!(
             animations.keys().collect::<Vec<_>>(),
-            ["lift", "walk", "wave"].iter().collect::<Vec<_>>()
+            ["hop", "lift", "walk", "wave"].iter().collect::<Vec<_>>()
         );
         for (name, anim) in &animations {
             anim.check_rig(name, &handles, &parts, &events).unwrap();

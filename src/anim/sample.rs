@@ -256,6 +256,11 @@ impl Animation {
                 pose.cages.insert(name.clone(), CagePose { polygon });
             }
         }
+        for (name, keys) in &self.deform {
+            if let Some(offsets) = sample_keys_with(keys, t, curves) {
+                pose.deform.insert(name.clone(), offsets);
+            }
+        }
         for (name, timelines) in &self.parts {
             let mut part = PartPose::default();
             let mut keyed = false;

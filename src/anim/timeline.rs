@@ -208,6 +208,10 @@ pub struct Animation {
     /// several keys may share a time.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<super::event::EventKey>,
+    /// Deform keys ([`super::deform`]): part name → per-vertex offsets of its mesh (canvas px,
+    /// rest frame), added before skinning; the same count on every key as the part's vertices.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub deform: BTreeMap<String, super::deform::DeformKeys>,
 }
 
 /// What is wrong with one timeline (the enclosing [`AnimError`] names it).
@@ -452,6 +456,9 @@ impl Animation {
         for (cage, keys) in &self.cages {
             check_cage_keys(keys).map_err(fail(format!("cages.{cage}")))?;
         }
+        for (part, keys) in &self.deform {
+            check_cage_keys(keys).map_err(fail(format!("deform.{part}")))?;
+        }
         for (part, t) in &self.parts {
             if let Some(keys) = &t.color {
                 check_color_keys(keys).map_err(fail(format!("parts.{part}.color")))?;
@@ -505,7 +512,7 @@ impl Animation {
                 see(keys.as_deref().map_or(0.0, |k| last(k, key2)));
             }
         }
-        for keys in self.cages.values() {
+        for keys in self.cages.values().chain(self.deform.values()) {
             see(last(keys, |k| k.time));
         }
         for t in self.parts.values() {
@@ -605,13 +612,13 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                     }
                 }
             }
-            "cages" => {
+            "cages" | "deform" => {
                 let Some(cages) = content.as_object() else {
                     return Some(fail(section.clone(), NOT_A_MAP.into()));
                 };
                 for (cage, keys) in cages {
                     if let Err((at, reason)) = probe_keys::<Key<Vec<[f64; 2]>>>(keys) {
-                        return Some(fail(format!("cages.{cage}{at}"), reason));
+                        return Some(fail(format!("{section}.{cage}{at}"), reason));
                     }
                 }
             }
@@ -643,7 +650,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
             other => {
                 return Some(malformed(format!(
                     "unknown section '{other}' (expected bones, points, cages, parts, \
-                     draw_order, ik or events)"
+                     draw_order, ik, events or deform)"
                 )))
             }
         }

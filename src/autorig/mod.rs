@@ -230,6 +230,7 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
         regions: Vec::new(),
         bind,
         ik: Vec::new(),
+        physics: Vec::new(),
     };
     handles.validate()?;
     Ok(Proposal { handles, notes })

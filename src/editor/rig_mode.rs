@@ -128,7 +128,7 @@ impl EditorApp {
             self.rig_mode.worker = None;
             match result {
                 Ok(scene) => {
-                    if self.apply(Command::SetRig(Arc::new(scene), key)) {
+                    if self.apply(Command::SetRig(Arc::new(scene), Box::new(key))) {
                         self.message = Some("weights computed".into());
                     }
                 }

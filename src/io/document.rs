@@ -273,7 +273,13 @@ impl RigDocument {
         crate::anim::check_animations(&self.animations, &self.handles, &slots, &self.events)?;
         self.animations
             .iter()
-            .try_for_each(|(name, animation)| animation.check_attachments(name, self))
+            .try_for_each(|(name, animation)| animation.check_attachments(name, self))?;
+        let sizes: Vec<(&str, usize)> = self
+            .parts
+            .iter()
+            .map(|p| (p.name.as_str(), p.mesh.vertices.len()))
+            .collect();
+        crate::anim::deform::check_deform_sizes(&self.animations, &sizes)
     }
 
     /// The image of `part`, resolved against the folder of the document at `doc_path`.
@@ -453,7 +459,7 @@ mod tests {
         let bundled: serde_json::Value = serde_json::from_str(&text).unwrap();
         // The animations file on its own.
         let parsed = crate::anim::animations_from_json(&bundled).unwrap();
-        assert_eq!(parsed.len(), 3);
+        assert_eq!(parsed.len(), 4);
         assert!(same_json(&serde_json::to_value(&parsed).unwrap(), &bundled));
         // In a rig document: load, save, load.
         let mut v = serde_json::to_value(sample()).unwrap();

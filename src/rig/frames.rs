@@ -183,6 +183,10 @@ pub struct Pose {
     /// Part names back to front; `None` keeps the rig's order.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub draw_order: Option<Vec<String>>,
+    /// Deform offsets by part: one per vertex of the part's mesh (canvas px, rest frame), added
+    /// to the rest vertices before skinning ([`crate::anim::deform`]).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub deform: BTreeMap<String, Vec<[f64; 2]>>,
 }
 
 /// What is wrong with a pose for a given set of handles.
@@ -274,6 +278,10 @@ impl Pose {
         }
         for (name, c) in &self.cages {
             let numbers: Vec<f64> = c.polygon.iter().flatten().copied().collect();
+            bad(name, &numbers)?;
+        }
+        for (name, offsets) in &self.deform {
+            let numbers: Vec<f64> = offsets.iter().flatten().copied().collect();
             bad(name, &numbers)?;
         }
         for drag in &self.ik {

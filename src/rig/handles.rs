@@ -66,6 +66,10 @@ pub struct Handles {
     /// kinematics.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub ik: Vec<BoneIk>,
+    /// Bone physics constraints (see [`super::physics`]), applied in order after the IK
+    /// constraints while animations play; static poses leave them out.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub physics: Vec<super::physics::PhysicsConstraint>,
 }
 
 /// An IK constraint of the handles file (solved by [`super::bone_ik`]).
@@ -128,6 +132,8 @@ pub enum HandleError {
     EmptyBind(String),
     #[error("ik constraint '{name}': {problem}")]
     BadIkConstraint { name: String, problem: String },
+    #[error("physics constraint '{name}': {problem}")]
+    BadPhysicsConstraint { name: String, problem: String },
     #[error("handle '{name}' has a coordinate beyond ±{MAX_COORDINATE_PX} px: {value:e}")]
     TooFar { name: String, value: f64 },
     #[error("{kind} '{name}': {problem}")]
@@ -261,6 +267,7 @@ impl Handles {
             constraint.bones.iter_mut().for_each(fix);
             fix(&mut constraint.target);
         }
+        self.physics.iter_mut().for_each(|c| fix(&mut c.bone));
     }
 
     /// Removes handle `name`. A removed bone's children move up to its parent, and the bone IK
@@ -280,6 +287,7 @@ impl Handles {
         self.bind.remove(name);
         self.ik
             .retain(|c| c.target != name && !c.bones.iter().any(|b| b == name));
+        self.physics.retain(|c| c.bone != name);
     }
 
     /// Every handle's name, in the order weights columns use: bones, points, cages, regions.
@@ -303,6 +311,7 @@ impl Handles {
     pub fn for_part(&self, part: &str) -> Handles {
         Handles {
             ik: Vec::new(),
+            physics: Vec::new(),
             bones: self
                 .bones
                 .iter()
@@ -413,7 +422,31 @@ impl Handles {
             return Err(HandleError::TooManyColumns { columns });
         }
         self.check_parents()?;
-        self.check_ik()
+        self.check_ik()?;
+        self.check_physics()
+    }
+
+    /// Every physics constraint names a known bone, has a name no IK or physics constraint
+    /// shares, and parameters as [`super::physics::PhysicsConstraint::check`] wants.
+    fn check_physics(&self) -> Result<(), HandleError> {
+        let mut names: HashSet<&str> = self.ik.iter().map(|c| c.name.as_str()).collect();
+        for c in &self.physics {
+            let bad = |problem: String| HandleError::BadPhysicsConstraint {
+                name: c.name.clone(),
+                problem,
+            };
+            if c.name.is_empty() {
+                return Err(bad("its name is empty".into()));
+            }
+            if !names.insert(c.name.as_str()) {
+                return Err(bad("another constraint has this name".into()));
+            }
+            if !self.bones.iter().any(|b| b.name == c.bone) {
+                return Err(bad(format!("bone '{}' does not exist", c.bone)));
+            }
+            c.check().map_err(bad)?;
+        }
+        Ok(())
     }
 
     /// Every IK chain is a parent-linked run of known bones whose target is a known bone that the

@@ -8,7 +8,9 @@ pub mod bone_ik;
 pub mod fk_edit;
 pub mod frames;
 pub mod handles;
+pub mod physics;
 pub mod pose;
 
 pub use handles::{Bone, Cage, HandleError, Handles, PointHandle, Region};
+pub use physics::PhysicsConstraint;
 pub use pose::{handle_columns, handle_transforms, Affine, Pose, PoseError};

@@ -16,6 +16,7 @@
 //!   from the animation's start, independent of the output frame rate.
 //! - Posed parts → a frame: [`draw_pose`] (the pose's draw order, tint and visibility).
 
+pub mod physics;
 pub mod play;
 
 pub use crate::pipeline::Scene;

@@ -58,6 +58,7 @@ pub struct Playhead<'a> {
     /// factorization only ([`RigIk::solve_pose`]).
     ik: Option<RigIk>,
     simulation: Option<Simulation>,
+    physics: Option<super::physics::PhysicsRun>,
 }
 
 /// The momentum simulation at `steps · step_s`.
@@ -75,6 +76,7 @@ impl<'a> Playhead<'a> {
             options,
             ik: None,
             simulation: None,
+            physics: None,
         }
     }
 
@@ -89,10 +91,33 @@ impl<'a> Playhead<'a> {
             .sample_with(time_s, self.options.looping, &self.options.sampling)
     }
 
+    /// Whether the rig has physics constraints (frames depend on the motion before them).
+    pub fn has_physics(&self) -> bool {
+        !self.scene.doc.handles.physics.is_empty()
+    }
+
     /// The frame at `time_s`.
     pub fn frame(&mut self, time_s: f64) -> Result<Frame, PipelineError> {
         let pose = self.pose_at(time_s);
-        let transforms = if self.has_momentum() {
+        let transforms = if self.has_physics() {
+            if self.has_momentum() {
+                return Err(PipelineError::PhysicsWithMomentum);
+            }
+            let (scene, animation, options) = (self.scene, self.animation, self.options);
+            let mut ik = self.ik.take();
+            let mut posed = |t: f64| {
+                let pose = animation.sample_with(t, options.looping, &options.sampling);
+                scene.handle_transforms_with(&mut ik, &pose)
+            };
+            let out = super::physics::transforms_at(
+                &mut self.physics,
+                &scene.doc.handles,
+                time_s,
+                &mut posed,
+            );
+            self.ik = ik;
+            out?
+        } else if self.has_momentum() {
             self.simulate(time_s, &pose)?
         } else {
             self.scene.handle_transforms_with(&mut self.ik, &pose)?
@@ -153,7 +178,7 @@ impl Playhead<'_> {
     /// of times simulates once forward). Either way each frame is what [`Playhead::frame`]
     /// gives for its time alone.
     pub fn frames(&mut self, times_s: &[f64]) -> Result<Vec<Frame>, PipelineError> {
-        if self.has_momentum() {
+        if self.has_momentum() || self.has_physics() {
             let mut order: Vec<usize> = (0..times_s.len()).collect();
             order.sort_by(|&a, &b| times_s[a].total_cmp(&times_s[b]));
             let mut out: Vec<Option<Frame>> = vec![None; times_s.len()];

@@ -175,6 +175,7 @@ mod tests {
     #[test]
     fn bones_points_cages_and_regions_fix_their_vertices() {
         let handles = Handles {
+            physics: Vec::new(),
             bones: vec![
                 Bone {
                     name: "a".into(),

@@ -47,6 +47,9 @@ pub fn compute(doc: &mut Document) {
         &mut |_, _| {},
     )
     .unwrap();
-    doc.apply(Command::SetRig(std::sync::Arc::new(scene), inputs.key()))
-        .unwrap();
+    doc.apply(Command::SetRig(
+        std::sync::Arc::new(scene),
+        Box::new(inputs.key()),
+    ))
+    .unwrap();
 }

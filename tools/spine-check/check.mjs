@@ -39,23 +39,28 @@ try {
   console.error(`spine-core refused ${skeletonPath}: ${e.message}`);
   process.exit(2);
 }
-const skeleton = new spine.Skeleton(data);
 // Skins combined in order (a later one overrides an earlier one on a slot), as a game does.
-if ((request.skins || []).length > 0) {
-  const combined = new spine.Skin("combined");
-  for (const name of request.skins) {
-    const skin = data.findSkin(name);
-    if (!skin) {
-      console.error(`no skin '${name}' in ${skeletonPath}`);
-      process.exit(2);
+function makeSkeleton() {
+  const made = new spine.Skeleton(data);
+  if ((request.skins || []).length > 0) {
+    const combined = new spine.Skin("combined");
+    for (const name of request.skins) {
+      const skin = data.findSkin(name);
+      if (!skin) {
+        console.error(`no skin '${name}' in ${skeletonPath}`);
+        process.exit(2);
+      }
+      combined.addSkin(skin);
     }
-    combined.addSkin(skin);
+    made.setSkin(combined);
   }
-  skeleton.setSkin(combined);
+  return made;
 }
+let skeleton = makeSkeleton();
 
-function snapshot() {
-  skeleton.updateWorldTransform(spine.Physics.none);
+// `physics` false: the world transforms as the last update left them (physics applied).
+function snapshot(update = true) {
+  if (update) skeleton.updateWorldTransform(spine.Physics.none);
   const order = v43 ? skeleton.drawOrder.appliedPose : skeleton.drawOrder;
   return order.map((slot) => {
     const a = v43 ? slot.appliedPose.getAttachment() : slot.getAttachment();
@@ -72,6 +77,29 @@ function snapshot() {
 }
 
 const setupPose = () => (v43 ? skeleton.setupPose() : skeleton.setToSetupPose());
+// Physics constraints (4.2): history matters, so a time is played as a game plays it: a fresh
+// skeleton updated at UPDATE_HZ from time 0 (skeleton.update(1 / UPDATE_HZ) between updates,
+// Physics.update at each, the animation applied at k / UPDATE_HZ), then, for a time between
+// updates, the animation at that time posed with Physics.pose (sinew's scene::physics).
+const UPDATE_HZ = 60;
+const hasPhysics = !v43 && (data.physicsConstraints || []).length > 0;
+function simulated(applyAt, time) {
+  skeleton = makeSkeleton();
+  const step = 1 / UPDATE_HZ;
+  const whole = Math.max(Math.floor(time / step + 1e-9), 0);
+  for (let k = 0; k <= whole; k++) {
+    applyAt(k * step);
+    if (k > 0) skeleton.update(step);
+    skeleton.updateWorldTransform(spine.Physics.update);
+  }
+  if (!(time - whole * step <= 1e-9 * step)) {
+    applyAt(time);
+    skeleton.updateWorldTransform(spine.Physics.pose);
+  }
+  const out = snapshot(false);
+  skeleton = makeSkeleton();
+  return out;
+}
 setupPose();
 const result = { setup: snapshot(), animations: {}, warnings };
 for (const [name, times] of Object.entries(request.times || {})) {
@@ -80,10 +108,14 @@ for (const [name, times] of Object.entries(request.times || {})) {
     console.error(`no animation '${name}' in ${skeletonPath}`);
     process.exit(2);
   }
-  const frames = times.map((time) => {
+  const applyAt = (time) => {
     setupPose();
     if (v43) animation.apply(skeleton, time, time, false, [], 1, spine.MixFrom.setup, false, false, false);
     else animation.apply(skeleton, time, time, false, [], 1, spine.MixBlend.setup, spine.MixDirection.mixIn);
+  };
+  const frames = times.map((time) => {
+    if (hasPhysics) return { time, slots: simulated(applyAt, time) };
+    applyAt(time);
     return { time, slots: snapshot() };
   });
   result.animations[name] = { duration: animation.duration, frames };
@@ -138,6 +170,15 @@ function lint(json, atlas) {
     if (!(k.bones.length === 1 || k.bones.length === 2)) out.push(`ik ${k.name}: ${k.bones.length} bones (the runtime solves 1 or 2)`);
     if (!v43 && k.order !== i) out.push(`ik ${k.name}: order ${k.order} at position ${i}`);
     for (const b of [...k.bones, k.target]) if (!boneIndex.has(b)) out.push(`ik ${k.name}: unknown bone ${b}`);
+  });
+  (v43 ? [] : json.physics || []).forEach((p, i) => {
+    only(`physics ${p.name}`, p, ["name", "order", "skin", "bone", "x", "y", "rotate", "scaleX", "shearX", "limit", "fps", "inertia",
+      "strength", "damping", "mass", "wind", "gravity", "mix", "inertiaGlobal", "strengthGlobal", "dampingGlobal", "massGlobal",
+      "windGlobal", "gravityGlobal", "mixGlobal"]);
+    if (constraints.has(p.name)) out.push(`physics ${p.name}: name taken`);
+    constraints.add(p.name);
+    if (!boneIndex.has(p.bone)) out.push(`physics ${p.name}: unknown bone ${p.bone}`);
+    if (p.order !== iks.length + i) out.push(`physics ${p.name}: order ${p.order}, expected ${iks.length + i}`);
   });
   const events = new Set(Object.keys(json.events || {}));
   for (const [name, e] of Object.entries(json.events || {})) {
@@ -225,6 +266,24 @@ function lint(json, atlas) {
     for (const [constraint, keys] of Object.entries(a.ik || {})) {
       if (!constraints.has(constraint)) out.push(`animation ${name}: unknown IK constraint ${constraint}`);
       keysOk(`animation ${name}, ik ${constraint}`, keys, ["mix", "softness", "bendPositive", "compress", "stretch"], 2);
+    }
+    for (const [skin, slotsMap] of Object.entries(a.attachments || {})) {
+      for (const [slot, entries] of Object.entries(slotsMap)) {
+        for (const [key, timelines] of Object.entries(entries)) {
+          const where = `animation ${name}, attachments ${skin}/${slot}/${key}`;
+          const att = attachmentsOf.get(`${slot}/${key}`);
+          if (!att) { out.push(`${where}: no such attachment`); continue; }
+          let influences = 0;
+          for (let i = 0; i < att.vertices.length; i += 1 + 4 * att.vertices[i]) influences += att.vertices[i];
+          for (const [kind, keys] of Object.entries(timelines)) {
+            if (kind !== "deform") { out.push(`${where}, ${kind}: timeline sinew does not write`); continue; }
+            keysOk(`${where}, deform`, keys, ["vertices", "offset"], 1);
+            keys.forEach((k, i) => {
+              if ((k.offset || 0) + (k.vertices || []).length > 2 * influences) out.push(`${where}, deform key ${i}: ${k.vertices.length} numbers for ${influences} influences`);
+            });
+          }
+        }
+      }
     }
     let lastEvent = -Infinity;
     for (const [i, k] of (a.events || []).entries()) {

@@ -65,7 +65,17 @@ pub fn sample_path(
     scene: &Scene,
     animation: &Animation,
     times: &[f64],
+    native_physics: bool,
 ) -> Result<Vec<(Pose, Vec<Affine>)>, PipelineError> {
+    // Where the runtime simulates physics constraints itself (4.2), the bake leaves them out;
+    // elsewhere their motion is baked like any other.
+    let unphysical;
+    let scene = if !native_physics || scene.doc.handles.physics.is_empty() {
+        scene
+    } else {
+        unphysical = scene.without_physics();
+        &unphysical
+    };
     let frames = crate::scene::frames(scene, animation, times, PlayOptions::default())?;
     Ok(frames
         .into_iter()

@@ -15,6 +15,8 @@
 //! - [`timelines`]: sinew timelines as native Spine timelines with their curves;
 //! - [`constraints`]: one- and two-bone IK constraints as Spine IK constraints;
 //! - [`events`]: event definitions and event keys as Spine events;
+//! - [`deform`]: deform keys as deform timelines (offsets in each influence's bone frame);
+//! - [`physics`]: physics constraints as Spine 4.2 physics constraints;
 //! - [`bake`]: what Spine cannot express, sampled at `bake_fps` through the one pose path.
 //!
 //! Spine facts relied on are in `docs/spine-format.md` (the "spine-format.md §N" cited in these
@@ -25,9 +27,11 @@ pub mod atlas;
 pub mod bake;
 pub mod constraints;
 pub mod decimate;
+pub mod deform;
 pub mod events;
 pub mod frame;
 pub mod mesh;
+pub mod physics;
 pub mod played;
 pub mod skeleton;
 pub mod skins;
@@ -276,7 +280,9 @@ pub fn plan_bake(
     // Where a handle's transformation is compared when deciding what to bake.
     let corners = crate::playback::rest_corners(doc);
     let times = bake::bake_times(animation.duration_s(), options.bake_fps);
-    let samples = bake::sample_path(scene, animation, &times).map_err(SpineError::Pose)?;
+    let native_physics = physics::native(options.version);
+    let samples =
+        bake::sample_path(scene, animation, &times, native_physics).map_err(SpineError::Pose)?;
     let mut baked = bake::bones_to_bake(
         options.bake,
         &spine_handles,
@@ -354,6 +360,10 @@ pub fn export_spine(
         check_name("event", event, false)?;
     }
     let exported_ik = constraints::exported(&doc.handles);
+    for c in &doc.handles.physics {
+        check_name("physics constraint", &c.name, false)?;
+    }
+    let physics = physics::physics_entries(&doc.handles, exported_ik.len(), options.version);
     let frame = SpineFrame::for_canvas(doc.canvas);
     let skeleton = build_skeleton(&doc.handles, &frame, &options.root_bone)?;
     let columns = handle_columns(&doc.handles);
@@ -483,6 +493,20 @@ pub fn export_spine(
         if let Some(d) = draw_order {
             a.insert("drawOrder".into(), d);
         }
+        if !animation.deform.is_empty() {
+            let mut slots = Map::new();
+            for (part, keys) in &animation.deform {
+                let Some(exported) = parts.iter().find(|p| &p.name == part) else {
+                    continue;
+                };
+                let timeline = deform::deform_timeline(keys, &exported.mesh, &skeleton, &frame)?;
+                slots.insert(
+                    part.clone(),
+                    json!({ part.clone(): { "deform": timeline } }),
+                );
+            }
+            a.insert("attachments".into(), json!({ "default": slots }));
+        }
         if !animation.events.is_empty() {
             a.insert(
                 "events".into(),
@@ -508,6 +532,7 @@ pub fn export_spine(
         &parts,
         &atlas,
         &exported_ik,
+        physics,
         animations_json,
     );
     let mut pages = Vec::with_capacity(atlas.pages.len());
@@ -548,6 +573,7 @@ fn skeleton_json(
     parts: &[ExportedPart],
     atlas: &atlas::Atlas,
     exported_ik: &[usize],
+    physics: Vec<Value>,
     animations: Map<String, Value>,
 ) -> String {
     // Bounds of the setup pose: the rest meshes in Spine's world.
@@ -625,7 +651,7 @@ fn skeleton_json(
             "height": num(hi[1] - lo[1]),
             "images": "./",
             "fps": num(options.bake_fps),
-            "hash": content_hash(name, &bones, &ik, &skins, &animations),
+            "hash": content_hash(name, &bones, &ik, &physics, &skins, &animations),
         },
         "bones": bones,
         "slots": slots,
@@ -634,6 +660,9 @@ fn skeleton_json(
     });
     if !ik.is_empty() {
         out[constraints::block_key(options.version)] = Value::from(ik);
+    }
+    if !physics.is_empty() {
+        out["physics"] = Value::from(physics);
     }
     if !doc.events.is_empty() {
         out["events"] = events::event_defs_json(&doc.events);
@@ -648,10 +677,11 @@ fn content_hash(
     name: &str,
     bones: &[Value],
     ik: &[Value],
+    physics: &[Value],
     skins: &[Value],
     animations: &Map<String, Value>,
 ) -> String {
-    let text = format!(
+    let mut text = format!(
         "{name}{}{}{}{}",
         Value::from(bones.to_vec()),
         Value::from(ik.to_vec()),
@@ -662,6 +692,10 @@ fn content_hash(
         },
         Value::Object(animations.clone())
     );
+    // Left out when empty: the hashes of rigs without physics stay as they were.
+    if !physics.is_empty() {
+        text += &Value::from(physics.to_vec()).to_string();
+    }
     let mut h: u64 = 0xcbf29ce484222325;
     for b in text.bytes() {
         h ^= u64::from(b);

@@ -45,7 +45,16 @@ impl AsPlayed {
             curves: CurveEvaluation::SpineRuntime,
         };
         let pose = self.animation.sample_with(time_s, looping, &sampling);
-        let transforms = handle_transforms(&self.handles, &pose)?;
+        let transforms = if self.handles.physics.is_empty() {
+            handle_transforms(&self.handles, &pose)?
+        } else {
+            // Physics: the runtime updated at a fixed rate from the start (scene::physics).
+            let mut posed = |t: f64| {
+                let pose = self.animation.sample_with(t, looping, &sampling);
+                Ok(handle_transforms(&self.handles, &pose)?)
+            };
+            crate::scene::physics::transforms_at(&mut None, &self.handles, time_s, &mut posed)?
+        };
         Ok(Frame {
             time_s,
             pose,
@@ -113,8 +122,13 @@ pub fn as_played(
         .into_iter()
         .filter(|c| !switched_off.contains(c))
         .collect();
+    let mut handles = constraints::with_constraints(&doc.handles, &solved);
+    if !super::physics::native(options.version) {
+        // Not simulated by that runtime: baked into keys instead.
+        handles.physics.clear();
+    }
     Ok(AsPlayed {
         animation: played,
-        handles: constraints::with_constraints(&doc.handles, &solved),
+        handles,
     })
 }

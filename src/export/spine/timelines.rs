@@ -35,7 +35,7 @@ pub fn num(x: f64) -> Value {
 }
 
 /// One key's object with its time and curve; `fields` come from the value.
-fn key_object(time: f64, fields: Vec<(&str, Value)>, curve: Option<Value>) -> Value {
+pub(super) fn key_object(time: f64, fields: Vec<(&str, Value)>, curve: Option<Value>) -> Value {
     let mut m = Map::new();
     m.insert("time".into(), num(time));
     for (k, v) in fields {
@@ -48,7 +48,7 @@ fn key_object(time: f64, fields: Vec<(&str, Value)>, curve: Option<Value>) -> Va
 }
 
 /// Keys of a timeline with a key at 0 s added when the first comes later (holding its value).
-fn with_start<V: Clone>(keys: &[Key<V>]) -> Vec<Key<V>> {
+pub(super) fn with_start<V: Clone>(keys: &[Key<V>]) -> Vec<Key<V>> {
     let mut out = Vec::with_capacity(keys.len() + 1);
     if let Some(first) = keys.first() {
         if first.time > 0.0 {
@@ -79,7 +79,7 @@ fn steps_with_start<V: Clone>(keys: &[StepKey<V>]) -> Vec<StepKey<V>> {
 
 /// A curve as Spine writes it, channel by channel: `None` for linear. `channel_map(c, cy)` maps
 /// a `cy` of channel `c` into the written units.
-fn curve_json(curve: &Curve, channel_map: &dyn Fn(usize, f64) -> f64) -> Option<Value> {
+pub(super) fn curve_json(curve: &Curve, channel_map: &dyn Fn(usize, f64) -> f64) -> Option<Value> {
     match curve {
         Curve::Linear => None,
         Curve::Stepped => Some(json!("stepped")),

@@ -1,0 +1,194 @@
+//! Physics constraints over time: the skeleton updated at a fixed rate from the animation's
+//! start.
+//!
+//! In: the rig's [`Handles`] (its `physics` constraints) and a way to pose the animation at a
+//! time (one transform per handle column, from the one path: forward kinematics, bone IK,
+//! skinning IK). Out: the transforms at a time with the physics constraints applied: each
+//! constrained bone's world frame moved by [`PhysicsState::update`] and its descendant bones
+//! carried along (as Spine's children inherit their parent's world transform), constraints in
+//! list order (list a constrained ancestor first).
+//!
+//! The skeleton is updated at [`UPDATE_HZ`] from time 0 (its clock advancing by 1/[`UPDATE_HZ`]
+//! s per update, summed as spine-core's `Skeleton.update` sums it) with the pose at that grid
+//! time ([`PhysicsMode::Update`]; each constraint steps at its own fixed step inside); a time
+//! between grid times shows the pose at that time with the simulation as it stood at the last
+//! grid time ([`PhysicsMode::Pose`]). So the frame at t is a function of (rig, animation, t),
+//! never of the output frame rate. Static poses (pose files, the editor's pose mode) show no
+//! physics, as spine-core's `Physics.none`.
+
+use crate::pipeline::PipelineError;
+use crate::rig::physics::{PhysicsMode, PhysicsState, SpineWorld};
+use crate::rig::pose::bone_rest_frame;
+use crate::rig::{Affine, Handles};
+
+pub use crate::rig::physics::UPDATE_HZ;
+
+/// The skeleton update step, s.
+pub fn update_step_s() -> f64 {
+    1.0 / UPDATE_HZ
+}
+
+/// A constrained bone: its index, rest frame and length, and its descendants' indices.
+#[derive(Clone, Debug)]
+struct Constrained {
+    bone: usize,
+    rest: Affine,
+    length_px: f64,
+    carried: Vec<usize>,
+}
+
+/// The physics simulation of a rig after some whole updates.
+#[derive(Clone, Debug)]
+pub struct PhysicsRun {
+    states: Vec<PhysicsState>,
+    bones: Vec<Constrained>,
+    /// Updates done so far (the first is at time 0).
+    pub updates: u64,
+    /// The skeleton's clock, s, summed as spine-core sums it.
+    clock_s: f64,
+    /// The transforms of the last update.
+    last: Vec<Affine>,
+}
+
+impl PhysicsRun {
+    /// A fresh simulation of `handles`' physics constraints (validated handles: every
+    /// constrained bone exists).
+    pub fn new(handles: &Handles) -> Self {
+        let bones = handles
+            .physics
+            .iter()
+            .filter_map(|c| {
+                let bone = handles.bones.iter().position(|b| b.name == c.bone)?;
+                let b = &handles.bones[bone];
+                let length_px = (b.tail[0] - b.head[0]).hypot(b.tail[1] - b.head[1]);
+                let mut carried = vec![bone];
+                // Parents are acyclic: grow the set until no bone joins.
+                loop {
+                    let before = carried.len();
+                    for (j, other) in handles.bones.iter().enumerate() {
+                        let parent = other
+                            .parent
+                            .as_deref()
+                            .and_then(|p| handles.bones.iter().position(|b| b.name == p));
+                        if parent.is_some_and(|p| carried.contains(&p)) && !carried.contains(&j) {
+                            carried.push(j);
+                        }
+                    }
+                    if carried.len() == before {
+                        break;
+                    }
+                }
+                Some(Constrained {
+                    bone,
+                    rest: bone_rest_frame(b.head, b.tail),
+                    length_px,
+                    carried,
+                })
+            })
+            .collect();
+        PhysicsRun {
+            states: vec![PhysicsState::default(); handles.physics.len()],
+            bones,
+            updates: 0,
+            clock_s: 0.0,
+            last: Vec::new(),
+        }
+    }
+
+    /// The next skeleton update (at time `updates / UPDATE_HZ`) on `transforms`, the pose there.
+    pub fn update(&mut self, handles: &Handles, transforms: Vec<Affine>) -> Vec<Affine> {
+        if self.updates > 0 {
+            self.clock_s += update_step_s();
+        }
+        self.updates += 1;
+        let clock = self.clock_s;
+        let out = apply(
+            handles,
+            transforms,
+            &self.bones,
+            &mut self.states,
+            clock,
+            PhysicsMode::Update,
+        );
+        self.last.clone_from(&out);
+        out
+    }
+
+    /// `transforms` (the pose at a time after the last update, before the next) with the
+    /// simulation as it stands.
+    pub fn pose(&self, handles: &Handles, transforms: Vec<Affine>) -> Vec<Affine> {
+        let mut states = self.states.clone();
+        apply(
+            handles,
+            transforms,
+            &self.bones,
+            &mut states,
+            self.clock_s,
+            PhysicsMode::Pose,
+        )
+    }
+}
+
+/// Each constraint on its bone's world frame (`transform · rest`), the change carried to the
+/// bone and its descendants.
+fn apply(
+    handles: &Handles,
+    mut transforms: Vec<Affine>,
+    bones: &[Constrained],
+    states: &mut [PhysicsState],
+    clock_s: f64,
+    mode: PhysicsMode,
+) -> Vec<Affine> {
+    for ((data, c), state) in handles.physics.iter().zip(bones).zip(states.iter_mut()) {
+        let Some(transform) = transforms.get(c.bone) else {
+            continue;
+        };
+        let world = transform.then_after(&c.rest);
+        let mut spine = SpineWorld::from_canvas(&world);
+        state.update(data, c.length_px, &mut spine, clock_s, mode);
+        let Some(world_inverse) = world.inverse() else {
+            continue;
+        };
+        let change = spine.to_canvas().then_after(&world_inverse);
+        for &j in &c.carried {
+            transforms[j] = change.then_after(&transforms[j]);
+        }
+    }
+    transforms
+}
+
+/// The whole updates at or before `time_s` (a time within a billionth of a step of a grid time
+/// is that grid time), and whether `time_s` is a grid time.
+pub fn updates_until(time_s: f64) -> (u64, bool) {
+    let step = update_step_s();
+    let whole = (time_s / step + 1e-9).floor().max(0.0) as u64;
+    let on_grid = time_s - whole as f64 * step <= 1e-9 * step;
+    (whole + 1, on_grid)
+}
+
+/// The transforms at `time_s` of an animation posed at any time by `posed`, simulated in `run`
+/// (advanced as far as needed; restarted when it is already past `time_s`).
+pub fn transforms_at(
+    run: &mut Option<PhysicsRun>,
+    handles: &Handles,
+    time_s: f64,
+    posed: &mut dyn FnMut(f64) -> Result<Vec<Affine>, PipelineError>,
+) -> Result<Vec<Affine>, PipelineError> {
+    if !(time_s.is_finite() && (0.0..=super::MAX_SIMULATED_S).contains(&time_s)) {
+        return Err(PipelineError::SimulatedTime(time_s));
+    }
+    let (needed, on_grid) = updates_until(time_s);
+    if run.as_ref().is_none_or(|r| r.updates > needed) {
+        *run = Some(PhysicsRun::new(handles));
+    }
+    let run = run.get_or_insert_with(|| PhysicsRun::new(handles));
+    while run.updates < needed {
+        let k = run.updates;
+        let transforms = posed(k as f64 * update_step_s())?;
+        run.update(handles, transforms);
+    }
+    if on_grid {
+        return Ok(run.last.clone());
+    }
+    Ok(run.pose(handles, posed(time_s)?))
+}
