@@ -21,14 +21,7 @@ need_x11
 cd "$root"
 if [ "$profile" = release ]; then cargo build --locked --quiet --release; else cargo build --locked --quiet; fi
 sinew="${CARGO_TARGET_DIR:-$root/target}/$profile/sinew"
-work="$(mktemp -d)"
-xvfb_pid=""; editor_pid=""
-cleanup() {
-  [ -n "$editor_pid" ] && kill "$editor_pid" 2>/dev/null || true
-  [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
+make_work
 
 "$sinew" demo -o "$work/demo" >/dev/null
 start_x11

@@ -1,10 +1,23 @@
 # Shared by the editor's X11 scripts (sourced): installing Xvfb and xdotool, starting an X
 # server on a free display, starting the editor on it and waiting for its window.
 #
-# Expects: $root (the checkout), $work (a scratch folder), $sinew (the binary). Defines skip,
-# fail, need_x11 (installs or skips), start_x11 (sets DISPLAY, xvfb_pid) and start_editor
+# Expects: $root (the checkout), $sinew (the binary). Defines skip, fail, make_work (a scratch
+# folder $work, removed with the editor and X server at exit), need_x11 (installs or skips),
+# start_x11 (sets DISPLAY, xvfb_pid) and start_editor
 # ARGS… (sets editor_pid, wid, and the window geometry X, Y, WIDTH, HEIGHT; `at DX DY` prints
 # a screen point relative to the window).
+
+make_work() {
+  work="$(mktemp -d)"
+  xvfb_pid=""; editor_pid=""
+  trap cleanup EXIT
+}
+
+cleanup() {
+  [ -n "$editor_pid" ] && kill "$editor_pid" 2>/dev/null || true
+  [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null || true
+  rm -rf "$work"
+}
 
 skip() { echo "editor-x11: skipped: $*"; exit 0; }
 fail() { echo "editor-x11: FAILED: $*" >&2; exit 1; }
