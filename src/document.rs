@@ -1074,22 +1074,28 @@ fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
         put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear);
     }
     for drag in &pose.ik {
-        match anim
-            .ik
-            .iter_mut()
-            .find(|t| t.at == drag.at && t.weight == drag.weight)
-        {
-            Some(t) => put_key(&mut t.to, time_s, drag.to),
-            None => anim.ik.push(IkTimeline {
-                at: drag.at,
-                to: vec![Key {
-                    time: time_s,
-                    value: drag.to,
-                    curve: Curve::Linear,
-                }],
-                weight: drag.weight,
-            }),
-        }
+        key_drag(anim, drag, time_s);
+    }
+}
+
+/// Keys `drag`'s target at `time_s` on the IK timeline of its rest point and weight (made,
+/// with a linear key, when the animation has none).
+pub(crate) fn key_drag(anim: &mut Animation, drag: &crate::rig::pose::IkDrag, time_s: f64) {
+    match anim
+        .ik
+        .iter_mut()
+        .find(|t| t.at == drag.at && t.weight == drag.weight)
+    {
+        Some(t) => put_key(&mut t.to, time_s, drag.to),
+        None => anim.ik.push(IkTimeline {
+            at: drag.at,
+            to: vec![Key {
+                time: time_s,
+                value: drag.to,
+                curve: Curve::Linear,
+            }],
+            weight: drag.weight,
+        }),
     }
 }
 

@@ -7,7 +7,7 @@
 
 use super::{DocumentError, State};
 use crate::anim::edit::put_key;
-use crate::anim::{Animation, Curve, IkTimeline, Key};
+use crate::anim::Animation;
 use crate::rig::Pose;
 
 /// One edit of the list of animations (see [`super::Command::Animations`]).
@@ -155,22 +155,7 @@ pub fn key_changes(anim: &mut Animation, time_s: f64, before: &Pose, pose: &Pose
             continue;
         }
         keyed += 1;
-        match anim
-            .ik
-            .iter_mut()
-            .find(|t| t.at == drag.at && t.weight == drag.weight)
-        {
-            Some(t) => put_key(&mut t.to, time_s, drag.to),
-            None => anim.ik.push(IkTimeline {
-                at: drag.at,
-                to: vec![Key {
-                    time: time_s,
-                    value: drag.to,
-                    curve: Curve::Linear,
-                }],
-                weight: drag.weight,
-            }),
-        }
+        crate::document::key_drag(anim, drag, time_s);
     }
     keyed
 }
