@@ -83,6 +83,11 @@ pub enum PipelineError {
     Cage { cage: String, problem: String },
     #[error("part '{part}': {source}")]
     Render { part: String, source: RenderError },
+    #[error("part '{part}': skinning: {source}")]
+    Skin {
+        part: String,
+        source: crate::skin::PlanError,
+    },
     #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
     TextureSize {
         part: String,

@@ -12,7 +12,7 @@ use crate::pipeline::PipelineError;
 use crate::render::{self, MeshRenderer, PartDraw, RenderError, RenderPart, Texture};
 use crate::rig::pose::{bone_stretches_under, Affine};
 use crate::rig::{handle_columns, handle_transforms, Pose};
-use crate::skin::{skin, stretchable_blend, Blend, SkinWeights};
+use crate::skin::{skin, stretchable_blend, Blend, LbsPlan, PlanError, SkinWeights};
 use image::RgbaImage;
 use std::borrow::Borrow;
 use std::path::{Path, PathBuf};
@@ -41,6 +41,17 @@ pub fn load_part_images(path: &Path, doc: &RigDocument) -> Result<Vec<RgbaImage>
         .collect()
 }
 
+/// Each part's skinning plan, or the first part whose weights could not be planned.
+type PartPlans = Result<Vec<Option<LbsPlan>>, (String, PlanError)>;
+
+/// A skinning failure of `part`.
+fn skin_error(part: &io::PartDoc, source: PlanError) -> PipelineError {
+    PipelineError::Skin {
+        part: part.name.clone(),
+        source,
+    }
+}
+
 /// A document with its textures and per-part render state, ready to draw.
 pub struct Scene {
     pub doc: RigDocument,
@@ -48,6 +59,9 @@ pub struct Scene {
     parts: std::sync::Arc<Vec<RenderPart>>,
     /// The skinning-IK precomputation, made the first time a pose has drags.
     ik: std::sync::OnceLock<Result<RigIk, crate::ik::IkError>>,
+    /// Each part's packed skinning plan (none for parts without weights), made on first pose;
+    /// shared by the scenes that keep the weights.
+    plans: std::sync::Arc<std::sync::OnceLock<PartPlans>>,
     /// The skins drawn, combined in order (see [`crate::io::slots`]); none: each slot's own part.
     skins: Vec<String>,
 }
@@ -99,6 +113,7 @@ impl Scene {
             doc,
             parts: std::sync::Arc::new(parts),
             ik: std::sync::OnceLock::new(),
+            plans: Default::default(),
             skins: Vec::new(),
         })
     }
@@ -126,6 +141,7 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            plans: Default::default(),
             skins: self.skins.clone(),
         })
     }
@@ -150,6 +166,7 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            plans: Default::default(),
             skins: self.skins.clone(),
         }
     }
@@ -163,6 +180,7 @@ impl Scene {
             doc,
             parts: self.parts.clone(),
             ik: std::sync::OnceLock::new(),
+            plans: self.plans.clone(),
             skins: self.skins.clone(),
         }
     }
@@ -304,8 +322,11 @@ impl Scene {
     }
 
     /// Every part's vertex positions under per-column skinning `transforms` (from
-    /// [`handle_transforms`] or the skinning IK). With [`Blend::Stretch`], a bone the pose
-    /// scales along its length stretches from its transform in `transforms`, solved or not.
+    /// [`handle_transforms`] or the skinning IK). [`Blend::Linear`] skins with each part's
+    /// packed f32 plan ([`LbsPlan`], every influence kept; made once per scene), so posed
+    /// positions carry f32 rounding (about 1e-4 px on a 1000 px canvas) like the runtimes'. With
+    /// [`Blend::Stretch`], a bone the pose scales along its length stretches from its transform
+    /// in `transforms`, solved or not (f64, as is [`Blend::Dqs`]).
     pub fn positions_from_transforms(
         &self,
         transforms: &[Affine],
@@ -325,8 +346,9 @@ impl Scene {
         {
             return Err(PipelineError::DeformUnknownPart(part.clone()));
         }
+        let plans = self.plans()?;
         let mut out = self.rest_positions();
-        for (part, positions) in self.doc.parts.iter().zip(out.iter_mut()) {
+        for (index, (part, positions)) in self.doc.parts.iter().zip(out.iter_mut()).enumerate() {
             let Some(weights) = &part.weights else {
                 continue;
             };
@@ -352,21 +374,71 @@ impl Scene {
                 }
                 *positions = rest.clone();
             }
-            let skin_weights = SkinWeights::from_rows(&weights.rows);
             match blend {
+                Blend::Linear => {
+                    let deformed;
+                    let plan = if pose.deform.contains_key(&part.name) {
+                        // The deformed rest is this pose's alone: plan it for this call.
+                        let skin_weights = SkinWeights::from_rows(&weights.rows);
+                        deformed = LbsPlan::precompute_exact(&rest, &skin_weights)
+                            .map_err(|source| skin_error(part, source))?;
+                        &deformed
+                    } else {
+                        match plans.get(index).and_then(Option::as_ref) {
+                            Some(plan) => plan,
+                            None => continue,
+                        }
+                    };
+                    let mut posed = vec![[0.0f32; 2]; rest.len()];
+                    plan.solve(&part_transforms, &mut posed)
+                        .map_err(|source| skin_error(part, source))?;
+                    for (p, q) in positions.iter_mut().zip(&posed) {
+                        *p = Point::new(f64::from(q[0]), f64::from(q[1]));
+                    }
+                }
                 Blend::Stretch => stretchable_blend(
                     &rest,
-                    &skin_weights,
+                    &SkinWeights::from_rows(&weights.rows),
                     &part_transforms,
                     &part_stretches,
                     positions,
                 ),
-                Blend::Linear | Blend::Dqs => {
-                    skin(&rest, &skin_weights, &part_transforms, blend, positions)
-                }
+                Blend::Dqs => skin(
+                    &rest,
+                    &SkinWeights::from_rows(&weights.rows),
+                    &part_transforms,
+                    blend,
+                    positions,
+                ),
             }
         }
         Ok(out)
+    }
+
+    /// Every part's packed skinning plan, made once per set of weights.
+    fn plans(&self) -> Result<&[Option<LbsPlan>], PipelineError> {
+        let made = self.plans.get_or_init(|| {
+            self.doc
+                .parts
+                .iter()
+                .map(|part| {
+                    let Some(weights) = &part.weights else {
+                        return Ok(None);
+                    };
+                    let rest = part.mesh.to_mesh().vertices;
+                    LbsPlan::precompute_exact(&rest, &SkinWeights::from_rows(&weights.rows))
+                        .map(Some)
+                        .map_err(|source| (part.name.clone(), source))
+                })
+                .collect()
+        });
+        match made {
+            Ok(plans) => Ok(plans),
+            Err((part, source)) => Err(PipelineError::Skin {
+                part: part.clone(),
+                source: source.clone(),
+            }),
+        }
     }
 
     /// Draws every slot's part (as the skins choose it) at `positions` (one list per part,
