@@ -7,12 +7,12 @@ mod choices;
 mod colorize;
 
 use anyhow::{anyhow, bail, Context, Result};
-use choices::{BakeModeArg, BlendArg, SchemaKindArg, TemplateArg, WeightMethodArg};
+use choices::{BakeModeArg, BlendArg, SchemaKindArg, SpinePresetArg, TemplateArg, WeightMethodArg};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
-use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
+use sinew::export::spine::{self, BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use sinew::io::outputs::{check_not_overwriting, check_output_kind, check_outputs, parent_dir};
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
@@ -133,6 +133,10 @@ pub struct SpineArgs {
     /// Keys per second for motion Spine cannot express natively (baked).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// full: every vertex and influence; game: meshes decimated to 250 vertices per part and
+    /// at most 4 influences per vertex (the two options below override the preset's).
+    #[arg(long, value_parser = choices::parser::<SpinePresetArg, SpinePreset>(), default_value = "full")]
+    pub preset: SpinePreset,
     /// Keep the K strongest weights per vertex, renormalized.
     #[arg(long, value_name = "K")]
     pub max_influences: Option<usize>,
@@ -255,6 +259,9 @@ pub struct RigArgs {
     /// Also write the mesh wireframe over the sprites as a PNG.
     #[arg(long)]
     pub preview: Option<PathBuf>,
+    /// Write the rig document indented, one value per line (default: compact).
+    #[arg(long)]
+    pub pretty: bool,
     /// The handles file (bones, points, cages, regions); with it, weights are computed.
     #[arg(long)]
     pub handles: Option<PathBuf>,
@@ -580,7 +587,12 @@ fn rig(args: &RigArgs) -> Result<()> {
         None => None,
     };
     art.write_parts()?;
-    doc.save(&args.output)?;
+    let layout = if args.pretty {
+        io::JsonLayout::Pretty
+    } else {
+        io::JsonLayout::Compact
+    };
+    doc.save_with(&args.output, layout)?;
     if let (Some(path), Some(image)) = (&args.preview, preview) {
         io::save_png(path, &image)?;
     }
@@ -1015,13 +1027,14 @@ fn load_rig_with_images(path: &Path) -> Result<(RigDocument, Vec<image::RgbaImag
 }
 
 fn export_spine(args: &SpineArgs) -> Result<()> {
+    let preset = args.preset.options();
     let options = SpineOptions {
         version: SpineVersion::parse(&args.spine_version)?,
         bake_fps: args.fps,
         bake: args.bake,
-        max_influences: args.max_influences,
-        max_vertices: args.max_vertices,
-        ..SpineOptions::default()
+        max_influences: args.max_influences.or(preset.max_influences),
+        max_vertices: args.max_vertices.or(preset.max_vertices),
+        ..preset
     };
     let (doc, images) = load_rig_with_images(&args.rig)?;
     let scene = Scene::new(doc, &images)?;
