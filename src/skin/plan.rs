@@ -626,6 +626,26 @@ mod tests {
         (rest, SkinWeights::from_rows(&rows), transforms)
     }
 
+    /// Skins with `plan` and checks the result against the f64 reference; returns it.
+    fn assert_matches_reference(
+        plan: &LbsPlan,
+        rest: &[Point],
+        weights: &SkinWeights,
+        transforms: &[Affine],
+    ) -> Vec<[f32; 2]> {
+        let mut expected = vec![Point::origin(); rest.len()];
+        linear_blend(rest, weights, transforms, &mut expected);
+        let mut got = vec![[0.0f32; 2]; rest.len()];
+        plan.solve(transforms, &mut got).unwrap();
+        let worst = expected
+            .iter()
+            .zip(&got)
+            .map(|(e, g)| (e - Point::new(g[0] as f64, g[1] as f64)).norm())
+            .fold(0.0, f64::max);
+        assert!(worst < F32_TOLERANCE_PX, "worst error {worst} px");
+        got
+    }
+
     fn bits(v: &[[f32; 2]]) -> Vec<u32> {
         v.iter().flatten().map(|x| x.to_bits()).collect()
     }
@@ -637,16 +657,7 @@ mod tests {
         let plan = LbsPlan::precompute(&rest, &weights, 4).unwrap();
         assert_eq!(plan.influences(), 4);
         assert_eq!(plan.handle_count(), 20);
-        let mut expected = vec![Point::origin(); rest.len()];
-        linear_blend(&rest, &weights, &transforms, &mut expected);
-        let mut got = vec![[0.0f32; 2]; rest.len()];
-        plan.solve(&transforms, &mut got).unwrap();
-        let worst = expected
-            .iter()
-            .zip(&got)
-            .map(|(e, g)| (e - Point::new(g[0] as f64, g[1] as f64)).norm())
-            .fold(0.0, f64::max);
-        assert!(worst < F32_TOLERANCE_PX, "worst error {worst} px");
+        assert_matches_reference(&plan, &rest, &weights, &transforms);
     }
 
     #[test]
@@ -659,16 +670,7 @@ mod tests {
             "{}",
             plan.influences()
         );
-        let mut expected = vec![Point::origin(); rest.len()];
-        linear_blend(&rest, &weights, &transforms, &mut expected);
-        let mut got = vec![[0.0f32; 2]; rest.len()];
-        plan.solve(&transforms, &mut got).unwrap();
-        let worst = expected
-            .iter()
-            .zip(&got)
-            .map(|(e, g)| (e - Point::new(g[0] as f64, g[1] as f64)).norm())
-            .fold(0.0, f64::max);
-        assert!(worst < F32_TOLERANCE_PX, "worst error {worst} px");
+        let got = assert_matches_reference(&plan, &rest, &weights, &transforms);
         let capped = LbsPlan::precompute(&rest, &weights, MAX_PLAN_INFLUENCES).unwrap();
         let mut truncated = vec![[0.0f32; 2]; rest.len()];
         capped.solve(&transforms, &mut truncated).unwrap();
