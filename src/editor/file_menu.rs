@@ -398,6 +398,18 @@ fn spine_options_ui(ui: &mut egui::Ui, options: &mut crate::export::spine::Spine
             200,
             3..=100_000,
         );
+        // `sinew export spine --preset game`: the two limits above, as the preset sets them.
+        ui.label("");
+        if ui
+            .button("Game preset")
+            .on_hover_text("At most 250 vertices per mesh and 4 influences per vertex")
+            .clicked()
+        {
+            let game = crate::export::spine::SpinePreset::Game.options();
+            options.max_influences = game.max_influences;
+            options.max_vertices = game.max_vertices;
+        }
+        ui.end_row();
     });
 }
 

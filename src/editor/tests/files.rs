@@ -302,9 +302,28 @@ fn export_spine_from_its_window_refuses_to_write_over_the_document() {
     assert_eq!(std::fs::read(&path).expect("the document"), before);
     let spine = dir.join("spine");
     type_into(&mut h, "Export folder:", &spine.display().to_string());
+    // The game preset's limits, as `--preset game` sets them.
+    h.get_by_label("Game preset").click();
+    h.run();
     h.get_by_label("Export").click();
     h.run();
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("exported"), "{message}");
-    assert!(spine.join("character.json").is_file());
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(spine.join("character.json")).expect("the export"))
+            .expect("JSON");
+    let limit = crate::export::spine::GAME_PRESET_MAX_VERTICES;
+    let mut meshes = 0;
+    for slot in json["skins"][0]["attachments"]
+        .as_object()
+        .expect("slots")
+        .values()
+    {
+        for mesh in slot.as_object().expect("attachments").values() {
+            let uvs = mesh["uvs"].as_array().expect("uvs").len() / 2;
+            assert!(uvs <= limit, "{uvs} vertices");
+            meshes += 1;
+        }
+    }
+    assert!(meshes > 0);
 }
