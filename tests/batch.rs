@@ -297,6 +297,14 @@ fn bad_manifests_are_refused_before_any_work() {
     own["outputs"]["image"] = json!("in/art0.png");
     assert_refused("own", &[own], "the output would overwrite an input");
 
+    let mut manifest = colorize_job(0);
+    manifest["outputs"]["image"] = json!("batch.json");
+    assert_refused(
+        "manifest",
+        &[manifest],
+        "the output would overwrite the manifest or its state",
+    );
+
     let mut option = colorize_job(0);
     option["options"]["fil"] = json!("flat");
     assert_refused("option", &[option], "unknown field `fil`");

@@ -75,5 +75,22 @@ pub fn load(path: &Path) -> Result<Plan, BatchError> {
         source,
     })?;
     let manifest = manifest::parse(&text)?;
-    plan::plan(manifest, crate::io::outputs::parent_dir(&path))
+    let plan = plan::plan(manifest, crate::io::outputs::parent_dir(&path))?;
+    // No job may write over the manifest or its state.
+    let state = record::state_path(&path);
+    for job in &plan.jobs {
+        for output in job.outputs() {
+            let output = plan::absolute(&plan.root, &output.path);
+            if [&path, &state].iter().any(|p| p.starts_with(&output)) {
+                return Err(BatchError::Job(
+                    format!("job '{}'", job.name()),
+                    format!(
+                        "{}: the output would overwrite the manifest or its state",
+                        output.display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(plan)
 }

@@ -18,40 +18,17 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
-say() { echo "ray-batch: $*"; }
-skip() { say "skipped: $*"; exit 0; }
-fail() { echo "ray-batch: FAILED: $*" >&2; exit 1; }
+source "$here/lib.sh"
 
 cd "$root"
 if ! reason="$("$here/install.sh" 2>&1 >/dev/null)"; then
   skip "${reason:-cannot install ray}"
 fi
-ray="$here/.venv/bin/ray"
 # The binary `cargo test` built (as tools/editor-x11/run.sh does).
 cargo test --locked --quiet --no-run --test batch
 sinew="${CARGO_TARGET_DIR:-$root/target}/debug/sinew"
 
-work="$(mktemp -d)"
-pids=()
-cleanup() {
-  # `ray start --block` stops its node's processes when it is terminated.
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  for pid in "${pids[@]}"; do wait "$pid" 2>/dev/null || true; done
-  rm -rf "$work"
-}
-trap cleanup EXIT
-
-# Every socket of the cluster's processes is on 127.0.0.1 (listening or connected).
-check_loopback() {
-  command -v ss >/dev/null || return 0
-  off="$(ss -tanp 2>/dev/null | awk '/gcs_server|raylet|ray::/ {
-    for (k = 4; k <= 5; k++) {
-      a = $k; sub(/:[0-9*]+$/, "", a)
-      if (a != "127.0.0.1" && a != "[::ffff:127.0.0.1]" && !(k == 5 && (a == "0.0.0.0" || a == "*" || a == "[::]"))) print $4, $5, $6
-    }
-  }')"
-  [ -z "$off" ] || fail "Ray sockets off loopback: $off"
-}
+make_work
 
 # The batch, twice at the same depth (the demo rig names the bundled images by relative path).
 python3 "$here/make_batch.py" "$work/local" "$root/assets/character" >/dev/null
@@ -65,34 +42,9 @@ started=$SECONDS
   fail "the local batch failed: $(tail -c 600 "$work/local-report.json")"
 local_s=$((SECONDS - started))
 
-# The cluster: a head and a second worker node, one CPU each, on loopback only.
-export SINEW_RAY_LOOPBACK=1 RAY_USAGE_STATS_ENABLED=0
-port="$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
-address="127.0.0.1:$port"
 started=$SECONDS
-"$ray" start --head --block --node-ip-address 127.0.0.1 --port "$port" --num-cpus 1 \
-  --include-dashboard false --disable-usage-stats --temp-dir "$work/ray-tmp" >"$work/head.log" 2>&1 &
-pids+=($!)
-for _ in $(seq 120); do
-  "$ray" status --address "$address" >/dev/null 2>&1 && break
-  kill -0 "${pids[0]}" 2>/dev/null || fail "the Ray head did not start: $(tail -3 "$work/head.log")"
-  sleep 0.5
-done
-"$ray" start --block --address "$address" --node-ip-address 127.0.0.1 --num-cpus 1 \
-  --disable-usage-stats >"$work/worker.log" 2>&1 &
-pids+=($!)
-nodes=0
-for _ in $(seq 120); do
-  nodes="$("$ray" status --address "$address" 2>/dev/null | grep -c '^ 1 node_' || true)"
-  [ "$nodes" -ge 2 ] && break
-  kill -0 "${pids[1]}" 2>/dev/null || fail "the Ray worker node did not start: $(tail -3 "$work/worker.log")"
-  sleep 0.5
-done
-[ "$nodes" -ge 2 ] || fail "the cluster has $nodes nodes, not 2"
+start_cluster
 cluster_s=$((SECONDS - started))
-
-check_loopback
-
 
 # The batch on Ray; the character's rig is killed under it.
 export SINEW_RAY_LOG_DIR="$work/attempts"
