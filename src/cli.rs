@@ -526,11 +526,10 @@ fn rig(args: &RigArgs) -> Result<()> {
         output: args.output.clone(),
         preview: args.preview.clone(),
     };
-    // A bar over the parts; indicatif draws nothing when stderr is not a terminal.
-    let bar = indicatif::ProgressBar::new(args.images.len() as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("rigging {bar:30} {pos}/{len} parts {msg}")
-    {
+    // Parts done (a layered file holds several); indicatif draws nothing when stderr is not a
+    // terminal.
+    let bar = indicatif::ProgressBar::no_length();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("rigging: {pos} parts done {msg}") {
         bar.set_style(style);
     }
     let done = sinew::jobs::rig_files(&files, &args.build.options(), &mut |done, name| {

@@ -37,6 +37,9 @@ pub struct RayOptions {
 pub struct RayExecutor<'a> {
     plan: &'a Plan,
     child: Child,
+    /// The driver's last line on stderr (its error when it stops); its other lines (Ray's
+    /// warnings) are not shown.
+    last_error: std::sync::Arc<std::sync::Mutex<String>>,
     stdin: Option<ChildStdin>,
     stdout: BufReader<ChildStdout>,
 }
@@ -66,6 +69,7 @@ impl<'a> RayExecutor<'a> {
             .arg(options.max_retries.to_string())
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
             .spawn()
             .map_err(|e| {
                 BatchError::Executor(format!(
@@ -79,9 +83,23 @@ impl<'a> RayExecutor<'a> {
             .take()
             .map(BufReader::new)
             .ok_or_else(|| BatchError::Executor("the Ray driver has no stdout".into()))?;
+        let last_error = std::sync::Arc::new(std::sync::Mutex::new(String::new()));
+        if let Some(stderr) = child.stderr.take() {
+            let last = last_error.clone();
+            std::thread::spawn(move || {
+                for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                    if !line.trim().is_empty() {
+                        if let Ok(mut last) = last.lock() {
+                            *last = line.trim().to_string();
+                        }
+                    }
+                }
+            });
+        }
         Ok(RayExecutor {
             plan,
             child,
+            last_error,
             stdin,
             stdout,
         })
@@ -94,9 +112,14 @@ impl<'a> RayExecutor<'a> {
             .wait()
             .map(|s| s.to_string())
             .unwrap_or_else(|e| e.to_string());
-        BatchError::Executor(format!(
-            "the Ray driver stopped ({status}); its error is above"
-        ))
+        // The stderr reader has the driver's last words once the pipe closes.
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        let last = self
+            .last_error
+            .lock()
+            .map(|l| l.clone())
+            .unwrap_or_default();
+        BatchError::Executor(format!("the Ray driver stopped ({status}): {last}"))
     }
 }
 
@@ -118,9 +141,8 @@ impl Executor for RayExecutor<'_> {
                 Ok(0) | Err(_) => return Err(self.driver_gone()),
                 Ok(_) => {}
             }
-            // Lines that are not a result (Ray's own messages) are passed on.
+            // Lines that are not a result (Ray's own messages) are left out.
             let Ok(done) = serde_json::from_str::<Finished>(line.trim()) else {
-                eprint!("{line}");
                 continue;
             };
             let index = self

@@ -19,6 +19,7 @@ import json
 import os
 import queue
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -69,11 +70,19 @@ def main():
     parser.add_argument("--max-retries", type=int, default=3)
     args = parser.parse_args()
     # Ray's own messages go to stderr; stdout carries only result lines.
-    ray.init(
-        address=args.address,
-        logging_level="ERROR",
-        log_to_driver=False,
-    )
+    # Nothing listening there: say so at once (ray.init would wait for a minute).
+    host, _, port = args.address.rpartition(":")
+    try:
+        socket.create_connection((host, int(port)), timeout=5).close()
+    except (OSError, ValueError) as error:
+        print(f"cannot connect to the Ray cluster at {args.address}: {error}", file=sys.stderr)
+        sys.exit(2)
+    try:
+        ray.init(address=args.address, logging_level="ERROR", log_to_driver=False)
+    except Exception as error:  # no cluster there, another Ray version, …
+        lines = str(error).strip().splitlines() or [type(error).__name__]
+        print(f"cannot connect to the Ray cluster at {args.address}: {lines[0]}", file=sys.stderr)
+        sys.exit(2)
     log_dir = os.environ.get("SINEW_RAY_LOG_DIR", "")
     names = queue.Queue()
 
