@@ -8,12 +8,12 @@ mod choices;
 mod colorize;
 
 use anyhow::{anyhow, bail, Context, Result};
-use choices::{BakeModeArg, BlendArg, SchemaKindArg, TemplateArg, WeightMethodArg};
+use choices::{BakeModeArg, BlendArg, SchemaKindArg, SpinePresetArg, TemplateArg, WeightMethodArg};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
-use sinew::export::spine::{self, BakeMode, SpineOptions, SpineVersion};
+use sinew::export::spine::{self, BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use sinew::io::outputs::check_outputs;
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
@@ -137,6 +137,10 @@ pub struct SpineArgs {
     /// Keys per second for motion Spine cannot express natively (baked).
     #[arg(long, default_value_t = 30.0)]
     pub fps: f64,
+    /// full: every vertex and influence; game: meshes decimated to 250 vertices per part and
+    /// at most 4 influences per vertex (the two options below override the preset's).
+    #[arg(long, value_parser = choices::parser::<SpinePresetArg, SpinePreset>(), default_value = "full")]
+    pub preset: SpinePreset,
     /// Keep the K strongest weights per vertex, renormalized.
     #[arg(long, value_name = "K")]
     pub max_influences: Option<usize>,
@@ -259,6 +263,9 @@ pub struct RigArgs {
     /// Also write the mesh wireframe over the sprites as a PNG.
     #[arg(long)]
     pub preview: Option<PathBuf>,
+    /// Write the rig document indented, one value per line (default: compact).
+    #[arg(long)]
+    pub pretty: bool,
     /// The handles file (bones, points, cages, regions); with it, weights are computed.
     #[arg(long)]
     pub handles: Option<PathBuf>,
@@ -525,6 +532,11 @@ fn rig(args: &RigArgs) -> Result<()> {
         attachments: args.attachments.iter().cloned().collect(),
         output: args.output.clone(),
         preview: args.preview.clone(),
+        layout: if args.pretty {
+            io::JsonLayout::Pretty
+        } else {
+            io::JsonLayout::Compact
+        },
     };
     // Parts done (a layered file holds several); indicatif draws nothing when stderr is not a
     // terminal.
@@ -877,13 +889,14 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 }
 
 fn export_spine(args: &SpineArgs) -> Result<()> {
+    let preset = args.preset.options();
     let options = SpineOptions {
         version: SpineVersion::parse(&args.spine_version)?,
         bake_fps: args.fps,
         bake: args.bake,
-        max_influences: args.max_influences,
-        max_vertices: args.max_vertices,
-        ..SpineOptions::default()
+        max_influences: args.max_influences.or(preset.max_influences),
+        max_vertices: args.max_vertices.or(preset.max_vertices),
+        ..preset
     };
     let (export, written) =
         sinew::jobs::export_spine_files(&args.rig, &args.output, args.name.as_deref(), &options)?;

@@ -21,7 +21,7 @@
 
 use crate::anim::edit::{self, put_key, CopiedKey, KeyRef};
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
-use crate::io::{BuildOptions, DocumentError as RigFileError, RigDocument};
+use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle, Pose, Region};
 use crate::weights::{BrushMode, BrushOptions, PaintMesh, PaintTarget};
@@ -69,6 +69,8 @@ pub enum DocumentError {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error("slots and skins: {0}")]
+    Slots(String),
     #[error("computing the weights was cancelled")]
     Cancelled,
     #[error(transparent)]
@@ -136,6 +138,50 @@ pub struct State {
     pub pose: Pose,
     /// Handles whose weights painting and recomputing keep (see [`Command::SetLocked`]).
     pub locked: BTreeSet<String>,
+    /// Which parts are other attachments of a slot, and the skins: kept as opened and given to
+    /// every rig built (the editor does not edit them yet).
+    pub slots: SlotLayout,
+}
+
+/// A document's slots and skins (see [`crate::io::slots`]): each part that is another
+/// attachment of a slot (part → slot) and the skins by name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SlotLayout {
+    pub attachments: BTreeMap<String, String>,
+    pub skins: io::Skins,
+    /// The skins the posed rig draws, combined in order (a view choice, not saved).
+    pub shown: Vec<String>,
+}
+
+impl SlotLayout {
+    /// The slots and skins of `doc`.
+    pub fn of(doc: &RigDocument) -> Self {
+        SlotLayout {
+            attachments: doc
+                .parts
+                .iter()
+                .filter_map(|p| Some((p.name.clone(), p.slot.clone()?)))
+                .collect(),
+            skins: doc.skins.clone(),
+            shown: Vec::new(),
+        }
+    }
+
+    /// Gives `doc` (a rig built from layers, whose parts are all slots) these slots and skins.
+    pub fn apply_to(&self, doc: &mut RigDocument) -> Result<(), DocumentError> {
+        doc.set_slots(&self.attachments, self.skins.clone())
+            .map_err(DocumentError::Slots)
+    }
+
+    /// Forgets part `name`: as an attachment, and wherever a skin shows it.
+    fn remove_part(&mut self, name: &str) {
+        self.attachments.remove(name);
+        // Attachments of a removed slot go with it.
+        self.attachments.retain(|_, slot| slot != name);
+        for skin in self.skins.values_mut() {
+            skin.retain(|slot, part| slot != name && part != name);
+        }
+    }
 }
 
 /// The inputs a rig is built from, copied out for a background build.
@@ -148,6 +194,8 @@ pub struct RigInputs {
     pub locked: BTreeSet<String>,
     /// The rig built before (current or stale): where locked weights come from.
     pub previous: Option<Arc<Scene>>,
+    /// The slots and skins the built rig gets.
+    pub slots: SlotLayout,
 }
 
 /// One edit of the document.
@@ -189,6 +237,8 @@ pub enum Command {
     /// Installs a rig built by [`compute_rig`] from the current inputs.
     SetRig(Arc<Scene>, Box<RigInputsKey>),
     SetPose(Pose),
+    /// Draws the posed rig in these skins, combined in order (none: each slot's own part).
+    ShowSkins(Vec<String>),
     /// Keys `pose` into `animation` at `time_s` (creating the animation): every bone and point
     /// the pose names gets rotate, translate, scale and shear keys, every IK drag a key of the
     /// drag timeline with the same rest point. A key already at that time is replaced.
@@ -327,6 +377,7 @@ impl Document {
                 rig_current: true,
                 pose: Pose::default(),
                 locked: BTreeSet::new(),
+                slots: SlotLayout::default(),
             },
             path: None,
             undo: Vec::new(),
@@ -373,6 +424,7 @@ impl Document {
             events: doc.events.clone(),
             rig_current: weighted,
             locked: doc.locked.iter().cloned().collect(),
+            slots: SlotLayout::of(&doc),
             rig: Some(Arc::new(Scene::new(doc, &images)?)),
             pose: Pose::default(),
         };
@@ -565,6 +617,7 @@ fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError
     doc.animations = state.animations.clone();
     doc.events = state.events.clone();
     doc.locked = state.locked.iter().cloned().collect();
+    state.slots.apply_to(&mut doc)?;
     Ok(doc)
 }
 
@@ -657,8 +710,13 @@ pub fn compute_rig(
     if let Some(previous) = &inputs.previous {
         pipeline::keep_locked_weights(&mut doc, &previous.doc, &inputs.locked)?;
     }
+    inputs.slots.apply_to(&mut doc)?;
     let images: Vec<&image::RgbaImage> = inputs.layers.iter().map(|l| &l.image).collect();
-    Ok(Scene::new(doc, &images)?)
+    let mut scene = Scene::new(doc, &images)?;
+    scene
+        .set_skins(&inputs.slots.shown)
+        .map_err(|e| DocumentError::Slots(e.to_string()))?;
+    Ok(scene)
 }
 
 /// Replaces animation `name` of `state` (an empty one when there is none) by `apply(name, it)`
@@ -702,6 +760,7 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
                 .position(|l| l.name == name)
                 .ok_or_else(|| DocumentError::UnknownLayer(name.clone()))?;
             next.layers.remove(index);
+            next.slots.remove_part(&name);
             for parts in next.handles.bind.values_mut() {
                 parts.retain(|p| *p != name);
             }
@@ -805,6 +864,16 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
                 .ok_or(DocumentError::NoWeights)?;
             scene.handle_transforms(&pose)?;
             next.pose = pose;
+            inputs_changed = false;
+        }
+        Command::ShowSkins(skins) => {
+            if let Some(rig) = &state.rig {
+                let shown = rig
+                    .with_skins(&skins)
+                    .map_err(|e| DocumentError::Slots(e.to_string()))?;
+                next.rig = Some(Arc::new(shown));
+            }
+            next.slots.shown = skins;
             inputs_changed = false;
         }
         Command::SetHandles(handles) => {
@@ -939,6 +1008,7 @@ fn rig_inputs_of(state: &State) -> RigInputs {
         options: state.options.clone(),
         locked: state.locked.clone(),
         previous: state.rig.clone(),
+        slots: state.slots.clone(),
     }
 }
 

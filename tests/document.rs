@@ -266,6 +266,31 @@ fn the_bundled_character_opens_and_poses() {
     assert_eq!(saved.events, scene_doc.events);
     assert!(!saved.animations["walk"].events.is_empty());
     assert_eq!(saved.animations, scene_doc.animations);
+    // Recomputing the weights (a rig built again from the layers) keeps the slots and skins:
+    // the rebuilt rig draws them, and the saved file still has them.
+    assert!(!scene_doc.skins.is_empty(), "the character has skins");
+    let slots = |d: &sinew::io::RigDocument| -> Vec<(String, Option<String>)> {
+        d.parts
+            .iter()
+            .map(|p| (p.name.clone(), p.slot.clone()))
+            .collect()
+    };
+    compute(&mut doc);
+    let rebuilt = &doc.posable().expect("posable after the recompute").doc;
+    assert_eq!(rebuilt.skins, scene_doc.skins);
+    assert_eq!(slots(rebuilt), slots(&scene_doc));
+    let recomputed = dir.join("recomputed.json");
+    doc.save(&recomputed).unwrap();
+    let saved = sinew::io::RigDocument::load(&recomputed).unwrap();
+    assert_eq!(saved.skins, scene_doc.skins);
+    assert_eq!(slots(&saved), slots(&scene_doc));
+    // Removing an attachment's layer drops it from the slots and the skins that show it.
+    doc.apply(Command::RemoveLayer {
+        name: "bag_pail".into(),
+    })
+    .unwrap();
+    assert!(doc.state().slots.skins["pail"].is_empty());
+    assert!(!doc.state().slots.attachments.contains_key("bag_pail"));
 }
 
 #[test]

@@ -20,7 +20,9 @@ use serde::Deserialize;
 use sinew::anim::{CurveEvaluation, FiredEvent, SampleOptions};
 use sinew::export::spine::bake::bake_times;
 use sinew::export::spine::played::as_played;
-use sinew::export::spine::{export_spine, BakeMode, SpineExport, SpineOptions, SpineVersion};
+use sinew::export::spine::{
+    export_spine, BakeMode, SpineExport, SpineOptions, SpinePreset, SpineVersion,
+};
 use sinew::geom::Point;
 use sinew::io::{self, RigDocument};
 use sinew::pipeline::Scene;
@@ -35,6 +37,10 @@ const ANIMATION_TOLERANCE_PX: f64 = 0.01;
 const SETUP_TOLERANCE_PX: f64 = 0.001;
 /// Slot colour channels (0..1): f32 storage only.
 const COLOR_TOLERANCE: f64 = 1e-4;
+/// How far `--preset game` may play from sinew's preview of the full rig (issue 24).
+const GAME_PRESET_TOLERANCE_PX: f64 = 0.5;
+/// The demo character's Spine JSON under `--preset game` stays below this (0.6 MB).
+const GAME_PRESET_MAX_BYTES: u64 = 600_000;
 /// Times sampled per animation, evenly, besides every key time.
 const TIMES_PER_ANIMATION: usize = 60;
 /// Frame rates at which events are stepped through, frame to frame.
@@ -190,6 +196,9 @@ enum Compare {
     ExactAtBakeTimes(f64),
     /// Coarser weights: deviations are printed, not bounded.
     ReportOnly,
+    /// A lean export (decimated, fewer influences): within this many px of sinew's preview of
+    /// the full rig as the runtime would play it (`--match-runtime spine`).
+    WithinPreview(f64),
 }
 
 /// How one animation is compared. Runtime mode holds for every animation, baked ones included:
@@ -397,6 +406,9 @@ fn check_rig_in_skins(
                     "baked {name} at {t} s: {d_exact} px"
                 ),
                 Compare::ReportOnly => {}
+                Compare::WithinPreview(px) => {
+                    assert!(d <= px, "{flags:?} {name} at {t} s: {d} px")
+                }
             }
             // Draw order, attachments and colours.
             let order: Vec<&str> = frame.slots.iter().map(|s| s.name.as_str()).collect();
@@ -538,6 +550,23 @@ fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
             &skins,
         );
     }
+    // The game preset: a JSON under 0.6 MB that still plays within 0.5 px of sinew's preview.
+    let game = SpinePreset::Game.options();
+    check_rig(
+        &rig,
+        &dir.join("export-game"),
+        &["--preset", "game"],
+        &game,
+        Compare::WithinPreview(GAME_PRESET_TOLERANCE_PX),
+    );
+    let full_bytes = std::fs::metadata(dir.join("export/rig.json"))
+        .unwrap()
+        .len();
+    let game_bytes = std::fs::metadata(dir.join("export-game/rig.json"))
+        .unwrap()
+        .len();
+    println!("demo Spine JSON: full {full_bytes} bytes, --preset game {game_bytes} bytes");
+    assert!(game_bytes < GAME_PRESET_MAX_BYTES, "{game_bytes} bytes");
     // The runtime's polyline does differ from the exact curves: the mode is not idle.
     assert!(
         exact > ANIMATION_TOLERANCE_PX,

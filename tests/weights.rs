@@ -38,6 +38,9 @@ fn layer(name: &str, image: RgbaImage) -> Layer {
     }
 }
 
+/// Posing skins in f32 (the packed plan) on the f64 rest points: a motion lands within this of
+/// the exact answer (f32 carries ~7 digits; displacements here are under a few hundred px).
+const F32_SKINNING_TOLERANCE_PX: f64 = 1e-3;
 #[test]
 fn character_weights_sum_to_one_stay_bounded_and_interpolate() {
     let (layers, handles) = character();
@@ -351,7 +354,7 @@ fn a_whole_rig_rigid_motion_moves_every_vertex_rigidly() {
         for (p, q) in rest.iter().zip(posed) {
             let want = moved([p.x, p.y]);
             assert!(
-                (q.coords - want).norm() < 1e-9,
+                (q.coords - want).norm() < F32_SKINNING_TOLERANCE_PX,
                 "{p:?} went to {q:?}, not {want:?}"
             );
         }
@@ -495,7 +498,10 @@ fn cages_reaching_past_the_shape_and_regions_get_weights() {
             p.x + (1.0 - w_patch) * shift[0],
             p.y + (1.0 - w_patch) * shift[1],
         );
-        assert!((q - want).norm() < 1e-9);
+        assert!(
+            (q - want).norm() < F32_SKINNING_TOLERANCE_PX,
+            "{q:?} not {want:?}"
+        );
     }
 }
 

@@ -74,6 +74,7 @@ pub fn run_job(job: &Job, root: &Path) -> Result<(), BatchError> {
                 attachments: j.options.attachments.clone(),
                 output: at(&j.outputs.rig),
                 preview: at_opt(&j.outputs.preview),
+                layout: Default::default(),
             };
             jobs::rig_files(&files, &j.options.build, &mut |_, _| {})?;
         }

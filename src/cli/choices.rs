@@ -9,7 +9,7 @@ use clap::builder::{EnumValueParser, TypedValueParser};
 use clap::ValueEnum;
 use sinew::autorig::Template;
 use sinew::colorize::{ColorWeights, FillMode};
-use sinew::export::spine::BakeMode;
+use sinew::export::spine::{BakeMode, SpinePreset};
 use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
 use sinew::weights::WeightMethod;
@@ -79,6 +79,13 @@ mirror!(BakeModeArg => BakeMode {
     All,
 });
 
+mirror!(SpinePresetArg => SpinePreset {
+    /// Every vertex and influence: plays exactly what sinew draws (default).
+    Full,
+    /// For games: at most 250 vertices per part and 4 influences per vertex.
+    Game,
+});
+
 mirror!(TemplateArg => Template {
     /// Spine (hip, chest), head, two arms and two legs of two bones each.
     Humanoid,
@@ -145,6 +152,7 @@ mod tests {
         check::<BlendArg, Blend>();
         check::<WeightMethodArg, WeightMethod>();
         check::<BakeModeArg, BakeMode>();
+        check::<SpinePresetArg, SpinePreset>();
         check::<TemplateArg, Template>();
         check::<FillModeArg, FillMode>();
         check::<ColorWeightsArg, ColorWeights>();

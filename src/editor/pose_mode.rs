@@ -101,6 +101,9 @@ pub struct PoseMode {
     ik_warmed: Option<Identity<Scene>>,
 }
 
+/// The skin picker's entry for "no skin".
+const NO_SKIN: &str = "(none)";
+
 /// The one way from a pose to posed vertices, as `sinew render` takes it: the scene's handle
 /// transforms (forward kinematics, bone IK, then the skinning IK solved from the
 /// forward-kinematics pose with no warm start, so the result depends on the pose only), then
@@ -161,9 +164,44 @@ impl EditorApp {
 
     /// The tree view under pose and animate mode's panels.
     pub(super) fn pose_tree(&mut self, ui: &mut egui::Ui) {
+        self.skin_picker(ui);
         ui.separator();
         ui.heading("Tree");
         self.tree_view(ui);
+    }
+
+    /// The skin the canvas draws, when the rig has skins: "(none)" shows each slot's own part.
+    fn skin_picker(&mut self, ui: &mut egui::Ui) {
+        let Some(scene) = self.doc.posable() else {
+            return;
+        };
+        if scene.doc.skins.is_empty() {
+            return;
+        }
+        let names: Vec<String> = scene.doc.skins.keys().cloned().collect();
+        let shown = self.doc.state().slots.shown.clone();
+        let label = if shown.is_empty() {
+            NO_SKIN.to_string()
+        } else {
+            shown.join(" + ")
+        };
+        let mut chosen = None;
+        egui::ComboBox::from_label("Skin")
+            .selected_text(label)
+            .show_ui(ui, |ui| {
+                if ui.selectable_label(shown.is_empty(), NO_SKIN).clicked() {
+                    chosen = Some(Vec::new());
+                }
+                for name in names {
+                    let on = shown.len() == 1 && shown[0] == name;
+                    if ui.selectable_label(on, &name).clicked() {
+                        chosen = Some(vec![name]);
+                    }
+                }
+            });
+        if let Some(skins) = chosen.filter(|s| *s != shown) {
+            self.apply(Command::ShowSkins(skins));
+        }
     }
 
     /// Poses `scene` for the static `pose` through [`pose_frame`] into [`PoseMode::posed`]

@@ -40,6 +40,12 @@ fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
 /// The bundled character rigged with default options, saved (with absolute image paths) in a
 /// fresh folder.
 fn character_rig(name: &str) -> PathBuf {
+    character_rig_with(name, false)
+}
+
+/// [`character_rig`] with, when `skins`, the other attachments of its slots and its skins, as
+/// `sinew demo` rigs them (`layers.json`'s `attachments` and `skins`).
+fn character_rig_with(name: &str, skins: bool) -> PathBuf {
     let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
     let list: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
@@ -51,6 +57,12 @@ fn character_rig(name: &str) -> PathBuf {
         .iter()
         .map(|n| assets.join(format!("{}.png", n.as_str().expect("a name"))))
         .collect();
+    let mut paths = paths;
+    let attachments: std::collections::BTreeMap<String, String> = match skins {
+        true => serde_json::from_value(list["attachments"].clone()).expect("attachments"),
+        false => Default::default(),
+    };
+    paths.extend(attachments.keys().map(|n| assets.join(format!("{n}.png"))));
     let layers = crate::pipeline::load_layers(&paths).expect("layers");
     let handles: crate::rig::Handles = serde_json::from_str(
         &std::fs::read_to_string(assets.join("handles.json")).expect("handles.json"),
@@ -61,6 +73,10 @@ fn character_rig(name: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).expect("scratch dir");
     let (mut doc, _) = crate::pipeline::build_rig(&layers, &assets, &Default::default(), &handles)
         .expect("the character rigs");
+    if skins {
+        let skins = serde_json::from_value(list["skins"].clone()).expect("skins");
+        doc.set_slots(&attachments, skins).expect("slots and skins");
+    }
     for part in &mut doc.parts {
         part.image = assets.join(&part.image).to_string_lossy().into_owned();
     }

@@ -9,6 +9,8 @@ pub mod sequence;
 pub mod slots;
 
 pub use atomic::write_atomic;
-pub use document::{BuildOptions, DocumentError, MeshDoc, PartDoc, RigDocument, WeightsDoc};
+pub use document::{
+    BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RigDocument, WeightsDoc,
+};
 pub use image::{load_png, save_png, ImageError};
 pub use slots::{Skin, Skins, SlotError};

@@ -62,6 +62,8 @@ pub struct RigFiles {
     pub output: PathBuf,
     /// The rest pose with the wireframe on top, PNG.
     pub preview: Option<PathBuf>,
+    /// How the rig document's JSON is laid out (default compact).
+    pub layout: io::JsonLayout,
 }
 
 /// What a rig job made.
@@ -137,7 +139,7 @@ pub fn rig_files(
         None => None,
     };
     art.write_parts()?;
-    doc.save(&files.output)?;
+    doc.save_with(&files.output, files.layout)?;
     if let (Some(path), Some(image)) = (&files.preview, preview) {
         io::save_png(path, &image)?;
     }

@@ -193,6 +193,23 @@ impl Scene {
         Ok(())
     }
 
+    /// This scene drawing `skins` (see [`Scene::set_skins`]), everything else shared or kept.
+    pub fn with_skins(&self, skins: &[String]) -> Result<Scene, io::SlotError> {
+        self.doc.check_skins(skins)?;
+        let ik = std::sync::OnceLock::new();
+        if let Some(Ok(solver)) = self.ik.get() {
+            // The same meshes and handles: the solver's precomputation carries over.
+            let _ = ik.set(Ok(solver.clone()));
+        }
+        Ok(Scene {
+            doc: self.doc.clone(),
+            parts: self.parts.clone(),
+            ik,
+            plans: self.plans.clone(),
+            skins: skins.to_vec(),
+        })
+    }
+
     /// The skins drawn (see [`Scene::set_skins`]).
     pub fn skins(&self) -> &[String] {
         &self.skins
@@ -323,7 +340,8 @@ impl Scene {
 
     /// Every part's vertex positions under per-column skinning `transforms` (from
     /// [`handle_transforms`] or the skinning IK). [`Blend::Linear`] skins with each part's
-    /// packed f32 plan ([`LbsPlan`], every influence kept; made once per scene), so posed
+    /// packed f32 plan ([`LbsPlan`], every influence kept; made once per scene): the f32
+    /// displacement is added to the f64 rest point, so the rest pose is exact and posed
     /// positions carry f32 rounding (about 1e-4 px on a 1000 px canvas) like the runtimes'. With
     /// [`Blend::Stretch`], a bone the pose scales along its length stretches from its transform
     /// in `transforms`, solved or not (f64, as is [`Blend::Dqs`]).
@@ -392,8 +410,14 @@ impl Scene {
                     let mut posed = vec![[0.0f32; 2]; rest.len()];
                     plan.solve(&part_transforms, &mut posed)
                         .map_err(|source| skin_error(part, source))?;
-                    for (p, q) in positions.iter_mut().zip(&posed) {
-                        *p = Point::new(f64::from(q[0]), f64::from(q[1]));
+                    // The f32 displacement on the f64 rest point: identity transforms give
+                    // back the rest positions exactly (the plan returns its f32 rest bit for
+                    // bit, so the displacement is exactly zero).
+                    for ((p, r), q) in positions.iter_mut().zip(&rest).zip(&posed) {
+                        let moved = |rest: f64, posed: f32| {
+                            rest + (f64::from(posed) - f64::from(rest as f32))
+                        };
+                        *p = Point::new(moved(r.x, q[0]), moved(r.y, q[1]));
                     }
                 }
                 Blend::Stretch => stretchable_blend(

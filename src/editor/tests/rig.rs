@@ -248,9 +248,10 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     for (a, b) in head.iter().zip(column(&after, "head")) {
         assert_eq!(a.to_bits(), b.to_bits(), "the locked head column changed");
     }
+    // Read back from the saved file: weights are written at f32 precision.
     for row in &after.rows {
         let sum: f64 = row.iter().map(|e| e.1).sum();
-        assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
+        assert!((sum - 1.0).abs() < 1e-6, "{row:?}");
     }
     // The side panel reads out the weights under the pointer.
     h.get_by_label_contains("torso vertex");

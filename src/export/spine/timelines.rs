@@ -30,8 +30,21 @@ use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// A JSON number; −0 is written as 0.
+///
+/// Written at the precision the runtimes read (float32): the shortest decimal that reads back
+/// as `x`'s nearest f32, so no digit is written that a runtime would drop. Negative zero is
+/// written as 0.
 pub fn num(x: f64) -> Value {
-    json!(if x == 0.0 { 0.0 } else { x })
+    if x == 0.0 {
+        return json!(0.0);
+    }
+    let single = x as f32;
+    // Display of an f32 is its shortest round-trip decimal; read as f64, serde_json writes
+    // that same short text back (a non-finite value becomes null, as before).
+    json!(single
+        .to_string()
+        .parse::<f64>()
+        .unwrap_or(f64::from(single)))
 }
 
 /// One key's object with its time and curve; `fields` come from the value.
@@ -309,6 +322,22 @@ pub fn native_timelines(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_written_as_the_shortest_text_of_their_f32() {
+        let mut x = 0.1234567890123f64;
+        for _ in 0..2000 {
+            x = (x * 7.3 + 0.37).rem_euclid(2048.0) - 1024.0;
+            let text = num(x).to_string();
+            let read: f32 = text.parse().unwrap();
+            assert_eq!(read, x as f32, "{x} written as {text}");
+            let digits = text.chars().filter(char::is_ascii_digit).count();
+            assert!(digits <= 11, "{x} written as {text}");
+        }
+        assert_eq!(num(0.1).to_string(), "0.1");
+        assert_eq!(num(-0.0).to_string(), "0.0");
+        assert_eq!(num(1.0 / 3.0).to_string(), "0.33333334");
+    }
 
     #[test]
     fn translate_flips_y_and_its_handles_and_gets_a_start_key() {
