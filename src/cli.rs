@@ -3,6 +3,7 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+mod batch;
 mod choices;
 mod colorize;
 
@@ -13,7 +14,7 @@ use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
 use sinew::export::spine::{self, BakeMode, SpineOptions, SpinePreset, SpineVersion};
-use sinew::io::outputs::{check_not_overwriting, check_output_kind, check_outputs, parent_dir};
+use sinew::io::outputs::check_outputs;
 use sinew::io::{self, BuildOptions, RigDocument};
 use sinew::mesh::MeshOptions;
 use sinew::pipeline::{self, PartReport, Scene};
@@ -54,6 +55,9 @@ pub enum Command {
     Autorig(AutorigArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
+    /// Run the jobs of a manifest (rig, autorig, render, export, colorize) in parallel, here
+    /// or on a Ray cluster; unchanged jobs are skipped.
+    Batch(batch::BatchArgs),
     /// Print the JSON Schema of a file sinew reads (see docs/formats.md).
     Schema(SchemaArgs),
     /// Open the editor window (rig, weigh and pose by hand).
@@ -429,6 +433,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Colorize(args) => colorize::run(&args),
+        Command::Batch(args) => batch::run(&args),
         Command::Schema(args) => print_schema(&args),
         #[cfg(feature = "editor")]
         Command::Edit(args) => edit(&args),
@@ -474,12 +479,7 @@ fn print_schema(args: &SchemaArgs) -> Result<()> {
 }
 
 fn autorig(args: &AutorigArgs) -> Result<()> {
-    use sinew::autorig::{self as ar, AutorigOptions};
-    check_outputs(
-        args.images.iter().map(PathBuf::as_path),
-        [Some(args.output.as_path()), args.preview.as_deref()],
-    )?;
-    let layers = load_art(&args.images, &args.output)?.layers;
+    use sinew::autorig::AutorigOptions;
     let mut options = AutorigOptions {
         template: args.template,
         cage_vertices: args.cage,
@@ -487,20 +487,13 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         ..AutorigOptions::default()
     };
     options.skeleton.max_bones = args.bones;
-    let proposal = sinew::jobs::propose_handles(&layers, &options)?;
-    let text = serde_json::to_string_pretty(&proposal.handles)? + "\n";
-    let preview = match &args.preview {
-        Some(_) => {
-            let images: Vec<_> = layers.iter().map(|l| &l.image).collect();
-            Some(ar::draw_preview(&images, &proposal.handles)?)
-        }
-        None => None,
+    let files = sinew::jobs::AutorigFiles {
+        images: args.images.clone(),
+        output: args.output.clone(),
+        preview: args.preview.clone(),
     };
-    io::write_atomic(&args.output, text.as_bytes())
-        .with_context(|| format!("{}: cannot write", args.output.display()))?;
-    if let (Some(path), Some(image)) = (&args.preview, preview) {
-        io::save_png(path, &image)?;
-    }
+    let (proposal, notes) = sinew::jobs::autorig_files(&files, &options)?;
+    print_notes(&notes);
     let h = &proposal.handles;
     println!(
         "{}: {} bones, {} points, {} cages",
@@ -515,129 +508,56 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
     Ok(())
 }
 
-/// The image files of `doc`'s parts (`doc` read from `rig`).
-fn part_images(rig: &Path, doc: &RigDocument) -> Vec<PathBuf> {
-    doc.parts
-        .iter()
-        .map(|part| RigDocument::image_path(rig, part))
-        .collect()
+/// The notes on layers skipped or drawn differently.
+fn print_notes(notes: &[String]) {
+    for note in notes {
+        println!("note: {note}");
+    }
 }
 
-/// Reads a JSON file into `T`, naming the file in every error.
+/// The image files of `doc`'s parts (`doc` read from `rig`).
+fn part_images(rig: &Path, doc: &RigDocument) -> Vec<PathBuf> {
+    sinew::jobs::part_images(rig, doc)
+}
+
+/// Reads a JSON file that must hold one object into `T`, naming the file in every error.
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("{}: cannot read", path.display()))?;
-    // Every file read here is a JSON object; serde would also take an array for a struct.
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .with_context(|| format!("{}: not a valid {what}", path.display()))?;
-    if !value.is_object() {
-        bail!(
-            "{}: not a valid {what}: expected a JSON object",
-            path.display()
-        );
-    }
-    serde_json::from_str(&text).with_context(|| format!("{}: not a valid {what}", path.display()))
+    Ok(sinew::jobs::read_json(path, what)?)
 }
 
 fn rig(args: &RigArgs) -> Result<()> {
-    check_outputs(
-        args.images
-            .iter()
-            .map(PathBuf::as_path)
-            .chain(args.handles.as_deref()),
-        [Some(args.output.as_path()), args.preview.as_deref()],
-    )?;
-    let art = load_art(&args.images, &args.output)?;
-    // The parts of layered files are written beside the document: none may overwrite an input.
-    check_not_overwriting(
-        args.images
-            .iter()
-            .map(PathBuf::as_path)
-            .chain(args.handles.as_deref()),
-        art.part_paths()
-            .chain([args.output.as_path()])
-            .chain(args.preview.as_deref())
-            .map(Some),
-    )?;
-    let layers = art.layers.clone();
-    let handles: Handles = match &args.handles {
-        Some(path) => read_json(path, "handles file")?,
-        None => Handles::default(),
+    let files = sinew::jobs::RigFiles {
+        images: args.images.clone(),
+        handles: args.handles.clone(),
+        attachments: args.attachments.iter().cloned().collect(),
+        output: args.output.clone(),
+        preview: args.preview.clone(),
+        layout: if args.pretty {
+            io::JsonLayout::Pretty
+        } else {
+            io::JsonLayout::Compact
+        },
     };
-    // Attachments name layers: checked before any work.
-    let attachments: std::collections::BTreeMap<String, String> =
-        args.attachments.iter().cloned().collect();
-    if let Some(name) = attachments
-        .iter()
-        .flat_map(|(part, slot)| [part, slot])
-        .find(|n| !layers.iter().any(|l| &l.name == *n))
-    {
-        bail!("--attachment: '{name}' is not a layer of the rig");
+    // Parts done (a layered file holds several); indicatif draws nothing when stderr is not a
+    // terminal.
+    let bar = indicatif::ProgressBar::no_length();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("rigging: {pos} parts done {msg}") {
+        bar.set_style(style);
     }
-    let doc_dir = parent_dir(&args.output);
-    let (mut doc, stats) =
-        rig_with_progress_bar(&layers, doc_dir, &args.build.options(), &handles)?;
-    doc.set_slots(&attachments, io::Skins::new())
-        .map_err(|reason| anyhow!("--attachment: {reason}"))?;
-    let preview = match &args.preview {
-        Some(_) => {
-            let images: Vec<_> = layers.iter().map(|l| l.image.clone()).collect();
-            Some(preview_image(&Scene::new(doc.clone(), &images)?)?)
-        }
-        None => None,
-    };
-    art.write_parts()?;
-    let layout = if args.pretty {
-        io::JsonLayout::Pretty
-    } else {
-        io::JsonLayout::Compact
-    };
-    doc.save_with(&args.output, layout)?;
-    if let (Some(path), Some(image)) = (&args.preview, preview) {
-        io::save_png(path, &image)?;
-    }
-    for (part, s) in doc.parts.iter().zip(&stats) {
+    let done = sinew::jobs::rig_files(&files, &args.build.options(), &mut |done, name| {
+        bar.set_position(done as u64);
+        bar.set_message(name.to_string());
+    });
+    bar.finish_and_clear();
+    let done = done.map_err(|e| match e {
+        sinew::jobs::JobError::Attachment(reason) => anyhow!("--attachment: {reason}"),
+        e => e.into(),
+    })?;
+    print_notes(&done.notes);
+    for (part, s) in done.doc.parts.iter().zip(&done.stats) {
         report_part(&part.name, s);
     }
     Ok(())
-}
-
-/// Loads PNG layers and layered files (PSD, ORA, a Spine script's JSON) for a command that
-/// writes `output`: layered files' parts go to `OUTPUT.parts/` (see [`sinew::art`]). Prints
-/// the notes on skipped layers.
-fn load_art(images: &[PathBuf], output: &Path) -> Result<sinew::art::Art> {
-    let options = sinew::art::ArtOptions {
-        parts_dir: output.with_extension("parts"),
-        ..Default::default()
-    };
-    let art = sinew::art::load_art(images, &options)?;
-    for note in &art.notes {
-        println!("note: {note}");
-    }
-    Ok(art)
-}
-
-/// [`pipeline::build_rig`] with a bar over the parts; indicatif draws nothing when stderr is
-/// not a terminal.
-fn rig_with_progress_bar(
-    layers: &[pipeline::Layer],
-    doc_dir: &Path,
-    options: &BuildOptions,
-    handles: &Handles,
-) -> Result<(RigDocument, Vec<PartReport>)> {
-    let bar = indicatif::ProgressBar::new(layers.len() as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("rigging {bar:30} {pos}/{len} parts {msg}")
-    {
-        bar.set_style(style);
-    }
-    let result =
-        pipeline::build_rig_with_progress(layers, doc_dir, options, handles, &mut |done, name| {
-            bar.set_position(done as u64);
-            bar.set_message(name.to_string());
-        });
-    bar.finish_and_clear();
-    Ok(result?)
 }
 
 fn report_part(name: &str, r: &PartReport) {
@@ -663,24 +583,7 @@ fn report_part(name: &str, r: &PartReport) {
 
 /// The rest pose on white with every part's wireframe on top.
 fn preview_image(scene: &Scene) -> Result<image::RgbaImage> {
-    let doc = &scene.doc;
-    let [w, h] = doc.canvas;
-    let mut canvas = tiny_skia::Pixmap::new(w, h).context("canvas too large")?;
-    canvas.fill(tiny_skia::Color::WHITE);
-    let rest = scene.rest_positions();
-    scene.draw(&mut canvas, &rest, tiny_skia::Transform::identity())?;
-    let wire = tiny_skia::Color::from_rgba8(20, 90, 200, 170);
-    for (part, positions) in doc.parts.iter().zip(&rest) {
-        render::draw_wireframe(
-            &mut canvas,
-            positions,
-            &part.mesh.triangles,
-            tiny_skia::Transform::identity(),
-            wire,
-            0.75,
-        );
-    }
-    Ok(render::rgba_from_pixmap(&canvas))
+    Ok(sinew::jobs::preview_image(scene)?)
 }
 
 fn pose(args: &PoseArgs) -> Result<()> {
@@ -738,25 +641,6 @@ fn pose(args: &PoseArgs) -> Result<()> {
 }
 
 fn render_animation(args: &RenderArgs) -> Result<()> {
-    let mut scene = Scene::load(&args.rig)?;
-    scene.set_skins(&args.skins)?;
-    // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
-    let files = match io::sequence::format_for_path(&args.output)? {
-        io::sequence::SequenceFormat::Folder => vec![],
-        io::sequence::SequenceFormat::Gif => vec![args.output.clone()],
-        io::sequence::SequenceFormat::Sheet => {
-            vec![args.output.clone(), args.output.with_extension("json")]
-        }
-    };
-    if files.is_empty() {
-        check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
-    }
-    let images = part_images(&args.rig, &scene.doc);
-    check_outputs(
-        std::iter::once(args.rig.as_path()).chain(images.iter().map(PathBuf::as_path)),
-        files.iter().map(|f| Some(f.as_path())),
-    )?;
-    let animation = animation(&scene.doc, &args.anim)?;
     let settings = playback::RenderSettings {
         fps: args.fps,
         scale: args.scale,
@@ -769,31 +653,27 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         blend: args.blend,
         sampling: sample_options(args.match_runtime),
     };
-    // Check the settings and the target before rendering: a bad one fails at once.
-    settings.view(scene.doc.canvas)?;
-    let bar = indicatif::ProgressBar::new(
-        playback::frame_times(animation.duration_s(), args.fps)?.len() as u64,
-    );
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("rendering {bar:30} {pos}/{len} frames")
-    {
+    let files = sinew::jobs::RenderFiles {
+        rig: args.rig.clone(),
+        animation: args.anim.clone(),
+        skins: args.skins.clone(),
+        output: args.output.clone(),
+    };
+    // The frame count is known inside the job: the bar counts frames drawn.
+    let bar = indicatif::ProgressBar::no_length();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("rendering {pos} frames") {
         bar.set_style(style);
     }
     // Drawn and written a chunk of frames at a time: any length renders in bounded memory.
-    let written = playback::write_animation(
-        &scene,
-        &args.anim,
-        &animation,
-        &settings,
-        &args.output,
-        &Default::default(),
-        &|| bar.inc(1),
-    );
+    let written = sinew::jobs::render_files(&files, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
-    let (report, events) = written?;
+    let sinew::jobs::RenderDone {
+        report,
+        events,
+        frame_times_s,
+    } = written?;
     if args.events {
-        let times = playback::frame_times(animation.duration_s(), args.fps)?;
-        for (frame, (fired, time)) in events.iter().zip(times).enumerate() {
+        for (frame, (fired, time)) in events.iter().zip(frame_times_s).enumerate() {
             for event in fired {
                 let line = serde_json::json!({"frame": frame, "frame_time": time, "event": event});
                 println!("{line}");
@@ -819,18 +699,7 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
 
 /// The document's animation `name`, checked against its rig.
 fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
-    doc.check_animations()?;
-    doc.animations.get(name).cloned().ok_or_else(|| {
-        let known: Vec<&str> = doc.animations.keys().map(String::as_str).collect();
-        anyhow!(
-            "the rig has no animation '{name}' (it has: {})",
-            if known.is_empty() {
-                "none".to_string()
-            } else {
-                known.join(", ")
-            }
-        )
-    })
+    Ok(sinew::jobs::animation(doc, name)?)
 }
 
 /// The `--vertices` file of docs/formats.md.
@@ -1019,13 +888,6 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     Ok(())
 }
 
-/// Loads a rig document and its parts' images.
-fn load_rig_with_images(path: &Path) -> Result<(RigDocument, Vec<image::RgbaImage>)> {
-    let doc = RigDocument::load(path)?;
-    let images = pipeline::load_part_images(path, &doc)?;
-    Ok((doc, images))
-}
-
 fn export_spine(args: &SpineArgs) -> Result<()> {
     let preset = args.preset.options();
     let options = SpineOptions {
@@ -1036,35 +898,8 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
         max_vertices: args.max_vertices.or(preset.max_vertices),
         ..preset
     };
-    let (doc, images) = load_rig_with_images(&args.rig)?;
-    let scene = Scene::new(doc, &images)?;
-    let name = match &args.name {
-        Some(n) => n.clone(),
-        None => args
-            .rig
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "skeleton".into()),
-    };
-    let export = spine::export_spine(&scene, &images, &name, &options)?;
-    // `-o .` beside the rig would write NAME.json over the rig and NAME.png over a sprite.
-    let targets: Vec<PathBuf> = export
-        .file_names()
-        .into_iter()
-        .map(|file| args.output.join(file))
-        .collect();
-    let sprites = part_images(&args.rig, &scene.doc);
-    // The export folder is made where missing: only what is there and the overwriting are
-    // checked.
-    check_output_kind(&args.output, io::atomic::OutputKind::Folder)?;
-    for target in &targets {
-        check_output_kind(target, io::atomic::OutputKind::File)?;
-    }
-    check_not_overwriting(
-        std::iter::once(args.rig.as_path()).chain(sprites.iter().map(PathBuf::as_path)),
-        targets.iter().map(|t| Some(t.as_path())),
-    )?;
-    let written = export.write(&args.output)?;
+    let (export, written) =
+        sinew::jobs::export_spine_files(&args.rig, &args.output, args.name.as_deref(), &options)?;
     report_spine_export(&export, &written);
     Ok(())
 }

@@ -3,9 +3,13 @@
 //!
 //! In: a [`Document`] (or what [`Document::render_job`] copies out of it, or its layers) and the
 //! job's options. Out: the files written, or the proposal. Each runs to completion on the
-//! calling thread; the editor calls them from a background thread, the command line has its
-//! own glue for the same library calls. [`crate::document`] stays about the editable document:
-//! it does not reach into export, playback or the automatic rig.
+//! calling thread; the editor calls them from a background thread. [`files`]: the file-to-file
+//! jobs of the command line and of `sinew batch` ([`crate::batch`]). [`crate::document`] stays
+//! about the editable document: it does not reach into export, playback or the automatic rig.
+
+mod files;
+
+pub use files::*;
 
 use crate::anim::AnimError;
 use crate::autorig::{self, AutorigError, AutorigOptions, LayerRef, Proposal};
@@ -39,6 +43,50 @@ pub enum JobError {
     Autorig(#[from] AutorigError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    RigDocument(#[from] crate::io::DocumentError),
+    #[error(transparent)]
+    Image(#[from] crate::io::ImageError),
+    #[error(transparent)]
+    Slot(#[from] crate::io::SlotError),
+    #[error(transparent)]
+    Draw(#[from] crate::render::RenderError),
+    #[error("{}: cannot read: {source}", .path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: cannot write: {source}", .path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: cannot create the folder: {source}", .path.display())]
+    CreateFolder {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a valid {what}: {reason}", .path.display())]
+    Json {
+        path: PathBuf,
+        what: String,
+        reason: String,
+    },
+    /// A slot attachment naming no layer, or making a slot of something that cannot be one.
+    #[error("attachment: {0}")]
+    Attachment(String),
+    #[error("the rig has no animation '{name}' (it has: {known})")]
+    NoAnimation { name: String, known: String },
+    #[error("a canvas of {width}×{height} px is too large to draw")]
+    CanvasTooLarge { width: u32, height: u32 },
+    #[error("cannot write JSON: {0}")]
+    Serialize(serde_json::Error),
+    /// The scribbles or the colorization failed; `path` is the scribbles file.
+    #[error("{}: {source}", .path.display())]
+    Colorize {
+        path: PathBuf,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 /// Exports the document's current state for Spine's runtimes into `dir` (see

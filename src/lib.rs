@@ -9,6 +9,7 @@
 pub mod anim;
 pub mod art;
 pub mod autorig;
+pub mod batch;
 pub mod colorize;
 pub mod document;
 #[cfg(feature = "editor")]

@@ -43,24 +43,29 @@ pub enum SchemaKind {
     Scribbles,
     /// An events file: event name → definition, as the rig document's `events`.
     Events,
+    /// The batch manifest of `sinew batch`.
+    Batch,
 }
 
 /// What is wrong with a schema request.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SchemaError {
-    #[error("no schema named '{0}' (known: handles, rig, pose, animations, scribbles, events)")]
+    #[error(
+        "no schema named '{0}' (known: handles, rig, pose, animations, scribbles, events, batch)"
+    )]
     UnknownKind(String),
 }
 
 impl SchemaKind {
     /// Every kind, in the order `docs/formats.md` lists them.
-    pub const ALL: [SchemaKind; 6] = [
+    pub const ALL: [SchemaKind; 7] = [
         SchemaKind::Handles,
         SchemaKind::Rig,
         SchemaKind::Pose,
         SchemaKind::Animations,
         SchemaKind::Scribbles,
         SchemaKind::Events,
+        SchemaKind::Batch,
     ];
 
     /// The kind's name on the command line.
@@ -72,6 +77,7 @@ impl SchemaKind {
             SchemaKind::Animations => "animations",
             SchemaKind::Scribbles => "scribbles",
             SchemaKind::Events => "events",
+            SchemaKind::Batch => "batch",
         }
     }
 }
@@ -96,6 +102,7 @@ pub fn schema(kind: SchemaKind) -> Schema {
         SchemaKind::Animations => schemars::schema_for!(Animations),
         SchemaKind::Scribbles => schemars::schema_for!(StrokeFile),
         SchemaKind::Events => schemars::schema_for!(crate::anim::EventDefs),
+        SchemaKind::Batch => schemars::schema_for!(crate::batch::Manifest),
     }
 }
 

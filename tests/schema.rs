@@ -203,6 +203,10 @@ fn load(kind: SchemaKind, text: &str) -> Result<(), String> {
         SchemaKind::Events => anim::events_from_json(&value)
             .map(|_| ())
             .map_err(|e| e.to_string()),
+        // The manifest's own checks (inputs exist, no cycle) need its files: the parse only.
+        SchemaKind::Batch => sinew::batch::manifest::parse(text)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
     }
 }
 
@@ -317,6 +321,24 @@ fn wrong_files_are_rejected_by_the_schema_and_the_reader() {
             SchemaKind::Scribbles,
             json!({"strokes": [{"color": "#ff0000", "width": 4, "points": []}]}),
             "a stroke without points",
+        ),
+        (
+            SchemaKind::Batch,
+            json!({"jobs": [{"kind": "bake", "name": "a", "inputs": {}, "outputs": {}}]}),
+            "a job of an unknown kind",
+        ),
+        (
+            SchemaKind::Batch,
+            json!({"jobs": [{"kind": "colorize", "name": "a",
+                "inputs": {"lineart": "a.png", "scribbles": "a.json"},
+                "options": {"fill": "bucket"}, "outputs": {"image": "b.png"}}]}),
+            "an unknown fill",
+        ),
+        (
+            SchemaKind::Batch,
+            json!({"jobs": [{"kind": "render", "name": "a", "inputs": {"rig": "r.json"},
+                "options": {"fps": 24}, "outputs": {"output": "a.gif"}}]}),
+            "a render without its animation",
         ),
     ];
     for (kind, value, what) in &wrong {

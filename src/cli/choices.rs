@@ -113,6 +113,8 @@ mirror!(SchemaKindArg => SchemaKind {
     Scribbles,
     /// An events file: event name → definition, as the rig document's `events`.
     Events,
+    /// The batch manifest of `sinew batch`.
+    Batch,
 });
 
 mirror!(ColorWeightsArg => ColorWeights {

@@ -1,11 +1,10 @@
 //! `sinew colorize LINEART.png --scribbles S.png|S.json -o OUT.png`: argument parsing and glue.
 
 use super::choices::{self, ColorWeightsArg, FillModeArg};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
-use sinew::colorize::{self, ColorWeights, ColorizeOptions, FillMode, Scribbles};
-use sinew::io;
-use std::path::{Path, PathBuf};
+use sinew::colorize::{self, ColorWeights, ColorizeOptions, FillMode};
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Args, Debug)]
@@ -33,55 +32,27 @@ pub struct ColorizeArgs {
     pub scale: f64,
 }
 
-/// Whether the scribble file is the JSON polyline format (by extension).
-fn is_json(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.to_string_lossy().eq_ignore_ascii_case("json"))
-}
-
 pub fn run(args: &ColorizeArgs) -> Result<()> {
     let start = Instant::now();
-    super::check_outputs(
-        [args.lineart.as_path(), args.scribbles.as_path()],
-        // --layers is a folder, made where missing.
-        [Some(args.output.as_path())],
-    )?;
     let options = ColorizeOptions {
         scale: args.scale,
         weights: args.weights,
         fill: args.fill,
         ..Default::default()
     };
-    let lineart = io::load_png(&args.lineart)?;
-    let scribbles_path = args.scribbles.display();
-    let scribbles = if is_json(&args.scribbles) {
-        let text = std::fs::read_to_string(&args.scribbles)
-            .with_context(|| format!("{scribbles_path}: cannot read"))?;
-        Scribbles::from_json(&text, lineart.width(), lineart.height(), &options.scribbles)
-            .with_context(|| format!("{scribbles_path}"))?
-    } else {
-        let layer = io::load_png(&args.scribbles)?;
-        Scribbles::from_layer(&layer, &options.scribbles)
-            .with_context(|| format!("{scribbles_path}"))?
+    let files = sinew::jobs::ColorizeFiles {
+        lineart: args.lineart.clone(),
+        scribbles: args.scribbles.clone(),
+        output: args.output.clone(),
+        layers: args.layers.clone(),
     };
-    let result = colorize::colorize(&lineart, &scribbles, &options, args.layers.is_some())
-        .with_context(|| format!("{scribbles_path}"))?;
-    // Everything is computed; now write, each file atomically.
-    if let Some(dir) = &args.layers {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("{}: cannot create the folder", dir.display()))?;
-        for (k, (layer, color)) in result.layers.iter().zip(&result.palette).enumerate() {
-            let path = dir.join(format!("{k:02}-{}.png", colorize::scribbles::hex(*color)));
-            io::save_png(&path, layer)?;
-        }
-    }
-    io::save_png(&args.output, &result.image)?;
-    let s = &result.stats;
+    let done = sinew::jobs::colorize_files(&files, &options)?;
+    let s = &done.stats;
     println!(
         "colorized {}×{} px with {} colors: {} mesh vertices, {} triangles, {:.2} s",
-        lineart.width(),
-        lineart.height(),
-        result.palette.len(),
+        done.size_px.0,
+        done.size_px.1,
+        done.colors,
         s.vertices,
         s.triangles,
         start.elapsed().as_secs_f64()

@@ -1,0 +1,218 @@
+//! A manifest checked as a whole, before any work: every input exists or is written by a job,
+//! no two jobs write one output, no job writes its own input, no cycle; each job's dependencies
+//! (the jobs that write what it reads).
+//!
+//! In: a [`Manifest`] and the folder its paths are relative to. Out: a [`Plan`], or the first
+//! problem found as one [`BatchError`].
+
+use super::manifest::{Job, JobPath, Manifest};
+use super::BatchError;
+use std::path::{Component, Path, PathBuf};
+
+/// A checked manifest.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The folder the manifest's paths are relative to.
+    pub root: PathBuf,
+    pub jobs: Vec<Job>,
+    /// For each job, the jobs (indices) that write one of its inputs.
+    pub dependencies: Vec<Vec<usize>>,
+}
+
+/// `path` against `root`, with `.` and `..` resolved by name (the file need not exist).
+pub fn absolute(root: &Path, path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in root.join(path).components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+/// Whether `output` writes `path`: the same path, or `path` lies inside output folder.
+fn writes(output: &JobPath, path: &Path) -> bool {
+    path == output.path || (output.folder && path.starts_with(&output.path))
+}
+
+/// Checks `manifest` (paths relative to `root`) and finds each job's dependencies.
+pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
+    let jobs = manifest.jobs;
+    let named = |j: &Job| format!("job '{}'", j.name());
+    for (i, job) in jobs.iter().enumerate() {
+        if job.name().is_empty() {
+            return Err(BatchError::Job(
+                format!("job {i}"),
+                "the name is empty".into(),
+            ));
+        }
+        if jobs[..i].iter().any(|other| other.name() == job.name()) {
+            return Err(BatchError::Job(
+                named(job),
+                "two jobs have this name".into(),
+            ));
+        }
+        // Options that can be wrong on their own: refused before any work.
+        match job {
+            Job::Render(j) => {
+                j.options
+                    .settings()
+                    .map_err(|e| BatchError::Job(named(job), e.to_string()))?;
+            }
+            Job::Export(j) => {
+                j.options
+                    .spine()
+                    .map_err(|e| BatchError::Job(named(job), e.to_string()))?;
+            }
+            _ => {}
+        }
+    }
+    let outputs: Vec<Vec<JobPath>> = jobs
+        .iter()
+        .map(|j| {
+            j.outputs()
+                .into_iter()
+                .map(|o| JobPath {
+                    path: absolute(root, &o.path),
+                    folder: o.folder,
+                })
+                .collect()
+        })
+        .collect();
+    let inputs: Vec<Vec<PathBuf>> = jobs
+        .iter()
+        .map(|j| j.inputs().iter().map(|p| absolute(root, p)).collect())
+        .collect();
+    // No two jobs write one output (nor one into the other's folder); no job writes its own
+    // input.
+    for (i, outs) in outputs.iter().enumerate() {
+        for (k, out) in outs.iter().enumerate() {
+            for (j, others) in outputs.iter().enumerate() {
+                for (l, other) in others.iter().enumerate() {
+                    if (j, l) <= (i, k) {
+                        continue;
+                    }
+                    if writes(out, &other.path) || writes(other, &out.path) {
+                        return Err(BatchError::SameOutput {
+                            path: out.path.clone(),
+                            first: jobs[i].name().to_string(),
+                            second: jobs[j].name().to_string(),
+                        });
+                    }
+                }
+            }
+            if let Some(input) = inputs[i].iter().find(|p| writes(out, p)) {
+                return Err(BatchError::Job(
+                    named(&jobs[i]),
+                    format!("{}: the output would overwrite an input", input.display()),
+                ));
+            }
+        }
+    }
+    // Every input exists or is written by a job.
+    let mut dependencies = vec![Vec::new(); jobs.len()];
+    for (i, ins) in inputs.iter().enumerate() {
+        for input in ins {
+            let writer = outputs
+                .iter()
+                .position(|outs| outs.iter().any(|o| writes(o, input)));
+            match writer {
+                Some(j) => {
+                    if !dependencies[i].contains(&j) {
+                        dependencies[i].push(j);
+                    }
+                }
+                None if input.is_file() => {}
+                None => {
+                    return Err(BatchError::Job(
+                        named(&jobs[i]),
+                        format!(
+                            "{}: the input does not exist and no job writes it",
+                            input.display()
+                        ),
+                    ))
+                }
+            }
+        }
+    }
+    if let Some(cycle) = find_cycle(&dependencies) {
+        let names: Vec<String> = cycle
+            .iter()
+            .map(|&i| format!("'{}'", jobs[i].name()))
+            .collect();
+        return Err(BatchError::Cycle(names.join(" → ")));
+    }
+    Ok(Plan {
+        root: root.to_path_buf(),
+        jobs,
+        dependencies,
+    })
+}
+
+/// A cycle of the dependency graph, as job indices from a job back to itself, if any.
+fn find_cycle(dependencies: &[Vec<usize>]) -> Option<Vec<usize>> {
+    // 0 unvisited, 1 on the current path, 2 finished.
+    let mut state = vec![0u8; dependencies.len()];
+    let mut path = Vec::new();
+    fn visit(
+        node: usize,
+        dependencies: &[Vec<usize>],
+        state: &mut [u8],
+        path: &mut Vec<usize>,
+    ) -> Option<Vec<usize>> {
+        state[node] = 1;
+        path.push(node);
+        for &next in &dependencies[node] {
+            if state[next] == 1 {
+                let start = path.iter().position(|&n| n == next).unwrap_or(0);
+                // Dependencies point from a reader to its writer: reverse for writer → reader.
+                let mut cycle: Vec<usize> = path[start..].iter().rev().copied().collect();
+                cycle.push(cycle[0]);
+                return Some(cycle);
+            }
+            if state[next] == 0 {
+                if let Some(c) = visit(next, dependencies, state, path) {
+                    return Some(c);
+                }
+            }
+        }
+        path.pop();
+        state[node] = 2;
+        None
+    }
+    for start in 0..dependencies.len() {
+        if state[start] == 0 {
+            if let Some(c) = visit(start, dependencies, &mut state, &mut path) {
+                return Some(c);
+            }
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cycles_are_found_and_named_in_writing_order() {
+        // 0 reads what 1 writes, 1 reads what 2 writes, 2 reads what 0 writes.
+        let deps = vec![vec![1], vec![2], vec![0]];
+        let cycle = find_cycle(&deps).expect("a cycle");
+        assert_eq!(cycle.len(), 4);
+        assert_eq!(cycle.first(), cycle.last());
+        assert_eq!(find_cycle(&[vec![], vec![0], vec![0, 1]]), None);
+    }
+
+    #[test]
+    fn paths_resolve_by_name() {
+        assert_eq!(
+            absolute(Path::new("/a/b"), Path::new("./c/../d.png")),
+            PathBuf::from("/a/b/d.png")
+        );
+    }
+}
