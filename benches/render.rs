@@ -8,6 +8,12 @@
 //! - `render/1024/rest` and `render/1024/posed`: clear the canvas, then draw every part, inside a
 //!   one-thread rayon pool's `install` (the single-core cost).
 //!
+//! - `pose_positions/character/{f32_plan,f64_reference}` (one thread): the posed pose's
+//!   vertices from its handle transforms. `f32_plan` is the one path every consumer takes
+//!   (`Scene::positions_from_transforms`, packed f32 plans made once per scene);
+//!   `f64_reference` is the compressed-row f64 `linear_blend` over the same parts, what the
+//!   path did before and what the tests compare against.
+//!
 //! Target (issue "Keyframed timelines, rendered animations, golden-image tests"): one frame in
 //! < 8 ms on one core.
 //!
@@ -17,8 +23,9 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use sinew::geom::Point;
 use sinew::io::BuildOptions;
 use sinew::pipeline::{self, Scene};
-use sinew::rig::pose::BonePose;
+use sinew::rig::pose::{Affine, BonePose};
 use sinew::rig::{Handles, Pose};
+use sinew::skin::{linear_blend, Blend, SkinWeights};
 use std::path::{Path, PathBuf};
 
 /// Side of the rendered frame, px.
@@ -118,5 +125,59 @@ fn render(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, render);
+/// Posed vertices from transforms: the scene's one path against the f64 reference.
+fn pose_positions(c: &mut Criterion) {
+    let character = character();
+    let scene = &character.scene;
+    let pose = posed();
+    let transforms = scene.handle_transforms(&pose).expect("the pose applies");
+    let columns = sinew::rig::handle_columns(&scene.doc.handles);
+    // The reference's per-part inputs, made outside the timing like the scene's plans.
+    let parts: Vec<(Vec<Point>, SkinWeights, Vec<Affine>)> = scene
+        .doc
+        .parts
+        .iter()
+        .filter_map(|part| {
+            let weights = part.weights.as_ref()?;
+            let part_transforms = weights
+                .handles
+                .iter()
+                .map(|name| {
+                    let column = columns.iter().position(|c| c == name).expect("a column");
+                    transforms[column]
+                })
+                .collect();
+            let rest = part.mesh.to_mesh().vertices;
+            Some((rest, SkinWeights::from_rows(&weights.rows), part_transforms))
+        })
+        .collect();
+    let single = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("one-thread pool");
+    let mut group = c.benchmark_group("pose_positions");
+    group.sample_size(50);
+    group.bench_function("character/f32_plan", |b| {
+        single.install(|| {
+            b.iter(|| {
+                scene
+                    .positions_from_transforms(&transforms, &pose, Blend::Linear)
+                    .expect("the pose applies")
+            })
+        })
+    });
+    let mut out: Vec<Vec<Point>> = parts.iter().map(|(rest, _, _)| rest.clone()).collect();
+    group.bench_function("character/f64_reference", |b| {
+        single.install(|| {
+            b.iter(|| {
+                for ((rest, weights, part_transforms), out) in parts.iter().zip(out.iter_mut()) {
+                    linear_blend(rest, weights, part_transforms, out);
+                }
+            })
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, render, pose_positions);
 criterion_main!(benches);

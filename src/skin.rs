@@ -8,7 +8,9 @@
 //!
 //! For skinning the same mesh frame after frame, [`LbsPlan`] ([`plan`]) lays the weights out once
 //! (fixed influences per vertex, f32, blocks of 16 vertices) and skins in f32 several times
-//! faster than [`linear_blend`]; the f64 functions here stay the reference.
+//! faster than [`linear_blend`]. Posing takes the plan ([`crate::scene::Scene`] keeps one per
+//! part): render, the editor and the export's bake all skin with it. [`linear_blend`] stays the
+//! tests' f64 reference; dual-quaternion and stretchable blending are f64 only.
 //!
 //! Dual-quaternion blending ([`dual_quaternion_blend`], Kavan, Collins, Žára & O'Sullivan 2008)
 //! avoids LBS's collapse at strongly rotated joints: each transform is split by polar

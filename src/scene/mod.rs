@@ -18,7 +18,8 @@
 
 pub mod physics;
 pub mod play;
+mod rig_scene;
 
-pub use crate::pipeline::Scene;
 pub use crate::playback::draw_pose;
 pub use play::{frames, Frame, PlayOptions, Playhead, MAX_SIMULATED_S};
+pub use rig_scene::{load_part_images, Scene};

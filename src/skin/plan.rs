@@ -108,6 +108,22 @@ impl LbsPlan {
         if !(1..=MAX_PLAN_INFLUENCES).contains(&max_influences) {
             return Err(PlanError::InfluenceCap(max_influences));
         }
+        Self::build(rest, weights, Some(max_influences))
+    }
+
+    /// Lays out `rest` and `weights` keeping every influence: the plan is as wide as the longest
+    /// row, so it skins exactly what the rows say (in f32). This is what posing uses: a rig's
+    /// rows are sparse (their influence limit is the document's choice, not the plan's).
+    pub fn precompute_exact(rest: &[Point], weights: &SkinWeights) -> Result<Self, PlanError> {
+        Self::build(rest, weights, None)
+    }
+
+    /// [`LbsPlan::precompute`] with an optional cap (none: as wide as the longest row).
+    fn build(
+        rest: &[Point],
+        weights: &SkinWeights,
+        max_influences: Option<usize>,
+    ) -> Result<Self, PlanError> {
         check_structure(weights)?;
         if weights.vertex_count() != rest.len() {
             return Err(PlanError::VertexCount {
@@ -119,7 +135,7 @@ impl LbsPlan {
             .map(|i| (weights.offsets[i + 1] - weights.offsets[i]) as usize)
             .max()
             .unwrap_or(0);
-        let influences = longest.clamp(1, max_influences);
+        let influences = longest.clamp(1, max_influences.unwrap_or(longest.max(1)));
         let blocks = rest.len().div_ceil(LANES);
         let mut plan = LbsPlan {
             vertex_count: rest.len(),
@@ -631,6 +647,32 @@ mod tests {
             .map(|(e, g)| (e - Point::new(g[0] as f64, g[1] as f64)).norm())
             .fold(0.0, f64::max);
         assert!(worst < F32_TOLERANCE_PX, "worst error {worst} px");
+    }
+
+    #[test]
+    fn an_exact_plan_keeps_rows_longer_than_any_cap() {
+        // Rows of up to 12 influences, past MAX_PLAN_INFLUENCES: nothing is dropped.
+        let (rest, weights, transforms) = case(13, 517, 30, 12);
+        let plan = LbsPlan::precompute_exact(&rest, &weights).unwrap();
+        assert!(
+            plan.influences() > MAX_PLAN_INFLUENCES,
+            "{}",
+            plan.influences()
+        );
+        let mut expected = vec![Point::origin(); rest.len()];
+        linear_blend(&rest, &weights, &transforms, &mut expected);
+        let mut got = vec![[0.0f32; 2]; rest.len()];
+        plan.solve(&transforms, &mut got).unwrap();
+        let worst = expected
+            .iter()
+            .zip(&got)
+            .map(|(e, g)| (e - Point::new(g[0] as f64, g[1] as f64)).norm())
+            .fold(0.0, f64::max);
+        assert!(worst < F32_TOLERANCE_PX, "worst error {worst} px");
+        let capped = LbsPlan::precompute(&rest, &weights, MAX_PLAN_INFLUENCES).unwrap();
+        let mut truncated = vec![[0.0f32; 2]; rest.len()];
+        capped.solve(&transforms, &mut truncated).unwrap();
+        assert!(bits(&truncated) != bits(&got), "the cap dropped nothing");
     }
 
     #[test]
