@@ -23,7 +23,7 @@ use sinew::colorize::score::score;
 use sinew::colorize::synthetic::{scene, Scene, SceneSpec};
 use sinew::colorize::{
     self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
-    ScribbleOptions, Scribbles,
+    RegionSplit, ScribbleOptions, Scribbles,
 };
 #[cfg(feature = "cli")]
 use sinew::io::{load_png, save_png};
@@ -133,31 +133,127 @@ fn scribbles_touching_and_crossing_lines() {
 }
 
 #[test]
-fn edge_stretch_holds_thin_lines_where_the_5d_cotangent_laplacian_leaks() {
-    // Why `LiftedStiffness::EdgeStretch` is the default: on 1.5 px antialiased curves the 5D
-    // cotangent weights of the lifted needle triangles let colors through.
+fn thin_closed_lines_are_exact_whatever_the_stiffness() {
+    // On 1.5 px antialiased curves the 5D cotangent weights of the lifted needle triangles let
+    // colors through (why `LiftedStiffness::EdgeStretch` is the weights' default); regions
+    // closed by lines no longer depend on the weights at all: both are exact.
     let s = scene(&SceneSpec {
         line_width: 1.5,
         shapes: 6,
         ..Default::default()
     });
-    let with = |stiffness| {
-        scores(
-            &s,
-            &ColorizeOptions {
+    for stiffness in [LiftedStiffness::EdgeStretch, LiftedStiffness::Cotangent] {
+        for split in [RegionSplit::Depth, RegionSplit::Weights] {
+            let options = ColorizeOptions {
                 stiffness,
+                split,
                 ..Default::default()
-            },
-        )
-        .0
-    };
-    let (stretch, cotangent) = (
-        with(LiftedStiffness::EdgeStretch),
-        with(LiftedStiffness::Cotangent),
+            };
+            let ours = scores(&s, &options).0;
+            println!("thin black lines, {stiffness:?}, {split:?}: {ours:.5}");
+            assert!(ours >= 0.999, "{stiffness:?}, {split:?}: {ours:.5}");
+        }
+    }
+}
+
+/// A 64×32 drawing: a closed box (x 8..=24, y 8..=24) holding a thin closed bar (a
+/// "moustache", 3 px tall), and a wall at x = 44 from top to bottom with an opening of
+/// `gap_px` px at y 14..14 + gap_px; 1-px black lines on white.
+fn box_and_wall(gap_px: u32) -> RgbaImage {
+    let mut art = RgbaImage::from_pixel(64, 32, Rgba([255, 255, 255, 255]));
+    let black = Rgba([0, 0, 0, 255]);
+    for t in 8..=24 {
+        for (x, y) in [(t, 8), (t, 24), (8, t), (24, t)] {
+            art.put_pixel(x, y, black);
+        }
+    }
+    for x in 11..=21 {
+        art.put_pixel(x, 14, black);
+        art.put_pixel(x, 18, black);
+    }
+    for y in 14..=18 {
+        art.put_pixel(11, y, black);
+        art.put_pixel(21, y, black);
+    }
+    for y in 0..32 {
+        if !(14..14 + gap_px).contains(&y) {
+            art.put_pixel(44, y, black);
+        }
+    }
+    art
+}
+
+fn layer_scribbles(width: u32, height: u32, dots: &[([u32; 2], [u8; 3])]) -> Scribbles {
+    let mut layer = RgbaImage::new(width, height);
+    for &([x, y], c) in dots {
+        layer.put_pixel(x, y, Rgba([c[0], c[1], c[2], 255]));
+    }
+    Scribbles::from_layer(&layer, &ScribbleOptions::default()).expect("scribbles")
+}
+
+#[test]
+fn closed_regions_take_only_the_colors_scribbled_inside_them() {
+    // The bar inside the box inside the page: three nested closed regions, one dot each.
+    let art = box_and_wall(0);
+    let (red, green, blue) = ([220, 40, 40], [40, 200, 40], [40, 40, 220]);
+    let sc = layer_scribbles(
+        64,
+        32,
+        &[([2, 2], red), ([12, 22], green), ([16, 16], blue)],
     );
-    println!("thin black lines: edge stretch {stretch:.4}, 5D cotangent {cotangent:.4}");
-    assert!(stretch >= 0.99, "edge stretch {stretch:.4}");
-    assert!(cotangent < stretch, "5D cotangent {cotangent:.4}");
+    for fill in [FillMode::Flat, FillMode::Soft] {
+        let options = ColorizeOptions {
+            fill,
+            ..Default::default()
+        };
+        let result = colorize::colorize(&art, &sc, &options, false).expect("colorizes");
+        let line = LineArt::new(&art).line_mask(0.5);
+        for y in 0..32u32 {
+            for x in 0..64u32 {
+                let i = (y * 64 + x) as usize;
+                // Soft edges blend over one pixel beside the lines: check the rest.
+                let near_line = (y.saturating_sub(1)..=(y + 1).min(31)).any(|yy| {
+                    (x.saturating_sub(1)..=(x + 1).min(63)).any(|xx| line[(yy * 64 + xx) as usize])
+                });
+                if line[i] || (fill == FillMode::Soft && near_line) {
+                    continue;
+                }
+                let inside_box = (9..24).contains(&x) && (9..24).contains(&y);
+                let inside_bar = (12..21).contains(&x) && (15..18).contains(&y);
+                let expected = if inside_bar {
+                    blue
+                } else if inside_box {
+                    green
+                } else {
+                    red
+                };
+                let got = result.fill_only.get_pixel(x, y).0;
+                assert_eq!(&got[..3], &expected[..], "{fill:?} ({x}, {y})");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_gap_is_cut_at_its_opening() {
+    // Left of the wall red, right of it blue, the wall open over 3 px: the boundary is the
+    // opening itself (x = 44 ± 1), not halfway between the scribbles (x = 32).
+    let art = box_and_wall(3);
+    let (red, blue) = ([220, 40, 40], [40, 40, 220]);
+    let sc = layer_scribbles(64, 32, &[([2, 16], red), ([62, 2], blue)]);
+    let result =
+        colorize::colorize(&art, &sc, &ColorizeOptions::default(), false).expect("colorizes");
+    let line = LineArt::new(&art).line_mask(0.5);
+    for y in 0..32u32 {
+        for x in (0..64u32).filter(|x| !(43..=45).contains(x)) {
+            if line[(y * 64 + x) as usize] {
+                continue;
+            }
+            let expected = if x < 44 { red } else { blue };
+            let got = result.fill_only.get_pixel(x, y).0;
+            assert_eq!(&got[..3], &expected[..], "({x}, {y})");
+        }
+    }
 }
 
 fn gapped(gap_px: f32) -> (f64, f64) {
@@ -189,6 +285,18 @@ fn an_undrawn_color_boundary_splits_between_the_scribbles() {
         ..Default::default()
     });
     let (ours, flood) = scores(&s, &ColorizeOptions::default());
+    for d in [8.0, 16.0, 32.0, 64.0, 128.0] {
+        let o = ColorizeOptions {
+            split_depth_px: d,
+            ..Default::default()
+        };
+        println!("XX depth {d}: {:.4}", scores(&s, &o).0);
+    }
+    let o = ColorizeOptions {
+        split: colorize::RegionSplit::Weights,
+        ..Default::default()
+    };
+    println!("XX weights: {:.4}", scores(&s, &o).0);
     println!("undrawn boundary: weights {ours:.4}, flood fill {flood:.4}");
     assert!(
         ours >= flood + 0.2 && ours >= 0.9,

@@ -8,7 +8,7 @@
 use clap::builder::{EnumValueParser, TypedValueParser};
 use clap::ValueEnum;
 use sinew::autorig::Template;
-use sinew::colorize::{ColorWeights, FillMode};
+use sinew::colorize::{ColorWeights, FillMode, RegionSplit};
 use sinew::export::spine::{BakeMode, SpinePreset};
 use sinew::schema::SchemaKind;
 use sinew::skin::Blend;
@@ -94,10 +94,18 @@ mirror!(TemplateArg => Template {
 });
 
 mirror!(FillModeArg => FillMode {
-    /// Each pixel takes the color of its largest weight: crisp cartoon fills.
+    /// Each pixel its color: crisp cartoon fills.
     Flat,
-    /// Colors blended by weight.
+    /// Region edges antialiased: each color's share of a small box around the pixel.
     Soft,
+});
+
+mirror!(RegionSplitArg => RegionSplit {
+    /// A depth flood: boundaries where the region is narrowest; a scribble in the middle
+    /// claims more than one in a corner.
+    Depth,
+    /// The content-aware (5D-lifted) weights decide.
+    Weights,
 });
 
 mirror!(SchemaKindArg => SchemaKind {
@@ -156,6 +164,7 @@ mod tests {
         check::<TemplateArg, Template>();
         check::<FillModeArg, FillMode>();
         check::<ColorWeightsArg, ColorWeights>();
+        check::<RegionSplitArg, RegionSplit>();
         for &kind in SchemaKindArg::value_variants() {
             let name = kind.to_possible_value().expect("no hidden values");
             assert_eq!(SchemaKind::from(kind).name(), name.get_name());

@@ -1,9 +1,9 @@
 //! `sinew colorize LINEART.png --scribbles S.png|S.json -o OUT.png`: argument parsing and glue.
 
-use super::choices::{self, ColorWeightsArg, FillModeArg};
+use super::choices::{self, ColorWeightsArg, FillModeArg, RegionSplitArg};
 use anyhow::Result;
 use clap::Args;
-use sinew::colorize::{self, ColorWeights, ColorizeOptions, FillMode};
+use sinew::colorize::{self, ColorWeights, ColorizeOptions, FillMode, RegionSplit};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -18,7 +18,7 @@ pub struct ColorizeArgs {
     /// The colored image to write (PNG).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// flat: each pixel takes its largest weight's color; soft: colors blended by weight.
+    /// flat: each pixel its region's color; soft: region edges antialiased over about 3 px.
     #[arg(long, value_parser = choices::parser::<FillModeArg, FillMode>(), default_value = "flat")]
     pub fill: FillMode,
     /// Also write one mask PNG per scribble color into this folder (NN-rrggbb.png).
@@ -30,6 +30,17 @@ pub struct ColorizeArgs {
     /// Lift scale: a full color change counts as S px.
     #[arg(long, value_name = "S", default_value_t = colorize::DEFAULT_LIFT_SCALE)]
     pub scale: f64,
+    /// Gap closing: lines cast a ridge of ink fading over PX pixels; openings up to about PX
+    /// px wide are closed (0: off).
+    #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().gap_closing_px)]
+    pub gap_closing: f64,
+    /// How a region holding several colors is split: depth (boundaries where it is
+    /// narrowest) or weights (the content-aware weights).
+    #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "depth")]
+    pub split: RegionSplit,
+    /// With --split depth: distances to the lines beyond PX count as PX.
+    #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_depth_px)]
+    pub split_depth: f64,
 }
 
 pub fn run(args: &ColorizeArgs) -> Result<()> {
@@ -38,6 +49,9 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         scale: args.scale,
         weights: args.weights,
         fill: args.fill,
+        gap_closing_px: args.gap_closing,
+        split: args.split,
+        split_depth_px: args.split_depth,
         ..Default::default()
     };
     let files = sinew::jobs::ColorizeFiles {

@@ -1,34 +1,31 @@
-//! From per-vertex color weights to pixels: flat fills, soft blends, per-color masks.
+//! From every pixel's color to pixels: flat fills, antialiased soft fills, per-color masks.
 //!
-//! In: the [`ImageMesh`], its [`WeightMatrix`] (vertices × colors), the palette, the
-//! [`LineArt`] and the original line-art image. Out: the colored image (RGBA8, opaque where the
-//! line art is drawn on paper) and, on request, one mask layer per color.
+//! In: each pixel's color (a 1-based palette index, from [`super::ink_regions::owners`]), the
+//! palette, the [`LineArt`] and the original line-art image. Out: the colored image (RGBA8,
+//! opaque where the line art is drawn on paper) and, on request, one mask layer per color.
 //!
-//! Weights are interpolated linearly inside each triangle to every pixel. `flat`: each pixel
-//! takes the color of its largest weight (ties: the earlier color); `soft`: colors blended by
-//! weight. The line art goes on top: multiplied when it is opaque (ink on paper, as a
-//! "multiply" layer in a paint program: white paper leaves the fill untouched), composited
-//! "over" when it has transparency (lines on their own layer).
+//! `flat`: each pixel its color; `soft`: each color's share of a small box around the pixel
+//! (antialiased region edges, nothing wider). The line art goes on top: multiplied when it is
+//! opaque (ink on paper, as a "multiply" layer in a paint program: white paper leaves the fill
+//! untouched), composited "over" when it has transparency (lines on their own layer).
 
-use super::image_mesh::ImageMesh;
 use super::lineart::LineArt;
-use crate::weights::WeightMatrix;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
 
-/// How weights become colors.
+/// How the pixels' colors are drawn.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FillMode {
-    /// Each pixel takes the color of its largest weight: crisp cartoon fills.
+    /// Each pixel its color: crisp cartoon fills.
     #[default]
     Flat,
-    /// Colors blended by weight.
+    /// Region edges antialiased: each color's share of a small box around the pixel.
     Soft,
 }
 
 /// The filled image and, if asked for, one RGBA mask per color (the color, with the pixel's
-/// share as alpha: 0/255 in flat mode, the weight in soft mode).
+/// share as alpha: 0/255 in flat mode, the share of the box in soft mode).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Filled {
     pub image: RgbaImage,
@@ -36,17 +33,22 @@ pub struct Filled {
     pub layers: Vec<RgbaImage>,
 }
 
-/// Fills the image. `weights` is `None` when there is a single color (it takes everything).
-pub fn fill(
-    mesh: &ImageMesh,
-    weights: Option<&WeightMatrix>,
+/// Fills the image from every pixel's color (`owner`: 1-based palette index, 0 = none:
+/// white). `flat`: each pixel its color; `soft`: each color's share of the pixel's
+/// `soft_radius_px` box (clamped at the border): region edges are antialiased over about
+/// 2·radius + 1 px and nothing spreads further (no halos). Masks: the color with its share as
+/// alpha (they sum to 255 wherever every pixel is owned).
+pub fn fill_owners(
+    owner: &[u16],
     palette: &[[u8; 3]],
     art: &LineArt,
     lineart: &RgbaImage,
     mode: FillMode,
+    soft_radius_px: u32,
     want_layers: bool,
 ) -> Filled {
     let (width, height) = (art.width, art.height);
+    let (w, h) = (width as usize, height as usize);
     let m = palette.len();
     let mut fill_only = RgbaImage::new(width, height);
     let mut layers: Vec<RgbaImage> = if want_layers {
@@ -54,50 +56,61 @@ pub fn fill(
     } else {
         Vec::new()
     };
-    let mut shares = vec![0.0f64; m];
     let fill_raw: &mut [u8] = &mut fill_only;
     let mut layer_raws: Vec<&mut [u8]> = layers.iter_mut().map(|l| &mut **l).collect();
-    let mut paint = |i: usize, shares: &[f64]| {
-        let best = argmax(shares);
-        let color = match mode {
-            FillMode::Flat => palette[best],
-            FillMode::Soft => {
-                let total: f64 = shares.iter().sum();
-                let mut c = [0.0; 3];
-                for (s, p) in shares.iter().zip(palette) {
-                    for k in 0..3 {
-                        c[k] += s * p[k] as f64;
+    let r = match mode {
+        FillMode::Flat => 0,
+        FillMode::Soft => soft_radius_px as usize,
+    };
+    let mut counts = vec![0u32; m + 1];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            let own = owner[i] as usize;
+            let (y0, y1, x0, x1) = (
+                y.saturating_sub(r),
+                (y + r).min(h - 1),
+                x.saturating_sub(r),
+                (x + r).min(w - 1),
+            );
+            // Uniform neighborhoods (the common case) skip the counting.
+            let mut uniform = true;
+            'scan: for yy in y0..=y1 {
+                for &o in &owner[yy * w + x0..=yy * w + x1] {
+                    if o as usize != own {
+                        uniform = false;
+                        break 'scan;
                     }
                 }
-                c.map(|v| (v / total.max(f64::MIN_POSITIVE)).round().clamp(0.0, 255.0) as u8)
             }
-        };
-        fill_raw[4 * i..4 * i + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
-        for (j, layer) in layer_raws.iter_mut().enumerate() {
-            let alpha = match mode {
-                FillMode::Flat => 255 * (j == best) as u8,
-                FillMode::Soft => (shares[j] * 255.0).round().clamp(0.0, 255.0) as u8,
-            };
-            let p = palette[j];
-            layer[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], alpha]);
-        }
-    };
-    match weights {
-        None => {
-            shares.fill(1.0);
-            for i in 0..art.pixel_count() {
-                paint(i, &shares);
+            let total;
+            if uniform {
+                counts.fill(0);
+                counts[own] = 1;
+                total = 1;
+            } else {
+                counts.fill(0);
+                for yy in y0..=y1 {
+                    for &o in &owner[yy * w + x0..=yy * w + x1] {
+                        counts[o as usize] += 1;
+                    }
+                }
+                total = ((y1 - y0 + 1) * (x1 - x0 + 1)) as u32;
             }
-        }
-        Some(w) => mesh.interpolate(|i, bary| {
-            shares.fill(0.0);
-            for (v, b) in bary {
-                for (s, x) in shares.iter_mut().zip(w.row(v as usize)) {
-                    *s += b * x;
+            let mut c = [counts[0] as f64 * 255.0; 3];
+            for (k, p) in palette.iter().enumerate() {
+                for ch in 0..3 {
+                    c[ch] += counts[k + 1] as f64 * p[ch] as f64;
                 }
             }
-            paint(i, &shares);
-        }),
+            let color = c.map(|v| (v / total as f64).round().clamp(0.0, 255.0) as u8);
+            fill_raw[4 * i..4 * i + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
+            for (k, layer) in layer_raws.iter_mut().enumerate() {
+                let alpha = ((counts[k + 1] as f64 * 255.0) / total as f64).round() as u8;
+                let p = palette[k];
+                layer[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], alpha]);
+            }
+        }
     }
     let image = with_lines_on_top(&fill_only, lineart, art.opaque);
     Filled {
@@ -105,17 +118,6 @@ pub fn fill(
         fill_only,
         layers,
     }
-}
-
-/// The first index of the largest value.
-pub fn argmax(values: &[f64]) -> usize {
-    let mut best = 0;
-    for (j, &v) in values.iter().enumerate() {
-        if v > values[best] {
-            best = j;
-        }
-    }
-    best
 }
 
 /// The line art on top of an opaque fill: multiplied if the line art is opaque, composited
@@ -153,11 +155,5 @@ mod tests {
         let out = with_lines_on_top(&fill, &layer, false);
         assert_eq!(out.get_pixel(0, 0).0, [200, 100, 50, 255]);
         assert_eq!(out.get_pixel(1, 0).0, [0, 0, 255, 255]);
-    }
-
-    #[test]
-    fn argmax_prefers_the_earlier_color_on_ties() {
-        assert_eq!(argmax(&[0.25, 0.5, 0.5]), 1);
-        assert_eq!(argmax(&[0.0, 0.0]), 0);
     }
 }

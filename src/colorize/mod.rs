@@ -4,27 +4,26 @@
 //! (a label per pixel, a palette) and [`ColorizeOptions`]. Out: [`Colorized`]: the colored
 //! image (line art on top), the fill alone, and optionally one mask layer per color.
 //!
-//! The method is content-aware weights (Jacobson, Baran, Popović & Sorkine 2011; Jacobson's
-//! thesis 2013 § 3.4 shows this very application), the same machinery `sinew rig
-//! --content-aware` uses, run over the image itself:
+//! The fill respects the ink:
 //!
 //! 1. [`lineart`]: the drawing composited over white paper, and its ink per pixel.
 //! 2. [`scribbles`]: scribble pixels per color (layer or lyon-tessellated polylines); those
 //!    lying on a line are dropped (a line belongs to no region).
-//! 3. [`gap_closing`]: every line casts a fading ridge of ink, so small gaps read as hills
-//!    and one-pixel antialiased lines as walls.
-//! 4. [`image_mesh`]: an adaptive mesh (quadtree vertices, spade Delaunay): one vertex per
-//!    pixel along lines and scribble rims, big triangles over flat paper.
-//! 5. [`weights`]: the mesh lifted to (x, y, s·r, s·g, s·b) by [`crate::weights::lift`], one
-//!    harmonic (or bounded biharmonic) weight function per color, the color's scribble pixels
-//!    fixed at 1 and the other colors' at 0. Across a line the lifted mesh is long, so weights
-//!    stay in their region; through a gap of a few pixels the region's own scribble still
-//!    dominates, so a color boundary forms at the gap instead of a flood.
-//! 6. [`fill`]: weights interpolated to every pixel; flat (largest weight wins) or soft
-//!    (blended) colors; the line art on top.
+//! 3. [`gap_closing`]: every line casts a fading ridge of ink, so small gaps close.
+//! 4. [`ink_regions`]: the regions the closed lines enclose. A region holding scribbles of one
+//!    color takes it, exactly. A region holding several is split by [`RegionSplit`]: a depth
+//!    flood (boundaries where the region is narrowest), or the content-aware weights
+//!    (Jacobson, Baran, Popović & Sorkine 2011; Jacobson's thesis 2013 § 3.4 shows this very
+//!    application): [`image_mesh`] (an adaptive mesh, one vertex per pixel along lines and
+//!    scribble rims) lifted to (x, y, s·r, s·g, s·b) by [`crate::weights::lift`], one
+//!    harmonic (or bounded biharmonic) weight function per color ([`weights`]), each pixel
+//!    taking the largest among its region's colors. Lines, ridges and unscribbled regions
+//!    are reached by a watershed over the ink: colors meet on crests.
+//! 5. [`fill`]: flat (each pixel its color) or soft (antialiased region edges); the line
+//!    art on top.
 //!
-//! [`PreparedLineArt`] keeps steps 1 and 3 (the line art alone) for repeated colorizations of
-//! one drawing; [`session`] is the interactive editing of scribble strokes over it, with undo.
+//! [`PreparedLineArt`] keeps steps 1, 3 and the regions of 4 (the line art alone) for repeated
+//! colorizations of one drawing; [`session`] is the interactive editing of scribble strokes over it, with undo.
 //!
 //! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
 //! [`synthetic`] draws test line art with known true colorings.
@@ -33,6 +32,7 @@ pub mod fill;
 pub mod flood;
 pub mod gap_closing;
 pub mod image_mesh;
+pub mod ink_regions;
 pub mod lineart;
 pub mod score;
 pub mod scribbles;
@@ -42,6 +42,7 @@ pub mod weights;
 
 pub use fill::FillMode;
 pub use image_mesh::{ImageMesh, MeshOptions};
+pub use ink_regions::{InkRegions, RegionSplit};
 pub use lineart::LineArt;
 pub use scribbles::{ScribbleError, ScribbleOptions, Scribbles};
 pub use weights::{ColorWeights, LiftedStiffness};
@@ -72,6 +73,15 @@ pub struct ColorizeOptions {
     pub weights: ColorWeights,
     /// Default: flat.
     pub fill: FillMode,
+    /// How a region holding several scribble colors is split. Default: depth.
+    pub split: RegionSplit,
+    /// `split: depth`: distances to the lines beyond this many px count as this deep (deeper,
+    /// the flood is a plain geodesic one). Default 16.
+    pub split_depth_px: f64,
+
+    /// `soft` fill: each color's share of the (2·r + 1)² px box around a pixel, so region
+    /// edges are antialiased over about that width and nothing spreads further. Default 1.
+    pub soft_radius_px: u32,
     pub mesh: MeshOptions,
     pub scribbles: ScribbleOptions,
     /// Used with `weights: bbw`.
@@ -90,6 +100,10 @@ impl Default for ColorizeOptions {
             stiffness: LiftedStiffness::EdgeStretch,
             weights: ColorWeights::Harmonic,
             fill: FillMode::Flat,
+            split: RegionSplit::Depth,
+            split_depth_px: 16.0,
+
+            soft_radius_px: 1,
             mesh: MeshOptions::default(),
             scribbles: ScribbleOptions::default(),
             bbw: BbwOptions::default(),
@@ -226,6 +240,8 @@ pub struct PreparedLineArt {
     pub art: LineArt,
     /// The colors the lift and the mesh see: [`gap_closing::close_gaps`] of `art.over_white`.
     pub closed: Vec<[u8; 3]>,
+    /// The regions the closed lines enclose, and the ink levels the watershed follows.
+    pub regions: InkRegions,
     pub options: ColorizeOptions,
 }
 
@@ -233,6 +249,9 @@ pub struct PreparedLineArt {
 /// sweep saw 1e300 fail as "not positive definite"; where between the two the solve breaks
 /// down was not measured).
 pub const MAX_LIFT_SCALE_PX: f64 = 1e5;
+
+/// Largest soft-fill radius, px: a wider blend is a blur, not an antialiased edge.
+pub const MAX_SOFT_RADIUS_PX: u32 = 8;
 
 impl PreparedLineArt {
     /// Checks `options` and prepares `lineart` for colorizations with them.
@@ -249,6 +268,18 @@ impl PreparedLineArt {
                 options.line_threshold
             )));
         }
+        if !(options.split_depth_px.is_finite() && options.split_depth_px >= 0.5) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "split_depth_px must be at least 0.5, not {}",
+                options.split_depth_px
+            )));
+        }
+        if options.soft_radius_px > MAX_SOFT_RADIUS_PX {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "soft_radius_px must be at most {MAX_SOFT_RADIUS_PX}, not {}",
+                options.soft_radius_px
+            )));
+        }
         if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
             return Err(ColorizeError::InvalidOptions(format!(
                 "gap_closing_px must be finite and non-negative, not {}",
@@ -263,10 +294,18 @@ impl PreparedLineArt {
             art.height,
             options.gap_closing_px,
         );
+        let regions = InkRegions::new(
+            &closed,
+            art.width,
+            art.height,
+            options.line_threshold,
+            options.split_depth_px,
+        );
         Ok(PreparedLineArt {
             image: lineart,
             art,
             closed,
+            regions,
             options,
         })
     }
@@ -290,20 +329,31 @@ impl PreparedLineArt {
         };
         let (labels, dropped) = effective_labels(art, scribbles, options.line_threshold)?;
         cancelled()?;
-        let mesh = ImageMesh::new(art.width, art.height, closed, &labels, &options.mesh)?;
-        cancelled()?;
         let m = scribbles.colors.len();
-        let weights = if m == 1 {
-            // One color: the whole drawing takes it; nothing to solve.
-            None
-        } else {
+        let (mut vertices, mut triangles) = (0, 0);
+        // Regions closed by lines take their one color; regions holding several are split by
+        // the content-aware weights (only then is the mesh built and solved); the watershed
+        // reaches the rest (ink_regions).
+        let regions = &self.regions;
+        let owner = ink_regions::owners(regions, &labels, |per_region, owner| {
+            let contested = |i: usize| {
+                let r = regions.region[i] as usize;
+                r > 0 && per_region[r - 1].len() > 1
+            };
+            if options.split == RegionSplit::Depth {
+                let (w, h) = (art.width, art.height);
+                ink_regions::watershed_within(&regions.shallowness, owner, w, h, contested);
+                return Ok(());
+            }
+            let mesh = ImageMesh::new(art.width, art.height, closed, &labels, &options.mesh)?;
+            cancelled()?;
             let vertex_pixels = mesh.pixel_indices();
             let colors: Vec<[f64; 3]> = vertex_pixels
                 .iter()
                 .map(|&i| closed[i].map(|c| c as f64 / 255.0))
                 .collect();
             let vertex_labels: Vec<u16> = vertex_pixels.iter().map(|&i| labels[i]).collect();
-            Some(weights::color_weights(
+            let w = weights::color_weights(
                 &mesh,
                 &colors,
                 &vertex_labels,
@@ -314,16 +364,37 @@ impl PreparedLineArt {
                     method: options.weights,
                     bbw: options.bbw.clone(),
                 },
-            )?)
-        };
+            )?;
+            cancelled()?;
+            mesh.interpolate(|i, bary| {
+                if labels[i] != 0 || !contested(i) {
+                    return;
+                }
+                let r = regions.region[i] as usize;
+                let mut best = (f64::NEG_INFINITY, 0u16);
+                for &c in &per_region[r - 1] {
+                    let share: f64 = bary
+                        .iter()
+                        .map(|&(v, b)| b * w.row(v as usize)[c as usize - 1])
+                        .sum();
+                    if share > best.0 {
+                        best = (share, c);
+                    }
+                }
+                owner[i] = best.1;
+            });
+            vertices = mesh.vertex_count();
+            triangles = mesh.triangles.len();
+            Ok::<(), ColorizeError>(())
+        })?;
         cancelled()?;
-        let filled = fill::fill(
-            &mesh,
-            weights.as_ref(),
+        let filled = fill::fill_owners(
+            &owner,
             &scribbles.colors,
             art,
             lineart,
             options.fill,
+            options.soft_radius_px,
             want_layers,
         );
         Ok(Colorized {
@@ -333,8 +404,8 @@ impl PreparedLineArt {
             palette: scribbles.colors.clone(),
             stats: ColorizeStats {
                 pixels: art.pixel_count(),
-                vertices: mesh.vertex_count(),
-                triangles: mesh.triangles.len(),
+                vertices,
+                triangles,
                 scribble_pixels_on_lines: dropped,
             },
         })
