@@ -889,14 +889,13 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
 }
 
 fn export_spine(args: &SpineArgs) -> Result<()> {
-    let preset = args.preset.options();
     let options = SpineOptions {
         version: SpineVersion::parse(&args.spine_version)?,
         bake_fps: args.fps,
         bake: args.bake,
-        max_influences: args.max_influences.or(preset.max_influences),
-        max_vertices: args.max_vertices.or(preset.max_vertices),
-        ..preset
+        ..args
+            .preset
+            .options_with(args.max_influences, args.max_vertices)
     };
     let (export, written) =
         sinew::jobs::export_spine_files(&args.rig, &args.output, args.name.as_deref(), &options)?;

@@ -6,7 +6,7 @@
 //! written once, no cycle) are [`super::plan`]'s.
 
 use crate::colorize::{ColorWeights, ColorizeOptions, FillMode};
-use crate::export::spine::{BakeMode, SpineOptions, SpineVersion};
+use crate::export::spine::{BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use crate::io::BuildOptions;
 use crate::playback::RenderSettings;
 use schemars::JsonSchema;
@@ -210,9 +210,12 @@ pub struct ExportJobOptions {
     /// What is baked. Default auto.
     #[schemars(with = "BakeModeName")]
     pub bake: BakeMode,
-    /// Keep the K strongest weights per vertex. Default all.
+    /// "full" (default) or "game" (at most 250 vertices per mesh and 4 influences per vertex),
+    /// as `--preset`; the two limits below override the preset's.
+    pub preset: SpinePreset,
+    /// Keep the K strongest weights per vertex. Default all (or the preset's).
     pub max_influences: Option<usize>,
-    /// Decimate each mesh to at most N vertices. Default the fine mesh.
+    /// Decimate each mesh to at most N vertices. Default the fine mesh (or the preset's).
     pub max_vertices: Option<usize>,
 }
 
@@ -224,6 +227,7 @@ impl Default for ExportJobOptions {
             spine_version: "4.2".into(),
             bake_fps: spine.bake_fps,
             bake: spine.bake,
+            preset: SpinePreset::Full,
             max_influences: None,
             max_vertices: None,
         }
@@ -423,9 +427,9 @@ impl ExportJobOptions {
                 .map_err(|e| BatchError::Options(e.to_string()))?,
             bake_fps: self.bake_fps,
             bake: self.bake,
-            max_influences: self.max_influences,
-            max_vertices: self.max_vertices,
-            ..SpineOptions::default()
+            ..self
+                .preset
+                .options_with(self.max_influences, self.max_vertices)
         })
     }
 }
@@ -481,4 +485,29 @@ pub fn parse(text: &str) -> Result<Manifest, BatchError> {
         parsed.push(job);
     }
     Ok(Manifest { jobs: parsed })
+}
+
+#[cfg(test)]
+mod preset_tests {
+    use super::*;
+
+    #[test]
+    fn an_export_job_reads_the_preset_and_explicit_limits_override_it() {
+        let job: ExportJobOptions = serde_json::from_str(r#"{"preset": "game"}"#).unwrap();
+        let game = job.spine().unwrap();
+        assert_eq!(
+            game.max_vertices,
+            Some(crate::export::spine::GAME_PRESET_MAX_VERTICES)
+        );
+        assert_eq!(
+            game.max_influences,
+            Some(crate::export::spine::GAME_PRESET_MAX_INFLUENCES)
+        );
+        let job: ExportJobOptions =
+            serde_json::from_str(r#"{"preset": "game", "max_vertices": 40}"#).unwrap();
+        assert_eq!(job.spine().unwrap().max_vertices, Some(40));
+        let full = ExportJobOptions::default().spine().unwrap();
+        assert_eq!(full, SpineOptions::default());
+        assert!(serde_json::from_str::<ExportJobOptions>(r#"{"preset": "tiny"}"#).is_err());
+    }
 }

@@ -132,7 +132,9 @@ impl Default for SpineOptions {
 }
 
 /// A named set of [`SpineOptions`] for a kind of target; explicit options override its fields.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum SpinePreset {
     /// Every vertex and influence of the rig: the export plays exactly what sinew draws.
@@ -153,6 +155,22 @@ pub const GAME_PRESET_MAX_VERTICES: usize = 250;
 pub const GAME_PRESET_MAX_INFLUENCES: usize = 4;
 
 impl SpinePreset {
+    /// The preset's options with the limits given explicitly in their place (the rest of the
+    /// preset's options kept): how `sinew export spine --preset P --max-vertices N` and a batch
+    /// export job read.
+    pub fn options_with(
+        self,
+        max_influences: Option<usize>,
+        max_vertices: Option<usize>,
+    ) -> SpineOptions {
+        let preset = self.options();
+        SpineOptions {
+            max_influences: max_influences.or(preset.max_influences),
+            max_vertices: max_vertices.or(preset.max_vertices),
+            ..preset
+        }
+    }
+
     /// The preset's options (the rest default).
     pub fn options(self) -> SpineOptions {
         match self {
