@@ -5,7 +5,7 @@
 mod command;
 mod common;
 
-use command::{assert_bad_input, s, scratch, sinew};
+use command::{assert_bad_input, s, scratch};
 use serde_json::{json, Value};
 use sinew::export::spine::{export_spine, SpineOptions, SpineVersion};
 use sinew::pipeline::Scene;
@@ -16,22 +16,13 @@ use std::path::{Path, PathBuf};
 fn rig(dir: &Path) -> (Value, PathBuf) {
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
+    command::rig_cli(
+        dir,
+        &[&sprite],
         r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,30]},
                      {"name":"b","parent":"a","head":[32,30],"tail":[32,18]}]}"#,
+        &[],
     )
-    .unwrap();
-    let rig = dir.join("rig.json");
-    let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
-    (doc, rig)
 }
 
 fn write(path: &Path, value: &Value) -> PathBuf {

@@ -14,17 +14,12 @@ use std::path::Path;
 fn rig_with(dir: &Path, events: serde_json::Value, animation: serde_json::Value) -> String {
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
+    let (mut doc, rig) = command::rig_cli(
+        dir,
+        &[&sprite],
         r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
-    )
-    .unwrap();
-    let rig = dir.join("rig.json");
-    let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(out.status.success());
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+        &[],
+    );
     doc["events"] = events;
     doc["animations"] = serde_json::json!({ "go": animation });
     let text = doc.to_string();

@@ -17,23 +17,10 @@ use std::time::Instant;
 fn rig(dir: &Path, size: u32, seconds: f64) -> PathBuf {
     let sprite = dir.join("critter.png");
     common::critter(size).save(&sprite).unwrap();
-    let handles = dir.join("handles.json");
     let c = f64::from(size) / 2.0;
-    std::fs::write(
-        &handles,
-        serde_json::json!({"bones": [{"name": "a", "head": [c, c * 1.4], "tail": [c, c * 0.6]}]})
-            .to_string(),
-    )
-    .unwrap();
-    let rig = dir.join("rig.json");
-    let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    let handles =
+        serde_json::json!({"bones": [{"name": "a", "head": [c, c * 1.4], "tail": [c, c * 0.6]}]});
+    let (mut doc, rig) = command::rig_cli(dir, &[&sprite], &handles.to_string(), &[]);
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": seconds, "value": 90}
     ]}}}});

@@ -4,7 +4,7 @@
 mod command;
 mod common;
 
-use command::{assert_bad_input, s, scratch, sinew};
+use command::{assert_bad_input, s, scratch};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 
@@ -12,20 +12,12 @@ use std::path::{Path, PathBuf};
 fn rig(dir: &Path) -> (Value, PathBuf) {
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
+    let (mut doc, rig) = command::rig_cli(
+        dir,
+        &[&sprite],
         r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
-    )
-    .unwrap();
-    let rig = dir.join("rig.json");
-    let out = sinew(&["rig", s(&sprite), "--handles", s(&handles), "-o", s(&rig)]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &[],
     );
-    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
     doc["animations"] = json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
     ]}}}});

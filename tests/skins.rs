@@ -21,30 +21,12 @@ fn rig(dir: &Path) -> (Value, PathBuf) {
         p.0.swap(0, 2);
     }
     blue.save(dir.join("critter_blue.png")).unwrap();
-    let handles = dir.join("handles.json");
-    std::fs::write(
-        &handles,
+    let (mut doc, rig) = command::rig_cli(
+        dir,
+        &[&dir.join("critter.png"), &dir.join("critter_blue.png")],
         r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
-    )
-    .unwrap();
-    let rig = dir.join("rig.json");
-    let out = sinew(&[
-        "rig",
-        s(&dir.join("critter.png")),
-        s(&dir.join("critter_blue.png")),
-        "--handles",
-        s(&handles),
-        "--attachment",
-        "critter_blue=critter",
-        "-o",
-        s(&rig),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        &["--attachment", "critter_blue=critter"],
     );
-    let mut doc: Value = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
     assert_eq!(doc["parts"][1]["slot"], json!("critter"));
     doc["skins"] = json!({"blue": {"critter": "critter_blue"}});
     doc["animations"] = json!({"swap": {

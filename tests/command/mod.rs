@@ -39,6 +39,32 @@ pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `sinew rig IMAGES --handles DIR/handles.json -o DIR/rig.json EXTRA...` with `handles_json`
+/// written to that handles file; asserts success. Returns the rig document and its path.
+#[cfg(feature = "cli")]
+pub fn rig_cli(
+    dir: &Path,
+    images: &[&Path],
+    handles_json: &str,
+    extra: &[&str],
+) -> (serde_json::Value, PathBuf) {
+    let handles = dir.join("handles.json");
+    std::fs::write(&handles, handles_json).unwrap();
+    let rig = dir.join("rig.json");
+    let mut args = vec!["rig"];
+    args.extend(images.iter().map(|p| s(p)));
+    args.extend(["--handles", s(&handles), "-o", s(&rig)]);
+    args.extend_from_slice(extra);
+    let out = sinew(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc = serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    (doc, rig)
+}
+
 /// Runs a command that must fail on bad input, checks the contract and that the message
 /// mentions `expect_in_message`; returns stderr.
 #[cfg(feature = "cli")]
