@@ -42,23 +42,14 @@ impl Animation {
 
 #[cfg(test)]
 mod tests {
-    use crate::io::{MeshDoc, PartDoc, RigDocument};
+    use crate::io::slots::tests::part;
+    use crate::io::RigDocument;
     use serde_json::json;
 
     fn doc(animation: serde_json::Value) -> RigDocument {
         let mut doc = RigDocument::new([4, 4]);
         for (name, slot) in [("body", None), ("hand", None), ("fist", Some("hand"))] {
-            doc.parts.push(PartDoc {
-                name: name.into(),
-                slot: slot.map(Into::into),
-                image: format!("{name}.png"),
-                mesh: MeshDoc {
-                    vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-                    triangles: vec![[0, 1, 2]],
-                },
-                weights: None,
-                stale_weights: None,
-            });
+            doc.parts.push(part(name, slot));
         }
         doc.animations = crate::anim::animations_from_json(&json!({ "grab": animation })).unwrap();
         doc

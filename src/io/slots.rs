@@ -223,12 +223,14 @@ pub(super) fn validate_slots(doc: &RigDocument) -> Result<(), String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::io::{MeshDoc, PartDoc};
     use std::path::Path;
 
-    fn part(name: &str, slot: Option<&str>) -> PartDoc {
+    /// A one-triangle part named `name` (image `NAME.png`), another attachment of `slot` if
+    /// given; no weights. Shared by the crate's slot and attachment tests.
+    pub(crate) fn part(name: &str, slot: Option<&str>) -> PartDoc {
         PartDoc {
             name: name.into(),
             slot: slot.map(Into::into),
