@@ -195,16 +195,8 @@ fn remove_bone(bones: &mut Vec<ProtoBone>, r: usize, shape: &Shape) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::autorig::shape::tests::square;
     use crate::trace::Outline;
-
-    fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Point> {
-        vec![
-            Point::new(x0, y0),
-            Point::new(x1, y0),
-            Point::new(x1, y1),
-            Point::new(x0, y1),
-        ]
-    }
 
     fn bone(head: (f64, f64), tail: (f64, f64), parent: Option<usize>) -> ProtoBone {
         ProtoBone {

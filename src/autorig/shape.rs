@@ -259,10 +259,11 @@ fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Point> {
+    /// The axis-aligned rectangle (x0, y0)–(x1, y1): its four corners from (x0, y0) along x first.
+    pub(crate) fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Point> {
         vec![
             Point::new(x0, y0),
             Point::new(x1, y0),
