@@ -286,8 +286,8 @@ impl RigDocument {
 
     /// Writes the document to `path` atomically in `layout`. Weights are written at f32
     /// precision (the shortest text that reads back as the weight's nearest f32): a row then
-    /// sums to one within 1e-7, well inside [`WEIGHT_TOLERANCE`], and the file is about a
-    /// third of the f64 text.
+    /// sums to one within 1e-7, well inside [`WEIGHT_TOLERANCE`]. The bundled character's
+    /// document is 1.3 MB this way (compact), against 5.7 MB pretty-printed with f64 weights.
     pub fn save_with(&self, path: &Path, layout: JsonLayout) -> Result<(), DocumentError> {
         let json_error = |e: serde_json::Error| DocumentError::Json {
             path: path.into(),
