@@ -32,10 +32,7 @@ fn bench_autorig(c: &mut Criterion) {
     };
     for size in [512u32, 2048] {
         let image = character(size);
-        let layers = [LayerRef {
-            name: "flat",
-            image: &image,
-        }];
+        let layers = [LayerRef::whole("flat", &image)];
         group.bench_with_input(BenchmarkId::new("skeleton", size), &layers, |b, layers| {
             b.iter(|| autorig(black_box(layers), &AutorigOptions::default()).unwrap())
         });

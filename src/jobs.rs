@@ -168,9 +168,14 @@ pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
 ) -> Result<Proposal, JobError> {
     let refs: Vec<LayerRef> = layers
         .iter()
-        .map(|l| LayerRef {
-            name: &l.borrow().name,
-            image: &l.borrow().image,
+        .map(|l| {
+            let l = l.borrow();
+            LayerRef {
+                name: &l.name,
+                image: &l.image,
+                offset_px: l.offset_px,
+                canvas_px: l.canvas_px,
+            }
         })
         .collect();
     Ok(autorig::autorig(&refs, options)?)

@@ -93,9 +93,9 @@ fn a_failing_command_changes_nothing() {
         assert!(doc.posable().is_some());
     }
     assert_eq!(doc.can_undo(), undo_depth_probe);
-    // A layer of another size is refused too.
-    let mut small = bar_layer("small", &std::env::temp_dir(), false);
-    small.image = RgbaImage::new(10, 10);
+    // A layer on a canvas of another size is refused too.
+    let bar = bar_layer("small", &std::env::temp_dir(), false);
+    let small = sinew::pipeline::Layer::whole("small", bar.path, RgbaImage::new(10, 10));
     assert!(matches!(
         doc.apply(Command::AddLayer(small)),
         Err(DocumentError::LayerSize { .. })

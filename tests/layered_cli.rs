@@ -74,10 +74,54 @@ fn rest_pose_matches(file: &str, reference: &RgbaImage, name: &str) {
         ["torso", "arm_l/upper", "arm_l/hand", "head", "leaf"]
     );
     assert!(dir.join("rig.parts/arm_l/hand.png").is_file());
+    parts_keep_their_layers_bounds(&art, &dir, &doc);
     let rest = image::open(&rest).unwrap().into_rgba8();
     let db = psnr(&rest, reference);
     println!("{file}: rest pose vs the tool's flattened image: PSNR {db:.1} dB");
     assert!(db >= 40.0, "{file}: PSNR {db:.1} dB");
+}
+
+/// Each part's image is its layer's opaque pixels, no larger than the layer's bounds, placed at
+/// their offset on the canvas (a trimmed layer does not become a canvas-sized texture).
+fn parts_keep_their_layers_bounds(art: &Path, dir: &Path, doc: &serde_json::Value) {
+    let file = sinew::io::layered::load_layered(art, &Default::default()).unwrap();
+    let canvas = file.canvas_px;
+    for part in doc["parts"].as_array().unwrap() {
+        let name = part["name"].as_str().unwrap();
+        let layer = file.layers.iter().find(|l| l.path == name).unwrap();
+        let image = image::open(dir.join(part["image"].as_str().unwrap()))
+            .unwrap()
+            .into_rgba8();
+        let (w, h) = image.dimensions();
+        let bounds = layer.image.dimensions();
+        assert!(
+            w <= bounds.0 && h <= bounds.1,
+            "{name}: {w}×{h} px image for a layer of {bounds:?} px"
+        );
+        assert!(
+            w < canvas[0] || h < canvas[1],
+            "{name}: its image is the whole canvas"
+        );
+        let offset: Vec<i64> = match part.get("offset_px") {
+            Some(o) => o
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_i64().unwrap())
+                .collect(),
+            None => vec![0, 0],
+        };
+        assert!(
+            offset[0] >= i64::from(layer.offset_px[0])
+                && offset[1] >= i64::from(layer.offset_px[1]),
+            "{name}: placed at {offset:?}, left of or above its layer at {:?}",
+            layer.offset_px
+        );
+        // Its opaque pixels touch every side of the image: it is trimmed.
+        let opaque = |x: u32, y: u32| image.get_pixel(x, y)[3] > 0;
+        assert!((0..h).any(|y| opaque(0, y)) && (0..h).any(|y| opaque(w - 1, y)));
+        assert!((0..w).any(|x| opaque(x, 0)) && (0..w).any(|x| opaque(x, h - 1)));
+    }
 }
 
 #[test]

@@ -34,12 +34,19 @@ pub struct Shape {
     edges: EdgeGrid,
 }
 
-/// The union of the layers' alpha (the largest alpha per pixel; color is not used).
-pub fn union_alpha(layers: &[&RgbaImage]) -> RgbaImage {
-    let (w, h) = layers.first().map_or((0, 0), |l| l.dimensions());
+/// The union of the layers' alpha on the first layer's canvas (the largest alpha per pixel;
+/// color is not used; pixels off the canvas dropped).
+pub fn union_alpha(layers: &[super::LayerRef]) -> RgbaImage {
+    let [w, h] = layers.first().map_or([0, 0], |l| l.canvas_px);
     let mut out = RgbaImage::new(w, h);
     for layer in layers {
-        for (o, p) in out.pixels_mut().zip(layer.pixels()) {
+        let [ox, oy] = layer.offset_px.map(i64::from);
+        for (x, y, p) in layer.image.enumerate_pixels() {
+            let (cx, cy) = (ox + i64::from(x), oy + i64::from(y));
+            if cx < 0 || cy < 0 || cx >= i64::from(w) || cy >= i64::from(h) {
+                continue;
+            }
+            let o = out.get_pixel_mut(cx as u32, cy as u32);
             o[3] = o[3].max(p[3]);
         }
     }
@@ -58,6 +65,20 @@ impl Shape {
             image.width(),
             image.height(),
         )))
+    }
+
+    /// Traces one layer's image and places the shape where the layer lies on its canvas.
+    /// Returns `Ok(None)` when no region is large enough.
+    pub fn trace_placed(
+        layer: &super::LayerRef,
+        options: &TraceOptions,
+    ) -> Result<Option<Shape>, TraceError> {
+        let outlines = trace::translated(trace::trace(layer.image, options)?, layer.offset_px);
+        if outlines.is_empty() {
+            return Ok(None);
+        }
+        let [w, h] = layer.canvas_px;
+        Ok(Some(Shape::from_outlines(outlines, w, h)))
     }
 
     /// A shape from outlines already traced on a `width` × `height` canvas.
