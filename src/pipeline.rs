@@ -480,11 +480,39 @@ pub fn vertex_colors(layer: &Layer, vertices: &[Point]) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// `path` with its nearest existing ancestor resolved ([`std::fs::canonicalize`]: absolute,
+/// symbolic links followed) and the components below it appended; `None` when no ancestor
+/// resolves or a `..` follows a component that does not exist.
+fn resolved(path: &Path) -> Option<PathBuf> {
+    let mut missing = Vec::new();
+    let mut existing = path;
+    loop {
+        if let Ok(base) = std::fs::canonicalize(if existing.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            existing
+        }) {
+            let mut out = base;
+            for component in missing.iter().rev() {
+                match component {
+                    std::path::Component::Normal(name) => out.push(name),
+                    std::path::Component::CurDir => {}
+                    _ => return None,
+                }
+            }
+            return Some(out);
+        }
+        let component = existing.components().next_back()?;
+        missing.push(component);
+        existing = existing.parent()?;
+    }
+}
+
 /// `target` as a path relative to `dir` (with `/` separators) when both resolve; otherwise
-/// `target` made absolute.
+/// `target` as given. Either may not exist yet (a part image written with the document):
+/// its nearest existing folder is resolved and the rest appended.
 pub fn relative_path(dir: &Path, target: &Path) -> String {
-    let absolute = |p: &Path| std::fs::canonicalize(p).ok();
-    let (Some(dir), Some(target)) = (absolute(dir), absolute(target)) else {
+    let (Some(dir), Some(target)) = (resolved(dir), resolved(target)) else {
         return target.to_string_lossy().into_owned();
     };
     let common = dir
@@ -653,6 +681,19 @@ mod tests {
             "../../c/x.png"
         );
         assert_eq!(relative_path(&dir.join("c"), &dir.join("c/x.png")), "x.png");
+        // A part image not written yet, under a folder not made yet (`sinew rig art.psd -o
+        // out/rig.json` writes `out/rig.parts/…` with the document).
+        assert_eq!(
+            relative_path(&dir.join("c"), &dir.join("c/./rig.parts/arm/hand.png")),
+            "rig.parts/arm/hand.png"
+        );
+        let cwd_relative = dir.strip_prefix(std::env::current_dir().unwrap());
+        if let Ok(from_cwd) = cwd_relative {
+            assert_eq!(
+                relative_path(&from_cwd.join("c"), &from_cwd.join("c/rig.parts/x.png")),
+                "rig.parts/x.png"
+            );
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -88,6 +88,11 @@ fn parts_keep_their_layers_bounds(art: &Path, dir: &Path, doc: &serde_json::Valu
     let canvas = file.canvas_px;
     for part in doc["parts"].as_array().unwrap() {
         let name = part["name"].as_str().unwrap();
+        let image_path = part["image"].as_str().unwrap();
+        assert!(
+            image_path.starts_with("rig.parts/"),
+            "{name}: image '{image_path}' is not relative to the document's folder"
+        );
         let layer = file.layers.iter().find(|l| l.path == name).unwrap();
         let image = image::open(dir.join(part["image"].as_str().unwrap()))
             .unwrap()
