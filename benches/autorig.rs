@@ -34,12 +34,12 @@ fn bench_autorig(c: &mut Criterion) {
         let image = character(size);
         let layers = [LayerRef::whole("flat", &image)];
         group.bench_with_input(BenchmarkId::new("skeleton", size), &layers, |b, layers| {
-            b.iter(|| autorig(black_box(layers), &AutorigOptions::default()).unwrap())
+            b.iter(|| autorig(black_box(layers), &[], &AutorigOptions::default()).unwrap())
         });
         group.bench_with_input(
             BenchmarkId::new("template+cage+points", size),
             &layers,
-            |b, layers| b.iter(|| autorig(black_box(layers), &everything).unwrap()),
+            |b, layers| b.iter(|| autorig(black_box(layers), &[], &everything).unwrap()),
         );
     }
     group.finish();

@@ -32,6 +32,8 @@ pub struct Art {
     pub notes: Vec<String>,
     /// Indices into `layers` of the images to write (those from layered files).
     pub unwritten: Vec<usize>,
+    /// Bone origins marked in the layered files (pivot layers), canvas px.
+    pub pivots: Vec<layered::Pivot>,
 }
 
 impl Art {
@@ -111,6 +113,7 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
     let mut layers = Vec::new();
     let mut notes = Vec::new();
     let mut unwritten = Vec::new();
+    let mut pivots = Vec::new();
     for path in paths {
         if !is_layered(path) {
             let name = path
@@ -121,6 +124,7 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
             continue;
         }
         let file = layered::load_layered(path, &options.limits)?;
+        pivots.extend(file.pivots.iter().cloned());
         let shown = path.display();
         notes.extend(file.warnings.iter().map(|w| format!("{shown}: {w}")));
         for l in &file.layers {
@@ -149,6 +153,7 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
         layers: checked_layers(layers)?,
         notes,
         unwritten,
+        pivots,
     })
 }
 

@@ -164,6 +164,7 @@ pub fn render_animation(
 /// [`crate::document::Command::SetHandles`] and edit like hand-placed ones.
 pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
     layers: &[L],
+    pivots: &[crate::io::layered::Pivot],
     options: &AutorigOptions,
 ) -> Result<Proposal, JobError> {
     let refs: Vec<LayerRef> = layers
@@ -178,5 +179,5 @@ pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
             }
         })
         .collect();
-    Ok(autorig::autorig(&refs, options)?)
+    Ok(autorig::autorig(&refs, pivots, options)?)
 }

@@ -257,7 +257,7 @@ fn propose(images: &[(&str, &RgbaImage)], options: &AutorigOptions) -> Handles {
         .iter()
         .map(|(name, image)| LayerRef::whole(name, image))
         .collect();
-    autorig(&layers, options).expect("autorig").handles
+    autorig(&layers, &[], options).expect("autorig").handles
 }
 
 fn one(image: &RgbaImage) -> Handles {

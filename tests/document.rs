@@ -397,7 +397,7 @@ fn cages_regions_and_proposed_handles_are_commands() {
     pose.bones.insert("upper".into(), Default::default());
     doc.apply(Command::SetPose(pose)).unwrap();
     let before = doc.state().handles.clone();
-    let proposal = sinew::jobs::propose_handles(&doc.state().layers, &Default::default())
+    let proposal = sinew::jobs::propose_handles(&doc.state().layers, &[], &Default::default())
         .expect("the bar gets a skeleton");
     assert!(!proposal.handles.bones.is_empty());
     doc.apply(Command::SetHandles(proposal.handles.clone()))

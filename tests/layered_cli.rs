@@ -144,6 +144,40 @@ fn krita_ora_rig_rest_pose_renders_kritas_merged_image() {
     rest_pose_matches("krita.ora", &reference, "ora");
 }
 
+/// A group's pivot layer (`shoulder [origin]` in `arm_l`) starts the bone of the group's first
+/// part there; the next part of the group joins it where they overlap, as without pivots.
+#[test]
+fn a_groups_pivot_layer_is_where_its_first_bone_starts() {
+    let dir = scratch("pivots");
+    let handles = dir.join("handles.json");
+    ok(&["autorig", s(&fixture("pivots.psd")), "-o", s(&handles)]);
+    let proposal: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&handles).unwrap()).unwrap();
+    let head = |name: &str| -> [f64; 2] {
+        let bone = proposal["bones"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|b| b["name"] == name)
+            .unwrap_or_else(|| panic!("no bone '{name}' in {proposal}"));
+        [0, 1].map(|k| bone["head"][k].as_f64().unwrap())
+    };
+    let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    // The dot's centre: pixels 74..78 × 49..53.
+    let pivot = [76.0, 51.0];
+    let upper = head("arm_l/upper");
+    assert!(
+        distance(upper, pivot) < 1.0,
+        "the upper arm starts at {upper:?}, not at the pivot {pivot:?}"
+    );
+    // The forearm hangs from the upper arm where they overlap (x 100..112, y 50..58).
+    let forearm = head("arm_l/forearm");
+    assert!(
+        distance(forearm, pivot) > 20.0 && (99.0..=113.0).contains(&forearm[0]),
+        "the forearm starts at {forearm:?}"
+    );
+}
+
 #[test]
 fn bad_layered_files_are_refused_and_nothing_is_written() {
     let dir = scratch("bad");

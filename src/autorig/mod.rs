@@ -111,8 +111,15 @@ pub enum AutorigError {
     InvalidOptions(String),
 }
 
-/// Proposes handles for `layers` (back to front, one canvas).
-pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal, AutorigError> {
+/// Proposes handles for `layers` (back to front, one canvas). `pivots` are bone origins the
+/// artist marked in a layered file (see [`crate::io::layered::Pivot`]): with several layers,
+/// the bone of a group's first part (the one joined to a part outside the group, or a root)
+/// starts at the group's pivot; a pivot outside any group starts the skeleton's root bone.
+pub fn autorig(
+    layers: &[LayerRef],
+    pivots: &[crate::io::layered::Pivot],
+    options: &AutorigOptions,
+) -> Result<Proposal, AutorigError> {
     let first = layers.first().ok_or(AutorigError::NoLayers)?;
     if let Some(l) = layers.iter().find(|l| l.canvas_px != first.canvas_px) {
         return Err(AutorigError::SizeMismatch(l.name.to_string()));
@@ -191,7 +198,7 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
             .iter()
             .map(|(name, shape)| layers::Part { name, shape })
             .collect();
-        let (bones, bone_part) = layers::layered_skeleton(&parts, &options.medial, so)?;
+        let (bones, bone_part) = layers::layered_skeleton(&parts, pivots, &options.medial, so)?;
         for (b, &p) in bones.iter().zip(&bone_part) {
             if let Some(name) = &b.name {
                 bind.insert(name.clone(), vec![parts[p].name.to_string()]);

@@ -106,6 +106,41 @@ impl Shape {
         x < self.width && y < self.height && self.inside[(y * self.width + x) as usize]
     }
 
+    /// The cells that may be inside, as `[x0, y0, x1, y1)` (columns x0..x1, rows y0..y1 of
+    /// [`Shape::inside`]): the outlines' bounding box on the grid. Loops over a layer's inside
+    /// cells stay within it, so a small layer on a large canvas costs its own size.
+    pub fn cell_box(&self) -> [usize; 4] {
+        let (mut lo, mut hi) = (
+            Point::new(f64::MAX, f64::MAX),
+            Point::new(f64::MIN, f64::MIN),
+        );
+        for p in rings(&self.outlines).flatten() {
+            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        if lo.x > hi.x {
+            return [0; 4];
+        }
+        let clamp = |v: f64, n: u32| (v.max(0.0) as usize).min(n as usize);
+        [
+            clamp(lo.x.floor(), self.width),
+            clamp(lo.y.floor(), self.height),
+            clamp(hi.x.ceil() + 1.0, self.width),
+            clamp(hi.y.ceil() + 1.0, self.height),
+        ]
+    }
+
+    /// The inside cells' centres, px, row by row.
+    pub fn inside_centers(&self) -> impl Iterator<Item = Point> + '_ {
+        let [x0, y0, x1, y1] = self.cell_box();
+        let w = self.width as usize;
+        (y0..y1).flat_map(move |y| {
+            (x0..x1)
+                .filter(move |&x| self.inside[y * w + x])
+                .map(move |x| Point::new(x as f64 + 0.5, y as f64 + 0.5))
+        })
+    }
+
     /// Whether `p` lies inside the outlines (even-odd over every ring), exactly.
     pub fn contains(&self, p: Point) -> bool {
         rings(&self.outlines)
