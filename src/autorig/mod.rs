@@ -223,6 +223,8 @@ pub fn autorig(
     budget::drop_short_bones(&mut bones, &silhouette, min_bone_px);
     let max_bones = budget::bone_budget(so, options.template);
     skeleton::limit_bones(&mut bones, Some(max_bones), &silhouette);
+    let min_bones = budget::bone_minimum(so, options.template);
+    budget::reach_minimum(&mut bones, min_bones.min(max_bones), min_bone_px);
     let bones = name_bones(bones);
     bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
 
