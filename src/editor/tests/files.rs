@@ -280,6 +280,20 @@ fn a_dropped_psd_becomes_its_visible_layers() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("'sketch' is hidden"), "{message}");
     assert!(dir.join("character.parts/arm_l/hand.png").is_file());
+    // Each layer keeps its own pixels (the hand is 20×20 px at (78, 96) on a 120×160 canvas),
+    // not a canvas-sized copy.
+    let layers = h.state().doc.state().layers.clone();
+    let hand = layers
+        .iter()
+        .find(|l| l.name == "arm_l/hand")
+        .expect("the hand");
+    assert_eq!(hand.canvas_px, [120, 160]);
+    assert!(hand.image.width() <= 20 && hand.image.height() <= 20);
+    assert!(
+        hand.offset_px[0] >= 78 && hand.offset_px[1] >= 96,
+        "{:?}",
+        hand.offset_px
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
