@@ -27,6 +27,7 @@ pub mod file_menu;
 pub mod gizmo;
 mod identity;
 pub mod messages;
+pub mod native_dialog;
 pub mod numbers;
 pub mod paint;
 pub mod pose_mode;
@@ -177,6 +178,8 @@ pub struct EditorApp {
     pub timeline: timeline::TimelineState,
     /// The tree view: renaming in place, the parts hidden on the canvas.
     pub tree: tree::TreeState,
+    /// Native file dialogs, where a portal answers ([`native_dialog`]).
+    pub dialogs: native_dialog::NativeDialogs,
 }
 
 impl EditorApp {
@@ -233,6 +236,7 @@ impl EditorApp {
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),
             tree: Default::default(),
+            dialogs: Default::default(),
         }
     }
 
@@ -267,6 +271,7 @@ impl EditorApp {
         self.dialog_takes_input(&ctx);
         self.poll_worker();
         self.poll_render();
+        self.poll_dialogs(&ctx);
         self.poll_rig_tools(&ctx);
         self.warm_ik();
         self.colorize_frame_start(&ctx);
@@ -632,6 +637,7 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         None => Document::new(),
     };
     let mut app = EditorApp::new(doc);
+    app.use_native_dialogs_where_a_portal_answers();
     if let Some(path) = &start.frame_log {
         app.frame_log = Some(
             FrameLog::create(path)
