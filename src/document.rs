@@ -50,6 +50,8 @@ pub enum DocumentError {
     UnknownHandle(String),
     #[error("there is no layer named '{0}'")]
     UnknownLayer(String),
+    #[error("'{parent}' cannot be the parent of '{bone}': it is '{bone}' or hangs below it")]
+    ReparentCycle { bone: String, parent: String },
     #[error("a layer named '{0}' already exists")]
     DuplicateLayer(String),
     #[error("layer '{name}' is {got:?} px but the canvas is {canvas:?} px")]
@@ -807,6 +809,29 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             }
         }
         Command::Reparent { bone, parent } => {
+            if let Some(parent) = &parent {
+                if !next.handles.bones.iter().any(|b| b.name == *parent) {
+                    return Err(DocumentError::UnknownHandle(parent.clone()));
+                }
+                // Walk up from the new parent: meeting `bone` would close a loop.
+                let mut up = Some(parent.clone());
+                let mut steps = 0;
+                while let Some(name) = up {
+                    if name == bone || steps > next.handles.bones.len() {
+                        return Err(DocumentError::ReparentCycle {
+                            bone,
+                            parent: parent.clone(),
+                        });
+                    }
+                    steps += 1;
+                    up = next
+                        .handles
+                        .bones
+                        .iter()
+                        .find(|b| b.name == name)
+                        .and_then(|b| b.parent.clone());
+                }
+            }
             let b = next
                 .handles
                 .bones
