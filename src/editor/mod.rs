@@ -25,6 +25,7 @@ pub mod drawing;
 pub mod file;
 pub mod file_menu;
 pub mod gizmo;
+pub mod graph_view;
 mod identity;
 pub mod messages;
 pub mod native_dialog;
@@ -297,6 +298,9 @@ impl EditorApp {
             help_window(&ctx, &mut self.show_help);
         }
         self.file_windows(&ctx);
+        if self.mode == Mode::Animate {
+            self.graph_view_window(&ctx);
+        }
         self.log_window(&ctx);
         self.close_dialog(&ctx);
         self.take_screenshot(&ctx);
