@@ -143,9 +143,13 @@ impl EditorApp {
             self.timeline.graph.layout = None;
             return;
         }
+        // Over the canvas's right side, not over the side panel.
+        let right_top = ctx.content_rect().right_top() + egui::vec2(-16.0, 48.0);
         egui::Window::new("Graph view")
             .open(&mut open)
             .resizable(true)
+            .pivot(egui::Align2::RIGHT_TOP)
+            .default_pos(right_top)
             .default_size(GRAPH_DEFAULT_PT)
             .show(ctx, |ui| self.graph_view(ui));
         self.timeline.graph.open = open;

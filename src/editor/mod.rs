@@ -590,6 +590,8 @@ pub struct Start {
     pub select: Option<String>,
     /// Take a picture of the first frames to this PNG, then quit.
     pub screenshot: Option<PathBuf>,
+    /// Open the graph view window ([`graph_view`]) at start.
+    pub graph_view: bool,
     /// Line art to open in colorize mode.
     pub line_art: Option<PathBuf>,
     /// Scribbles (the JSON file of `sinew colorize --scribbles`) to draw on the line art.
@@ -675,6 +677,7 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         app.rig_mode.rename_to = name.clone();
         app.selected = Some(name);
     }
+    app.timeline.graph.open = start.graph_view;
     if let Some(path) = &start.line_art {
         app.open_lineart(path);
         if app.colorize.session.is_none() {
