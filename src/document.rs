@@ -249,6 +249,15 @@ pub enum Command {
         time_s: f64,
         pose: Pose,
     },
+    /// Keys which attachment slot `slot` shows from `time_s` on in `animation` (a stepped
+    /// key of `parts.SLOT.attachment`; `None`: the slot shows nothing). A key already at that
+    /// time is replaced; an attachment the slot does not have is refused.
+    KeyAttachment {
+        animation: String,
+        slot: String,
+        time_s: f64,
+        attachment: Option<String>,
+    },
     /// Removes every key of `animation` at `time_s`.
     DeleteKeys {
         animation: String,
@@ -871,6 +880,18 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             if anim == before && state.animations.contains_key(&animation) {
                 return Err(DocumentError::NothingToKey(time_s));
             }
+            store_animation(&mut next, &animation, anim)?;
+            inputs_changed = false;
+        }
+        Command::KeyAttachment {
+            animation,
+            slot,
+            time_s,
+            attachment,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation);
+            animations::key_attachment(state, &mut anim, &slot, time_s, attachment)?;
             store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }

@@ -263,3 +263,69 @@ mod tests {
         assert!(matches!(e, Err(DocumentError::NothingToKey(_))), "{e:?}");
     }
 }
+
+/// The attachments slot `slot` can show, by part name: its own part first, then the parts that
+/// are its other attachments.
+pub fn slot_attachments(state: &State, slot: &str) -> Vec<String> {
+    let mut names = vec![slot.to_string()];
+    names.extend(
+        state
+            .slots
+            .attachments
+            .iter()
+            .filter(|(_, s)| *s == slot)
+            .map(|(part, _)| part.clone()),
+    );
+    names
+}
+
+/// Puts a stepped key of `parts.SLOT.attachment` at `time_s` in `anim` (replacing one at the
+/// same time): from then on the slot shows `attachment` (`None`: nothing). Refused for a name
+/// that is not a slot, or an attachment the slot does not have.
+pub(super) fn key_attachment(
+    state: &State,
+    anim: &mut Animation,
+    slot: &str,
+    time_s: f64,
+    attachment: Option<String>,
+) -> Result<(), DocumentError> {
+    let is_slot =
+        state.layers.iter().any(|l| l.name == slot) && !state.slots.attachments.contains_key(slot);
+    if !is_slot {
+        return Err(DocumentError::Slots(format!(
+            "there is no slot named '{slot}'"
+        )));
+    }
+    if let Some(name) = &attachment {
+        let names = slot_attachments(state, slot);
+        if !names.contains(name) {
+            return Err(DocumentError::Slots(format!(
+                "slot '{slot}' has no attachment '{name}' (its attachments: {})",
+                names.join(", ")
+            )));
+        }
+    }
+    let keys = anim
+        .parts
+        .entry(slot.to_string())
+        .or_default()
+        .attachment
+        .get_or_insert_with(Vec::new);
+    match keys
+        .iter_mut()
+        .find(|k| (k.time - time_s).abs() <= crate::anim::edit::KEY_TIME_TOLERANCE_S)
+    {
+        Some(k) => k.value = attachment,
+        None => {
+            let at = keys.partition_point(|k| k.time < time_s);
+            keys.insert(
+                at,
+                crate::anim::StepKey {
+                    time: time_s,
+                    value: attachment,
+                },
+            );
+        }
+    }
+    Ok(())
+}

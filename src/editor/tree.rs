@@ -254,11 +254,91 @@ impl EditorApp {
                         if shown {
                             self.tree.hidden_parts.remove(&part);
                         } else {
-                            self.tree.hidden_parts.insert(part);
+                            self.tree.hidden_parts.insert(part.clone());
                         }
+                    }
+                    if matches!(self.mode, Mode::Pose | Mode::Animate) {
+                        self.attachment_list(ui, &part);
                     }
                 }
             });
+    }
+
+    /// A slot's attachments (when it has more than its own part), the one shown at the
+    /// playhead ticked; a click shows another: keyed at the playhead in animate mode (an
+    /// attachment key), the pose's in pose mode.
+    fn attachment_list(&mut self, ui: &mut egui::Ui, slot: &str) {
+        let names = crate::document::animations::slot_attachments(self.doc.state(), slot);
+        if names.len() < 2 || self.doc.state().slots.attachments.contains_key(slot) {
+            return;
+        }
+        let pose = self.edited_pose();
+        let shown = match pose.parts.get(slot) {
+            Some(p) if !p.visible => None,
+            Some(p) => Some(
+                p.attachment
+                    .clone()
+                    .unwrap_or_else(|| self.default_attachment(slot)),
+            ),
+            None => Some(self.default_attachment(slot)),
+        };
+        let mut chosen = None;
+        ui.indent(("attachments", slot), |ui| {
+            for name in names.into_iter().map(Some).chain([None]) {
+                let label = match &name {
+                    Some(n) => format!("{slot} shows {n}"),
+                    None => format!("{slot} shows nothing"),
+                };
+                if ui.radio(shown == name, label).clicked() && shown != name {
+                    chosen = Some(name);
+                }
+            }
+        });
+        if let Some(attachment) = chosen {
+            self.show_attachment(slot, attachment);
+        }
+    }
+
+    /// What slot `slot` shows by default: the part the last shown skin gives it, else its own.
+    fn default_attachment(&self, slot: &str) -> String {
+        let slots = &self.doc.state().slots;
+        slots
+            .shown
+            .iter()
+            .rev()
+            .find_map(|skin| slots.skins.get(skin)?.get(slot).cloned())
+            .unwrap_or_else(|| slot.to_string())
+    }
+
+    /// Shows `attachment` (none: nothing) in `slot`: an attachment key at the playhead in
+    /// animate mode, the document's pose in pose mode.
+    pub fn show_attachment(&mut self, slot: &str, attachment: Option<String>) {
+        let part = |pose: &mut crate::rig::Pose| {
+            let p = pose.parts.entry(slot.to_string()).or_default();
+            p.visible = attachment.is_some();
+            p.attachment = attachment.clone();
+        };
+        if self.mode == Mode::Animate {
+            let time_s = self.animate.time_s;
+            if self.apply(Command::KeyAttachment {
+                animation: self.animate.animation.clone(),
+                slot: slot.to_string(),
+                time_s,
+                attachment: attachment.clone(),
+            }) {
+                if let Some(shown) = &mut self.animate.shown {
+                    part(shown);
+                }
+                self.message = Some(format!(
+                    "keyed '{slot}' showing {} at {time_s:.3} s",
+                    attachment.as_deref().unwrap_or("nothing")
+                ));
+            }
+        } else {
+            let mut pose = self.doc.state().pose.clone();
+            part(&mut pose);
+            self.apply(Command::SetPose(pose));
+        }
     }
 
     /// `pose` with the parts hidden in the tree made invisible, for the canvas's picture.

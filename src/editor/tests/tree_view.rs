@@ -226,3 +226,62 @@ fn a_bone_dragged_onto_another_in_the_tree_hangs_from_it_undoably_and_loops_are_
     click_label(&mut h, "chest");
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
 }
+
+#[test]
+fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
+    let path = character_rig_with("attachment-list", true);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("New animation").click();
+    h.run();
+    let animation = h.state().animate.animation.clone();
+    let keys = |h: &Harness<'_, EditorApp>| -> Vec<(f64, Option<String>)> {
+        let anim = crate::document::animation_named(h.state().doc.state(), &animation);
+        anim.parts
+            .get("bag")
+            .and_then(|p| p.attachment.clone())
+            .unwrap_or_default()
+            .into_iter()
+            .map(|k| (k.time, k.value))
+            .collect()
+    };
+    let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
+        let picture = h.state().drawing.picture.as_ref().expect("a picture");
+        let draws = picture.draws.iter().filter(|d| d.visible);
+        draws.map(|d| d.name.clone()).collect()
+    };
+    // The bag slot lists its own part, the pail and nothing; its own part is ticked.
+    assert!(tree_selected(&h, "bag shows bag"));
+    assert!(drawn(&h).contains(&"bag".to_string()));
+
+    // A click on the pail keys it at 0 s; the canvas shows the pail.
+    click_label(&mut h, "bag shows bag_pail");
+    assert_eq!(
+        keys(&h),
+        [(0.0, Some("bag_pail".to_string()))],
+        "{:?}",
+        h.state().message
+    );
+    assert!(tree_selected(&h, "bag shows bag_pail"));
+    let names = drawn(&h);
+    assert!(names.contains(&"bag_pail".to_string()) && !names.contains(&"bag".to_string()));
+
+    // Twelve frames on (0.5 s at 24 fps), "nothing" keys the slot hidden.
+    for _ in 0..12 {
+        h.get_by_label("Next frame").click();
+        h.run();
+    }
+    click_label(&mut h, "bag shows nothing");
+    assert_eq!(keys(&h), [(0.0, Some("bag_pail".into())), (0.5, None)]);
+    let names = drawn(&h);
+    assert!(!names.iter().any(|n| n.starts_with("bag")), "{names:?}");
+    assert!(tree_selected(&h, "bag shows nothing"));
+
+    // Ctrl+Z takes the second key back; the pail is shown there again.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
+    assert!(drawn(&h).contains(&"bag_pail".to_string()));
+}
