@@ -83,6 +83,9 @@ pub struct EditArgs {
     /// A handle to select first (rig mode shows its weights).
     #[arg(long)]
     pub select: Option<String>,
+    /// Open animate mode's graph view (every curve of the selected handle) at start.
+    #[arg(long)]
+    pub graph_view: bool,
     /// Line art (PNG) to open in colorize mode.
     #[arg(long)]
     pub line_art: Option<PathBuf>,
@@ -459,6 +462,7 @@ fn edit(args: &EditArgs) -> Result<()> {
         pose,
         select: args.select.clone(),
         screenshot: args.screenshot.clone(),
+        graph_view: args.graph_view,
         line_art: args.line_art.clone(),
         scribbles: args.scribbles.clone(),
         frame_log: args.frame_log.clone(),

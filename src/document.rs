@@ -50,6 +50,8 @@ pub enum DocumentError {
     UnknownHandle(String),
     #[error("there is no layer named '{0}'")]
     UnknownLayer(String),
+    #[error("'{parent}' cannot be the parent of '{bone}': it is '{bone}' or hangs below it")]
+    ReparentCycle { bone: String, parent: String },
     #[error("a layer named '{0}' already exists")]
     DuplicateLayer(String),
     #[error("layer '{name}' is {got:?} px but the canvas is {canvas:?} px")]
@@ -246,6 +248,15 @@ pub enum Command {
         animation: String,
         time_s: f64,
         pose: Pose,
+    },
+    /// Keys which attachment slot `slot` shows from `time_s` on in `animation` (a stepped
+    /// key of `parts.SLOT.attachment`; `None`: the slot shows nothing). A key already at that
+    /// time is replaced; an attachment the slot does not have is refused.
+    KeyAttachment {
+        animation: String,
+        slot: String,
+        time_s: f64,
+        attachment: Option<String>,
     },
     /// Removes every key of `animation` at `time_s`.
     DeleteKeys {
@@ -809,6 +820,29 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             }
         }
         Command::Reparent { bone, parent } => {
+            if let Some(parent) = &parent {
+                if !next.handles.bones.iter().any(|b| b.name == *parent) {
+                    return Err(DocumentError::UnknownHandle(parent.clone()));
+                }
+                // Walk up from the new parent: meeting `bone` would close a loop.
+                let mut up = Some(parent.clone());
+                let mut steps = 0;
+                while let Some(name) = up {
+                    if name == bone || steps > next.handles.bones.len() {
+                        return Err(DocumentError::ReparentCycle {
+                            bone,
+                            parent: parent.clone(),
+                        });
+                    }
+                    steps += 1;
+                    up = next
+                        .handles
+                        .bones
+                        .iter()
+                        .find(|b| b.name == name)
+                        .and_then(|b| b.parent.clone());
+                }
+            }
             let b = next
                 .handles
                 .bones
@@ -848,6 +882,18 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             if anim == before && state.animations.contains_key(&animation) {
                 return Err(DocumentError::NothingToKey(time_s));
             }
+            store_animation(&mut next, &animation, anim)?;
+            inputs_changed = false;
+        }
+        Command::KeyAttachment {
+            animation,
+            slot,
+            time_s,
+            attachment,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation);
+            animations::key_attachment(state, &mut anim, &slot, time_s, attachment)?;
             store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }

@@ -160,6 +160,72 @@ pub fn key_changes(anim: &mut Animation, time_s: f64, before: &Pose, pose: &Pose
     keyed
 }
 
+/// The attachments slot `slot` can show, by part name: its own part first, then the parts that
+/// are its other attachments.
+pub fn slot_attachments(state: &State, slot: &str) -> Vec<String> {
+    let mut names = vec![slot.to_string()];
+    names.extend(
+        state
+            .slots
+            .attachments
+            .iter()
+            .filter(|(_, s)| *s == slot)
+            .map(|(part, _)| part.clone()),
+    );
+    names
+}
+
+/// Puts a stepped key of `parts.SLOT.attachment` at `time_s` in `anim` (replacing one at the
+/// same time): from then on the slot shows `attachment` (`None`: nothing). Refused for a name
+/// that is not a slot, or an attachment the slot does not have.
+pub(super) fn key_attachment(
+    state: &State,
+    anim: &mut Animation,
+    slot: &str,
+    time_s: f64,
+    attachment: Option<String>,
+) -> Result<(), DocumentError> {
+    let is_slot =
+        state.layers.iter().any(|l| l.name == slot) && !state.slots.attachments.contains_key(slot);
+    if !is_slot {
+        return Err(DocumentError::Slots(format!(
+            "there is no slot named '{slot}'"
+        )));
+    }
+    if let Some(name) = &attachment {
+        let names = slot_attachments(state, slot);
+        if !names.contains(name) {
+            return Err(DocumentError::Slots(format!(
+                "slot '{slot}' has no attachment '{name}' (its attachments: {})",
+                names.join(", ")
+            )));
+        }
+    }
+    let keys = anim
+        .parts
+        .entry(slot.to_string())
+        .or_default()
+        .attachment
+        .get_or_insert_with(Vec::new);
+    match keys
+        .iter_mut()
+        .find(|k| (k.time - time_s).abs() <= crate::anim::edit::KEY_TIME_TOLERANCE_S)
+    {
+        Some(k) => k.value = attachment,
+        None => {
+            let at = keys.partition_point(|k| k.time < time_s);
+            keys.insert(
+                at,
+                crate::anim::StepKey {
+                    time: time_s,
+                    value: attachment,
+                },
+            );
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{animation_named, Command, Document};
@@ -261,5 +327,45 @@ mod tests {
             pose: before,
         });
         assert!(matches!(e, Err(DocumentError::NothingToKey(_))), "{e:?}");
+    }
+
+    #[test]
+    fn attachment_keys_replace_at_the_same_time_and_refuse_what_the_slot_lacks() {
+        let mut doc = Document::new();
+        let key = |slot: &str, time_s: f64, attachment: Option<&str>| Command::KeyAttachment {
+            animation: "swap".into(),
+            slot: slot.into(),
+            time_s,
+            attachment: attachment.map(str::to_string),
+        };
+        let e = doc.apply(key("hand", 0.0, Some("hand"))).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "slots and skins: there is no slot named 'hand'"
+        );
+        doc.apply(Command::AddLayer(crate::pipeline::Layer::whole(
+            "hand",
+            "hand.png",
+            image::RgbaImage::new(8, 8),
+        )))
+        .expect("a layer");
+        let e = doc.apply(key("hand", 0.0, Some("fist"))).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "slots and skins: slot 'hand' has no attachment 'fist' (its attachments: hand)"
+        );
+        doc.apply(key("hand", 0.5, None)).expect("hidden at 0.5 s");
+        doc.apply(key("hand", 0.0, Some("hand")))
+            .expect("shown at 0 s");
+        doc.apply(key("hand", 0.5, Some("hand"))).expect("replaced");
+        let keys = animation_named(doc.state(), "swap").parts["hand"]
+            .attachment
+            .clone()
+            .expect("keys");
+        let keys: Vec<_> = keys.into_iter().map(|k| (k.time, k.value)).collect();
+        assert_eq!(
+            keys,
+            [(0.0, Some("hand".into())), (0.5, Some("hand".into()))]
+        );
     }
 }

@@ -173,7 +173,10 @@ impl EditorApp {
             ..saving
         });
         let repaint = self.repaint.take();
+        // Whether dialogs are native is the desktop's, not the document's.
+        let dialogs = std::mem::take(&mut self.dialogs);
         *self = EditorApp::new(doc);
+        self.dialogs = dialogs;
         self.autosaving = autosaving;
         self.saving = saving;
         self.colorize = colorize;

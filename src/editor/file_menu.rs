@@ -8,8 +8,10 @@
 //!
 //! The menu keeps working text fields: it closes on a click outside it or on an action, never on
 //! a click into a field. Paths are typed (in the menu's field or in the path window a shortcut
-//! opens).
+//! opens), or picked in a native dialog where the desktop's portal answers
+//! ([`super::native_dialog`]).
 
+use super::native_dialog::DialogFor;
 use super::EditorApp;
 use crate::skin::Blend;
 use eframe::egui::{self, Key, Modifiers};
@@ -181,9 +183,16 @@ impl EditorApp {
         }
     }
 
-    /// Asks for a path to `action`: the path window, with the document's path (or the menu's
-    /// field) filled in for a save.
+    /// Asks for a path to `action`: the native dialog where a portal answers, else the path
+    /// window, with the document's path filled in for a save.
     pub fn ask_path(&mut self, action: PathAction) {
+        let current = match action {
+            PathAction::SaveAs => self.doc.path.clone(),
+            _ => None,
+        };
+        if self.native_dialog(super::native_dialog::DialogFor::Path(action), current) {
+            return;
+        }
         let path = match action {
             PathAction::SaveAs => self
                 .doc
@@ -279,8 +288,11 @@ impl EditorApp {
             .collapsible(false)
             .show(ctx, |ui| {
                 let label = ui.label("Export folder:");
-                ui.text_edit_singleline(&mut self.export_dir)
-                    .labelled_by(label.id);
+                ui.horizontal(|ui| {
+                    ui.text_edit_singleline(&mut self.export_dir)
+                        .labelled_by(label.id);
+                    self.browse_button(ui, DialogFor::ExportFolder);
+                });
                 spine_options_ui(ui, &mut self.spine_options);
                 if ui.button("Export").clicked() {
                     let dir = PathBuf::from(self.export_dir.trim());
@@ -303,8 +315,11 @@ impl EditorApp {
             .show(ctx, |ui| {
                 let label =
                     ui.label("Render the current animation to (.gif, .png sheet or a folder):");
-                ui.text_edit_singleline(&mut self.render_path)
-                    .labelled_by(label.id);
+                ui.horizontal(|ui| {
+                    ui.text_edit_singleline(&mut self.render_path)
+                        .labelled_by(label.id);
+                    self.browse_button(ui, DialogFor::RenderPath);
+                });
                 render_settings_ui(ui, &mut self.render_settings);
                 if ui
                     .add_enabled(self.render.is_none(), egui::Button::new("Render"))

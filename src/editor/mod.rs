@@ -25,8 +25,10 @@ pub mod drawing;
 pub mod file;
 pub mod file_menu;
 pub mod gizmo;
+pub mod graph_view;
 mod identity;
 pub mod messages;
+pub mod native_dialog;
 pub mod numbers;
 pub mod paint;
 pub mod pose_mode;
@@ -177,6 +179,8 @@ pub struct EditorApp {
     pub timeline: timeline::TimelineState,
     /// The tree view: renaming in place, the parts hidden on the canvas.
     pub tree: tree::TreeState,
+    /// Native file dialogs, where a portal answers ([`native_dialog`]).
+    pub dialogs: native_dialog::NativeDialogs,
 }
 
 impl EditorApp {
@@ -233,6 +237,7 @@ impl EditorApp {
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),
             tree: Default::default(),
+            dialogs: Default::default(),
         }
     }
 
@@ -267,6 +272,7 @@ impl EditorApp {
         self.dialog_takes_input(&ctx);
         self.poll_worker();
         self.poll_render();
+        self.poll_dialogs(&ctx);
         self.poll_rig_tools(&ctx);
         self.warm_ik();
         self.colorize_frame_start(&ctx);
@@ -292,6 +298,9 @@ impl EditorApp {
             help_window(&ctx, &mut self.show_help);
         }
         self.file_windows(&ctx);
+        if self.mode == Mode::Animate {
+            self.graph_view_window(&ctx);
+        }
         self.log_window(&ctx);
         self.close_dialog(&ctx);
         self.take_screenshot(&ctx);
@@ -581,6 +590,8 @@ pub struct Start {
     pub select: Option<String>,
     /// Take a picture of the first frames to this PNG, then quit.
     pub screenshot: Option<PathBuf>,
+    /// Open the graph view window ([`graph_view`]) at start.
+    pub graph_view: bool,
     /// Line art to open in colorize mode.
     pub line_art: Option<PathBuf>,
     /// Scribbles (the JSON file of `sinew colorize --scribbles`) to draw on the line art.
@@ -632,6 +643,7 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         None => Document::new(),
     };
     let mut app = EditorApp::new(doc);
+    app.use_native_dialogs_where_a_portal_answers();
     if let Some(path) = &start.frame_log {
         app.frame_log = Some(
             FrameLog::create(path)
@@ -665,6 +677,7 @@ pub fn run(start: Start) -> anyhow::Result<()> {
         app.rig_mode.rename_to = name.clone();
         app.selected = Some(name);
     }
+    app.timeline.graph.open = start.graph_view;
     if let Some(path) = &start.line_art {
         app.open_lineart(path);
         if app.colorize.session.is_none() {

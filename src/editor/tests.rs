@@ -21,6 +21,7 @@ mod animate;
 mod colorize;
 mod documents;
 mod files;
+mod graph;
 mod outputs;
 mod pose;
 mod rig;

@@ -109,6 +109,8 @@ pub struct TimelineState {
     pub curve_channel: usize,
     pub sheet: Option<SheetLayout>,
     pub curve: Option<CurveLayout>,
+    /// The graph view window: every curve of the selected handle ([`super::graph_view`]).
+    pub graph: super::graph_view::GraphView,
     pub(super) gesture: Option<SheetGesture>,
     /// The animation the selection belongs to.
     selection_of: String,
@@ -125,6 +127,7 @@ impl Default for TimelineState {
             curve_channel: 0,
             sheet: None,
             curve: None,
+            graph: Default::default(),
             gesture: None,
             selection_of: String::new(),
         }
@@ -398,7 +401,10 @@ impl EditorApp {
                 .max_width(width)
                 .show(ui, |ui| self.dopesheet(ui, width, &timelines));
             ui.separator();
-            ui.vertical(|ui| self.curve_editor(ui, &animation));
+            ui.vertical(|ui| {
+                self.graph_view_button(ui);
+                self.curve_editor(ui, &animation)
+            });
         });
     }
 

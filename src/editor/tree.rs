@@ -2,14 +2,18 @@
 //! under their parents, the points, cages and regions, and the parts (slots) front to back.
 //!
 //! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
-//! the parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename`
-//! commands, and which parts the canvas hides (a view setting, not part of the document: the
+//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row), the
+//! parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename` and
+//! `Reparent` commands (undoable; a loop is refused with a message), and which parts the canvas hides (a view setting, not part of the document: the
 //! posed picture drops them from the library's draw list; rig mode leaves their images out).
 
 use super::{EditorApp, Mode};
 use crate::document::Command;
 use eframe::egui::{self, Key};
 use std::collections::BTreeSet;
+
+/// A bone being dragged in the tree (egui's drag-and-drop payload).
+struct DraggedBone(String);
 
 /// The tree's own state.
 #[derive(Default)]
@@ -53,6 +57,15 @@ impl EditorApp {
                 for root in roots {
                     self.bone_subtree(ui, &handles, &root, 0);
                 }
+                // While a bone is dragged: a row to drop it on to make it a skeleton's root.
+                if egui::DragAndDrop::has_payload_of_type::<DraggedBone>(ui.ctx()) {
+                    let row = ui.add(
+                        egui::Label::new("(drop here: no parent)").sense(egui::Sense::hover()),
+                    );
+                    if let Some(bone) = row.dnd_release_payload::<DraggedBone>() {
+                        self.reparent_bone(&bone.0, None);
+                    }
+                }
             });
         let groups = [
             (
@@ -77,7 +90,7 @@ impl EditorApp {
                 .default_open(true)
                 .show(ui, |ui| {
                     for name in names {
-                        self.handle_row(ui, &name);
+                        let _ = self.handle_row(ui, &name);
                     }
                 });
         }
@@ -95,10 +108,31 @@ impl EditorApp {
         if depth > handles.bones.len() {
             return;
         }
-        ui.horizontal(|ui| {
-            ui.add_space(12.0 * depth as f32);
-            self.handle_row(ui, name);
-        });
+        let row = ui
+            .horizontal(|ui| {
+                ui.add_space(12.0 * depth as f32);
+                self.handle_row(ui, name)
+            })
+            .inner;
+        // Rig mode (the setup pose, where the hierarchy is edited): drag a bone's row onto
+        // another bone's row to hang it there.
+        if let (Some(row), Mode::Rig) = (row, self.mode) {
+            let row = row.interact(egui::Sense::drag());
+            row.dnd_set_drag_payload(DraggedBone(name.to_string()));
+            if row
+                .dnd_hover_payload::<DraggedBone>()
+                .is_some_and(|b| b.0 != name)
+            {
+                let stroke = ui.visuals().selection.stroke;
+                ui.painter()
+                    .rect_stroke(row.rect, 2.0, stroke, egui::StrokeKind::Outside);
+            }
+            if let Some(bone) = row.dnd_release_payload::<DraggedBone>() {
+                if bone.0 != name {
+                    self.reparent_bone(&bone.0, Some(name));
+                }
+            }
+        }
         let children: Vec<String> = handles
             .bones
             .iter()
@@ -111,8 +145,8 @@ impl EditorApp {
     }
 
     /// One handle: its name to click (select) or double-click (rename); its rename field while
-    /// renamed; rig mode's lock box.
-    fn handle_row(&mut self, ui: &mut egui::Ui, name: &str) {
+    /// renamed; rig mode's lock box. Returns the name's response (none while renamed).
+    fn handle_row(&mut self, ui: &mut egui::Ui, name: &str) -> Option<egui::Response> {
         ui.horizontal(|ui| {
             if self.mode == Mode::Rig {
                 self.lock_box(ui, name);
@@ -133,7 +167,7 @@ impl EditorApp {
                             self.rename_handle(&from, &to);
                         }
                     }
-                    return;
+                    return None;
                 }
             }
             let selected = self.selected.as_deref() == Some(name);
@@ -144,7 +178,35 @@ impl EditorApp {
             if response.double_clicked() {
                 self.start_rename(name);
             }
-        });
+            Some(response)
+        })
+        .inner
+    }
+
+    /// Hangs `bone` from `parent` (none: a skeleton's root) through the document's undoable
+    /// `Reparent`; the rest geometry is in canvas px, so the bone stays where it is drawn. A
+    /// parent that would close a loop is refused with the document's message.
+    pub fn reparent_bone(&mut self, bone: &str, parent: Option<&str>) {
+        let now = self
+            .doc
+            .state()
+            .handles
+            .bones
+            .iter()
+            .find(|b| b.name == bone)
+            .map(|b| b.parent.clone());
+        if now.as_ref().map(|p| p.as_deref()) == Some(parent) {
+            return;
+        }
+        if self.apply(Command::Reparent {
+            bone: bone.to_string(),
+            parent: parent.map(str::to_string),
+        }) {
+            self.message = Some(match parent {
+                Some(p) => format!("'{bone}' now hangs from '{p}'"),
+                None => format!("'{bone}' is now a skeleton's root"),
+            });
+        }
     }
 
     fn start_rename(&mut self, name: &str) {
@@ -192,11 +254,91 @@ impl EditorApp {
                         if shown {
                             self.tree.hidden_parts.remove(&part);
                         } else {
-                            self.tree.hidden_parts.insert(part);
+                            self.tree.hidden_parts.insert(part.clone());
                         }
+                    }
+                    if matches!(self.mode, Mode::Pose | Mode::Animate) {
+                        self.attachment_list(ui, &part);
                     }
                 }
             });
+    }
+
+    /// A slot's attachments (when it has more than its own part), the one shown at the
+    /// playhead ticked; a click shows another: keyed at the playhead in animate mode (an
+    /// attachment key), the pose's in pose mode.
+    fn attachment_list(&mut self, ui: &mut egui::Ui, slot: &str) {
+        let names = crate::document::animations::slot_attachments(self.doc.state(), slot);
+        if names.len() < 2 || self.doc.state().slots.attachments.contains_key(slot) {
+            return;
+        }
+        let pose = self.edited_pose();
+        let shown = match pose.parts.get(slot) {
+            Some(p) if !p.visible => None,
+            Some(p) => Some(
+                p.attachment
+                    .clone()
+                    .unwrap_or_else(|| self.default_attachment(slot)),
+            ),
+            None => Some(self.default_attachment(slot)),
+        };
+        let mut chosen = None;
+        ui.indent(("attachments", slot), |ui| {
+            for name in names.into_iter().map(Some).chain([None]) {
+                let label = match &name {
+                    Some(n) => format!("{slot} shows {n}"),
+                    None => format!("{slot} shows nothing"),
+                };
+                if ui.radio(shown == name, label).clicked() && shown != name {
+                    chosen = Some(name);
+                }
+            }
+        });
+        if let Some(attachment) = chosen {
+            self.show_attachment(slot, attachment);
+        }
+    }
+
+    /// What slot `slot` shows by default: the part the last shown skin gives it, else its own.
+    fn default_attachment(&self, slot: &str) -> String {
+        let slots = &self.doc.state().slots;
+        slots
+            .shown
+            .iter()
+            .rev()
+            .find_map(|skin| slots.skins.get(skin)?.get(slot).cloned())
+            .unwrap_or_else(|| slot.to_string())
+    }
+
+    /// Shows `attachment` (none: nothing) in `slot`: an attachment key at the playhead in
+    /// animate mode, the document's pose in pose mode.
+    pub fn show_attachment(&mut self, slot: &str, attachment: Option<String>) {
+        let part = |pose: &mut crate::rig::Pose| {
+            let p = pose.parts.entry(slot.to_string()).or_default();
+            p.visible = attachment.is_some();
+            p.attachment = attachment.clone();
+        };
+        if self.mode == Mode::Animate {
+            let time_s = self.animate.time_s;
+            if self.apply(Command::KeyAttachment {
+                animation: self.animate.animation.clone(),
+                slot: slot.to_string(),
+                time_s,
+                attachment: attachment.clone(),
+            }) {
+                if let Some(shown) = &mut self.animate.shown {
+                    part(shown);
+                }
+                self.message = Some(format!(
+                    "keyed '{slot}' showing {} at {time_s:.3} s",
+                    attachment.as_deref().unwrap_or("nothing")
+                ));
+            }
+        } else {
+            let mut pose = self.doc.state().pose.clone();
+            part(&mut pose);
+            self.apply(Command::SetPose(pose));
+        }
     }
 
     /// `pose` with the parts hidden in the tree made invisible, for the canvas's picture.

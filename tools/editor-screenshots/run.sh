@@ -4,6 +4,9 @@
 #
 #   tools/editor-screenshots/run.sh [OUT_DIR]      (default: docs/)
 #
+# Builds in $CARGO_TARGET_DIR (default target/) with $PROFILE (default release; debug works
+# too and is what a worktree sharing its dependencies with others would use).
+#
 # Runs the editor under Xvfb with Mesa's software OpenGL (no GPU needed). Installs what it needs
 # on first use from Debian's packages (needs root or sudo): xvfb, xauth and the X libraries winit
 # loads at run time. Exit status: 0 done, 3 on a setup error.
@@ -25,8 +28,10 @@ if ! command -v xvfb-run >/dev/null; then
 fi
 
 cd "$root"
-cargo build --release --locked
-sinew="$root/target/release/sinew"
+profile="${PROFILE:-release}"
+target="${CARGO_TARGET_DIR:-$root/target}"
+if [ "$profile" = release ]; then cargo build --release --locked; else cargo build --locked; fi
+sinew="$target/$profile/sinew"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # The bundled character, rigged; the demo's rig refers to the assets by relative paths.
@@ -40,9 +45,12 @@ shoot() { # MODE OUT.png [extra args]
 }
 shoot rig "$out/editor-rig.png" --select arm_upper_l
 shoot pose "$out/editor-pose.png" --pose "$root/assets/character/poses/lift.json" --select chest
-shoot animate "$out/editor-animate.png" --pose "$root/assets/character/poses/lift.json"
+# Animate mode with the graph view open on the left upper arm's curves in 'hop'.
+shoot animate "$out/editor-animate.png" --select arm_upper_l --graph-view
+# The tree: pose mode, the right forearm selected in it (its row highlighted).
+shoot pose "$out/editor-tree.png" --select arm_lower_r
 # Colorize mode on a generated line-art scene with its scribbles.
-cargo run --quiet --release --locked --example colorize_scenes -- "$work/scenes" >/dev/null
+cargo run --quiet --profile "$([ "$profile" = debug ] && echo dev || echo "$profile")" --locked --example colorize_scenes -- "$work/scenes" >/dev/null
 shoot colorize "$out/editor-colorize.png" --line-art "$work/scenes/closed-art.png" \
   --scribbles "$work/scenes/closed-scribbles.json"
-echo "wrote $out/editor-{rig,pose,animate,colorize}.png"
+echo "wrote $out/editor-{rig,pose,animate,tree,colorize}.png"

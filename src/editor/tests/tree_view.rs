@@ -150,3 +150,138 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
     h.run();
     assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
 }
+
+/// Drags the tree row labelled `from` (pressed at its middle) and releases it on the row
+/// labelled `onto`, in pointer steps.
+fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
+    h.get_by_label(from).scroll_to_me();
+    h.run();
+    let start = h.get_by_label(from).rect().center();
+    h.drag_at(start);
+    h.step();
+    // Past egui's drag threshold, so the drop row for "no parent" shows.
+    h.hover_at(start + egui::vec2(0.0, 12.0));
+    h.step();
+    h.step();
+    let end = h.get_by_label(onto).rect().center();
+    assert!(end.y > 0.0, "the row {onto} is scrolled out of view");
+    for k in 1..=4 {
+        h.hover_at(start + (end - start) * (k as f32 / 4.0));
+        h.step();
+    }
+    h.drop_at(end);
+    h.step();
+    h.run();
+}
+
+fn parent_of(h: &Harness<'_, EditorApp>, bone: &str) -> Option<String> {
+    let handles = &h.state().doc.state().handles;
+    let bone = handles.bones.iter().find(|b| b.name == bone).expect("bone");
+    bone.parent.clone()
+}
+
+#[test]
+fn a_bone_dragged_onto_another_in_the_tree_hangs_from_it_undoably_and_loops_are_refused() {
+    let mut h = open_character("reparent");
+    assert_eq!(h.state().mode, Mode::Rig);
+    let rest = |h: &Harness<'_, EditorApp>| {
+        let handles = &h.state().doc.state().handles;
+        let b = handles.bones.iter().find(|b| b.name == "lantern").unwrap();
+        (b.head, b.tail)
+    };
+    let before = rest(&h);
+    assert_eq!(parent_of(&h, "lantern").as_deref(), Some("arm_lower_r"));
+
+    // The lantern's row onto the left forearm's: it hangs from it, where it was drawn.
+    drag_row(&mut h, "lantern", "arm_lower_l");
+    assert_eq!(
+        parent_of(&h, "lantern").as_deref(),
+        Some("arm_lower_l"),
+        "{:?}",
+        h.state().message
+    );
+    assert_eq!(rest(&h), before, "the bone moved");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(
+        message.contains("now hangs from 'arm_lower_l'"),
+        "{message}"
+    );
+
+    // Ctrl+Z puts it back under the lower arm.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(parent_of(&h, "lantern").as_deref(), Some("arm_lower_r"));
+
+    // The upper arm onto the lantern (below it): a loop, refused with a message.
+    drag_row(&mut h, "arm_upper_r", "lantern");
+    assert_eq!(parent_of(&h, "arm_upper_r"), None);
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("cannot be the parent"), "{message}");
+
+    // The lantern onto the "no parent" row: a skeleton's root of its own.
+    drag_row(&mut h, "lantern", "(drop here: no parent)");
+    assert_eq!(parent_of(&h, "lantern"), None, "{:?}", h.state().message);
+    assert_eq!(rest(&h), before);
+    // A plain click still selects.
+    click_label(&mut h, "chest");
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+}
+
+#[test]
+fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
+    let path = character_rig_with("attachment-list", true);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("New animation").click();
+    h.run();
+    let animation = h.state().animate.animation.clone();
+    let keys = |h: &Harness<'_, EditorApp>| -> Vec<(f64, Option<String>)> {
+        let anim = crate::document::animation_named(h.state().doc.state(), &animation);
+        anim.parts
+            .get("bag")
+            .and_then(|p| p.attachment.clone())
+            .unwrap_or_default()
+            .into_iter()
+            .map(|k| (k.time, k.value))
+            .collect()
+    };
+    let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
+        let picture = h.state().drawing.picture.as_ref().expect("a picture");
+        let draws = picture.draws.iter().filter(|d| d.visible);
+        draws.map(|d| d.name.clone()).collect()
+    };
+    // The bag slot lists its own part, the pail and nothing; its own part is ticked.
+    assert!(tree_selected(&h, "bag shows bag"));
+    assert!(drawn(&h).contains(&"bag".to_string()));
+
+    // A click on the pail keys it at 0 s; the canvas shows the pail.
+    click_label(&mut h, "bag shows bag_pail");
+    assert_eq!(
+        keys(&h),
+        [(0.0, Some("bag_pail".to_string()))],
+        "{:?}",
+        h.state().message
+    );
+    assert!(tree_selected(&h, "bag shows bag_pail"));
+    let names = drawn(&h);
+    assert!(names.contains(&"bag_pail".to_string()) && !names.contains(&"bag".to_string()));
+
+    // Twelve frames on (0.5 s at 24 fps), "nothing" keys the slot hidden.
+    for _ in 0..12 {
+        h.get_by_label("Next frame").click();
+        h.run();
+    }
+    click_label(&mut h, "bag shows nothing");
+    assert_eq!(keys(&h), [(0.0, Some("bag_pail".into())), (0.5, None)]);
+    let names = drawn(&h);
+    assert!(!names.iter().any(|n| n.starts_with("bag")), "{names:?}");
+    assert!(tree_selected(&h, "bag shows nothing"));
+
+    // Ctrl+Z takes the second key back; the pail is shown there again.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
+    assert!(drawn(&h).contains(&"bag_pail".to_string()));
+}

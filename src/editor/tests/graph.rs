@@ -1,0 +1,113 @@
+//! Animate mode's graph view driven by input events only: every channel of the selected
+//! handle drawn at once with a legend, a window that resizes, handles that drag.
+
+use super::*;
+use crate::anim::edit::TransformChannel::*;
+
+fn rotate_numbers(h: &Harness<'_, EditorApp>) -> Vec<f64> {
+    serde_json::from_value(head_rotate_keys(h)[0].2.clone()).expect("a Bézier")
+}
+
+#[test]
+fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() {
+    let mut h = open_character("graph-view");
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("New animation").click();
+    h.run();
+    type_into(&mut h, "Rename to:", "nod");
+    h.get_by_label("Rename animation").click();
+    h.run();
+    // The head keyed at 0° at 0 s and 20° at 0.5 s (every transform channel gets keys).
+    click(&mut h, [256.0, 150.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("head"));
+    for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
+        for _ in 0..frames {
+            h.get_by_label("Next frame").click();
+            h.run();
+        }
+        set_number(&mut h, "Rotation", degrees + 5.0);
+        set_number(&mut h, "Rotation", degrees);
+        h.get_by_label("Set key").click();
+        h.run();
+    }
+    // The rotate key at 0 s made a Bézier in the one-segment curve editor.
+    let at = key_on_sheet(&h, Rotate, 0.0);
+    click_screen(&mut h, at);
+    h.get_by_label("Bézier").click();
+    h.run();
+    let numbers = rotate_numbers(&h);
+
+    // The graph view: seven curves, each named in the legend.
+    h.get_by_label("Graph view").click();
+    h.run();
+    let names = [
+        "head rotate",
+        "head translate x",
+        "head translate y",
+        "head scale x",
+        "head scale y",
+        "head shear x",
+        "head shear y",
+    ];
+    for name in names {
+        h.get_by_label(name);
+    }
+    let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+    let drawn: Vec<&str> = layout.curves.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(drawn, names);
+    // Only the rotate curve is a Bézier: its two handles are drawn, no other curve has any.
+    let handles: Vec<usize> = layout.curves.iter().map(|c| c.handles.len()).collect();
+    assert_eq!(handles, [2, 0, 0, 0, 0, 0, 0]);
+
+    // The window's corner dragged out: the plot grows with it.
+    let before = layout.rect;
+    let corner = before.right_bottom() + egui::vec2(16.0, 16.0);
+    drag_screen(&mut h, corner, corner + egui::vec2(160.0, 100.0));
+    let after = h
+        .state()
+        .timeline
+        .graph
+        .layout
+        .clone()
+        .expect("the graph")
+        .rect;
+    assert!(
+        after.width() > before.width() + 100.0 && after.height() > before.height() + 60.0,
+        "{before:?} → {after:?}"
+    );
+
+    // The legend hides a curve and shows it again.
+    h.get_by_label("head translate x").click();
+    h.run();
+    let shown = |h: &Harness<'_, EditorApp>| {
+        let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+        layout
+            .curves
+            .iter()
+            .map(|c| c.name.clone())
+            .collect::<Vec<_>>()
+    };
+    assert!(!shown(&h).iter().any(|n| n == "head translate x"));
+    assert_eq!(shown(&h).len(), 6);
+    h.get_by_label("head translate x").click();
+    h.run();
+    assert_eq!(shown(&h).len(), 7);
+
+    // The rotate curve's first handle dragged right and down: a later, lower handle.
+    let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+    let first = layout.curves[0].handles[0].2;
+    drag_screen(&mut h, first, first + egui::vec2(30.0, 25.0));
+    let dragged = rotate_numbers(&h);
+    assert!(dragged[0] > numbers[0] + 1e-3, "{dragged:?} vs {numbers:?}");
+    assert!(dragged[1] < numbers[1] - 1e-3, "{dragged:?} vs {numbers:?}");
+    assert!(
+        dragged[0] <= 0.5 && dragged[2..] == numbers[2..],
+        "{dragged:?}"
+    );
+
+    // One undo step puts it back.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert_eq!(rotate_numbers(&h), numbers);
+}
