@@ -280,3 +280,38 @@ fn ora_stacks_merge_and_refusals() {
         Err(LayeredError::Zip(_))
     ));
 }
+
+#[test]
+fn a_part_image_is_the_layers_pixels_on_the_canvas_trimmed_and_placed() {
+    // A 6×4 layer at (-2, 1) on a 10×10 canvas: columns 0–1 lie off the canvas; the last
+    // column is transparent; half opacity rounds alpha 1 to 1 and alpha 255 to 128.
+    let mut image = RgbaImage::new(6, 4);
+    for (x, y, p) in image.enumerate_pixels_mut() {
+        let alpha = match (x, y) {
+            (5, _) => 0,
+            (_, 0) => 1,
+            _ => 255,
+        };
+        *p = image::Rgba([x as u8, y as u8, 7, alpha]);
+    }
+    let layer = ArtLayer {
+        name: "l".into(),
+        path: "l".into(),
+        offset_px: [-2, 1],
+        image,
+        opacity: 0.5,
+        visible: true,
+        blend: BlendMode::Normal,
+    };
+    let (part, offset_px) = part_image(&layer, [10, 10]).expect("pixels left");
+    assert_eq!(offset_px, [0, 1]);
+    assert_eq!(part.dimensions(), (3, 4));
+    assert_eq!(part.get_pixel(0, 0).0, [2, 0, 7, 1]);
+    assert_eq!(part.get_pixel(2, 3).0, [4, 3, 7, 128]);
+    // Wholly off the canvas: nothing.
+    let off = ArtLayer {
+        offset_px: [10, 0],
+        ..layer
+    };
+    assert!(part_image(&off, [10, 10]).is_none());
+}
