@@ -41,13 +41,28 @@ pub fn union_alpha(layers: &[super::LayerRef]) -> RgbaImage {
     let mut out = RgbaImage::new(w, h);
     for layer in layers {
         let [ox, oy] = layer.offset_px.map(i64::from);
-        for (x, y, p) in layer.image.enumerate_pixels() {
-            let (cx, cy) = (ox + i64::from(x), oy + i64::from(y));
-            if cx < 0 || cy < 0 || cx >= i64::from(w) || cy >= i64::from(h) {
-                continue;
+        let (lw, lh) = (
+            i64::from(layer.image.width()),
+            i64::from(layer.image.height()),
+        );
+        // The layer's columns and rows that lie on the canvas.
+        let (x0, x1) = ((-ox).max(0), (i64::from(w) - ox).min(lw));
+        let (y0, y1) = ((-oy).max(0), (i64::from(h) - oy).min(lh));
+        if x0 >= x1 || y0 >= y1 {
+            continue;
+        }
+        let (source, target) = (layer.image.as_raw(), &mut *out);
+        for y in y0..y1 {
+            // In range: 0 ≤ y < lh, 0 ≤ oy + y < h, and likewise for the columns.
+            let from = ((y * lw + x0) * 4) as usize;
+            let to = (((oy + y) * i64::from(w) + ox + x0) * 4) as usize;
+            let n = ((x1 - x0) * 4) as usize;
+            for (o, p) in target[to..to + n]
+                .chunks_exact_mut(4)
+                .zip(source[from..from + n].chunks_exact(4))
+            {
+                o[3] = o[3].max(p[3]);
             }
-            let o = out.get_pixel_mut(cx as u32, cy as u32);
-            o[3] = o[3].max(p[3]);
         }
     }
     out
@@ -317,6 +332,29 @@ fn segment_gap(a: Point, b: Point, c: Point, d: Point) -> f64 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    #[test]
+    fn the_union_places_each_layer_at_its_offset_and_drops_what_is_off_the_canvas() {
+        let whole = RgbaImage::from_fn(8, 6, |x, _| image::Rgba([0, 0, 0, x as u8 * 10]));
+        let small = RgbaImage::from_pixel(3, 3, image::Rgba([9, 9, 9, 200]));
+        let layers = [
+            super::super::LayerRef::whole("whole", &whole),
+            super::super::LayerRef {
+                name: "small",
+                image: &small,
+                offset_px: [6, -1],
+                canvas_px: [8, 6],
+            },
+        ];
+        let union = union_alpha(&layers);
+        assert_eq!(union.dimensions(), (8, 6));
+        for (x, y, p) in union.enumerate_pixels() {
+            let covered = x >= 6 && y <= 1;
+            let expected = if covered { 200 } else { x as u8 * 10 };
+            assert_eq!(p[3], expected, "({x}, {y})");
+            assert_eq!(p.0[..3], [0, 0, 0], "colour is not used");
+        }
+    }
 
     /// The axis-aligned rectangle (x0, y0)–(x1, y1): its four corners from (x0, y0) along x first.
     pub(crate) fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<Point> {
