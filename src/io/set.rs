@@ -284,7 +284,8 @@ fn parse_journal(bytes: &[u8]) -> Journal {
         if tmp.components().count() != 1 || tmp.file_name().is_none() || !target.is_absolute() {
             return Journal::Foreign;
         }
-        entries.push((target.clone(), target.with_file_name(tmp)));
+        let tmp = target.with_file_name(tmp);
+        entries.push((target, tmp));
     }
     Journal::Committed(entries)
 }

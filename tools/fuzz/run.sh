@@ -128,7 +128,7 @@ cat "$results"
 if grep -q FAILED "$results"; then failed=1; fi
 # The replay test: every seed, crash and queue entry through the plain target functions
 # (a crash shows its panic message and backtrace here).
-if ! cargo afl test --release --locked >"$repo/target/fuzz-replay.log" 2>&1; then
+if ! cargo afl test --release --locked --test replay >"$repo/target/fuzz-replay.log" 2>&1; then
     echo "fuzz: FAILED: the replay test (fuzz/tests/replay.rs) failed; see target/fuzz-replay.log"
     tail -n 40 "$repo/target/fuzz-replay.log"
     failed=1
