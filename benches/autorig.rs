@@ -32,17 +32,14 @@ fn bench_autorig(c: &mut Criterion) {
     };
     for size in [512u32, 2048] {
         let image = character(size);
-        let layers = [LayerRef {
-            name: "flat",
-            image: &image,
-        }];
+        let layers = [LayerRef::whole("flat", &image)];
         group.bench_with_input(BenchmarkId::new("skeleton", size), &layers, |b, layers| {
-            b.iter(|| autorig(black_box(layers), &AutorigOptions::default()).unwrap())
+            b.iter(|| autorig(black_box(layers), &[], &AutorigOptions::default()).unwrap())
         });
         group.bench_with_input(
             BenchmarkId::new("template+cage+points", size),
             &layers,
-            |b, layers| b.iter(|| autorig(black_box(layers), &everything).unwrap()),
+            |b, layers| b.iter(|| autorig(black_box(layers), &[], &everything).unwrap()),
         );
     }
     group.finish();

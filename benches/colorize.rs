@@ -10,11 +10,15 @@
 //! Targets (two-core reference machine): 512² < 0.3 s, 2048² < 3 s; peak memory at 2048²
 //! < 1 GiB (`cargo bench --bench colorize_memory`).
 //!
+//! `incremental/1024`: the line art prepared once ([`PreparedLineArt`]: gap closing, ink
+//! regions), then the colorization after one more scribble, as the editor's colorize mode
+//! re-solves while the artist scribbles (issue 24's target: under 100 ms at 1024²).
+//!
 //! `cargo bench --bench colorize`; one case: `cargo bench --bench colorize -- '2048/10'`.
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
 use sinew::colorize::synthetic::{scene, SceneSpec};
-use sinew::colorize::{self, ColorizeOptions, ScribbleOptions, Scribbles};
+use sinew::colorize::{self, ColorizeOptions, PreparedLineArt, ScribbleOptions, Scribbles};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
@@ -47,6 +51,26 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    let size = 1024;
+    let s = scene(&SceneSpec {
+        size,
+        shapes: 9,
+        ..Default::default()
+    });
+    let prepared =
+        PreparedLineArt::new(s.lineart.clone(), ColorizeOptions::default()).expect("prepares");
+    // After a scribble is added, the re-solve colorizes the prepared line art from every
+    // scribble (nothing scribble-dependent is kept between solves).
+    let scribbles = Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
+        .expect("the strokes rasterize");
+    let never = std::sync::atomic::AtomicBool::new(false);
+    group.bench_function(format!("incremental/{size}"), |b| {
+        b.iter(|| {
+            prepared
+                .colorize(black_box(&scribbles), false, &never)
+                .expect("colorizes")
+        })
+    });
     group.finish();
 }
 

@@ -4,11 +4,11 @@
 //!
 //! In: paths in draw order (back to front) and the folder where a layered file's parts will be
 //! written ([`ArtOptions::parts_dir`]). Out: [`Art`]: one [`Layer`] per PNG and per visible pixel
-//! layer of a layered file (named by its group path, `arm_l/hand`, its image the layer placed
-//! on the canvas with its opacity), the notes a person should read (skipped layers), and which
-//! layers still have to be written ([`Art::write_parts`]) before a document may refer to them.
-//! Hidden layers do not become parts (a note says so). Layers are expanded to the canvas here
-//! because every later stage takes canvas-sized part images.
+//! layer of a layered file (named by its group path, `arm_l/hand`; its image the layer's pixels
+//! on the canvas with its opacity, trimmed to the opaque ones and placed at their offset, so a
+//! small layer on a big canvas stays small), the notes a person should read (skipped layers),
+//! and which layers still have to be written ([`Art::write_parts`]) before a document may refer
+//! to them. Hidden layers do not become parts (a note says so).
 
 use crate::io::layered::{self, LayeredFormat, LayeredLimits};
 use crate::io::{self, ImageError};
@@ -32,6 +32,8 @@ pub struct Art {
     pub notes: Vec<String>,
     /// Indices into `layers` of the images to write (those from layered files).
     pub unwritten: Vec<usize>,
+    /// Bone origins marked in the layered files (pivot layers), canvas px.
+    pub pivots: Vec<layered::Pivot>,
 }
 
 impl Art {
@@ -111,19 +113,18 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
     let mut layers = Vec::new();
     let mut notes = Vec::new();
     let mut unwritten = Vec::new();
+    let mut pivots = Vec::new();
     for path in paths {
         if !is_layered(path) {
-            layers.push(Layer {
-                name: path
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
-                path: path.clone(),
-                image: io::load_png(path)?,
-            });
+            let name = path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            layers.push(Layer::whole(name, path.clone(), io::load_png(path)?));
             continue;
         }
         let file = layered::load_layered(path, &options.limits)?;
+        pivots.extend(file.pivots.iter().cloned());
         let shown = path.display();
         notes.extend(file.warnings.iter().map(|w| format!("{shown}: {w}")));
         for l in &file.layers {
@@ -131,19 +132,20 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
                 notes.push(format!("{shown}: layer '{}' is hidden; not a part", l.path));
                 continue;
             }
-            let image = layered::canvas_image(l, file.canvas_px);
-            if image.pixels().all(|p| p[3] == 0) {
+            let Some((image, offset_px)) = layered::part_image(l, file.canvas_px) else {
                 notes.push(format!(
                     "{shown}: layer '{}' lies outside the canvas; not a part",
                     l.path
                 ));
                 continue;
-            }
+            };
             unwritten.push(layers.len());
             layers.push(Layer {
                 name: l.path.clone(),
                 path: part_image_path(&options.parts_dir, &l.path),
                 image,
+                offset_px,
+                canvas_px: file.canvas_px,
             });
         }
     }
@@ -151,6 +153,7 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
         layers: checked_layers(layers)?,
         notes,
         unwritten,
+        pivots,
     })
 }
 

@@ -402,6 +402,8 @@ impl Document {
                     name: part.name.clone(),
                     path: RigDocument::image_path(path, part),
                     image,
+                    offset_px: part.offset_px,
+                    canvas_px: doc.canvas,
                 })
             })
             .collect();
@@ -740,9 +742,9 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             if next.layers.iter().any(|l| l.name == layer.name) {
                 return Err(DocumentError::DuplicateLayer(layer.name));
             }
-            let got = [layer.image.width(), layer.image.height()];
+            let got = layer.canvas_px;
             if let Some(first) = next.layers.first() {
-                let canvas = [first.image.width(), first.image.height()];
+                let canvas = first.canvas_px;
                 if got != canvas {
                     return Err(DocumentError::LayerSize {
                         name: layer.name,

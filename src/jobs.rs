@@ -164,14 +164,20 @@ pub fn render_animation(
 /// [`crate::document::Command::SetHandles`] and edit like hand-placed ones.
 pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
     layers: &[L],
+    pivots: &[crate::io::layered::Pivot],
     options: &AutorigOptions,
 ) -> Result<Proposal, JobError> {
     let refs: Vec<LayerRef> = layers
         .iter()
-        .map(|l| LayerRef {
-            name: &l.borrow().name,
-            image: &l.borrow().image,
+        .map(|l| {
+            let l = l.borrow();
+            LayerRef {
+                name: &l.name,
+                image: &l.image,
+                offset_px: l.offset_px,
+                canvas_px: l.canvas_px,
+            }
         })
         .collect();
-    Ok(autorig::autorig(&refs, options)?)
+    Ok(autorig::autorig(&refs, pivots, options)?)
 }

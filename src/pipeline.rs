@@ -22,13 +22,33 @@ use std::path::{Path, PathBuf};
 
 pub use crate::scene::{load_part_images, Scene};
 
-/// One input image: a part of the rig.
+/// One input image: a part of the rig, placed on the rig's canvas.
 #[derive(Clone, Debug)]
 pub struct Layer {
     /// The part's name: the file name without extension.
     pub name: String,
     pub path: PathBuf,
+    /// Straight-alpha RGBA8: a whole canvas for a PNG layer, or trimmed to the layer's opaque
+    /// pixels for a layer of a layered file.
     pub image: RgbaImage,
+    /// Canvas position of the image's top-left pixel, px (y down).
+    pub offset_px: [i32; 2],
+    /// The size of the canvas the layer lies on, px.
+    pub canvas_px: [u32; 2],
+}
+
+impl Layer {
+    /// A layer whose image is the whole canvas (a PNG layer).
+    pub fn whole(name: impl Into<String>, path: impl Into<PathBuf>, image: RgbaImage) -> Self {
+        let canvas_px = [image.width(), image.height()];
+        Layer {
+            name: name.into(),
+            path: path.into(),
+            image,
+            offset_px: [0, 0],
+            canvas_px,
+        }
+    }
 }
 
 /// What went wrong between the input files and a rig.
@@ -88,11 +108,11 @@ pub enum PipelineError {
         part: String,
         source: crate::skin::PlanError,
     },
-    #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
+    #[error("part '{part}': its mesh reaches past its {}×{} px image placed at {offset_px:?} (was the image replaced by one of another size?)", got[0], got[1])]
     TextureSize {
         part: String,
         got: [u32; 2],
-        canvas: [u32; 2],
+        offset_px: [i32; 2],
     },
     #[error("part '{part}': {got} vertex positions for a mesh of {expected} vertices")]
     PositionCount {
@@ -151,26 +171,22 @@ pub fn load_layers(paths: &[PathBuf]) -> Result<Vec<Layer>, PipelineError> {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        layers.push(Layer {
-            name,
-            path: path.clone(),
-            image,
-        });
+        layers.push(Layer::whole(name, path.clone(), image));
     }
     checked_layers(layers)
 }
 
-/// `layers` when they can be the parts of one rig: at least one, each at least
-/// [`MIN_SPRITE_SIDE_PX`] on a side, all of the first one's size, names unique.
+/// `layers` when they can be the parts of one rig: at least one, on canvases of the first
+/// one's size, each canvas at least [`MIN_SPRITE_SIDE_PX`] on a side, names unique.
 pub fn checked_layers(layers: Vec<Layer>) -> Result<Vec<Layer>, PipelineError> {
     let mut names = HashSet::new();
     let canvas = match layers.first() {
-        Some(first) => [first.image.width(), first.image.height()],
+        Some(first) => first.canvas_px,
         None => return Err(PipelineError::NoImages),
     };
     for layer in &layers {
         let path = &layer.path;
-        let got = [layer.image.width(), layer.image.height()];
+        let got = layer.canvas_px;
         if got[0] < MIN_SPRITE_SIDE_PX || got[1] < MIN_SPRITE_SIDE_PX {
             return Err(PipelineError::TooSmall {
                 path: path.clone(),
@@ -231,7 +247,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
     cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     let first: &Layer = layers.first().ok_or(PipelineError::NoImages)?.borrow();
-    let canvas = [first.image.width(), first.image.height()];
+    let canvas = first.canvas_px;
     let canvas_area = canvas[0] as f64 * canvas[1] as f64;
     let mut doc = RigDocument::new(canvas);
     doc.options = options.clone();
@@ -257,8 +273,9 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             return Err(PipelineError::Cancelled);
         }
         progress(done, &layer.name);
-        let outlines =
-            trace::trace(&layer.image, &options.trace).map_err(|source| PipelineError::Trace {
+        let outlines = trace::trace(&layer.image, &options.trace)
+            .map(|o| trace::translated(o, layer.offset_px))
+            .map_err(|source| PipelineError::Trace {
                 path: layer.path.clone(),
                 source,
             })?;
@@ -292,7 +309,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
                 options
                     .weights
                     .content_aware
-                    .map(|_| vertex_colors(&layer.image, &mesh.domain.vertices))
+                    .map(|_| vertex_colors(layer, &mesh.domain.vertices))
             };
             let part = match &coarse {
                 Some(coarse) => weights::two_level::two_level_weights(
@@ -337,6 +354,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             name: layer.name.clone(),
             slot: None,
             image: relative_path(doc_dir, &layer.path),
+            offset_px: layer.offset_px,
             mesh: MeshDoc::from(&mesh),
             weights,
             stale_weights: None,
@@ -436,27 +454,65 @@ pub fn handle_geometry(handles: &Handles) -> HandleGeometry {
     }
 }
 
-/// Premultiplied RGB in [0, 1] of the pixel under each vertex (nearest pixel, clamped to the
-/// image), for content-aware weights.
-pub fn vertex_colors(image: &RgbaImage, vertices: &[Point]) -> Vec<[f64; 3]> {
-    let (w, h) = (image.width() as i64, image.height() as i64);
+/// Premultiplied RGB in [0, 1] of the layer's pixel under each vertex (canvas px; nearest
+/// pixel, clamped to the canvas; black where the layer's image has no pixel), for
+/// content-aware weights.
+pub fn vertex_colors(layer: &Layer, vertices: &[Point]) -> Vec<[f64; 3]> {
+    let [cw, ch] = layer.canvas_px.map(i64::from);
+    let [ox, oy] = layer.offset_px.map(i64::from);
     vertices
         .iter()
         .map(|p| {
-            let x = (p.x.floor() as i64).clamp(0, w - 1) as u32;
-            let y = (p.y.floor() as i64).clamp(0, h - 1) as u32;
-            let px = image.get_pixel(x, y);
+            // Clamped to the canvas, then read from the layer's image (transparent outside it).
+            let x = (p.x.floor() as i64).clamp(0, cw - 1) - ox;
+            let y = (p.y.floor() as i64).clamp(0, ch - 1) - oy;
+            let inside = x >= 0
+                && y >= 0
+                && x < i64::from(layer.image.width())
+                && y < i64::from(layer.image.height());
+            if !inside {
+                return [0.0; 3];
+            }
+            let px = layer.image.get_pixel(x as u32, y as u32);
             let a = px[3] as f64 / 255.0;
             [0, 1, 2].map(|c| a * px[c] as f64 / 255.0)
         })
         .collect()
 }
 
+/// `path` with its nearest existing ancestor resolved ([`std::fs::canonicalize`]: absolute,
+/// symbolic links followed) and the components below it appended; `None` when no ancestor
+/// resolves or a `..` follows a component that does not exist.
+fn resolved(path: &Path) -> Option<PathBuf> {
+    let mut missing = Vec::new();
+    let mut existing = path;
+    loop {
+        if let Ok(base) = std::fs::canonicalize(if existing.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            existing
+        }) {
+            let mut out = base;
+            for component in missing.iter().rev() {
+                match component {
+                    std::path::Component::Normal(name) => out.push(name),
+                    std::path::Component::CurDir => {}
+                    _ => return None,
+                }
+            }
+            return Some(out);
+        }
+        let component = existing.components().next_back()?;
+        missing.push(component);
+        existing = existing.parent()?;
+    }
+}
+
 /// `target` as a path relative to `dir` (with `/` separators) when both resolve; otherwise
-/// `target` made absolute.
+/// `target` as given. Either may not exist yet (a part image written with the document):
+/// its nearest existing folder is resolved and the rest appended.
 pub fn relative_path(dir: &Path, target: &Path) -> String {
-    let absolute = |p: &Path| std::fs::canonicalize(p).ok();
-    let (Some(dir), Some(target)) = (absolute(dir), absolute(target)) else {
+    let (Some(dir), Some(target)) = (resolved(dir), resolved(target)) else {
         return target.to_string_lossy().into_owned();
     };
     let common = dir
@@ -625,6 +681,19 @@ mod tests {
             "../../c/x.png"
         );
         assert_eq!(relative_path(&dir.join("c"), &dir.join("c/x.png")), "x.png");
+        // A part image not written yet, under a folder not made yet (`sinew rig art.psd -o
+        // out/rig.json` writes `out/rig.parts/…` with the document).
+        assert_eq!(
+            relative_path(&dir.join("c"), &dir.join("c/./rig.parts/arm/hand.png")),
+            "rig.parts/arm/hand.png"
+        );
+        let cwd_relative = dir.strip_prefix(std::env::current_dir().unwrap());
+        if let Ok(from_cwd) = cwd_relative {
+            assert_eq!(
+                relative_path(&from_cwd.join("c"), &from_cwd.join("c/rig.parts/x.png")),
+                "rig.parts/x.png"
+            );
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -80,6 +80,25 @@ pub struct Outline {
     pub holes: Vec<Vec<Point>>,
 }
 
+/// `outlines` moved by a whole number of pixels (`offset_px`, y down): the outlines of an
+/// image traced in its own pixels, placed where the image lies on a canvas.
+pub fn translated(mut outlines: Vec<Outline>, offset_px: [i32; 2]) -> Vec<Outline> {
+    if offset_px == [0, 0] {
+        return outlines;
+    }
+    let shift = crate::geom::Vec2::new(f64::from(offset_px[0]), f64::from(offset_px[1]));
+    for outline in &mut outlines {
+        for p in outline
+            .outer
+            .iter_mut()
+            .chain(outline.holes.iter_mut().flatten())
+        {
+            *p += shift;
+        }
+    }
+    outlines
+}
+
 /// What the caller got wrong.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum TraceError {

@@ -255,9 +255,9 @@ fn load(path: &Path) -> RgbaImage {
 fn propose(images: &[(&str, &RgbaImage)], options: &AutorigOptions) -> Handles {
     let layers: Vec<LayerRef> = images
         .iter()
-        .map(|(name, image)| LayerRef { name, image })
+        .map(|(name, image)| LayerRef::whole(name, image))
         .collect();
-    autorig(&layers, options).expect("autorig").handles
+    autorig(&layers, &[], options).expect("autorig").handles
 }
 
 fn one(image: &RgbaImage) -> Handles {

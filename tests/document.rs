@@ -93,9 +93,9 @@ fn a_failing_command_changes_nothing() {
         assert!(doc.posable().is_some());
     }
     assert_eq!(doc.can_undo(), undo_depth_probe);
-    // A layer of another size is refused too.
-    let mut small = bar_layer("small", &std::env::temp_dir(), false);
-    small.image = RgbaImage::new(10, 10);
+    // A layer on a canvas of another size is refused too.
+    let bar = bar_layer("small", &std::env::temp_dir(), false);
+    let small = sinew::pipeline::Layer::whole("small", bar.path, RgbaImage::new(10, 10));
     assert!(matches!(
         doc.apply(Command::AddLayer(small)),
         Err(DocumentError::LayerSize { .. })
@@ -397,7 +397,7 @@ fn cages_regions_and_proposed_handles_are_commands() {
     pose.bones.insert("upper".into(), Default::default());
     doc.apply(Command::SetPose(pose)).unwrap();
     let before = doc.state().handles.clone();
-    let proposal = sinew::jobs::propose_handles(&doc.state().layers, &Default::default())
+    let proposal = sinew::jobs::propose_handles(&doc.state().layers, &[], &Default::default())
         .expect("the bar gets a skeleton");
     assert!(!proposal.handles.bones.is_empty());
     doc.apply(Command::SetHandles(proposal.handles.clone()))

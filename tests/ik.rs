@@ -407,11 +407,7 @@ fn two_skeleton_bar() -> Scene {
         ]
     }))
     .unwrap();
-    let layers = vec![Layer {
-        name: "bar".into(),
-        path: "bar.png".into(),
-        image: image.clone(),
-    }];
+    let layers = vec![Layer::whole("bar", "bar.png", image.clone())];
     let (doc, _) = build_rig(
         &layers,
         std::path::Path::new("."),

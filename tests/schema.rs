@@ -102,11 +102,7 @@ fn a_written_rig_validates() {
     let path = dir.join("critter.png");
     let image = common::critter(96);
     image.save(&path).unwrap();
-    let layer = Layer {
-        name: "critter".into(),
-        path,
-        image,
-    };
+    let layer = Layer::whole("critter", path, image);
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
         parent: parent.map(Into::into),

@@ -266,11 +266,7 @@ fn coarse_meshes_are_much_smaller_and_still_cover() {
 /// Renders the freshly rigged sprite in its rest pose.
 fn rest_render(image: &RgbaImage) -> RgbaImage {
     let dir = std::env::temp_dir();
-    let layer = pipeline::Layer {
-        name: "sprite".into(),
-        path: dir.join("sprite.png"),
-        image: image.clone(),
-    };
+    let layer = pipeline::Layer::whole("sprite", dir.join("sprite.png"), image.clone());
     let (doc, _) = pipeline::build_rig(
         std::slice::from_ref(&layer),
         &dir,

@@ -54,11 +54,11 @@ fn critter(max_area_fraction: f64) -> (Vec<Layer>, Handles, BuildOptions) {
         ],
         ..Default::default()
     };
-    let layers = vec![Layer {
-        name: "critter".into(),
-        path: std::env::temp_dir().join("critter.png"),
-        image: common::critter(512),
-    }];
+    let layers = vec![Layer::whole(
+        "critter",
+        std::env::temp_dir().join("critter.png"),
+        common::critter(512),
+    )];
     let mut options = BuildOptions::default();
     options.mesh.max_area_fraction = max_area_fraction;
     (layers, handles, options)

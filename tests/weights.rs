@@ -31,11 +31,11 @@ fn scene(layers: &[Layer], doc: RigDocument) -> Scene {
 }
 
 fn layer(name: &str, image: RgbaImage) -> Layer {
-    Layer {
-        name: name.into(),
-        path: std::env::temp_dir().join(format!("{name}.png")),
+    Layer::whole(
+        name,
+        std::env::temp_dir().join(format!("{name}.png")),
         image,
-    }
+    )
 }
 
 /// Posing skins in f32 (the packed plan) on the f64 rest points: a motion lands within this of

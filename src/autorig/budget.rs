@@ -14,7 +14,9 @@
 //!    first), their children hung from their parent and, where the child started at the
 //!    removed bone's tail, started at its head instead (when that stays inside).
 //!
-//! The budget itself is [`super::skeleton::limit_bones`] with [`bone_budget`].
+//! The budget itself is [`super::skeleton::limit_bones`] with [`bone_budget`]; a template's
+//! proposal with fewer bones than [`bone_minimum`] has its longest bones split
+//! ([`reach_minimum`]).
 
 use super::shape::Shape;
 use super::skeleton::{ProtoBone, SkeletonOptions};
@@ -28,6 +30,59 @@ pub const HUMANOID_MAX_BONES: usize = 20;
 pub const QUADRUPED_MAX_BONES: usize = 25;
 /// Default bone budget without a template.
 pub const FREE_MAX_BONES: usize = 25;
+/// Fewest bones of a humanoid template's proposal: a spine, a neck, a head and two bones per
+/// limb, as an animator places them even on a drawing the template does not fit.
+pub const HUMANOID_MIN_BONES: usize = 12;
+/// Fewest bones of a quadruped template's proposal.
+pub const QUADRUPED_MIN_BONES: usize = 15;
+
+/// The fewest bones a proposal should have: the template's minimum, none without a template
+/// or with `options.max_bones` given.
+pub fn bone_minimum(options: &SkeletonOptions, template: Option<Template>) -> usize {
+    match (options.max_bones, template) {
+        (Some(_), _) | (None, None) => 1,
+        (None, Some(Template::Humanoid)) => HUMANOID_MIN_BONES,
+        (None, Some(Template::Quadruped)) => QUADRUPED_MIN_BONES,
+    }
+}
+
+/// Splits the longest bones in two at their middle until there are `min` bones, never making
+/// a bone shorter than `min_px` (so it may stop short of `min`): a limb drawn as one straight
+/// piece gets an elbow. The second half is a new, unnamed child of the first; the bone's
+/// children that start past its middle hang from it. Halves of a bone inside the shape stay
+/// inside.
+pub fn reach_minimum(bones: &mut Vec<ProtoBone>, min: usize, min_px: f64) {
+    while bones.len() < min {
+        let longest = (0..bones.len())
+            .filter(|&b| bones[b].length_px() >= 2.0 * min_px)
+            .max_by(|&a, &b| {
+                bones[a]
+                    .length_px()
+                    .total_cmp(&bones[b].length_px())
+                    .then(b.cmp(&a))
+            });
+        let Some(b) = longest else { return };
+        let (head, tail) = (bones[b].head, bones[b].tail);
+        let middle = Point::from((head.coords + tail.coords) / 2.0);
+        let second = ProtoBone {
+            head: middle,
+            tail,
+            parent: Some(b),
+            name: None,
+        };
+        bones[b].tail = middle;
+        // Where along the bone a child starts: those past the middle hang from the second half.
+        let along = |p: Point| (p - head).dot(&(tail - head)) / (tail - head).norm_squared();
+        for bone in bones.iter_mut() {
+            match bone.parent {
+                Some(p) if p == b && along(bone.head) >= 0.5 => bone.parent = Some(b + 1),
+                Some(p) if p > b => bone.parent = Some(p + 1),
+                _ => {}
+            }
+        }
+        bones.insert(b + 1, second);
+    }
+}
 
 /// The bone budget: `options.max_bones` when given, else the template's default.
 pub fn bone_budget(options: &SkeletonOptions, template: Option<Template>) -> usize {
@@ -195,6 +250,42 @@ fn remove_bone(bones: &mut Vec<ProtoBone>, r: usize, shape: &Shape) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reaching_the_minimum_splits_the_longest_bones_and_keeps_the_hierarchy() {
+        let bone = |head: [f64; 2], tail: [f64; 2], parent| ProtoBone {
+            head: Point::new(head[0], head[1]),
+            tail: Point::new(tail[0], tail[1]),
+            parent,
+            name: None,
+        };
+        // A 100 px trunk with a 30 px branch from its tail.
+        let mut bones = vec![
+            bone([0.0, 0.0], [0.0, 100.0], None),
+            bone([0.0, 100.0], [30.0, 100.0], Some(0)),
+        ];
+        reach_minimum(&mut bones, 4, 20.0);
+        // The trunk splits (100 → 50 + 50), then a half (50 → 25 + 25); the branch (30 px)
+        // could not split without a bone under 20 px.
+        assert_eq!(bones.len(), 4);
+        for (k, b) in bones.iter().enumerate() {
+            assert!(b.parent.is_none_or(|p| p < k), "bone {k} before its parent");
+            if let Some(p) = b.parent {
+                assert!(
+                    (bones[p].tail - b.head).norm() < 1e-12,
+                    "bone {k} is not joined"
+                );
+            }
+        }
+        let lengths: Vec<f64> = bones.iter().map(ProtoBone::length_px).collect();
+        assert_eq!(lengths, [25.0, 25.0, 50.0, 30.0]);
+        // The branch still hangs from the trunk's tail.
+        assert_eq!(bones[3].head, Point::new(0.0, 100.0));
+        // Only the 50 px bone can still split into halves of at least 20 px: it stops short.
+        reach_minimum(&mut bones, 10, 20.0);
+        let lengths: Vec<f64> = bones.iter().map(ProtoBone::length_px).collect();
+        assert_eq!(lengths, [25.0, 25.0, 25.0, 25.0, 30.0]);
+    }
     use crate::autorig::shape::tests::square;
     use crate::trace::Outline;
 

@@ -15,12 +15,14 @@
 //! axis to the far end of the axis. Parts that overlap nothing start their own skeleton. A
 //! part too curved for a straight axis bone inside it (a tail) gets the bones of its own
 //! medial axis instead, rooted at the axis point nearest to its joint. The largest part's
-//! bone runs upward from its lower end, as a hip does.
+//! bone runs upward from its lower end, as a hip does. Where the artist marked a group's pivot
+//! (a pivot layer, [`Pivot`]), the bone of the group's first part starts at the pivot instead.
 
 use super::medial::{medial_axis, MedialError, MedialOptions};
 use super::shape::Shape;
 use super::skeleton::{BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
 use crate::geom::{Point, Vec2};
+use crate::io::layered::Pivot;
 
 /// One part's principal axis: centroid, unit direction, extent along it (px from the centroid).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,15 +44,7 @@ impl PrincipalAxis {
 
 /// The area-weighted principal axis of the inside pixels of `shape` (None when empty).
 pub fn principal_axis(shape: &Shape) -> Option<PrincipalAxis> {
-    let w = shape.width as usize;
-    let centers = || {
-        shape
-            .inside
-            .iter()
-            .enumerate()
-            .filter(|(_, &b)| b)
-            .map(move |(i, _)| Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5))
-    };
+    let centers = || shape.inside_centers();
     let n = shape.area_px2;
     if n < 1.0 {
         return None;
@@ -119,9 +113,31 @@ pub struct Part<'a> {
     pub shape: &'a Shape,
 }
 
-/// The layered skeleton: bones (parents first) and, per bone, the index of its part.
+/// Whether the part named by its path (`arm_l/hand`) lies in the group `group` (a path; the
+/// empty path is the whole file).
+fn in_group(part: &str, group: &str) -> bool {
+    group.is_empty()
+        || part
+            .strip_prefix(group)
+            .is_some_and(|rest| rest.starts_with('/'))
+}
+
+/// The pivot where part `part`'s bone starts: that of the deepest group holding the part but
+/// not its parent part (so a group's pivot starts the bone of the group's first part, the one
+/// joined to the rest of the drawing, or a skeleton's root).
+fn pivot_of(part: &str, parent: Option<&str>, pivots: &[Pivot]) -> Option<Point> {
+    pivots
+        .iter()
+        .filter(|p| in_group(part, &p.group) && !parent.is_some_and(|q| in_group(q, &p.group)))
+        .max_by_key(|p| p.group.len())
+        .map(|p| Point::new(p.at_px[0], p.at_px[1]))
+}
+
+/// The layered skeleton: bones (parents first) and, per bone, the index of its part. A part
+/// with a pivot ([`pivot_of`]) starts its bone there (its joint with its parent is the pivot).
 pub fn layered_skeleton(
     parts: &[Part],
+    pivots: &[Pivot],
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
 ) -> Result<(Vec<ProtoBone>, Vec<usize>), MedialError> {
@@ -129,14 +145,24 @@ pub fn layered_skeleton(
     let axes: Vec<Option<PrincipalAxis>> = parts.iter().map(|p| principal_axis(p.shape)).collect();
     // Overlap area and centroid per pair.
     let mut overlap = vec![vec![(0.0f64, Vec2::zeros()); n]; n];
+    let boxes: Vec<[usize; 4]> = parts.iter().map(|p| p.shape.cell_box()).collect();
     for i in 0..n {
         for j in (i + 1)..n {
             let (a, b) = (&parts[i].shape.inside, &parts[j].shape.inside);
             let w = parts[i].shape.width as usize;
+            // Only where both boxes meet, row by row (the order of the sums over the whole
+            // canvas).
+            let [x0, y0] = [0, 1].map(|k| boxes[i][k].max(boxes[j][k]));
+            let [x1, y1] = [2, 3].map(|k| boxes[i][k].min(boxes[j][k]));
             let (mut count, mut sum) = (0.0, Vec2::zeros());
-            for (k, (_, _)) in a.iter().zip(b).enumerate().filter(|(_, (x, y))| **x && **y) {
-                count += 1.0;
-                sum += Vec2::new((k % w) as f64 + 0.5, (k / w) as f64 + 0.5);
+            for y in y0..y1.max(y0) {
+                for x in x0..x1.max(x0) {
+                    let k = y * w + x;
+                    if a[k] && b[k] {
+                        count += 1.0;
+                        sum += Vec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    }
+                }
             }
             let c = if count > 0.0 { sum / count } else { sum };
             overlap[i][j] = (count, c);
@@ -184,7 +210,8 @@ pub fn layered_skeleton(
     for &i in &order {
         let Some(axis) = axes[i] else { continue };
         let parent_bone = parent[i].and_then(|p| part_bone[p]);
-        let joint = parent[i].map(|p| Point::from(overlap[i][p].1));
+        let pivot = pivot_of(parts[i].name, parent[i].map(|p| parts[p].name), pivots);
+        let joint = pivot.or(parent[i].map(|p| Point::from(overlap[i][p].1)));
         // The axis line clipped to the part around the centroid: a straight bone needs it to
         // span most of the part's extent.
         let shape = parts[i].shape;
@@ -206,7 +233,8 @@ pub fn layered_skeleton(
         let first = bones.len();
         match straight {
             Some((t_head, t_tail)) => bones.push(ProtoBone {
-                head: axis.at(t_head),
+                // A marked pivot is the bone's origin itself, not its projection on the axis.
+                head: pivot.unwrap_or(axis.at(t_head)),
                 tail: axis.at(t_tail),
                 parent: parent_bone,
                 name: None,

@@ -64,6 +64,22 @@ pub struct AutorigOptions {
 pub struct LayerRef<'a> {
     pub name: &'a str,
     pub image: &'a RgbaImage,
+    /// Canvas position of the image's top-left pixel, px.
+    pub offset_px: [i32; 2],
+    /// The canvas the layer lies on, px.
+    pub canvas_px: [u32; 2],
+}
+
+impl<'a> LayerRef<'a> {
+    /// A layer whose image is the whole canvas.
+    pub fn whole(name: &'a str, image: &'a RgbaImage) -> Self {
+        LayerRef {
+            name,
+            image,
+            offset_px: [0, 0],
+            canvas_px: [image.width(), image.height()],
+        }
+    }
 }
 
 /// What autorig proposes.
@@ -95,11 +111,17 @@ pub enum AutorigError {
     InvalidOptions(String),
 }
 
-/// Proposes handles for `layers` (back to front, one canvas).
-pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal, AutorigError> {
+/// Proposes handles for `layers` (back to front, one canvas). `pivots` are bone origins the
+/// artist marked in a layered file (see [`crate::io::layered::Pivot`]): with several layers,
+/// the bone of a group's first part (the one joined to a part outside the group, or a root)
+/// starts at the group's pivot; a pivot outside any group starts the skeleton's root bone.
+pub fn autorig(
+    layers: &[LayerRef],
+    pivots: &[crate::io::layered::Pivot],
+    options: &AutorigOptions,
+) -> Result<Proposal, AutorigError> {
     let first = layers.first().ok_or(AutorigError::NoLayers)?;
-    let size = first.image.dimensions();
-    if let Some(l) = layers.iter().find(|l| l.image.dimensions() != size) {
+    if let Some(l) = layers.iter().find(|l| l.canvas_px != first.canvas_px) {
         return Err(AutorigError::SizeMismatch(l.name.to_string()));
     }
     let so = &options.skeleton;
@@ -125,8 +147,7 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
             "the bone budget must be at least 1".into(),
         ));
     }
-    let images: Vec<&RgbaImage> = layers.iter().map(|l| l.image).collect();
-    let union = shape::union_alpha(&images);
+    let union = shape::union_alpha(layers);
     let silhouette = Shape::trace(&union, &options.trace)?
         .ok_or(AutorigError::NoShape(options.trace.min_area_px2))?;
     let mut notes = Vec::new();
@@ -164,7 +185,7 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
     } else {
         let mut shapes = Vec::new();
         for layer in layers {
-            match Shape::trace(layer.image, &options.trace) {
+            match Shape::trace_placed(layer, &options.trace) {
                 Ok(Some(s)) => shapes.push((layer.name, s)),
                 Ok(None) | Err(TraceError::NoOpaquePixels { .. }) => notes.push(format!(
                     "layer '{}' has nothing to trace: no bone",
@@ -177,7 +198,7 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
             .iter()
             .map(|(name, shape)| layers::Part { name, shape })
             .collect();
-        let (bones, bone_part) = layers::layered_skeleton(&parts, &options.medial, so)?;
+        let (bones, bone_part) = layers::layered_skeleton(&parts, pivots, &options.medial, so)?;
         for (b, &p) in bones.iter().zip(&bone_part) {
             if let Some(name) = &b.name {
                 bind.insert(name.clone(), vec![parts[p].name.to_string()]);
@@ -202,6 +223,8 @@ pub fn autorig(layers: &[LayerRef], options: &AutorigOptions) -> Result<Proposal
     budget::drop_short_bones(&mut bones, &silhouette, min_bone_px);
     let max_bones = budget::bone_budget(so, options.template);
     skeleton::limit_bones(&mut bones, Some(max_bones), &silhouette);
+    let min_bones = budget::bone_minimum(so, options.template);
+    budget::reach_minimum(&mut bones, min_bones.min(max_bones), min_bone_px);
     let bones = name_bones(bones);
     bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
 

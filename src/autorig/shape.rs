@@ -34,12 +34,19 @@ pub struct Shape {
     edges: EdgeGrid,
 }
 
-/// The union of the layers' alpha (the largest alpha per pixel; color is not used).
-pub fn union_alpha(layers: &[&RgbaImage]) -> RgbaImage {
-    let (w, h) = layers.first().map_or((0, 0), |l| l.dimensions());
+/// The union of the layers' alpha on the first layer's canvas (the largest alpha per pixel;
+/// color is not used; pixels off the canvas dropped).
+pub fn union_alpha(layers: &[super::LayerRef]) -> RgbaImage {
+    let [w, h] = layers.first().map_or([0, 0], |l| l.canvas_px);
     let mut out = RgbaImage::new(w, h);
     for layer in layers {
-        for (o, p) in out.pixels_mut().zip(layer.pixels()) {
+        let [ox, oy] = layer.offset_px.map(i64::from);
+        for (x, y, p) in layer.image.enumerate_pixels() {
+            let (cx, cy) = (ox + i64::from(x), oy + i64::from(y));
+            if cx < 0 || cy < 0 || cx >= i64::from(w) || cy >= i64::from(h) {
+                continue;
+            }
+            let o = out.get_pixel_mut(cx as u32, cy as u32);
             o[3] = o[3].max(p[3]);
         }
     }
@@ -58,6 +65,20 @@ impl Shape {
             image.width(),
             image.height(),
         )))
+    }
+
+    /// Traces one layer's image and places the shape where the layer lies on its canvas.
+    /// Returns `Ok(None)` when no region is large enough.
+    pub fn trace_placed(
+        layer: &super::LayerRef,
+        options: &TraceOptions,
+    ) -> Result<Option<Shape>, TraceError> {
+        let outlines = trace::translated(trace::trace(layer.image, options)?, layer.offset_px);
+        if outlines.is_empty() {
+            return Ok(None);
+        }
+        let [w, h] = layer.canvas_px;
+        Ok(Some(Shape::from_outlines(outlines, w, h)))
     }
 
     /// A shape from outlines already traced on a `width` × `height` canvas.
@@ -83,6 +104,41 @@ impl Shape {
         }
         let (x, y) = (p.x as u32, p.y as u32);
         x < self.width && y < self.height && self.inside[(y * self.width + x) as usize]
+    }
+
+    /// The cells that may be inside, as `[x0, y0, x1, y1)` (columns x0..x1, rows y0..y1 of
+    /// [`Shape::inside`]): the outlines' bounding box on the grid. Loops over a layer's inside
+    /// cells stay within it, so a small layer on a large canvas costs its own size.
+    pub fn cell_box(&self) -> [usize; 4] {
+        let (mut lo, mut hi) = (
+            Point::new(f64::MAX, f64::MAX),
+            Point::new(f64::MIN, f64::MIN),
+        );
+        for p in rings(&self.outlines).flatten() {
+            lo = Point::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Point::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        if lo.x > hi.x {
+            return [0; 4];
+        }
+        let clamp = |v: f64, n: u32| (v.max(0.0) as usize).min(n as usize);
+        [
+            clamp(lo.x.floor(), self.width),
+            clamp(lo.y.floor(), self.height),
+            clamp(hi.x.ceil() + 1.0, self.width),
+            clamp(hi.y.ceil() + 1.0, self.height),
+        ]
+    }
+
+    /// The inside cells' centres, px, row by row.
+    pub fn inside_centers(&self) -> impl Iterator<Item = Point> + '_ {
+        let [x0, y0, x1, y1] = self.cell_box();
+        let w = self.width as usize;
+        (y0..y1).flat_map(move |y| {
+            (x0..x1)
+                .filter(move |&x| self.inside[y * w + x])
+                .map(move |x| Point::new(x as f64 + 0.5, y as f64 + 0.5))
+        })
     }
 
     /// Whether `p` lies inside the outlines (even-odd over every ring), exactly.

@@ -61,11 +61,18 @@ pub fn fit(canvas_px: [u32; 2], available: Vec2) -> View {
     }
 }
 
-/// A whole layer image as one quad at rest.
-pub fn image_quad(placed: &Placed, texture: &TextureHandle, canvas_px: [u32; 2]) -> Shape {
+/// An image of `size_px` whose top-left pixel lies at `offset_px` on the canvas, as one quad
+/// at rest.
+pub fn image_quad(
+    placed: &Placed,
+    texture: &TextureHandle,
+    offset_px: [i32; 2],
+    size_px: [u32; 2],
+) -> Shape {
+    let [x, y] = offset_px.map(f64::from);
     let rect = egui::Rect::from_two_pos(
-        placed.screen_from_canvas([0.0, 0.0]),
-        placed.screen_from_canvas([canvas_px[0] as f64, canvas_px[1] as f64]),
+        placed.screen_from_canvas([x, y]),
+        placed.screen_from_canvas([x + f64::from(size_px[0]), y + f64::from(size_px[1])]),
     );
     let uv = egui::Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
     Shape::image(texture.id(), rect, uv, Color32::WHITE)

@@ -664,7 +664,7 @@ impl EditorApp {
         let placed = self.place_canvas(&ctx, &response, size_px);
         let mut shapes = Vec::new();
         if let Some(texture) = self.colorize_textures(&ctx) {
-            shapes.push(canvas::image_quad(&placed, &texture.0, size_px));
+            shapes.push(canvas::image_quad(&placed, &texture.0, [0, 0], size_px));
             if let (Some(result), ColorizeView::Result) = (texture.1, self.colorize.view_mode) {
                 let alpha = (self.colorize.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
                 let quad = egui::Rect::from_two_pos(

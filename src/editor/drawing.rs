@@ -202,7 +202,7 @@ impl EditorApp {
             .state()
             .layers
             .first()
-            .map(|l| [l.image.width(), l.image.height()])
+            .map(|l| l.canvas_px)
             .unwrap_or([512, 512]);
         let placed = self.place_canvas(&ctx, &response, canvas_px);
         let posable = self.doc.posable().cloned();
@@ -252,7 +252,7 @@ impl EditorApp {
                     shapes.push(egui::Shape::circle_filled(s, 4.0, Color32::RED));
                 }
             }
-            _ => shapes.extend(self.rest_shapes(&placed, &textures, canvas_px, posable.is_some())),
+            _ => shapes.extend(self.rest_shapes(&placed, &textures, posable.is_some())),
         }
         let mut handles = posed_handles.unwrap_or_else(|| self.doc.state().handles.clone());
         match &self.gesture {

@@ -129,11 +129,7 @@ impl EditorApp {
                     .file_stem()
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_else(|| "layer".into());
-                if self.apply(Command::AddLayer(Layer {
-                    name,
-                    path: path.to_path_buf(),
-                    image,
-                })) {
+                if self.apply(Command::AddLayer(Layer::whole(name, path, image))) {
                     self.view = None;
                 }
             }

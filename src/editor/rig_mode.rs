@@ -59,14 +59,19 @@ impl EditorApp {
         &self,
         placed: &Placed,
         textures: &[TextureHandle],
-        canvas_px: [u32; 2],
         weighted: bool,
     ) -> Vec<Shape> {
         let mut shapes = Vec::new();
         let hidden = &self.tree.hidden_parts;
         for (texture, layer) in textures.iter().zip(&self.doc.state().layers) {
             if !hidden.contains(&layer.name) {
-                shapes.push(canvas::image_quad(placed, texture, canvas_px));
+                let size_px = [layer.image.width(), layer.image.height()];
+                shapes.push(canvas::image_quad(
+                    placed,
+                    texture,
+                    layer.offset_px,
+                    size_px,
+                ));
             }
         }
         let (Some(scene), Some(name)) = (&self.doc.state().rig, &self.selected) else {

@@ -301,7 +301,8 @@ impl EditorApp {
         let (send, receive) = std::sync::mpsc::channel();
         let ctx = ctx.clone();
         std::thread::spawn(move || {
-            let result = crate::jobs::propose_handles(&layers, &options).map_err(|e| e.to_string());
+            let result =
+                crate::jobs::propose_handles(&layers, &[], &options).map_err(|e| e.to_string());
             let _ = send.send(result);
             ctx.request_repaint();
         });

@@ -82,6 +82,11 @@ pub struct PartDoc {
     pub slot: Option<String>,
     /// Path of the image, relative to the document's folder.
     pub image: String,
+    /// Canvas position of the image's top-left pixel, px (y down). Absent: `[0, 0]`, the image
+    /// lies at the canvas's corner (a PNG layer covering the canvas). Parts from layered files
+    /// keep only their layer's opaque pixels, placed here.
+    #[serde(default, skip_serializing_if = "is_at_corner")]
+    pub offset_px: [i32; 2],
     pub mesh: MeshDoc,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weights: Option<WeightsDoc>,
@@ -90,6 +95,27 @@ pub struct PartDoc {
     /// from them. Never used to pose.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stale_weights: Option<WeightsDoc>,
+}
+
+impl PartDoc {
+    /// Whether an image of `image_px` (width, height) placed at this part's `offset_px` holds its
+    /// mesh, with `reach_px` of transparent frame allowed around the image (meshes reach past
+    /// the opaque pixels by the trace padding). A part's image that fails this is not the one
+    /// its mesh was traced from (an image file replaced by one of another size).
+    pub fn image_holds_mesh(&self, image_px: [u32; 2], reach_px: f64) -> bool {
+        let [ox, oy] = self.offset_px.map(f64::from);
+        let [w, h] = image_px.map(f64::from);
+        self.mesh.vertices.iter().all(|&[x, y]| {
+            x >= ox - reach_px
+                && y >= oy - reach_px
+                && x <= ox + w + reach_px
+                && y <= oy + h + reach_px
+        })
+    }
+}
+
+fn is_at_corner(offset_px: &[i32; 2]) -> bool {
+    *offset_px == [0, 0]
 }
 
 /// A mesh as stored: vertices in canvas px, triangles as vertex indices.
@@ -452,6 +478,7 @@ mod tests {
             name: "body".into(),
             slot: None,
             image: "body.png".into(),
+            offset_px: [0, 0],
             mesh: MeshDoc {
                 vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
                 triangles: vec![[0, 1, 2]],

@@ -235,6 +235,7 @@ pub(crate) mod tests {
             name: name.into(),
             slot: slot.map(Into::into),
             image: format!("{name}.png"),
+            offset_px: [0, 0],
             mesh: MeshDoc {
                 vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
                 triangles: vec![[0, 1, 2]],

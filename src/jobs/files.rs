@@ -197,7 +197,7 @@ pub fn autorig_files(
         [Some(files.output.as_path()), files.preview.as_deref()],
     )?;
     let art = load_art(&files.images, &files.output)?;
-    let proposal = super::propose_handles(&art.layers, options)?;
+    let proposal = super::propose_handles(&art.layers, &art.pivots, options)?;
     let text = serde_json::to_string_pretty(&proposal.handles).map_err(JobError::Serialize)? + "\n";
     let preview = match &files.preview {
         Some(_) => {

@@ -22,4 +22,5 @@ mod rig_scene;
 
 pub use crate::playback::draw_pose;
 pub use play::{frames, Frame, PlayOptions, Playhead, MAX_SIMULATED_S};
+pub(crate) use rig_scene::texture_border_px;
 pub use rig_scene::{load_part_images, Scene};

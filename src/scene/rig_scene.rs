@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 const TEXTURE_BORDER_MARGIN_PX: u32 = 2;
 
 /// The transparent frame each part's texture gets: the trace padding plus a margin.
-fn texture_border_px(doc: &RigDocument) -> u32 {
+pub(crate) fn texture_border_px(doc: &RigDocument) -> u32 {
     let padding = doc.options.trace.padding_px;
     let padding = if padding.is_finite() {
         padding.clamp(0.0, crate::trace::MAX_PADDING_PX)
@@ -84,19 +84,21 @@ impl Scene {
         for (part, image) in doc.parts.iter().zip(images) {
             let image: &RgbaImage = image.borrow();
             let got = [image.width(), image.height()];
-            if got != doc.canvas {
+            let border = texture_border_px(&doc);
+            if !part.image_holds_mesh(got, f64::from(border)) {
                 return Err(PipelineError::TextureSize {
                     part: part.name.clone(),
                     got,
-                    canvas: doc.canvas,
+                    offset_px: part.offset_px,
                 });
             }
-            // Meshes reach past the canvas by up to the trace padding; a transparent frame
-            // around the texture keeps the sampler from smearing edge pixels out there.
-            let border = texture_border_px(&doc);
-            let offset = crate::geom::Vec2::new(border as f64, border as f64);
+            // Meshes reach past the opaque pixels by up to the trace padding; a transparent
+            // frame around the texture keeps the sampler from smearing edge pixels out there.
+            // Texture px = canvas px − the image's offset + the frame.
+            let [ox, oy] = part.offset_px.map(f64::from);
+            let canvas_to_uv = crate::geom::Vec2::new(border as f64 - ox, border as f64 - oy);
             let mesh = part.mesh.to_mesh();
-            let uv_px: Vec<Point> = mesh.vertices.iter().map(|p| p + offset).collect();
+            let uv_px: Vec<Point> = mesh.vertices.iter().map(|p| p + canvas_to_uv).collect();
             let mut framed =
                 RgbaImage::new(image.width() + 2 * border, image.height() + 2 * border);
             image::imageops::replace(&mut framed, image, i64::from(border), i64::from(border));

@@ -21,11 +21,7 @@ pub fn bar_layer(name: &str, dir: &Path, save: bool) -> Layer {
     if save {
         image.save(&path).expect("the bar's PNG written");
     }
-    Layer {
-        name: name.into(),
-        path,
-        image,
-    }
+    Layer::whole(name, path, image)
 }
 
 pub fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bone {

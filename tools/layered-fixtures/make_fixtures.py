@@ -1,7 +1,7 @@
 """Writes the layered-art fixtures of tests/layered.rs with psd-tools (the Python PSD library
 most art pipelines use), and each file's flattened image as psd-tools composites it.
 
-Usage: make_fixtures.py OUT_DIR | --krita-source FILE.psd
+Usage: make_fixtures.py OUT_DIR | --krita-source FILE.psd | --pivots FILE.psd
 
 Writes (all small):
   character.psd           RGB, groups (arm_l/upper, arm_l/hand), a hidden layer, an [ignore]
@@ -13,6 +13,8 @@ Writes (all small):
   gray.composite.png
   deep16.psd              16-bit: must be refused
   cmyk.psd                CMYK: must be refused
+  pivots.psd              a torso and an arm group (upper, forearm) whose "shoulder [origin]"
+                          layer marks the arm's bone origin, away from where the parts overlap
   spine/character.json + spine/*.png
                           the layout GimpToSpine.py writes (trimmed PNGs, centre positions
                           relative to the canvas's bottom centre, y up), from character.psd
@@ -137,6 +139,24 @@ def main(out):
     PSDImage.new("RGB", (4, 4), depth=16).save(os.path.join(out, "deep16.psd"))
     PSDImage.new("CMYK", (4, 4)).save(os.path.join(out, "cmyk.psd"))
     spine_layout(PSDImage.open(os.path.join(out, "character.psd")), os.path.join(out, "spine"))
+    pivots(os.path.join(out, "pivots.psd"))
+
+
+def pivots(path):
+    """An arm group with a pivot layer: the shoulder dot (centre (76, 51)) lies on the upper
+    arm, 16 px from the centre of its overlap with the torso ((60, 51)), where a bone would
+    start without it."""
+    psd = PSDImage.new("RGB", (W, H), color=0, compression=Compression.RLE)
+    PixelLayer.frompil(shape((40, 90), (40, 90, 200), "rect"), psd, "torso", top=40, left=30,
+                       compression=Compression.RLE)
+    arm = Group.new(psd, "arm_l")
+    PixelLayer.frompil(shape((62, 14), (200, 150, 60), "rect"), arm, "upper", top=44, left=50,
+                       compression=Compression.RLE)
+    PixelLayer.frompil(shape((14, 50), (230, 180, 120), "rect"), arm, "forearm", top=50,
+                       left=100, compression=Compression.RLE)
+    PixelLayer.frompil(shape((4, 4), (255, 0, 0)), arm, "shoulder [origin]", top=49, left=74,
+                       compression=Compression.RLE)
+    psd.save(path)
 
 
 def krita_source(path):
@@ -152,5 +172,7 @@ def krita_source(path):
 if __name__ == "__main__":
     if sys.argv[1] == "--krita-source":
         krita_source(sys.argv[2])
+    elif sys.argv[1] == "--pivots":
+        pivots(sys.argv[2])
     else:
         main(sys.argv[1])

@@ -1,8 +1,8 @@
 //! Packing the parts' images into atlas pages, and the `.atlas` text Spine's runtimes read.
 //!
-//! In: each part's image (straight-alpha RGBA8 on the shared canvas) and its region rectangle
-//! on the canvas ([`RegionRect`]: the mesh's box plus a margin; it may reach past the canvas,
-//! where the pixels are transparent). Out: [`AtlasPage`]s holding the regions, packed on shelves
+//! In: each part's image (straight-alpha RGBA8, placed on the shared canvas at its offset) and
+//! its region rectangle on the canvas ([`RegionRect`]: the mesh's box plus a margin; it may
+//! reach past the image, where the pixels are transparent). Out: [`AtlasPage`]s holding the regions, packed on shelves
 //! (tallest first) with `padding_px` of transparent pixels between them, and the atlas text
 //! (spine-format.md §12): page name, `size`, `filter`, `pma`, then per region its name and
 //! `bounds: x, y, w, h` (top-left in page px, y down). Regions are never rotated or stripped:
@@ -67,16 +67,16 @@ pub struct Atlas {
     pub premultiplied_alpha: bool,
 }
 
-/// Packs `regions` (name, source image, rectangle on its canvas) into pages named
-/// `{base}.png`, `{base}_2.png`, …
+/// Packs `regions` (name, source image, the canvas position of the image's top-left pixel,
+/// rectangle on the canvas) into pages named `{base}.png`, `{base}_2.png`, …
 pub fn pack_atlas(
     base: &str,
-    regions: &[(String, &RgbaImage, RegionRect)],
+    regions: &[(String, &RgbaImage, [i32; 2], RegionRect)],
     options: &AtlasOptions,
 ) -> Result<Atlas, SpineError> {
     let pad = options.padding_px;
     let max = options.max_page_px;
-    for (name, _, r) in regions {
+    for (name, _, _, r) in regions {
         if r.width + 2 * pad > max || r.height + 2 * pad > max {
             return Err(SpineError::RegionTooLarge {
                 part: name.clone(),
@@ -89,11 +89,11 @@ pub fn pack_atlas(
     // widest region and at most the page limit.
     let area: u64 = regions
         .iter()
-        .map(|(_, _, r)| u64::from(r.width + pad) * u64::from(r.height + pad))
+        .map(|(_, _, _, r)| u64::from(r.width + pad) * u64::from(r.height + pad))
         .sum();
     let widest = regions
         .iter()
-        .map(|(_, _, r)| r.width + 2 * pad)
+        .map(|(_, _, _, r)| r.width + 2 * pad)
         .max()
         .unwrap_or(1);
     let side = ((area as f64).sqrt().ceil() as u32)
@@ -105,17 +105,17 @@ pub fn pack_atlas(
     let mut order: Vec<usize> = (0..regions.len()).collect();
     order.sort_by(|&a, &b| {
         regions[b]
-            .2
+            .3
             .height
-            .cmp(&regions[a].2.height)
+            .cmp(&regions[a].3.height)
             .then(regions[a].0.cmp(&regions[b].0))
     });
     let sizes: Vec<(u64, u64)> = order
         .iter()
         .map(|&i| {
             (
-                u64::from(regions[i].2.width),
-                u64::from(regions[i].2.height),
+                u64::from(regions[i].3.width),
+                u64::from(regions[i].3.height),
             )
         })
         .collect();
@@ -146,14 +146,16 @@ pub fn pack_atlas(
         })
         .collect();
     let mut packed = Vec::with_capacity(regions.len());
-    for (i, (name, source, r)) in regions.iter().enumerate() {
+    for (i, (name, source, [ox, oy], r)) in regions.iter().enumerate() {
         let Some((page, px, py)) = placed[i] else {
             continue;
         };
         let target = &mut pages[page].image;
         for dy in 0..r.height {
             for dx in 0..r.width {
-                let (sx, sy) = (r.x + i64::from(dx), r.y + i64::from(dy));
+                // Canvas px to the source image's px.
+                let sx = r.x + i64::from(dx) - i64::from(*ox);
+                let sy = r.y + i64::from(dy) - i64::from(*oy);
                 let inside = sx >= 0
                     && sy >= 0
                     && sx < i64::from(source.width())
@@ -224,11 +226,13 @@ mod tests {
     #[test]
     fn regions_do_not_overlap_and_keep_their_pixels() {
         let a = solid(40, 30, [255, 0, 0, 128]);
-        let b = solid(40, 30, [0, 255, 0, 255]);
+        let mut b = solid(40, 30, [0, 255, 0, 255]);
+        b.put_pixel(0, 0, Rgba([0, 0, 255, 255]));
         let regions = vec![
             (
                 "a".to_string(),
                 &a,
+                [0, 0],
                 RegionRect {
                     x: -2,
                     y: 5,
@@ -237,8 +241,10 @@ mod tests {
                 },
             ),
             (
+                // b's image lies at (10, 10) on the canvas: the region starts at its corner.
                 "b".to_string(),
                 &b,
+                [10, 10],
                 RegionRect {
                     x: 10,
                     y: 10,
@@ -260,7 +266,12 @@ mod tests {
         // premultiplied: 255·128/255 = 128.
         assert_eq!(page.get_pixel(ra.x, ra.y).0, [0, 0, 0, 0]);
         assert_eq!(page.get_pixel(ra.x + 2, ra.y).0, [128, 0, 0, 128]);
-        assert_eq!(page.get_pixel(rb.x, rb.y).0, [0, 255, 0, 255]);
+        assert_eq!(
+            page.get_pixel(rb.x, rb.y).0,
+            [0, 0, 255, 255],
+            "b's corner pixel"
+        );
+        assert_eq!(page.get_pixel(rb.x + 1, rb.y).0, [0, 255, 0, 255]);
         let text = atlas.text();
         assert!(text.starts_with("rig.png\nsize: "), "{text}");
         assert!(text.contains("pma: true\n"));
@@ -275,6 +286,7 @@ mod tests {
         let big = vec![(
             "big".to_string(),
             &img,
+            [0, 0],
             RegionRect {
                 x: 0,
                 y: 0,
@@ -295,6 +307,7 @@ mod tests {
                 (
                     format!("r{i}"),
                     &img,
+                    [0, 0],
                     RegionRect {
                         x: 0,
                         y: 0,

@@ -227,11 +227,11 @@ pub enum SpineError {
         size: [u32; 2],
         max_page_px: u32,
     },
-    #[error("part '{part}': image is {got:?} px but the rig's canvas is {canvas:?} px")]
+    #[error("part '{part}': its mesh reaches past its {}×{} px image placed at {offset_px:?} (was the image replaced by one of another size?)", got[0], got[1])]
     ImageSize {
         part: String,
         got: [u32; 2],
-        canvas: [u32; 2],
+        offset_px: [i32; 2],
     },
     #[error("the transformation of '{0}' is singular")]
     Singular(String),
@@ -426,11 +426,12 @@ pub fn export_spine(
     let mut regions = Vec::with_capacity(doc.parts.len());
     for (part, image) in doc.parts.iter().zip(images) {
         let got = [image.width(), image.height()];
-        if got != doc.canvas {
+        let reach_px = f64::from(crate::scene::texture_border_px(doc));
+        if !part.image_holds_mesh(got, reach_px) {
             return Err(SpineError::ImageSize {
                 part: part.name.clone(),
                 got,
-                canvas: doc.canvas,
+                offset_px: part.offset_px,
             });
         }
         let Some(weights) = &part.weights else {
@@ -480,7 +481,7 @@ pub fn export_spine(
         for v in &mut mesh.vertex_source {
             *v = kept[*v];
         }
-        regions.push((part.name.clone(), image, region));
+        regions.push((part.name.clone(), image, part.offset_px, region));
         parts.push(ExportedPart {
             name: part.name.clone(),
             mesh,

@@ -260,21 +260,44 @@ pub(crate) fn check_size(
     )
 }
 
-/// The canvas-sized image of one layer (pixels outside the canvas dropped), opacity applied to
-/// alpha: what sinew's parts are made from today.
-pub fn canvas_image(layer: &ArtLayer, canvas_px: [u32; 2]) -> RgbaImage {
-    let mut out = RgbaImage::new(canvas_px[0], canvas_px[1]);
-    let [ox, oy] = layer.offset_px;
-    for (x, y, p) in layer.image.enumerate_pixels() {
-        let (cx, cy) = (ox as i64 + x as i64, oy as i64 + y as i64);
-        if cx < 0 || cy < 0 || cx >= canvas_px[0] as i64 || cy >= canvas_px[1] as i64 {
+/// One layer as a part's image: its pixels on the canvas (those outside it dropped), opacity
+/// applied to alpha, trimmed to the pixels left with alpha > 0; with the canvas position of
+/// the image's top-left pixel (px). `None` when no pixel is left.
+pub fn part_image(layer: &ArtLayer, canvas_px: [u32; 2]) -> Option<(RgbaImage, [i32; 2])> {
+    let [ox, oy] = layer.offset_px.map(i64::from);
+    let alpha = |x: u32, y: u32| {
+        let a = layer.image.get_pixel(x, y)[3];
+        (f32::from(a) * layer.opacity).round() as u8
+    };
+    let on_canvas = |x: u32, y: u32| {
+        let (cx, cy) = (ox + i64::from(x), oy + i64::from(y));
+        cx >= 0 && cy >= 0 && cx < i64::from(canvas_px[0]) && cy < i64::from(canvas_px[1])
+    };
+    // The box of the pixels that stay, in the layer's own px.
+    let mut bounds: Option<[u32; 4]> = None;
+    for (x, y, _) in layer.image.enumerate_pixels() {
+        if alpha(x, y) == 0 || !on_canvas(x, y) {
             continue;
         }
-        let mut q = *p;
-        q[3] = (q[3] as f32 * layer.opacity).round() as u8;
-        out.put_pixel(cx as u32, cy as u32, q);
+        let b = bounds.get_or_insert([x, y, x, y]);
+        *b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
     }
-    out
+    let [x0, y0, x1, y1] = bounds?;
+    let mut out = RgbaImage::new(x1 - x0 + 1, y1 - y0 + 1);
+    for (x, y, q) in out.enumerate_pixels_mut() {
+        let (sx, sy) = (x0 + x, y0 + y);
+        if !on_canvas(sx, sy) {
+            continue;
+        }
+        let mut p = *layer.image.get_pixel(sx, sy);
+        p[3] = alpha(sx, sy);
+        if p[3] > 0 {
+            *q = p;
+        }
+    }
+    // Within the canvas, so within i32.
+    let offset_px = [(ox + i64::from(x0)) as i32, (oy + i64::from(y0)) as i32];
+    Some((out, offset_px))
 }
 
 #[cfg(test)]
