@@ -66,7 +66,7 @@ pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error
         remove_stale_temporaries(&target);
         targets.push(target);
     }
-    let Some(((last_path, _), last_target)) = files.iter().zip(&targets).last() else {
+    let (Some((last_path, _)), Some(last_target)) = (files.last(), targets.last()) else {
         return Ok(());
     };
     let mut temporaries = Vec::with_capacity(files.len());
@@ -272,7 +272,7 @@ fn parse_journal(bytes: &[u8]) -> Journal {
     }
     let fields: Vec<&[u8]> = body.split(|&b| b == 0).collect();
     let fields = &fields[..fields.len() - 1];
-    if fields.len() % 2 != 0 {
+    if !fields.len().is_multiple_of(2) {
         return Journal::CutShort;
     }
     let mut entries = Vec::with_capacity(fields.len() / 2);
