@@ -5,7 +5,7 @@
 #   tools/fuzz/run.sh --seeds-only                                 # only (re)make the seed corpus
 #
 # --quick (what .ci/run uses): build at opt-level 1 with 16 codegen units instead of cargo-afl's
-# opt-level 3 and one codegen unit. A cold build then takes about 60% of the time (12.7 min
+# opt-level 3 and one codegen unit. A cold build then takes about two thirds of the time (12.7 min
 # against 19.5 min measured on a loaded machine; sinew itself 224 s against 532 s), for fewer
 # executions per second. Targets run FUZZ_JOBS (default 2) at a time. After fuzzing,
 # `cargo afl test --release` runs fuzz/tests/replay.rs over the seeds and whatever AFL++ saved
