@@ -1,7 +1,8 @@
 //! What `sinew` does to what is already at an output path: it writes through symbolic links (as
 //! `cp` does), refuses pipes, devices and the wrong kind of entry, replaces a frame folder as a
-//! whole (a run killed mid-way, or ended by Ctrl+C's SIGINT, included), and tidies the
-//! temporaries a killed run left. Linux: the tests make FIFOs and devices and send signals.
+//! whole (a run killed mid-way, or ended by Ctrl+C's SIGINT, included), writes multi-file
+//! outputs as one set (completed by the next run when killed between its renames), and tidies
+//! the temporaries a killed run left. Linux: the tests make FIFOs and devices and send signals.
 #![cfg(target_os = "linux")]
 
 mod command;
@@ -347,4 +348,168 @@ fn temporaries_left_by_a_killed_run_are_removed_by_the_next() {
     ok(&["render", s(&rig), "--anim", "go", "-o", s(&frames)]);
     assert!(!staging.exists());
     assert_eq!(std::fs::read(frames.join("notes.txt")).unwrap(), b"mine");
+}
+
+/// Runs `sinew ARGS` under strace, which sends it SIGKILL on entering its `nth` call of one of
+/// `syscalls` (fault injection: a real signal at an exact point of the run, whatever the
+/// timing). Returns how it ended.
+fn killed_at_syscall(args: &[String], syscalls: &str, nth: usize) -> std::process::ExitStatus {
+    Command::new("strace")
+        .args(["-f", "-qq", "-o", "/dev/null", "-e"])
+        .arg(format!("trace={syscalls}"))
+        .arg("-e")
+        .arg(format!("inject={syscalls}:signal=SIGKILL:when={nth}"))
+        .arg(env!("CARGO_BIN_EXE_sinew"))
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .unwrap()
+}
+
+/// Multi-file outputs (a sprite sheet's PNG and JSON; a Spine export's skeleton, atlas and
+/// page) killed by SIGKILL before the set is committed, before each of its renames and before
+/// its journal is removed:
+/// the folder then holds the old set whole, or a journal beside it (a mixed set), and after the
+/// next run that writes anything into the folder (here a GIF) it holds the old or the new set
+/// whole, the user's file untouched, nothing hidden.
+#[test]
+fn a_set_of_files_killed_between_its_renames_is_whole_after_the_next_run() {
+    if Command::new("strace").arg("-V").output().is_err() {
+        eprintln!("skipped: no strace here to stop the run at its renames (apt install strace)");
+        return;
+    }
+    let dir = scratch("set-kill");
+    let small = dir.join("small");
+    let big = dir.join("big");
+    std::fs::create_dir_all(&small).unwrap();
+    std::fs::create_dir_all(&big).unwrap();
+    let (rig_old, rig_new) = (rig(&small, 64, 0.5), rig(&big, 96, 0.5));
+    let out = dir.join("out");
+    let sheet = |rig: &Path, fps: &str, folder: &Path| -> Vec<String> {
+        let png = folder.join("walk.png");
+        [
+            "render",
+            s(rig),
+            "--anim",
+            "go",
+            "--fps",
+            fps,
+            "-o",
+            s(&png),
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let spine = |rig: &Path, folder: &Path| -> Vec<String> {
+        ["export", "spine", s(rig), "-o", s(folder)]
+            .map(String::from)
+            .to_vec()
+    };
+    type Args = Box<dyn Fn(&Path) -> Vec<String>>;
+    let cases: Vec<(&str, Args, Args)> = vec![
+        (
+            "sheet",
+            Box::new(move |f: &Path| sheet(&rig_old, "4", f)),
+            Box::new(move |f: &Path| sheet(&rig_new, "12", f)),
+        ),
+        (
+            "spine",
+            Box::new({
+                let rig = dir.join("small/rig.json");
+                move |f: &Path| spine(&rig, f)
+            }),
+            Box::new({
+                let rig = dir.join("big/rig.json");
+                move |f: &Path| spine(&rig, f)
+            }),
+        ),
+    ];
+    let gif_rig = dir.join("small/rig.json");
+    let mut mixed = 0;
+    for (kind, old_args, new_args) in &cases {
+        let reference = |args: &Args, name: &str| {
+            let folder = dir.join(format!("{kind}-{name}"));
+            std::fs::create_dir_all(&folder).unwrap();
+            let a = args(&folder);
+            ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+            let mut files = listing(&folder);
+            files.insert("notes.txt".into(), b"mine".to_vec());
+            files
+        };
+        let old = reference(old_args, "old");
+        let new = reference(new_args, "new");
+        assert!(old.len() >= 3 && old.keys().eq(new.keys()), "{old:?}");
+        assert!(
+            old.iter()
+                .all(|(name, bytes)| name == "notes.txt" || new[name] != *bytes),
+            "{kind}: every file of the new set differs from the old"
+        );
+        let renames = old.len() - 1;
+        // Before the commit (syncing the first new file), before each rename, and before the
+        // journal is removed.
+        let points = [("fsync", 1)]
+            .into_iter()
+            .chain((1..=renames).map(|n| ("rename,renameat,renameat2", n)))
+            .chain([("unlink,unlinkat", 1)]);
+        for (syscalls, nth) in points {
+            let _ = std::fs::remove_dir_all(&out);
+            std::fs::create_dir_all(&out).unwrap();
+            for (name, bytes) in &old {
+                std::fs::write(out.join(name), bytes).unwrap();
+            }
+            let status = killed_at_syscall(&new_args(&out), syscalls, nth);
+            let at = format!("{kind}, SIGKILL at {syscalls} #{nth} ({status})");
+            let now = listing(&out);
+            let hidden = |name: &str| name.starts_with('.');
+            let journal = now
+                .keys()
+                .any(|n| n.starts_with(".sinew-set.") && n.ends_with(".journal"));
+            let visible: BTreeMap<String, Vec<u8>> =
+                now.into_iter().filter(|(n, _)| !hidden(n)).collect();
+            let before = if visible == old {
+                "old"
+            } else if visible == new {
+                "new"
+            } else {
+                assert!(journal, "{at}: a mixed set and no journal to complete it");
+                mixed += 1;
+                "mixed"
+            };
+            // The next run that writes into the folder completes or rolls back the set.
+            let gif = out.join("next.gif");
+            ok(&["render", s(&gif_rig), "--anim", "go", "-o", s(&gif)]);
+            std::fs::remove_file(&gif).unwrap();
+            let after = listing(&out);
+            // A set killed before its commit leaves temporaries of its other files (hidden,
+            // `.NAME.PID.N.tmp`), which the next write of those files removes.
+            if !journal {
+                after.keys().filter(|n| hidden(n)).for_each(|n| {
+                    assert!(n.ends_with(".tmp"), "{at}: {n} left");
+                });
+            }
+            let after: BTreeMap<String, Vec<u8>> =
+                after.into_iter().filter(|(n, _)| !hidden(n)).collect();
+            let outcome = if after == new {
+                "new"
+            } else if after == old {
+                "old"
+            } else {
+                panic!(
+                    "{at}: after the next run the folder holds neither set: {:?}",
+                    after.keys().collect::<Vec<_>>()
+                )
+            };
+            if journal {
+                assert_eq!(outcome, "new", "{at}: a committed set is completed");
+            }
+            eprintln!("{at}: {before} (journal: {journal}) -> {outcome}");
+            // Rerun whole, the set is new and nothing hidden stays.
+            let a = new_args(&out);
+            ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+            assert_eq!(listing(&out), new, "{at}: the rerun");
+        }
+    }
+    // The kills landed between renames at least once per set (each set has 2+ renames).
+    assert!(mixed >= 2, "no kill left a mixed set: {mixed}");
 }

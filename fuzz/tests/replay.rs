@@ -1,26 +1,41 @@
-//! Runs every fuzz target over its seed corpus (and any crashes AFL++ saved under
-//! `fuzz/out/TARGET/default/crashes`): a found crash stays a failing test until it is fixed.
+//! Runs every fuzz target over its seed corpus and over what AFL++ saved under
+//! `fuzz/out/TARGET/default` (its `crashes`, and its `queue`: the inputs that reached new code):
+//! a found crash stays a failing test, with its panic message, until it is fixed.
 
 use std::path::Path;
 
 #[test]
-fn every_target_takes_its_seeds_and_saved_crashes_without_panicking() {
+fn every_target_takes_its_seeds_and_saved_inputs_without_panicking() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut runs = 0;
+    let mut seeds = 0;
     for (name, target) in sinew_fuzz::TARGETS {
+        let mut runs = 0;
         for dir in [
             root.join("seeds").join(name),
             root.join("out").join(name).join("default/crashes"),
+            root.join("out").join(name).join("default/queue"),
         ] {
             let Ok(entries) = std::fs::read_dir(&dir) else {
                 continue;
             };
-            for entry in entries.flatten() {
-                let bytes = std::fs::read(entry.path()).unwrap();
+            let mut files: Vec<_> = entries
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| p.is_file())
+                .collect();
+            files.sort();
+            for file in files {
+                let bytes = std::fs::read(&file).unwrap();
+                eprintln!("{name}: {}", file.display());
                 target(&bytes);
                 runs += 1;
+                if dir.starts_with(root.join("seeds")) {
+                    seeds += 1;
+                }
             }
         }
+        println!("{name}: {runs} inputs");
+        assert!(runs > 0, "{name}: no seeds: run tools/fuzz/run.sh --seeds-only first");
     }
-    assert!(runs > 0, "no seeds: run tools/fuzz/run.sh --seeds-only first");
+    assert!(seeds > 0);
 }

@@ -7,11 +7,16 @@
 //! The content goes to a temporary file beside the (resolved) target, which is then renamed over
 //! it: the rename is atomic on one file system, so the target holds either its old or its new
 //! content. Temporaries are named `.NAME.PID.N.tmp`; ones left by a process that was killed are
-//! removed by the next write of the same target ([`remove_stale_temporaries`]).
+//! removed by the next write of the same target ([`remove_stale_temporaries`]). Files that
+//! belong together (a sprite sheet and its JSON, a Spine export) are written as one set by
+//! [`write_set`] (module [`super::set`]): a journal makes a set interrupted between its renames
+//! complete on the next write into its folder.
 
 use std::fs;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+
+pub use super::set::{complete_interrupted_sets, write_set};
 
 /// Symbolic links followed from an output path before giving up (as the kernel's own limit).
 pub const MAX_SYMLINK_HOPS: usize = 40;
@@ -116,46 +121,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
-/// Writes several files that belong together (a sprite sheet and its JSON; a skeleton, its
-/// atlas and pages): every target is checked first ([`resolve_output`]), then every temporary
-/// is written and synced, and only when all are written are they renamed into place, in the
-/// order given. A failure before the renames (a refused target, a full disk, no permission)
-/// leaves every target as it was and no temporary behind. Give the file that refers to the
-/// others last: the renames are atomic one by one, not as a set, and a reader that sees the
-/// new referring file then sees the new files it refers to. Returns the failing path with
-/// its error.
-pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error)> {
-    let mut targets = Vec::with_capacity(files.len());
-    for (path, _) in files {
-        let target = resolve_output(path, OutputKind::File).map_err(|e| (path.clone(), e))?;
-        remove_stale_temporaries(&target);
-        targets.push(target);
-    }
-    let mut temporaries = Vec::with_capacity(files.len());
-    let written = files
-        .iter()
-        .zip(&targets)
-        .try_for_each(|((path, bytes), target)| {
-            let tmp = temporary_sibling(target);
-            temporaries.push(tmp.clone());
-            write_new(&tmp, bytes).map_err(|e| (path.clone(), e))
-        });
-    if let Err(e) = written {
-        for tmp in &temporaries {
-            // A temporary not yet created has nothing to remove.
-            let _ = fs::remove_file(tmp);
-        }
-        return Err(e);
-    }
-    for (((path, _), target), tmp) in files.iter().zip(&targets).zip(&temporaries) {
-        if let Err(e) = fs::rename(tmp, target) {
-            let _ = fs::remove_file(tmp);
-            return Err((path.clone(), e));
-        }
-    }
-    Ok(())
-}
-
 /// Creates `path` (which must not exist) with `bytes`, synced to disk.
 pub fn write_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let mut file = fs::OpenOptions::new()
@@ -178,10 +143,18 @@ pub fn temporary_sibling(path: &Path) -> PathBuf {
     ))
 }
 
-fn file_name(path: &Path) -> String {
+pub(crate) fn file_name(path: &Path) -> String {
     path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default()
+}
+
+/// The folder `path` is in (`.` for a bare name).
+pub(crate) fn parent_or_dot(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
 }
 
 /// The process id in a temporary's name `.NAME.PID.N.tmp` of target name `name`.
@@ -198,7 +171,7 @@ fn temporary_pid(entry: &str, name: &str) -> Option<u32> {
 
 /// Whether process `pid` may still be running (and writing its temporaries). Where that cannot
 /// be told (no `/proc`), every process may be.
-fn may_be_running(pid: u32) -> bool {
+pub(crate) fn may_be_running(pid: u32) -> bool {
     if pid == std::process::id() {
         return true;
     }
@@ -231,10 +204,13 @@ pub fn stale_temporaries(target: &Path) -> Vec<PathBuf> {
     stale
 }
 
-/// Removes the stale temporary files of `target` (see [`stale_temporaries`]). Best effort: a
-/// temporary that cannot be removed stays (it is hidden and harms nothing). Temporary folders
-/// are left to [`crate::io::sequence::folder`], which knows what may be in them.
+/// Removes the stale temporary files of `target` (see [`stale_temporaries`]), after completing
+/// the sets a killed run left in its folder ([`complete_interrupted_sets`]: their temporaries
+/// are not stale, they are the set's new files). Best effort: a temporary that cannot be removed
+/// stays (it is hidden and harms nothing). Temporary folders are left to
+/// [`crate::io::sequence::folder`], which knows what may be in them.
 pub fn remove_stale_temporaries(target: &Path) {
+    complete_interrupted_sets(parent_or_dot(target));
     for tmp in stale_temporaries(target) {
         if fs::symlink_metadata(&tmp).is_ok_and(|m| m.is_file()) {
             let _ = fs::remove_file(tmp);
@@ -263,37 +239,6 @@ mod tests {
         assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
         // A write into a missing folder fails and leaves the target untouched.
         assert!(write_atomic(&dir.join("missing/b.json"), b"x").is_err());
-        fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn a_set_is_written_whole_or_not_at_all() {
-        let dir = scratch("set");
-        let (png, json) = (dir.join("sheet.png"), dir.join("sheet.json"));
-        write_set(&[
-            (png.clone(), b"old png".to_vec()),
-            (json.clone(), b"old".to_vec()),
-        ])
-        .unwrap();
-        // The second target cannot be written (a folder where a file goes; a file where a
-        // folder is needed): the first keeps its old content, and no temporary stays.
-        fs::create_dir(dir.join("taken")).unwrap();
-        for bad in [dir.join("taken"), json.join("below")] {
-            let failed = write_set(&[
-                (png.clone(), b"new png".to_vec()),
-                (bad.clone(), b"x".to_vec()),
-            ]);
-            assert_eq!(failed.map_err(|(path, _)| path), Err(bad));
-            assert_eq!(fs::read(&png).unwrap(), b"old png");
-        }
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 3);
-        write_set(&[
-            (png.clone(), b"new png".to_vec()),
-            (json.clone(), b"new".to_vec()),
-        ])
-        .unwrap();
-        assert_eq!(fs::read(&png).unwrap(), b"new png");
-        assert_eq!(fs::read(&json).unwrap(), b"new");
         fs::remove_dir_all(&dir).unwrap();
     }
 

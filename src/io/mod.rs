@@ -6,6 +6,7 @@ pub mod image;
 pub mod layered;
 pub mod outputs;
 pub mod sequence;
+pub mod set;
 pub mod slots;
 
 pub use atomic::write_atomic;
