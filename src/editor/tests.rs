@@ -306,6 +306,29 @@ fn head_turned(degrees: f64) -> Pose {
     pose
 }
 
+/// In animate mode, through the animation list and the numbers panel: a new animation renamed
+/// "nod", the head (a click on the bone selects it) keyed at 0° at 0 s and at 20° at 0.5 s.
+fn key_a_nod_from_the_numbers_panel(h: &mut Harness<'_, EditorApp>) {
+    h.get_by_label("New animation").click();
+    h.run();
+    type_into(h, "Rename to:", "nod");
+    h.get_by_label("Rename animation").click();
+    h.run();
+    click(h, [256.0, 150.0]);
+    assert_eq!(h.state().selected.as_deref(), Some("head"));
+    for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
+        for _ in 0..frames {
+            h.get_by_label("Next frame").click();
+            h.run();
+        }
+        // 0° is the rest pose's: another number first, so the pose names the head.
+        set_number(h, "Rotation", degrees + 5.0);
+        set_number(h, "Rotation", degrees);
+        h.get_by_label("Set key").click();
+        h.run();
+    }
+}
+
 /// Types `value` into the numbers panel's field `label` and enters it.
 fn set_number(h: &mut Harness<'_, EditorApp>, label: &str, value: f64) {
     type_into(h, label, &value.to_string());

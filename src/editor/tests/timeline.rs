@@ -65,29 +65,9 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let mut h = open_character("dopesheet");
     h.key_press(Key::Num3);
     h.run();
-    // A new animation from the list, renamed "nod".
-    h.get_by_label("New animation").click();
-    h.run();
-    type_into(&mut h, "Rename to:", "nod");
-    h.get_by_label("Rename animation").click();
-    h.run();
+    key_a_nod_from_the_numbers_panel(&mut h);
     assert_eq!(h.state().animate.animation, "nod");
     assert!(h.state().doc.state().animations.contains_key("nod"));
-    // Two keys from the numbers panel: the head (a click on the bone selects it) at 0° at
-    // 0 s and at 20° at 0.5 s.
-    click(&mut h, [256.0, 150.0]);
-    assert_eq!(h.state().selected.as_deref(), Some("head"));
-    for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
-        for _ in 0..frames {
-            h.get_by_label("Next frame").click();
-            h.run();
-        }
-        // 0° is the rest pose's: another number first, so the pose names the head.
-        set_number(&mut h, "Rotation", degrees + 5.0);
-        set_number(&mut h, "Rotation", degrees);
-        h.get_by_label("Set key").click();
-        h.run();
-    }
     assert_eq!(
         head_rotate_keys(&h),
         vec![
