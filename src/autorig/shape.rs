@@ -71,15 +71,7 @@ pub fn union_alpha(layers: &[super::LayerRef]) -> RgbaImage {
 impl Shape {
     /// Traces `image` with `options`. Returns `Ok(None)` when no region is large enough.
     pub fn trace(image: &RgbaImage, options: &TraceOptions) -> Result<Option<Shape>, TraceError> {
-        let outlines = trace::trace(image, options)?;
-        if outlines.is_empty() {
-            return Ok(None);
-        }
-        Ok(Some(Shape::from_outlines(
-            outlines,
-            image.width(),
-            image.height(),
-        )))
+        Shape::trace_placed(&super::LayerRef::whole("", image), options)
     }
 
     /// Traces one layer's image and places the shape where the layer lies on its canvas.
