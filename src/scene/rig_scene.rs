@@ -81,10 +81,10 @@ impl Scene {
         images: &[I],
     ) -> Result<Self, PipelineError> {
         let mut parts = Vec::with_capacity(images.len());
+        let border = texture_border_px(&doc);
         for (part, image) in doc.parts.iter().zip(images) {
             let image: &RgbaImage = image.borrow();
             let got = [image.width(), image.height()];
-            let border = texture_border_px(&doc);
             if !part.image_holds_mesh(got, f64::from(border)) {
                 return Err(PipelineError::TextureSize {
                     part: part.name.clone(),

@@ -424,9 +424,9 @@ pub fn export_spine(
     // Meshes and regions.
     let mut parts = Vec::with_capacity(doc.parts.len());
     let mut regions = Vec::with_capacity(doc.parts.len());
+    let reach_px = f64::from(crate::scene::texture_border_px(doc));
     for (part, image) in doc.parts.iter().zip(images) {
         let got = [image.width(), image.height()];
-        let reach_px = f64::from(crate::scene::texture_border_px(doc));
         if !part.image_holds_mesh(got, reach_px) {
             return Err(SpineError::ImageSize {
                 part: part.name.clone(),
