@@ -519,11 +519,6 @@ fn print_notes(notes: &[String]) {
     }
 }
 
-/// The image files of `doc`'s parts (`doc` read from `rig`).
-fn part_images(rig: &Path, doc: &RigDocument) -> Vec<PathBuf> {
-    sinew::jobs::part_images(rig, doc)
-}
-
 /// Reads a JSON file that must hold one object into `T`, naming the file in every error.
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T> {
     Ok(sinew::jobs::read_json(path, what)?)
@@ -596,7 +591,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
     }
     let mut scene = Scene::load(&args.rig)?;
     scene.set_skins(&args.skins)?;
-    let images = part_images(&args.rig, &scene.doc);
+    let images = sinew::jobs::part_images(&args.rig, &scene.doc);
     check_outputs(
         [Some(args.rig.as_path()), args.pose.as_deref()]
             .into_iter()
