@@ -182,7 +182,7 @@ pub fn mesh_attachment(
                 vertex: v,
             });
         }
-        let rest = frame.spine_from_canvas([vertices[v].x, vertices[v].y]);
+        let rest = frame.spine_from_canvas(vertices[v]);
         let mut out = Vec::with_capacity(row.len());
         for (column, w) in row {
             let bone = skeleton.column_bone[column];
