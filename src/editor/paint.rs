@@ -47,9 +47,8 @@ pub struct PaintStroke {
 
 /// The part and vertex under `at_px` at rest: the frontmost part with a triangle containing
 /// it, and that triangle's corner nearest to it.
-pub fn vertex_under(scene: &Scene, at_px: Point) -> Option<(usize, usize)> {
-    use crate::geom::{barycentric, Point};
-    let p = Point::new(at_px[0], at_px[1]);
+pub fn vertex_under(scene: &Scene, p: Point) -> Option<(usize, usize)> {
+    use crate::geom::barycentric;
     for (k, part) in scene.doc.parts.iter().enumerate().rev() {
         let v = &part.mesh.vertices;
         let pt = |i: u32| Point::new(v[i as usize][0], v[i as usize][1]);

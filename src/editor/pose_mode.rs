@@ -558,9 +558,8 @@ pub fn rest_point_under(
     scene: &Scene,
     positions: &[Vec<Point>],
     pose: &Pose,
-    at_px: Point,
+    p: Point,
 ) -> Option<Point> {
-    let p = Point::new(at_px[0], at_px[1]);
     let draws = crate::playback::pose_draws(scene, positions, pose);
     for draw in draws.iter().rev().filter(|d| d.visible) {
         let (Some(part), posed) = (scene.doc.parts.get(draw.part), draw.positions_px) else {

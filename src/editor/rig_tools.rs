@@ -411,14 +411,7 @@ impl EditorApp {
         };
         meshes
             .iter()
-            .flat_map(|m| {
-                let rest: Vec<crate::geom::Point> = m
-                    .vertices
-                    .iter()
-                    .map(|p| crate::geom::Point::new(p[0], p[1]))
-                    .collect();
-                canvas::wireframe(placed, &rest, &m.triangles)
-            })
+            .flat_map(|m| canvas::wireframe(placed, &m.vertices, &m.triangles))
             .collect()
     }
 

@@ -151,13 +151,12 @@ fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
         .find(|p| p.name == name)
         .expect("part");
     let from_bones = |p: Point| {
-        let pt = |q: Point| crate::geom::Point::new(q[0], q[1]);
         scene
             .doc
             .handles
             .bones
             .iter()
-            .map(|b| crate::geom::segment_distance(pt(p), pt(b.head), pt(b.tail)).0)
+            .map(|b| crate::geom::segment_distance(p, b.head, b.tail).0)
             .fold(f64::INFINITY, f64::min)
     };
     // Interior vertices only (a vertex of the outline may sit on the drawing's edge).

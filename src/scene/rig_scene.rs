@@ -5,7 +5,7 @@
 //! transforms for a [`Pose`], posed vertex positions (canvas px, one list per part), and frames
 //! drawn with tiny-skia.
 
-use crate::geom::{Point, Vec2};
+use crate::geom::Point;
 use crate::ik::{RigIk, SkinnedMesh};
 use crate::io::{self, RigDocument, WeightsDoc};
 use crate::pipeline::PipelineError;
@@ -390,7 +390,7 @@ impl Scene {
                 }
                 // Deform offsets move the rest mesh before skinning (crate::anim::deform).
                 for (p, o) in rest.iter_mut().zip(offsets) {
-                    *p += Vec2::new(o[0], o[1]);
+                    *p += *o;
                 }
                 *positions = rest.clone();
             }

@@ -175,10 +175,7 @@ mod tests {
             translation: Vec2::zeros(),
         };
         let spine_world = {
-            let to_spine = |p: Point| {
-                let q = f.spine_from_canvas(p);
-                Point::new(q[0], q[1])
-            };
+            let to_spine = |p: Point| f.spine_from_canvas(p);
             move |u: f64, v: f64| to_spine(rest.apply(bone_local_flip.apply(Point::new(u, v))))
         };
         let local = BoneLocal {
