@@ -33,6 +33,9 @@ use std::sync::Arc;
 #[path = "document_animations.rs"]
 pub mod animations;
 pub use animations::{unused_animation_name, AnimationEdit};
+#[path = "document_events.rs"]
+pub mod events;
+pub use events::EventEdit;
 
 /// Undo steps kept; older ones are forgotten.
 pub const UNDO_LIMIT: usize = 200;
@@ -107,6 +110,14 @@ pub enum DocumentError {
     AnimationExists(String),
     #[error("'{0}' cannot name an animation: give it a name without leading or trailing spaces")]
     AnimationName(String),
+    #[error("there is no event named '{name}' (defined: {known})")]
+    UnknownEvent { name: String, known: String },
+    #[error("an event named '{0}' is already defined")]
+    EventExists(String),
+    #[error("animation '{animation}' has no such event at {time_s} s")]
+    NoEventAt { animation: String, time_s: f64 },
+    #[error(transparent)]
+    EventDef(#[from] crate::anim::event::EventDefError),
 }
 
 /// Why a stroke may change nothing: the vertices the influence limit held back.
@@ -130,7 +141,7 @@ pub struct State {
     /// Animations by name, each checked on its own (names the rig lacks are checked where an
     /// animation is rendered or exported).
     pub animations: BTreeMap<String, Animation>,
-    /// Event definitions the animations fire (kept as read; the editor does not edit them).
+    /// Event definitions the animations fire ([`Command::Events`] edits them).
     pub events: crate::anim::EventDefs,
     /// The rig last built from layers, handles and options (meshes, weights, textures).
     pub rig: Option<Arc<Scene>>,
@@ -318,6 +329,8 @@ pub enum Command {
     },
     /// Adds, renames, duplicates or deletes an animation.
     Animations(AnimationEdit),
+    /// Defines events, adds event keys, sets their payloads.
+    Events(EventEdit),
     /// Auto-key: keys at `time_s` only the channels where `pose` differs from `before` (the
     /// animation's pose there), see [`animations::key_changes`]. Nothing changed → refused.
     KeyChanges {
@@ -1025,6 +1038,10 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::Animations(edit) => {
             animations::apply(&mut next, edit)?;
+            inputs_changed = false;
+        }
+        Command::Events(edit) => {
+            events::apply(&mut next, edit)?;
             inputs_changed = false;
         }
         Command::KeyChanges {

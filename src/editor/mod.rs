@@ -22,6 +22,7 @@ pub mod closing;
 pub mod colorize;
 pub mod curves;
 pub mod drawing;
+pub mod events;
 pub mod file;
 pub mod file_menu;
 pub mod gizmo;
@@ -179,6 +180,8 @@ pub struct EditorApp {
     pub timeline: timeline::TimelineState,
     /// The tree view: renaming in place, the parts hidden on the canvas.
     pub tree: tree::TreeState,
+    /// Animate mode's events: the selected event key's payload, adding and defining events.
+    pub events: events::EventsPanel,
     /// Native file dialogs, where a portal answers ([`native_dialog`]).
     pub dialogs: native_dialog::NativeDialogs,
 }
@@ -237,6 +240,7 @@ impl EditorApp {
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),
             tree: Default::default(),
+            events: Default::default(),
             dialogs: Default::default(),
         }
     }
@@ -300,6 +304,7 @@ impl EditorApp {
         self.file_windows(&ctx);
         if self.mode == Mode::Animate {
             self.graph_view_window(&ctx);
+            self.define_event_window(&ctx);
         }
         self.log_window(&ctx);
         self.close_dialog(&ctx);

@@ -20,6 +20,7 @@ use std::sync::Arc;
 mod animate;
 mod colorize;
 mod documents;
+mod events;
 mod files;
 mod graph;
 mod outputs;
