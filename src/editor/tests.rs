@@ -26,6 +26,7 @@ mod graph;
 mod outputs;
 mod pose;
 mod rig;
+mod rows;
 mod timeline;
 mod tree_view;
 mod workflow;
