@@ -269,6 +269,15 @@ pub enum Command {
         time_s: f64,
         attachment: Option<String>,
     },
+    /// Keys the deform offsets of part `part` (one per vertex of its mesh, canvas px in the
+    /// rest frame) at `time_s` in `animation`, as [`Command::SetKey`] keys a pose (a key inside
+    /// a segment splits its curve). A part the rig lacks, or a wrong count, is refused.
+    KeyDeform {
+        animation: String,
+        part: String,
+        time_s: f64,
+        offsets: Vec<[f64; 2]>,
+    },
     /// Removes every key of `animation` at `time_s`.
     DeleteKeys {
         animation: String,
@@ -907,6 +916,18 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             check_key_time(time_s)?;
             let mut anim = animation_named(state, &animation);
             animations::key_attachment(state, &mut anim, &slot, time_s, attachment)?;
+            store_animation(&mut next, &animation, anim)?;
+            inputs_changed = false;
+        }
+        Command::KeyDeform {
+            animation,
+            part,
+            time_s,
+            offsets,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation);
+            animations::key_deform(state, &mut anim, &part, time_s, offsets)?;
             store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }

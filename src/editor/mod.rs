@@ -21,6 +21,7 @@ pub mod canvas;
 pub mod closing;
 pub mod colorize;
 pub mod curves;
+pub mod deform_tool;
 pub mod drawing;
 pub mod events;
 pub mod file;
@@ -100,6 +101,8 @@ enum Gesture {
     Paint(paint::PaintStroke),
     /// A field of the numbers panel being dragged: the pose it shows ([`numbers`]).
     Numbers(Pose),
+    /// Mesh vertices dragged by animate mode's deform tool ([`deform_tool`]).
+    Deform(deform_tool::DeformDrag),
 }
 
 /// The editor's state: the document plus what only the view needs.
@@ -182,6 +185,8 @@ pub struct EditorApp {
     pub tree: tree::TreeState,
     /// Animate mode's events: the selected event key's payload, adding and defining events.
     pub events: events::EventsPanel,
+    /// Animate mode's deform tool: on or off, its radius.
+    pub deform: deform_tool::DeformTool,
     /// Native file dialogs, where a portal answers ([`native_dialog`]).
     pub dialogs: native_dialog::NativeDialogs,
 }
@@ -241,6 +246,7 @@ impl EditorApp {
             timeline: Default::default(),
             tree: Default::default(),
             events: Default::default(),
+            deform: Default::default(),
             dialogs: Default::default(),
         }
     }

@@ -19,6 +19,7 @@ use std::sync::Arc;
 
 mod animate;
 mod colorize;
+mod deform;
 mod documents;
 mod events;
 mod files;
