@@ -307,6 +307,10 @@ pub enum Command {
         samples_px: Vec<[f64; 2]>,
         options: BrushOptions,
     },
+    /// Replaces the physics constraint of the same name (its parameters, see
+    /// [`crate::rig::physics`]); checked as the handles file is (a NaN, a mass ≤ 0, … refused).
+    /// The constraints move no weights: the built rig takes them and stays as current as it was.
+    SetPhysics(crate::rig::PhysicsConstraint),
     /// Locks or unlocks a handle's weights. The built rig stays current.
     SetLocked {
         handle: String,
@@ -1008,6 +1012,20 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
                 &samples_px,
                 &options,
             )?));
+            inputs_changed = false;
+        }
+        Command::SetPhysics(constraint) => {
+            let slot = next
+                .handles
+                .physics
+                .iter_mut()
+                .find(|c| c.name == constraint.name)
+                .ok_or_else(|| DocumentError::UnknownHandle(constraint.name.clone()))?;
+            *slot = constraint;
+            next.handles.validate()?;
+            if let Some(rig) = &state.rig {
+                next.rig = Some(Arc::new(rig.with_physics(next.handles.physics.clone())));
+            }
             inputs_changed = false;
         }
         Command::SetLocked { handle, locked } => {

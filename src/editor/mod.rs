@@ -33,6 +33,7 @@ pub mod messages;
 pub mod native_dialog;
 pub mod numbers;
 pub mod paint;
+pub mod physics_fields;
 pub mod pose_mode;
 pub mod rig_mode;
 pub mod rig_tools;

@@ -25,6 +25,7 @@ mod events;
 mod files;
 mod graph;
 mod outputs;
+mod physics;
 mod pose;
 mod rig;
 mod rows;
