@@ -706,7 +706,7 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
     #[derive(Serialize)]
     struct Part<'a> {
         name: &'a str,
-        vertices: Vec<[f64; 2]>,
+        vertices: &'a [sinew::geom::Point],
         triangles: &'a [[u32; 3]],
     }
     #[derive(Serialize)]
@@ -719,7 +719,7 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
         .zip(positions)
         .map(|(p, pos)| Part {
             name: &p.name,
-            vertices: pos.iter().map(|v| [v.x, v.y]).collect(),
+            vertices: pos,
             triangles: &p.mesh.triangles,
         })
         .collect();

@@ -153,7 +153,7 @@ fn deviation(
         for (k, &v) in mesh.vertex_source.iter().enumerate() {
             let c = export
                 .frame
-                .canvas_from_spine([vertices[2 * k], vertices[2 * k + 1]]);
+                .canvas_from_spine([vertices[2 * k], vertices[2 * k + 1]].into());
             let d = (Point::new(c[0], c[1]) - sinew[part][v]).norm();
             worst = worst.max(d);
         }

@@ -6,6 +6,7 @@
 
 mod common;
 
+use sinew::geom::Point;
 use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer};
 use sinew::rig::{Bone, Handles, PointHandle};
@@ -29,13 +30,13 @@ fn critter(max_area_fraction: f64) -> (Vec<Layer>, Handles, BuildOptions) {
     let s = 2.0;
     let point = |name: &str, at: [f64; 2]| PointHandle {
         name: name.into(),
-        at: [at[0] * s, at[1] * s],
+        at: Point::new(at[0] * s, at[1] * s),
     };
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head: [head[0] * s, head[1] * s],
-        tail: [tail[0] * s, tail[1] * s],
+        head: Point::new(head[0] * s, head[1] * s),
+        tail: Point::new(tail[0] * s, tail[1] * s),
     };
     let handles = Handles {
         bones: vec![
@@ -112,8 +113,7 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
                 .zip(dt.iter().flatten())
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
-            let points: Vec<[f64; 2]> = e.mesh.vertices.clone();
-            let q = Domain::new(&points, &e.mesh.triangles).bilaplacian();
+            let q = Domain::planar(&e.mesh.vertices, &e.mesh.triangles).bilaplacian();
             let energy = |d: &[Vec<f64>]| -> f64 {
                 (0..m)
                     .map(|j| {
@@ -123,7 +123,7 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
                     })
                     .sum()
             };
-            (points.len(), worst, energy(&dt) / energy(&de))
+            (e.mesh.vertices.len(), worst, energy(&dt) / energy(&de))
         })
         .collect()
 }
