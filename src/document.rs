@@ -277,7 +277,7 @@ pub enum Command {
         animation: String,
         part: String,
         time_s: f64,
-        offsets: Vec<[f64; 2]>,
+        offsets: Vec<crate::geom::Vec2>,
     },
     /// Removes every key of `animation` at `time_s`.
     DeleteKeys {

@@ -233,7 +233,7 @@ pub(super) fn key_deform(
     anim: &mut Animation,
     part: &str,
     time_s: f64,
-    offsets: Vec<[f64; 2]>,
+    offsets: Vec<crate::geom::Vec2>,
 ) -> Result<(), DocumentError> {
     let rig = state.rig.as_ref().ok_or(DocumentError::NoWeights)?;
     let mesh = rig

@@ -13,7 +13,7 @@
 
 use super::{canvas, EditorApp, Gesture};
 use crate::document::Command;
-use crate::geom::Point;
+use crate::geom::{Point, Vec2};
 use crate::pipeline::Scene;
 use eframe::egui::{self, Color32, Pos2, Stroke};
 use std::sync::Arc;
@@ -43,8 +43,8 @@ impl Default for DeformTool {
 /// A deform drag in progress: the part, the press and the pointer (canvas px).
 pub(super) struct DeformDrag {
     part: usize,
-    from: [f64; 2],
-    to: [f64; 2],
+    from: Point,
+    to: Point,
 }
 
 /// How much a vertex at `distance_px` from the press follows the pointer: `(1 − (d/r)²)²`
@@ -58,7 +58,7 @@ pub fn falloff(distance_px: f64, radius_px: f64) -> f64 {
 }
 
 impl EditorApp {
-    /// The tool's switch and radius (animate mode's panel).
+    /// The tool's switch and radius (animate mode's side panel).
     pub(super) fn deform_tool_row(&mut self, ui: &mut egui::Ui) {
         ui.checkbox(&mut self.deform.enabled, "Deform tool")
             .on_hover_text("drag mesh vertices; the offsets are keyed at the playhead");
@@ -73,10 +73,9 @@ impl EditorApp {
 
     /// The part drawn (visible, front first) with a posed vertex nearest `at_px`, within the
     /// radius.
-    fn part_to_deform(&self, at_px: [f64; 2]) -> Option<usize> {
+    fn part_to_deform(&self, at: Point) -> Option<usize> {
         let posed = self.pose_mode.posed.as_ref()?;
         let picture = self.drawing.picture.as_ref()?;
-        let at = Point::new(at_px[0], at_px[1]);
         picture
             .draws
             .iter()
@@ -135,8 +134,8 @@ impl EditorApp {
 
     /// Keys the drag's offsets at the playhead.
     fn key_deform(&mut self, scene: &Arc<Scene>, drag: &DeformDrag) -> Result<(), String> {
-        let delta = [drag.to[0] - drag.from[0], drag.to[1] - drag.from[1]];
-        if delta[0].hypot(delta[1]) < super::CLICK_SLOP_PX {
+        let delta = drag.to - drag.from;
+        if delta.norm() < super::CLICK_SLOP_PX {
             return Ok(());
         }
         let posed = self
@@ -148,16 +147,13 @@ impl EditorApp {
         let part = &scene.doc.parts[drag.part];
         let n = part.mesh.vertices.len();
         let base = posed.pose.deform.get(&part.name).cloned();
-        let base = base.unwrap_or_else(|| vec![[0.0, 0.0]; n]);
+        let base = base.unwrap_or_else(|| vec![Vec2::zeros(); n]);
         // Each vertex's posed position as a function of its offset, measured through the one
         // pose path: with every offset moved by a unit along x, then y.
         let blend = self.render_settings.blend;
-        let posed_with = |shift: [f64; 2]| -> Result<Vec<Point>, String> {
+        let posed_with = |shift: Vec2| -> Result<Vec<Point>, String> {
             let mut pose = posed.pose.clone();
-            let offsets = base
-                .iter()
-                .map(|o| [o[0] + shift[0], o[1] + shift[1]])
-                .collect();
+            let offsets = base.iter().map(|o| o + shift).collect();
             pose.deform.insert(part.name.clone(), offsets);
             let mut all = scene
                 .positions_from_transforms(&posed.transforms, &pose, blend)
@@ -165,11 +161,11 @@ impl EditorApp {
             Ok(std::mem::take(&mut all[drag.part]))
         };
         let (at, along_x, along_y) = (
-            posed_with([0.0, 0.0])?,
-            posed_with([1.0, 0.0])?,
-            posed_with([0.0, 1.0])?,
+            posed_with(Vec2::zeros())?,
+            posed_with(Vec2::x())?,
+            posed_with(Vec2::y())?,
         );
-        let from = Point::new(drag.from[0], drag.from[1]);
+        let from = drag.from;
         let mut offsets = base.clone();
         for (v, offset) in offsets.iter_mut().enumerate() {
             let w = falloff((at[v] - from).norm(), self.deform.radius_px);
@@ -182,9 +178,9 @@ impl EditorApp {
             if det.abs() < 1e-9 {
                 continue;
             }
-            let (mx, my) = (w * delta[0], w * delta[1]);
-            offset[0] += (mx * jy.y - jy.x * my) / det;
-            offset[1] += (jx.x * my - mx * jx.y) / det;
+            let (mx, my) = (w * delta.x, w * delta.y);
+            offset.x += (mx * jy.y - jy.x * my) / det;
+            offset.y += (jx.x * my - mx * jx.y) / det;
         }
         let (name, time_s) = (part.name.clone(), self.animate.time_s);
         if self.apply(Command::KeyDeform {

@@ -77,8 +77,8 @@ impl EditorApp {
         self.selected_event_time().is_some()
     }
 
-    /// The row under the dopesheet's key buttons: *Add event* (the event picked) at the
-    /// playhead, and *Define event…*.
+    /// Animate mode's side panel row: *Add event* (the event picked) at the playhead, and
+    /// *Define event…*.
     pub(super) fn add_event_row(&mut self, ui: &mut egui::Ui) {
         let names: Vec<String> = self.doc.state().events.keys().cloned().collect();
         if !names.contains(&self.events.to_add) {

@@ -461,6 +461,10 @@ impl EditorApp {
             Mode::Animate => {
                 self.animation_list(ui);
                 ui.separator();
+                // Beside the list, not under the dopesheet: the canvas keeps its height.
+                ui.horizontal_wrapped(|ui| self.add_event_row(ui));
+                ui.horizontal(|ui| self.deform_tool_row(ui));
+                ui.separator();
                 self.pose_panel(ui);
                 self.numbers_panel(ui);
                 self.pose_tree(ui);

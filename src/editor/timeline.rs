@@ -381,11 +381,6 @@ impl EditorApp {
             );
             ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
         });
-        ui.horizontal(|ui| {
-            self.add_event_row(ui);
-            ui.separator();
-            self.deform_tool_row(ui);
-        });
         let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
         let timelines = edit::timelines(&animation);
         // Another animation, undo, redo and other edits can take selected keys away.

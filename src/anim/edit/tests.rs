@@ -519,7 +519,14 @@ fn attachment_deform_and_event_keys_are_rows_like_the_others() {
         .map(|k| (k.name.as_str(), k.int))
         .collect();
     assert_eq!(at_two, [("step", Some(2)), ("cue", None)]);
-    assert_eq!(pasted.deform["body"][2].value, vec![[0.0, 2.0], [0.0, 4.0]]);
+    let offsets = &pasted.deform["body"][2].value;
+    assert_eq!(
+        offsets,
+        &[
+            crate::geom::Vec2::new(0.0, 2.0),
+            crate::geom::Vec2::new(0.0, 4.0)
+        ]
+    );
     // Pasted again at the same time: replaced, not doubled.
     let again = paste_keys("grab", &pasted, 2.0, &copied).unwrap();
     assert_eq!(again, pasted);

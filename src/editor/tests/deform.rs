@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::editor::deform_tool::falloff;
+use crate::geom::Vec2;
 
 #[test]
 fn the_deform_tool_keys_soft_offsets_at_the_playhead() {
@@ -30,9 +31,9 @@ fn the_deform_tool_keys_soft_offsets_at_the_playhead() {
         .expect("a torso vertex");
     let before = shown_vertices(&h);
 
-    let motion = [6.0, -4.0];
-    drag(&mut h, grip, [grip[0] + motion[0], grip[1] + motion[1]]);
-    let offsets = |h: &Harness<'_, EditorApp>| -> Option<(f64, Vec<[f64; 2]>)> {
+    let motion = Vec2::new(6.0, -4.0);
+    drag(&mut h, grip, grip + motion);
+    let offsets = |h: &Harness<'_, EditorApp>| -> Option<(f64, Vec<Vec2>)> {
         let anim =
             crate::document::animation_named(h.state().doc.state(), &h.state().animate.animation);
         let keys = anim.deform.get("torso")?;
@@ -46,23 +47,20 @@ fn the_deform_tool_keys_soft_offsets_at_the_playhead() {
     // distance from the press, none beyond the radius.
     let mut moved = 0;
     for (v, offset) in keyed.iter().enumerate() {
-        let w = falloff(distance(rest[v], grip), 20.0);
-        let expected = [w * motion[0], w * motion[1]];
+        let w = falloff((rest[v] - grip).norm(), 20.0);
+        let expected = w * motion;
         assert!(
-            distance(*offset, expected) < 0.01,
+            (offset - expected).norm() < 0.01,
             "vertex {v}: {offset:?} vs {expected:?}"
         );
         moved += usize::from(w > 0.0);
     }
     assert!(moved > 3, "{moved} vertices within the radius");
-    assert!(distance(keyed[grabbed], motion) < 0.01);
+    assert!((keyed[grabbed] - motion).norm() < 0.01);
     // The canvas shows the grabbed vertex where the pointer let go; other parts stay.
     let shown = shown_vertices(&h);
     let at = shown[part][grabbed];
-    assert!(
-        distance([at.x, at.y], [grip[0] + motion[0], grip[1] + motion[1]]) < 0.01,
-        "{at:?}"
-    );
+    assert!((at - (grip + motion)).norm() < 0.01, "{at:?}");
     for (p, (a, b)) in before.iter().zip(&shown).enumerate() {
         if p != part {
             assert_eq!(a, b, "part {p} moved");
