@@ -34,6 +34,9 @@ use std::sync::Arc;
 #[path = "document_animations.rs"]
 pub mod animations;
 pub use animations::{unused_animation_name, AnimationEdit};
+#[path = "document_events.rs"]
+pub mod events;
+pub use events::EventEdit;
 
 /// Undo steps kept; older ones are forgotten.
 pub const UNDO_LIMIT: usize = 200;
@@ -108,6 +111,14 @@ pub enum DocumentError {
     AnimationExists(String),
     #[error("'{0}' cannot name an animation: give it a name without leading or trailing spaces")]
     AnimationName(String),
+    #[error("there is no event named '{name}' (defined: {known})")]
+    UnknownEvent { name: String, known: String },
+    #[error("an event named '{0}' is already defined")]
+    EventExists(String),
+    #[error("animation '{animation}' has no such event at {time_s} s")]
+    NoEventAt { animation: String, time_s: f64 },
+    #[error(transparent)]
+    EventDef(#[from] crate::anim::event::EventDefError),
 }
 
 /// Why a stroke may change nothing: the vertices the influence limit held back.
@@ -131,7 +142,7 @@ pub struct State {
     /// Animations by name, each checked on its own (names the rig lacks are checked where an
     /// animation is rendered or exported).
     pub animations: BTreeMap<String, Animation>,
-    /// Event definitions the animations fire (kept as read; the editor does not edit them).
+    /// Event definitions the animations fire ([`Command::Events`] edits them).
     pub events: crate::anim::EventDefs,
     /// The rig last built from layers, handles and options (meshes, weights, textures).
     pub rig: Option<Arc<Scene>>,
@@ -259,6 +270,15 @@ pub enum Command {
         time_s: f64,
         attachment: Option<String>,
     },
+    /// Keys the deform offsets of part `part` (one per vertex of its mesh, canvas px in the
+    /// rest frame) at `time_s` in `animation`, as [`Command::SetKey`] keys a pose (a key inside
+    /// a segment splits its curve). A part the rig lacks, or a wrong count, is refused.
+    KeyDeform {
+        animation: String,
+        part: String,
+        time_s: f64,
+        offsets: Vec<crate::geom::Vec2>,
+    },
     /// Removes every key of `animation` at `time_s`.
     DeleteKeys {
         animation: String,
@@ -288,6 +308,10 @@ pub enum Command {
         samples_px: Vec<Point>,
         options: BrushOptions,
     },
+    /// Replaces the physics constraint of the same name (its parameters, see
+    /// [`crate::rig::physics`]); checked as the handles file is (a NaN, a mass ≤ 0, … refused).
+    /// The constraints move no weights: the built rig takes them and stays as current as it was.
+    SetPhysics(crate::rig::PhysicsConstraint),
     /// Locks or unlocks a handle's weights. The built rig stays current.
     SetLocked {
         handle: String,
@@ -319,6 +343,8 @@ pub enum Command {
     },
     /// Adds, renames, duplicates or deletes an animation.
     Animations(AnimationEdit),
+    /// Defines events, adds event keys, sets their payloads.
+    Events(EventEdit),
     /// Auto-key: keys at `time_s` only the channels where `pose` differs from `before` (the
     /// animation's pose there), see [`animations::key_changes`]. Nothing changed → refused.
     KeyChanges {
@@ -898,6 +924,18 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             store_animation(&mut next, &animation, anim)?;
             inputs_changed = false;
         }
+        Command::KeyDeform {
+            animation,
+            part,
+            time_s,
+            offsets,
+        } => {
+            check_key_time(time_s)?;
+            let mut anim = animation_named(state, &animation);
+            animations::key_deform(state, &mut anim, &part, time_s, offsets)?;
+            store_animation(&mut next, &animation, anim)?;
+            inputs_changed = false;
+        }
         Command::DeleteKeys { animation, time_s } => {
             check_key_time(time_s)?;
             let mut anim = animation_named(state, &animation);
@@ -977,6 +1015,20 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
             )?));
             inputs_changed = false;
         }
+        Command::SetPhysics(constraint) => {
+            let slot = next
+                .handles
+                .physics
+                .iter_mut()
+                .find(|c| c.name == constraint.name)
+                .ok_or_else(|| DocumentError::UnknownHandle(constraint.name.clone()))?;
+            *slot = constraint;
+            next.handles.validate()?;
+            if let Some(rig) = &state.rig {
+                next.rig = Some(Arc::new(rig.with_physics(next.handles.physics.clone())));
+            }
+            inputs_changed = false;
+        }
         Command::SetLocked { handle, locked } => {
             if !state.handles.names().any(|n| n == handle) {
                 return Err(DocumentError::UnknownHandle(handle));
@@ -1026,6 +1078,10 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::Animations(edit) => {
             animations::apply(&mut next, edit)?;
+            inputs_changed = false;
+        }
+        Command::Events(edit) => {
+            events::apply(&mut next, edit)?;
             inputs_changed = false;
         }
         Command::KeyChanges {

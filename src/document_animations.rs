@@ -226,6 +226,38 @@ pub(super) fn key_attachment(
     Ok(())
 }
 
+/// Puts a deform key of part `part` at `time_s` in `anim` ([`put_key`]). Refused for a part
+/// the rig does not have, or offsets that are not one per vertex of its mesh.
+pub(super) fn key_deform(
+    state: &State,
+    anim: &mut Animation,
+    part: &str,
+    time_s: f64,
+    offsets: Vec<crate::geom::Vec2>,
+) -> Result<(), DocumentError> {
+    let rig = state.rig.as_ref().ok_or(DocumentError::NoWeights)?;
+    let mesh = rig
+        .doc
+        .parts
+        .iter()
+        .find(|p| p.name == part)
+        .map(|p| p.mesh.vertices.len())
+        .ok_or_else(|| DocumentError::UnknownLayer(part.to_string()))?;
+    if offsets.len() != mesh {
+        return Err(DocumentError::PolygonSize {
+            name: part.to_string(),
+            got: offsets.len(),
+            expected: mesh,
+        });
+    }
+    put_key(
+        anim.deform.entry(part.to_string()).or_default(),
+        time_s,
+        offsets,
+    );
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::{animation_named, Command, Document};

@@ -28,7 +28,7 @@ mod keys;
 use super::curve::{split_curve, Curve, BEZIER_NUMBERS_PER_CHANNEL};
 use super::timeline::Channels;
 use super::{AnimError, Animation, Key};
-use keys::{entries_of, find, write_keys, EditKey, Entry, TimelineEdit};
+use keys::{entries_of, find, find_all, write_keys, EditKey, Entry, TimelineEdit};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -122,6 +122,18 @@ pub enum TimelineId {
     },
     /// Stepped only.
     DrawOrder,
+    /// Which attachment slot `slot` shows (`parts.SLOT.attachment`). Stepped only.
+    Attachment {
+        slot: String,
+    },
+    /// The deform keys of part `part` (one of a slot's attachments): one curve for all its
+    /// vertex offsets, `cy` a 0..1 fraction, as a cage's.
+    Deform {
+        part: String,
+    },
+    /// The animation's events. No curves; several keys may share a time, and a key time names
+    /// every event at that time (moved, copied and deleted together).
+    Events,
 }
 
 impl TimelineId {
@@ -135,12 +147,21 @@ impl TimelineId {
             TimelineId::PartColor { part } => format!("{part} color"),
             TimelineId::PartVisible { part } => format!("{part} visible"),
             TimelineId::DrawOrder => "draw order".into(),
+            TimelineId::Attachment { slot } => format!("{slot} attachment"),
+            TimelineId::Deform { part } => format!("{part} deform"),
+            TimelineId::Events => "events".into(),
         }
     }
 
     /// Whether its keys carry a curve (the stepped-only timelines do not).
     pub fn has_curves(&self) -> bool {
-        !matches!(self, TimelineId::PartVisible { .. } | TimelineId::DrawOrder)
+        !matches!(
+            self,
+            TimelineId::PartVisible { .. }
+                | TimelineId::DrawOrder
+                | TimelineId::Attachment { .. }
+                | TimelineId::Events
+        )
     }
 }
 
@@ -232,8 +253,8 @@ impl Segment {
 }
 
 /// Every timeline of `animation` with its key times, in a stable order: bones, points, cages,
-/// IK drags, part colors and visibility, draw order (names alphabetical, channels as
-/// [`TransformChannel::ALL`]).
+/// deform keys, IK drags, part colors, visibility and attachments, draw order, events (names
+/// alphabetical, channels as [`TransformChannel::ALL`]; the events' times once each).
 pub fn timelines(animation: &Animation) -> Vec<(TimelineId, Vec<f64>)> {
     let mut out = Vec::new();
     for (bone, t) in &animation.bones {
@@ -251,6 +272,9 @@ pub fn timelines(animation: &Animation) -> Vec<(TimelineId, Vec<f64>)> {
     for (cage, keys) in &animation.cages {
         out.push((TimelineId::Cage { cage: cage.clone() }, times(keys)));
     }
+    for (part, keys) in &animation.deform {
+        out.push((TimelineId::Deform { part: part.clone() }, times(keys)));
+    }
     for (index, drag) in animation.ik.iter().enumerate() {
         out.push((TimelineId::Ik { index }, times(&drag.to)));
     }
@@ -261,9 +285,17 @@ pub fn timelines(animation: &Animation) -> Vec<(TimelineId, Vec<f64>)> {
         if let Some(keys) = &t.visible {
             out.push((TimelineId::PartVisible { part: part.clone() }, times(keys)));
         }
+        if let Some(keys) = &t.attachment {
+            out.push((TimelineId::Attachment { slot: part.clone() }, times(keys)));
+        }
     }
     if let Some(keys) = &animation.draw_order {
         out.push((TimelineId::DrawOrder, times(keys)));
+    }
+    if !animation.events.is_empty() {
+        let mut at = times(&animation.events);
+        at.dedup_by(|a, b| (*a - *b).abs() <= KEY_TIME_TOLERANCE_S);
+        out.push((TimelineId::Events, at));
     }
     out
 }
@@ -310,8 +342,9 @@ pub fn move_keys(
         ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             for &time_s in &self.times {
-                let entry = find(&mut entries, timeline, time_s)?;
-                entry.time_s = checked_time(entry.time_s + self.delta_s)?;
+                for entry in find_all(&mut entries, timeline, time_s)? {
+                    entry.time_s = checked_time(entry.time_s + self.delta_s)?;
+                }
             }
             *keys = write_keys(timeline, entries)?;
             Ok(())
@@ -370,15 +403,16 @@ pub fn copy_keys(animation: &Animation, keys: &[KeyRef]) -> Result<Vec<CopiedKey
         ) -> Result<(), EditError> {
             let mut entries = entries_of(keys);
             for (i, &time_s) in self.times.iter().enumerate() {
-                let entry = find(&mut entries, timeline, time_s)?;
-                let key = serde_json::to_value(&entry.key)
-                    .map_err(|e| malformed(&timeline.label(), i, e))?;
-                self.out.push(CopiedKey {
-                    timeline: timeline.clone(),
-                    offset_s: entry.time_s - self.earliest,
-                    key,
-                    next_time_s: entry.old_segment.map(|(_, end)| end),
-                });
+                for entry in find_all(&mut entries, timeline, time_s)? {
+                    let key = serde_json::to_value(&entry.key)
+                        .map_err(|e| malformed(&timeline.label(), i, e))?;
+                    self.out.push(CopiedKey {
+                        timeline: timeline.clone(),
+                        offset_s: entry.time_s - self.earliest,
+                        key,
+                        next_time_s: entry.old_segment.map(|(_, end)| end),
+                    });
+                }
             }
             Ok(())
         }
@@ -488,7 +522,10 @@ pub fn paste_keys(
                 let key =
                     K::deserialize(&copied.key).map_err(|e| malformed(&timeline.label(), i, e))?;
                 let old_time = key.time();
-                entries.retain(|e| (e.time_s - time_s).abs() > KEY_TIME_TOLERANCE_S);
+                // A key already there is replaced; keys pasted together stay together.
+                entries.retain(|e| {
+                    e.found_as.is_none() || (e.time_s - time_s).abs() > KEY_TIME_TOLERANCE_S
+                });
                 entries.push(Entry {
                     time_s,
                     key,

@@ -270,6 +270,7 @@ impl EditorApp {
         shapes.extend(self.mesh_shapes(&placed));
         shapes.extend(canvas::handles(&placed, &handles, self.selected.as_deref()));
         shapes.extend(self.polygon_shapes(&placed, response.hover_pos()));
+        shapes.extend(self.deform_shapes(&placed, response.hover_pos()));
         if let (Mode::Pose | Mode::Animate, Some(scene)) = (self.mode, &posable) {
             if let Some(target) = self.fk_target(scene) {
                 let active = match &self.gesture {
@@ -286,6 +287,11 @@ impl EditorApp {
         painter.extend(shapes);
         match self.mode {
             Mode::Rig => self.rig_gestures(&ctx, &response, placed),
+            Mode::Animate if self.deform.enabled => {
+                if let Some(scene) = posable {
+                    self.deform_gestures(&ctx, &response, placed, &scene)
+                }
+            }
             Mode::Pose | Mode::Animate => {
                 if let Some(scene) = posable {
                     self.pose_gestures(&ctx, &response, placed, &scene)

@@ -21,7 +21,9 @@ pub mod canvas;
 pub mod closing;
 pub mod colorize;
 pub mod curves;
+pub mod deform_tool;
 pub mod drawing;
+pub mod events;
 pub mod file;
 pub mod file_menu;
 pub mod gizmo;
@@ -31,6 +33,7 @@ pub mod messages;
 pub mod native_dialog;
 pub mod numbers;
 pub mod paint;
+pub mod physics_fields;
 pub mod pose_mode;
 pub mod rig_mode;
 pub mod rig_tools;
@@ -100,6 +103,8 @@ enum Gesture {
     Paint(paint::PaintStroke),
     /// A field of the numbers panel being dragged: the pose it shows ([`numbers`]).
     Numbers(Pose),
+    /// Mesh vertices dragged by animate mode's deform tool ([`deform_tool`]).
+    Deform(deform_tool::DeformDrag),
 }
 
 /// The editor's state: the document plus what only the view needs.
@@ -180,6 +185,10 @@ pub struct EditorApp {
     pub timeline: timeline::TimelineState,
     /// The tree view: renaming in place, the parts hidden on the canvas.
     pub tree: tree::TreeState,
+    /// Animate mode's events: the selected event key's payload, adding and defining events.
+    pub events: events::EventsPanel,
+    /// Animate mode's deform tool: on or off, its radius.
+    pub deform: deform_tool::DeformTool,
     /// Native file dialogs, where a portal answers ([`native_dialog`]).
     pub dialogs: native_dialog::NativeDialogs,
 }
@@ -238,6 +247,8 @@ impl EditorApp {
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),
             tree: Default::default(),
+            events: Default::default(),
+            deform: Default::default(),
             dialogs: Default::default(),
         }
     }
@@ -301,6 +312,7 @@ impl EditorApp {
         self.file_windows(&ctx);
         if self.mode == Mode::Animate {
             self.graph_view_window(&ctx);
+            self.define_event_window(&ctx);
         }
         self.log_window(&ctx);
         self.close_dialog(&ctx);
@@ -448,6 +460,10 @@ impl EditorApp {
             }
             Mode::Animate => {
                 self.animation_list(ui);
+                ui.separator();
+                // Beside the list, not under the dopesheet: the canvas keeps its height.
+                ui.horizontal_wrapped(|ui| self.add_event_row(ui));
+                ui.horizontal(|ui| self.deform_tool_row(ui));
                 ui.separator();
                 self.pose_panel(ui);
                 self.numbers_panel(ui);

@@ -20,12 +20,16 @@ use std::sync::Arc;
 
 mod animate;
 mod colorize;
+mod deform;
 mod documents;
+mod events;
 mod files;
 mod graph;
 mod outputs;
+mod physics;
 mod pose;
 mod rig;
+mod rows;
 mod timeline;
 mod tree_view;
 mod workflow;

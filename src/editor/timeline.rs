@@ -7,7 +7,9 @@
 //! checks are [`crate::anim::edit`]'s) — and pictures: the transport (play, pause, loop at the
 //! frame rate, frame steps), the dopesheet (a row per timeline, one per handle and channel:
 //! click, shift-click and box-select keys, drag them in time snapped to frames, copy, paste at
-//! the playhead, delete); beside it the curve editor ([`super::curves`]).
+//! the playhead, delete; rows for attachment swaps, deform keys and events too); beside it the
+//! curve editor ([`super::curves`]), or for a time of the events row its payload
+//! ([`super::events`]).
 
 use super::animate_mode::{OnionOptions, MAX_ONION_FRAMES};
 use super::curves::{CurveLayout, CURVE_GRAPH_PT};
@@ -404,7 +406,12 @@ impl EditorApp {
             ui.separator();
             ui.vertical(|ui| {
                 self.graph_view_button(ui);
-                self.curve_editor(ui, &animation)
+                if self.event_selected() {
+                    self.timeline.curve = None;
+                    self.event_key_panel(ui);
+                } else {
+                    self.curve_editor(ui, &animation);
+                }
             });
         });
     }

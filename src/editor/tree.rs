@@ -1,5 +1,6 @@
 //! The tree view (rig, pose and animate modes' side panel): skeletons with their bones nested
-//! under their parents, the points, cages and regions, and the parts (slots) front to back.
+//! under their parents (and each bone's physics constraints, [`super::physics_fields`]), the
+//! points, cages and regions, and the parts (slots) front to back.
 //!
 //! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
 //! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row), the
@@ -24,6 +25,8 @@ pub struct TreeState {
     renaming: Option<(String, String)>,
     /// The rename field wants the keyboard (it just appeared).
     focus: bool,
+    /// The physics constraint whose fields are shown ([`super::physics_fields`]).
+    pub physics: Option<String>,
 }
 
 impl EditorApp {
@@ -133,6 +136,7 @@ impl EditorApp {
                 }
             }
         }
+        self.physics_rows(ui, name, depth);
         let children: Vec<String> = handles
             .bones
             .iter()

@@ -176,8 +176,14 @@ impl Scene {
     /// This scene without its physics constraints, textures shared: what the Spine export bakes
     /// from (the runtime simulates physics itself).
     pub fn without_physics(&self) -> Scene {
+        self.with_physics(Vec::new())
+    }
+
+    /// This scene with `physics` as its physics constraints (checked by the caller), textures,
+    /// weights and skinning plans shared: the constraints move no weights.
+    pub fn with_physics(&self, physics: Vec<crate::rig::PhysicsConstraint>) -> Scene {
         let mut doc = self.doc.clone();
-        doc.handles.physics.clear();
+        doc.handles.physics = physics;
         Scene {
             doc,
             parts: self.parts.clone(),

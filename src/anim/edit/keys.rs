@@ -6,13 +6,16 @@
 use super::{unknown, EditError, TimelineId, TransformChannel, KEY_TIME_TOLERANCE_S};
 use crate::anim::curve::Curve;
 use crate::anim::timeline::{Channels, Key, StepKey};
-use crate::anim::Animation;
+use crate::anim::{Animation, EventKey};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// A stored key of any timeline, as the edits see it.
 pub(super) trait EditKey: Clone + Serialize + DeserializeOwned {
+    /// Whether several keys of one timeline may share a time (events); a time then names all
+    /// of them.
+    const SHARES_TIMES: bool = false;
     fn time(&self) -> f64;
     fn set_time(&mut self, time_s: f64);
     /// How it travels to the next key; `None` for the stepped-only kinds.
@@ -47,6 +50,25 @@ impl<V: Channels + Serialize + DeserializeOwned> EditKey for Key<V> {
 }
 
 impl<V: Clone + Serialize + DeserializeOwned> EditKey for StepKey<V> {
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn set_time(&mut self, time_s: f64) {
+        self.time = time_s;
+    }
+    fn curve(&self) -> Option<&Curve> {
+        None
+    }
+    fn curve_mut(&mut self) -> Option<&mut Curve> {
+        None
+    }
+    fn curve_values(&self, _fraction: f64) -> Vec<f64> {
+        Vec::new()
+    }
+}
+
+impl EditKey for EventKey {
+    const SHARES_TIMES: bool = true;
     fn time(&self) -> f64 {
         self.time
     }
@@ -112,14 +134,35 @@ pub(super) fn find<'a, K>(
         .ok_or_else(|| unknown(timeline, time_s))
 }
 
-/// Sorts `entries`, refuses two at one time, fits the Bézier handles' times to their new
+/// Every entry found as `time_s` (one, except on a timeline whose keys share times); none is
+/// an error.
+pub(super) fn find_all<'a, K>(
+    entries: &'a mut [Entry<K>],
+    timeline: &TimelineId,
+    time_s: f64,
+) -> Result<Vec<&'a mut Entry<K>>, EditError> {
+    let found: Vec<&mut Entry<K>> = entries
+        .iter_mut()
+        .filter(|e| {
+            e.found_as
+                .is_some_and(|old| (old - time_s).abs() <= KEY_TIME_TOLERANCE_S)
+        })
+        .collect();
+    if found.is_empty() {
+        return Err(unknown(timeline, time_s));
+    }
+    Ok(found)
+}
+
+/// Sorts `entries` (stably: events at one time keep their order), refuses two at one time
+/// (where keys may not share times), fits the Bézier handles' times to their new
 /// segments, and returns them as `timeline`'s keys.
 pub(super) fn write_keys<K: EditKey>(
     timeline: &TimelineId,
     mut entries: Vec<Entry<K>>,
 ) -> Result<Vec<K>, EditError> {
     entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    for pair in entries.windows(2) {
+    for pair in entries.windows(2).filter(|_| !K::SHARES_TIMES) {
         if pair[1].time_s - pair[0].time_s <= KEY_TIME_TOLERANCE_S {
             return Err(EditError::Collision {
                 timeline: timeline.label(),
@@ -212,6 +255,22 @@ pub(super) fn edit_timeline(
             drop_if_empty(&mut animation.parts, part);
         }
         TimelineId::DrawOrder => in_slot(&mut animation.draw_order, create, timeline, edit)?,
+        TimelineId::Attachment { slot } => {
+            let t = owner(&mut animation.parts, slot, create).ok_or_else(missing)?;
+            in_slot(&mut t.attachment, create, timeline, edit)?;
+            drop_if_empty(&mut animation.parts, slot);
+        }
+        TimelineId::Deform { part } => {
+            let keys = owner(&mut animation.deform, part, create).ok_or_else(missing)?;
+            edit.edit(timeline, keys)?;
+            drop_if_empty(&mut animation.deform, part);
+        }
+        TimelineId::Events => {
+            if !create && animation.events.is_empty() {
+                return Err(missing());
+            }
+            edit.edit(timeline, &mut animation.events)?;
+        }
     }
     Ok(())
 }

@@ -430,3 +430,116 @@ fn a_key_put_inside_an_eased_segment_leaves_the_motion_unchanged() {
     assert_eq!(moved[2].value, [1.0, 2.0]);
     assert_eq!(moved[3].curve, Curve::Linear);
 }
+
+/// A hand swapped to a fist at 0.5 s, a squash keyed on the body, footsteps (two events at 1 s).
+fn grab() -> Animation {
+    parsed(
+        "grab",
+        json!({
+            "parts": {"hand": {"attachment": [{"time": 0, "value": "hand"},
+                                              {"time": 0.5, "value": "fist"}]}},
+            "deform": {"body": [{"time": 0, "value": [[0, 0], [0, 0]],
+                                 "curve": [0.25, 0, 0.75, 1]},
+                                {"time": 1, "value": [[0, 2], [0, 4]]}]},
+            "events": [{"time": 0.5, "name": "step", "int": 1},
+                       {"time": 1, "name": "step", "int": 2},
+                       {"time": 1, "name": "cue", "string": "go"}]
+        }),
+    )
+}
+
+#[test]
+fn attachment_deform_and_event_keys_are_rows_like_the_others() {
+    let anim = grab();
+    let listed = timelines(&anim);
+    let ids: Vec<String> = listed.iter().map(|(t, _)| t.label()).collect();
+    assert_eq!(ids, ["body deform", "hand attachment", "events"]);
+    // Events at one time are one key of the row.
+    assert_eq!(listed[2].1, vec![0.5, 1.0]);
+    let (attachment, deform, events) = (
+        TimelineId::Attachment {
+            slot: "hand".into(),
+        },
+        TimelineId::Deform {
+            part: "body".into(),
+        },
+        TimelineId::Events,
+    );
+    assert!(!attachment.has_curves() && !events.has_curves() && deform.has_curves());
+
+    // Moving the events at 1 s moves both, in their order; the attachment key moves alone.
+    let moved = move_keys(
+        "grab",
+        &anim,
+        &[key(&events, 1.0), key(&attachment, 0.5)],
+        0.25,
+    )
+    .unwrap();
+    let fired: Vec<(f64, &str)> = moved
+        .events
+        .iter()
+        .map(|k| (k.time, k.name.as_str()))
+        .collect();
+    assert_eq!(fired, [(0.5, "step"), (1.25, "step"), (1.25, "cue")]);
+    let swap = moved.parts["hand"].attachment.as_ref().unwrap();
+    assert_eq!(
+        (swap[1].time, swap[1].value.as_deref()),
+        (0.75, Some("fist"))
+    );
+    // Onto the other event time: events may share it; attachment keys may not.
+    let shared = move_keys("grab", &anim, &[key(&events, 0.5)], 0.5).unwrap();
+    assert_eq!(shared.events.len(), 3);
+    assert!(shared.events.iter().all(|k| k.time == 1.0));
+    assert!(matches!(
+        move_keys("grab", &anim, &[key(&attachment, 0.0)], 0.5),
+        Err(EditError::Collision { .. })
+    ));
+
+    // Stepped rows have no curve; a deform key's is one 0..1 curve for all its offsets.
+    assert!(matches!(
+        set_curve("grab", &anim, &key(&attachment, 0.0), &Curve::Stepped),
+        Err(EditError::NoCurves(_))
+    ));
+    let segment = segment(&anim, &key(&deform, 0.0)).unwrap();
+    assert_eq!(
+        (segment.start.clone(), segment.end.clone()),
+        (vec![0.0], vec![1.0])
+    );
+    let stepped = set_curve("grab", &anim, &key(&deform, 0.0), &Curve::Stepped).unwrap();
+    assert_eq!(stepped.deform["body"][0].curve, Curve::Stepped);
+
+    // Copy the events at 1 s and the deform key at 1 s; paste them at 2 s.
+    let copied = copy_keys(&anim, &[key(&events, 1.0), key(&deform, 1.0)]).unwrap();
+    assert_eq!(copied.len(), 3);
+    let pasted = paste_keys("grab", &anim, 2.0, &copied).unwrap();
+    let at_two: Vec<(&str, Option<i32>)> = pasted
+        .events
+        .iter()
+        .filter(|k| k.time == 2.0)
+        .map(|k| (k.name.as_str(), k.int))
+        .collect();
+    assert_eq!(at_two, [("step", Some(2)), ("cue", None)]);
+    let offsets = &pasted.deform["body"][2].value;
+    assert_eq!(
+        offsets,
+        &[
+            crate::geom::Vec2::new(0.0, 2.0),
+            crate::geom::Vec2::new(0.0, 4.0)
+        ]
+    );
+    // Pasted again at the same time: replaced, not doubled.
+    let again = paste_keys("grab", &pasted, 2.0, &copied).unwrap();
+    assert_eq!(again, pasted);
+
+    // Deleting the rows' keys removes them, and the emptied timelines with them.
+    let all: Vec<KeyRef> = listed
+        .iter()
+        .flat_map(|(t, times)| times.iter().map(|&s| key(t, s)))
+        .collect();
+    let emptied = delete_keys("grab", &anim, &all).unwrap();
+    assert_eq!(emptied, Animation::default());
+    assert!(matches!(
+        delete_keys("grab", &emptied, &[key(&events, 0.5)]),
+        Err(EditError::UnknownTimeline(_))
+    ));
+}

@@ -1,0 +1,79 @@
+//! Physics constraints in the tree view: listed under their bone, their numbers edited as
+//! undoable commands, bad numbers refused with a message, the rig kept posable.
+
+use super::*;
+
+fn tail_sway(h: &Harness<'_, EditorApp>) -> crate::rig::PhysicsConstraint {
+    let physics = &h.state().doc.state().handles.physics;
+    physics
+        .iter()
+        .find(|c| c.name == "tail_sway")
+        .expect("the tail's constraint")
+        .clone()
+}
+
+/// Scrolls the side panel to `label` and types `text` into it, then Enter.
+fn enter(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
+    h.get_by_label(label).scroll_to_me();
+    h.run();
+    type_into(h, label, text);
+    h.key_press(Key::Enter);
+    h.run();
+}
+
+#[test]
+fn a_physics_constraints_fields_in_the_tree_edit_it_and_refuse_bad_numbers() {
+    let mut h = open_character("physics-fields");
+    h.key_press(Key::Num2);
+    h.run();
+    assert!(h.query_by_label("Physics mass").is_none());
+    h.get_by_label("physics tail_sway").scroll_to_me();
+    h.run();
+    h.get_by_label("physics tail_sway").click();
+    h.run();
+    let before = tail_sway(&h);
+    assert_eq!(before.bone, "tail_4");
+    let mass = h.get_by_label("Physics mass").value().unwrap_or_default();
+    assert_eq!(mass.parse::<f64>().ok(), Some(1.5), "{mass}");
+
+    // Strength and gravity typed in; each is one undo step. The rig stays posable.
+    enter(&mut h, "Physics strength", "80");
+    assert_eq!(tail_sway(&h).strength, 80.0, "{:?}", h.state().message);
+    enter(&mut h, "Physics gravity", "2.5");
+    enter(&mut h, "Moves x", "0.5");
+    let after = tail_sway(&h);
+    assert_eq!((after.gravity, after.x), (2.5, 0.5));
+    assert!(
+        h.state().doc.posable().is_some(),
+        "the edit made the rig stale"
+    );
+    let scene_physics = &h
+        .state()
+        .doc
+        .posable()
+        .expect("posable")
+        .doc
+        .handles
+        .physics;
+    assert_eq!(scene_physics, &h.state().doc.state().handles.physics);
+
+    // NaN (egui's field clamps it to infinity) and a mass of 0 are refused with the
+    // document's message; nothing changes.
+    enter(&mut h, "Physics damping", "NaN");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(
+        message.contains("damping is inf, not a finite number"),
+        "{message}"
+    );
+    enter(&mut h, "Physics mass", "0");
+    let message = h.state().message.clone().unwrap_or_default();
+    assert!(message.contains("mass must be > 0"), "{message}");
+    assert_eq!(tail_sway(&h), after);
+
+    // Undo, three steps, back to the constraint as opened.
+    for _ in 0..3 {
+        h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        h.run();
+    }
+    assert_eq!(tail_sway(&h), before);
+}
