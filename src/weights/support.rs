@@ -24,6 +24,7 @@ use super::solve::{check_reachable, fixed_column, free_vertices};
 use super::solve::{BoundaryConditions, Domain, WeightMatrix};
 use super::sparse::{fill_reducing_rank, mat_vec, SharedPattern, SolveError};
 use rayon::prelude::*;
+use sprs::CsMat;
 
 /// Default support floor: a free vertex whose guessed weight exceeds this is solved for, the
 /// others are held at zero. Measured on the critter at 5k, 20k and 50k vertices with 10
@@ -41,48 +42,79 @@ pub fn support_bbw(
     guess: &WeightMatrix,
     support_floor: f64,
 ) -> Result<WeightMatrix, SolveError> {
-    let q = domain.bilaplacian();
-    let n = q.rows();
-    check_reachable(&q, bc)?;
-    let free = free_vertices(n, bc);
-    let rank = fill_reducing_rank(&q, &free)?;
-    let columns: Vec<Result<Vec<f64>, SolveError>> = (0..bc.handle_count)
-        .into_par_iter()
-        .map(|j| {
-            let mut w = fixed_column(n, bc, j);
-            if w.iter().all(|&x| x == 0.0) {
-                // Zero boundary values: zero is optimal and feasible.
-                return Ok(w);
-            }
-            // Held at one where the guess is within the floor of it (a handle alone in a
-            // region of the domain owns it), at zero below the floor, solved in between.
-            let mut support = Vec::new();
-            for &i in &free {
-                let g = guess.get(i, j);
-                if g >= 1.0 - support_floor {
-                    w[i] = 1.0;
-                } else if g > support_floor {
-                    support.push(i);
-                }
-            }
-            if support.is_empty() {
-                return Ok(w);
-            }
-            // Q[S, S] x = −Q[S, held] · held values (the held zeros add nothing).
-            let qw = mat_vec(&q, &w);
-            let mut x: Vec<f64> = support.iter().map(|&i| -qw[i]).collect();
-            let pattern = SharedPattern::with_rank(&q, &support, &rank)?;
-            pattern
-                .factor_regularized(&pattern.values)?
-                .solve_in_place(&mut x);
-            for (&i, v) in support.iter().zip(x) {
-                w[i] = v.clamp(0.0, 1.0);
-            }
-            Ok(w)
+    SupportSolver::new(domain, bc)?.solve(guess, support_floor)
+}
+
+/// What [`support_bbw`] prepares before it sees the guess (the bi-Laplacian and one
+/// fill-reducing order of the whole mesh), so that a caller can prepare it while the guess is
+/// still being computed (the coarse solve, [`super::two_level`]).
+pub struct SupportSolver {
+    q: CsMat<f64>,
+    bc: BoundaryConditions,
+    free: Vec<usize>,
+    rank: Vec<usize>,
+}
+
+impl SupportSolver {
+    pub fn new(domain: &Domain, bc: &BoundaryConditions) -> Result<Self, SolveError> {
+        let q = domain.bilaplacian();
+        check_reachable(&q, bc)?;
+        let free = free_vertices(q.rows(), bc);
+        let rank = fill_reducing_rank(&q, &free)?;
+        Ok(SupportSolver {
+            q,
+            bc: bc.clone(),
+            free,
+            rank,
         })
-        .collect();
-    let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
-    Ok(WeightMatrix::from_columns(n, &columns))
+    }
+
+    /// [`support_bbw`] with `guess` (one row per vertex of the domain).
+    pub fn solve(
+        &self,
+        guess: &WeightMatrix,
+        support_floor: f64,
+    ) -> Result<WeightMatrix, SolveError> {
+        let (q, bc, free, rank) = (&self.q, &self.bc, &self.free, &self.rank);
+        let n = q.rows();
+        let columns: Vec<Result<Vec<f64>, SolveError>> = (0..bc.handle_count)
+            .into_par_iter()
+            .map(|j| {
+                let mut w = fixed_column(n, bc, j);
+                if w.iter().all(|&x| x == 0.0) {
+                    // Zero boundary values: zero is optimal and feasible.
+                    return Ok(w);
+                }
+                // Held at one where the guess is within the floor of it (a handle alone in a
+                // region of the domain owns it), at zero below the floor, solved in between.
+                let mut support = Vec::new();
+                for &i in free {
+                    let g = guess.get(i, j);
+                    if g >= 1.0 - support_floor {
+                        w[i] = 1.0;
+                    } else if g > support_floor {
+                        support.push(i);
+                    }
+                }
+                if support.is_empty() {
+                    return Ok(w);
+                }
+                // Q[S, S] x = −Q[S, held] · held values (the held zeros add nothing).
+                let qw = mat_vec(q, &w);
+                let mut x: Vec<f64> = support.iter().map(|&i| -qw[i]).collect();
+                let pattern = SharedPattern::with_rank(q, &support, rank)?;
+                pattern
+                    .factor_regularized(&pattern.values)?
+                    .solve_in_place(&mut x);
+                for (&i, v) in support.iter().zip(x) {
+                    w[i] = v.clamp(0.0, 1.0);
+                }
+                Ok(w)
+            })
+            .collect();
+        let columns = columns.into_iter().collect::<Result<Vec<_>, _>>()?;
+        Ok(WeightMatrix::from_columns(n, &columns))
+    }
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ use super::part::{
 };
 use super::solve::{BoundaryConditions, Domain, WeightMatrix};
 use super::sparse::SolveError;
-use super::support::support_bbw;
+use super::support::{support_bbw, SupportSolver};
 use super::{WeightError, WeightOptions};
 use crate::geom::Point;
 use crate::mesh::{EmbeddedMesh, Mesh};
@@ -47,15 +47,34 @@ pub fn two_level_weights(
 ) -> Result<PartWeights, WeightError> {
     check_options(handles, binding, options)?;
     let two_level = options.two_level.clone().unwrap_or_default();
-    let solved = domain_weights(coarse, handles, binding, coarse_colors, options)?;
-    let mut matrix = carry_to(&coarse.domain, &solved.matrix, &fine.domain.vertices);
     let (bc, touched, _) = boundary_conditions(fine, handles, binding);
-    if two_level.polish != TwoLevelPolish::None
+    let polished = two_level.polish != TwoLevelPolish::None
         && options.method == WeightMethod::Bbw
-        && !options.monotone
-    {
+        && !options.monotone;
+    // The fine mesh's support solver does not need the coarse weights: it is prepared while
+    // the coarse mesh solves.
+    let prepare = || -> Result<Option<(Domain, Option<SupportSolver>)>, WeightError> {
+        if !polished {
+            return Ok(None);
+        }
         let domain = weight_domain(&fine.domain, fine_colors, options)?;
-        matrix = polish(&domain, &bc, &matrix, &two_level)?;
+        let solver = match two_level.polish {
+            TwoLevelPolish::Support => Some(SupportSolver::new(&domain, &bc)?),
+            _ => None,
+        };
+        Ok(Some((domain, solver)))
+    };
+    let (solved, prepared) = rayon::join(
+        || domain_weights(coarse, handles, binding, coarse_colors, options),
+        prepare,
+    );
+    let solved = solved?;
+    let mut matrix = carry_to(&coarse.domain, &solved.matrix, &fine.domain.vertices);
+    if let Some((domain, solver)) = prepared? {
+        matrix = match solver {
+            Some(solver) => solver.solve(&matrix, two_level.support_floor)?,
+            None => polish(&domain, &bc, &matrix, &two_level)?,
+        };
         normalize_rows(&mut matrix, &fine.domain, handles, binding);
     }
     // The handles' own vertices keep exactly what the handles give them.
@@ -77,8 +96,8 @@ pub fn two_level_weights(
 }
 
 /// The fine mesh's bounded biharmonic weights from `carried` (weights carried from a coarse
-/// solve, one row per vertex of `domain`) by the polish `options` name, clamped to [0, 1],
-/// rows not normalized; `carried` itself with [`TwoLevelPolish::None`].
+/// solve, one row per vertex of `domain`) by the polish `options.polish` names, clamped to
+/// [0, 1], rows not normalized; `carried` itself with [`TwoLevelPolish::None`].
 pub fn polish(
     domain: &Domain,
     bc: &BoundaryConditions,

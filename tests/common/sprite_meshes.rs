@@ -6,10 +6,11 @@
 use sinew::geom::{ring_signed_area, triangle_area2, Point};
 use sinew::mesh::{triangulate, triangulate_with_handles, HandleGeometry, Mesh, MeshOptions};
 use sinew::trace::{trace, Outline, TraceOptions};
-use sinew::weights::two_level::{carry_to, polish};
+use sinew::weights::support::SupportSolver;
+use sinew::weights::two_level::carry_to;
 use sinew::weights::{
     bounded_biharmonic_weights, BbwOptions, BoundaryConditions, Domain, TwoLevelOptions,
-    WeightMatrix,
+    TwoLevelPolish, WeightMatrix,
 };
 
 /// The sprite's canvas side, px.
@@ -194,14 +195,23 @@ pub fn two_level(
     bc: &BoundaryConditions,
 ) -> WeightMatrix {
     let options = TwoLevelOptions::default();
-    let (coarse, coarse_bc) = coarse_mesh(outline, fine, handles, options.coarse_vertices);
-    let points: Vec<[f64; 2]> = coarse.vertices.iter().map(|p| [p.x, p.y]).collect();
-    let coarse_domain = Domain::new(&points, &coarse.triangles);
-    let (solved, _) =
-        bounded_biharmonic_weights(&coarse_domain, &coarse_bc, &BbwOptions::default())
-            .expect("coarse bbw solve");
-    let carried = carry_to(&coarse, &solved, &fine.vertices);
-    let mut w = polish(domain, bc, &carried, &options).expect("polish");
+    assert_eq!(options.polish, TwoLevelPolish::Support);
+    // As `two_level_weights` does: the fine support solver is prepared beside the coarse solve.
+    let (solved, solver) = rayon::join(
+        || {
+            let (coarse, coarse_bc) = coarse_mesh(outline, fine, handles, options.coarse_vertices);
+            let points: Vec<[f64; 2]> = coarse.vertices.iter().map(|p| [p.x, p.y]).collect();
+            let coarse_domain = Domain::new(&points, &coarse.triangles);
+            let (solved, _) =
+                bounded_biharmonic_weights(&coarse_domain, &coarse_bc, &BbwOptions::default())
+                    .expect("coarse bbw solve");
+            carry_to(&coarse, &solved, &fine.vertices)
+        },
+        || SupportSolver::new(domain, bc).expect("support solver"),
+    );
+    let mut w = solver
+        .solve(&solved, options.support_floor)
+        .expect("support solve");
     w.normalize_rows();
     w
 }
