@@ -15,6 +15,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use sinew::anim::{parse_animations, sample_mix, Animation, BoneTimelines, Curve, Key};
 use sinew::anim::{Playhead, PointTimelines};
+use sinew::geom::Point;
 use sinew::rig::{Bone, Handles, PointHandle};
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -63,14 +64,14 @@ fn synthetic() -> (Animation, Handles) {
             .map(|i| Bone {
                 name: format!("bone_{i:02}"),
                 parent: (i % 4 != 0).then(|| format!("bone_{:02}", i - 1)),
-                head: [10.0 * i as f64, 0.0],
-                tail: [10.0 * i as f64 + 8.0, 0.0],
+                head: Point::new(10.0 * i as f64, 0.0),
+                tail: Point::new(10.0 * i as f64 + 8.0, 0.0),
             })
             .collect(),
         points: (0..POINTS)
             .map(|i| PointHandle {
                 name: format!("point_{i}"),
-                at: [5.0 * i as f64, 40.0],
+                at: Point::new(5.0 * i as f64, 40.0),
             })
             .collect(),
         ..Default::default()

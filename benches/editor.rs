@@ -15,6 +15,7 @@ mod common;
 use egui_kittest::Harness;
 use sinew::document::Document;
 use sinew::editor::{EditorApp, Mode};
+use sinew::geom::Point;
 use std::time::Instant;
 
 /// Frames measured (pointer moves during one drag).
@@ -52,12 +53,12 @@ fn main() {
     let c = torso
         .vertices
         .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+        .fold(Point::origin(), |a, p| a + p.coords / n);
     let grip = *torso
         .vertices
         .iter()
         .min_by(|a, b| {
-            let d = |p: &[f64; 2]| (p[0] - c[0]).hypot(p[1] - c[1]);
+            let d = |p: &Point| (p - c).norm();
             d(a).total_cmp(&d(b))
         })
         .expect("vertices");
@@ -68,7 +69,7 @@ fn main() {
     let mut own_ms = Vec::with_capacity(FRAMES);
     for k in 0..FRAMES {
         let a = k as f64 / FRAMES as f64 * std::f64::consts::TAU;
-        let to = [grip[0] + 40.0 * a.sin(), grip[1] - 30.0 * (1.0 - a.cos())];
+        let to = Point::new(grip.x + 40.0 * a.sin(), grip.y - 30.0 * (1.0 - a.cos()));
         h.hover_at(placed.screen_from_canvas(to));
         let start = Instant::now();
         h.step();

@@ -161,34 +161,37 @@ fn character(c: &mut Criterion) {
     use sinew::rig::Pose;
     let scene = common::character_scene();
     let mut ik = scene.rig_ik().expect("the character's IK");
-    let pose = |to: [f64; 2]| Pose {
+    let pose = |to: Point| Pose {
         ik: vec![
             IkDrag {
-                at: [305.0, 440.0],
-                to: [305.0, 440.0],
+                at: Point::new(305.0, 440.0),
+                to: Point::new(305.0, 440.0),
                 weight: None,
             },
             IkDrag {
-                at: [207.0, 440.0],
-                to: [207.0, 440.0],
+                at: Point::new(207.0, 440.0),
+                to: Point::new(207.0, 440.0),
                 weight: None,
             },
             IkDrag {
-                at: [160.0, 330.0],
+                at: Point::new(160.0, 330.0),
                 to,
                 weight: None,
             },
         ],
         ..Pose::default()
     };
-    let lift = pose([140.0, 250.0]);
+    let lift = pose(Point::new(140.0, 250.0));
     c.bench_function("ik/character/cold", |b| {
         b.iter(|| ik.solve_pose(black_box(&lift)).expect("solves"))
     });
     let targets: Vec<Pose> = (0..64)
         .map(|k| {
             let angle = k as f64 * std::f64::consts::TAU / 64.0;
-            pose([150.0 + 30.0 * angle.cos(), 280.0 + 30.0 * angle.sin()])
+            pose(Point::new(
+                150.0 + 30.0 * angle.cos(),
+                280.0 + 30.0 * angle.sin(),
+            ))
         })
         .collect();
     ik.transforms(&targets[0]).expect("solves");

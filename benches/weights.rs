@@ -150,8 +150,7 @@ fn weights(c: &mut Criterion) {
         .iter()
         .map(|&(label, target)| {
             let (mesh, fraction) = mesh_near(&outline, target);
-            let points: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
-            let domain = Domain::new(&points, &mesh.triangles);
+            let domain = Domain::planar(&mesh.vertices, &mesh.triangles);
             println!(
                 "mesh {label}: {} vertices, {} triangles (max_area_fraction {fraction:.3e}, {SPRITE_SIZE}² canvas)",
                 mesh.vertices.len(),

@@ -52,15 +52,15 @@ fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) -> Bon
     Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head,
-        tail,
+        head: head.into(),
+        tail: tail.into(),
     }
 }
 
 fn point(name: &str, at: [f64; 2]) -> PointHandle {
     PointHandle {
         name: name.into(),
-        at,
+        at: at.into(),
     }
 }
 

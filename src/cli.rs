@@ -13,6 +13,7 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
 use sinew::autorig::Template;
+use sinew::export::spine::played::ExportPlayed;
 use sinew::export::spine::{self, BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use sinew::io::outputs::check_outputs;
 use sinew::io::{self, BuildOptions, RigDocument};
@@ -174,6 +175,14 @@ fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
     }
 }
 
+/// The export `--match-runtime spine` reproduces.
+fn export_played(spine_version: &str, bake_fps: f64) -> Result<ExportPlayed> {
+    Ok(ExportPlayed {
+        version: SpineVersion::parse(spine_version)?,
+        bake_fps,
+    })
+}
+
 #[derive(Args, Debug)]
 pub struct AutorigArgs {
     /// Layer images (PNG, all the same size) or layered files (.psd, .psb, .ora, or the .json
@@ -225,6 +234,14 @@ pub struct RenderArgs {
     /// Play curves as this runtime does instead of exactly (see README, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
+    /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
+    /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
+    #[arg(long, default_value = "4.2", requires = "match_runtime")]
+    pub spine_version: String,
+    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
+    /// --fps`).
+    #[arg(long, default_value_t = 30.0, requires = "match_runtime")]
+    pub bake_fps: f64,
     /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.
     #[arg(long = "skin", value_name = "NAME")]
@@ -408,6 +425,14 @@ pub struct PoseArgs {
     /// With --anim: sample curves as this runtime plays them instead of exactly.
     #[arg(long, value_enum, requires = "anim")]
     pub match_runtime: Option<RuntimeMatch>,
+    /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
+    /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
+    #[arg(long, default_value = "4.2", requires = "match_runtime")]
+    pub spine_version: String,
+    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
+    /// --fps`).
+    #[arg(long, default_value_t = 30.0, requires = "match_runtime")]
+    pub bake_fps: f64,
     /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.
     #[arg(long = "skin", value_name = "NAME")]
@@ -613,9 +638,18 @@ fn pose(args: &PoseArgs) -> Result<()> {
             }
             let animation = animation(&scene.doc, name)?;
             let sampling = sample_options(args.match_runtime);
-            let frame = playback::play(&scene, name, &animation, &[time_s], true, &sampling)?
-                .pop()
-                .context("no frame")?;
+            let export = export_played(&args.spine_version, args.bake_fps)?;
+            let frame = playback::play(
+                &scene,
+                name,
+                &animation,
+                &[time_s],
+                true,
+                &sampling,
+                &export,
+            )?
+            .pop()
+            .context("no frame")?;
             (frame.pose, frame.transforms)
         }
         (None, None) => (Pose::default(), scene.handle_transforms(&Pose::default())?),
@@ -651,6 +685,7 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
             .transpose()?,
         blend: args.blend,
         sampling: sample_options(args.match_runtime),
+        export: export_played(&args.spine_version, args.bake_fps)?,
     };
     let files = sinew::jobs::RenderFiles {
         rig: args.rig.clone(),
@@ -706,7 +741,7 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
     #[derive(Serialize)]
     struct Part<'a> {
         name: &'a str,
-        vertices: Vec<[f64; 2]>,
+        vertices: &'a [sinew::geom::Point],
         triangles: &'a [[u32; 3]],
     }
     #[derive(Serialize)]
@@ -719,7 +754,7 @@ fn vertices_json(doc: &RigDocument, positions: &[Vec<sinew::geom::Point>]) -> Re
         .zip(positions)
         .map(|(p, pos)| Part {
             name: &p.name,
-            vertices: pos.iter().map(|v| [v.x, v.y]).collect(),
+            vertices: pos,
             triangles: &p.mesh.triangles,
         })
         .collect();

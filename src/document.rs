@@ -21,6 +21,7 @@
 
 use crate::anim::edit::{self, put_key, CopiedKey, KeyRef};
 use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
+use crate::geom::Point;
 use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
 use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle, Pose, Region};
@@ -213,13 +214,13 @@ pub enum Command {
     /// Moves a bone's head and tail (canvas px).
     MoveBone {
         name: String,
-        head: [f64; 2],
-        tail: [f64; 2],
+        head: Point,
+        tail: Point,
     },
     AddPoint(PointHandle),
     MovePoint {
         name: String,
-        at: [f64; 2],
+        at: Point,
     },
     /// Renames a handle everywhere it is referred to (parents, bindings, IK constraints, pose).
     Rename {
@@ -273,7 +274,7 @@ pub enum Command {
     /// Moves a cage's or region's polygon (same vertex count, canvas px).
     SetPolygon {
         name: String,
-        polygon: Vec<[f64; 2]>,
+        polygon: Vec<Point>,
     },
     /// Paints one brush stroke (press to release) on `handle`'s weights over `part` (see
     /// [`crate::weights::paint`]): one undo step. Needs current weights; locked handles keep
@@ -284,7 +285,7 @@ pub enum Command {
         handle: String,
         mode: BrushMode,
         /// The pointer's path, canvas px.
-        samples_px: Vec<[f64; 2]>,
+        samples_px: Vec<Point>,
         options: BrushOptions,
     },
     /// Locks or unlocks a handle's weights. The built rig stays current.
@@ -1090,7 +1091,7 @@ fn paint_weights(
     part: &str,
     handle: &str,
     mode: BrushMode,
-    samples_px: &[[f64; 2]],
+    samples_px: &[Point],
     options: &BrushOptions,
 ) -> Result<Scene, DocumentError> {
     let (scene, index, locked) = part_weights_for_painting(state, part)?;

@@ -10,6 +10,22 @@ pub type Point = nalgebra::Point2<f64>;
 /// A displacement on the canvas, in pixels.
 pub type Vec2 = nalgebra::Vector2<f64>;
 
+/// The coordinates of a run of points, x0 y0 x1 y1 …, without copying.
+pub fn point_numbers(points: &[Point]) -> &[f64] {
+    bytemuck::cast_slice(points)
+}
+
+/// The points as coordinate arrays, without copying: for code generic over the dimension
+/// (`[f64; D]`: the weight metric measures 2D positions and 5D content-aware lifts alike).
+pub fn as_coordinate_arrays(points: &[Point]) -> &[[f64; 2]] {
+    bytemuck::cast_slice(points)
+}
+
+/// [`point_numbers`], mutable.
+pub fn point_numbers_mut(points: &mut [Point]) -> &mut [f64] {
+    bytemuck::cast_slice_mut(points)
+}
+
 /// Twice the signed area of a closed ring by the shoelace formula, in px².
 ///
 /// With y pointing down, a ring that runs clockwise on screen has a positive value.

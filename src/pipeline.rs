@@ -435,22 +435,16 @@ fn cage_error(handles: &Handles, error: MeshError) -> Result<PipelineError, Mesh
 /// The geometry every mesh must carry for the handles: bone segments, point positions, cage
 /// and region outlines (cage insides also join the weight domain).
 pub fn handle_geometry(handles: &Handles) -> HandleGeometry {
-    let pt = |a: &[f64; 2]| Point::new(a[0], a[1]);
-    let ring = |poly: &Vec<[f64; 2]>| poly.iter().map(pt).collect::<Vec<_>>();
     HandleGeometry {
-        points: handles.points.iter().map(|p| pt(&p.at)).collect(),
-        segments: handles
-            .bones
-            .iter()
-            .map(|b| [pt(&b.head), pt(&b.tail)])
-            .collect(),
+        points: handles.points.iter().map(|p| p.at).collect(),
+        segments: handles.bones.iter().map(|b| [b.head, b.tail]).collect(),
         polygons: handles
             .cages
             .iter()
-            .map(|c| ring(&c.polygon))
-            .chain(handles.regions.iter().map(|r| ring(&r.polygon)))
+            .map(|c| c.polygon.clone())
+            .chain(handles.regions.iter().map(|r| r.polygon.clone()))
             .collect(),
-        domain_extensions: handles.cages.iter().map(|c| ring(&c.polygon)).collect(),
+        domain_extensions: handles.cages.iter().map(|c| c.polygon.clone()).collect(),
     }
 }
 

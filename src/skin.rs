@@ -320,8 +320,8 @@ mod tests {
             bones: vec![Bone {
                 name: "b".into(),
                 parent: None,
-                head: [0.0, 0.0],
-                tail: [10.0, 0.0],
+                head: Point::new(0.0, 0.0),
+                tail: Point::new(10.0, 0.0),
             }],
             ..Default::default()
         };

@@ -279,8 +279,8 @@ fn traced(image: &RgbaImage) -> Shape {
         .expect("a shape")
 }
 
-fn pt(a: [f64; 2]) -> Point {
-    Point::new(a[0], a[1])
+fn pt(a: impl Into<Point>) -> Point {
+    a.into()
 }
 
 /// Every bone, sampled every half pixel, lies inside the traced outlines.

@@ -15,7 +15,6 @@
 mod command;
 mod common;
 
-#[cfg(feature = "cli")]
 use command::{s, scratch, sinew};
 use image::{Rgba, RgbaImage};
 use sinew::colorize::flood::flood_fill;
@@ -25,6 +24,8 @@ use sinew::colorize::{
     self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
     RegionSplit, ScribbleOptions, Scribbles,
 };
+#[cfg(feature = "cli")]
+use sinew::geom::Point;
 #[cfg(feature = "cli")]
 use sinew::io::{load_png, save_png};
 #[cfg(feature = "cli")]
@@ -121,11 +122,11 @@ fn scribbles_touching_and_crossing_lines() {
     let cell = (size - 2.0 * margin) / 2.0;
     for stroke in s.strokes.iter_mut().skip(1) {
         // Shapes sit in a 2 × 2 grid; extend each stroke right to the outline's x.
-        let [x0, y] = stroke.points[0];
+        let (x0, y) = (stroke.points[0].x, stroke.points[0].y);
         let cx = (stroke.points[0][0] + stroke.points[1][0]) / 2.0;
         let col = ((cx - margin) / cell).floor();
         let right = margin + cell * (col + 0.5) + cell * 0.36;
-        stroke.points = vec![[x0, y], [right, y]];
+        stroke.points = vec![Point::new(x0, y), Point::new(right, y)];
     }
     let (ours, flood) = scores(&s, &ColorizeOptions::default());
     println!("scribbles touching lines: weights {ours:.4}, flood fill {flood:.4}");

@@ -6,6 +6,7 @@ mod common;
 use common::document::{bar_layer, bone, compute};
 use image::RgbaImage;
 use sinew::document::{autosave_path, compute_rig, Command, Document, DocumentError};
+use sinew::geom::Point;
 use sinew::pipeline::Layer;
 use sinew::rig::pose::IkDrag;
 use sinew::rig::{PointHandle, Pose};
@@ -44,7 +45,7 @@ fn edits_undo_and_redo_in_order() {
     let before = doc.state().handles.clone();
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
-        at: [290.0, 50.0],
+        at: Point::new(290.0, 50.0),
     }))
     .unwrap();
     // Handles changed: the rig is stale until weights are computed again.
@@ -60,8 +61,8 @@ fn edits_undo_and_redo_in_order() {
     doc.undo();
     doc.apply(Command::MoveBone {
         name: "lower".into(),
-        head: [160.0, 40.0],
-        tail: [280.0, 40.0],
+        head: Point::new(160.0, 40.0),
+        tail: Point::new(280.0, 40.0),
     })
     .unwrap();
     assert!(!doc.can_redo());
@@ -136,14 +137,14 @@ fn a_rig_built_for_older_inputs_is_refused() {
     let mut doc = arm_document();
     doc.apply(Command::MoveBone {
         name: "lower".into(),
-        head: [160.0, 40.0],
-        tail: [250.0, 40.0],
+        head: Point::new(160.0, 40.0),
+        tail: Point::new(250.0, 40.0),
     })
     .unwrap();
     let stale_inputs = doc.rig_inputs();
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
-        at: [290.0, 50.0],
+        at: Point::new(290.0, 50.0),
     }))
     .unwrap();
     let scene = compute_rig(
@@ -176,8 +177,8 @@ fn posing_needs_current_weights_and_a_valid_pose() {
     let mut doc = arm_document();
     let mut drag = Pose::default();
     drag.ik.push(IkDrag {
-        at: [300.0, 40.0],
-        to: [250.0, 0.0],
+        at: Point::new(300.0, 40.0),
+        to: Point::new(250.0, 0.0),
         weight: None,
     });
     doc.apply(Command::SetPose(drag.clone())).unwrap();
@@ -186,7 +187,7 @@ fn posing_needs_current_weights_and_a_valid_pose() {
     assert!(doc.apply(Command::SetPose(unknown)).is_err());
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
-        at: [290.0, 50.0],
+        at: Point::new(290.0, 50.0),
     }))
     .unwrap();
     assert!(matches!(
@@ -212,8 +213,8 @@ fn saves_atomically_and_reopens_ready_to_pose() {
     // A stale rig saves without weights, and reopens asking for them.
     doc.apply(Command::MoveBone {
         name: "lower".into(),
-        head: [160.0, 40.0],
-        tail: [250.0, 40.0],
+        head: Point::new(160.0, 40.0),
+        tail: Point::new(250.0, 40.0),
     })
     .unwrap();
     // "Modified" is the state against the saved one: undoing back to it is clean again,
@@ -227,7 +228,10 @@ fn saves_atomically_and_reopens_ready_to_pose() {
     assert_eq!(autosaved, autosave_path(&path));
     let reopened = Document::open(&autosaved).unwrap();
     assert!(reopened.posable().is_none());
-    assert_eq!(reopened.state().handles.bones[1].tail, [250.0, 40.0]);
+    assert_eq!(
+        reopened.state().handles.bones[1].tail,
+        Point::new(250.0, 40.0)
+    );
 }
 
 #[test]
@@ -252,7 +256,7 @@ fn the_bundled_character_opens_and_poses() {
     let mut pose = Pose::default();
     pose.ik.push(IkDrag {
         at: grip,
-        to: [grip[0] + 20.0, grip[1] - 10.0],
+        to: Point::new(grip[0] + 20.0, grip[1] - 10.0),
         weight: None,
     });
     doc.apply(Command::SetPose(pose)).unwrap();
@@ -297,10 +301,10 @@ fn the_bundled_character_opens_and_poses() {
 fn keys_set_replace_sample_and_delete() {
     use sinew::document::{animation_named, key_times};
     let mut doc = arm_document();
-    let drag = |to: [f64; 2]| {
+    let drag = |to: Point| {
         let mut pose = Pose::default();
         pose.ik.push(IkDrag {
-            at: [300.0, 40.0],
+            at: Point::new(300.0, 40.0),
             to,
             weight: None,
         });
@@ -318,21 +322,21 @@ fn keys_set_replace_sample_and_delete() {
         time_s,
         pose,
     };
-    doc.apply(key(0.0, drag([300.0, 40.0]))).unwrap();
-    doc.apply(key(1.0, drag([260.0, 0.0]))).unwrap();
+    doc.apply(key(0.0, drag(Point::new(300.0, 40.0)))).unwrap();
+    doc.apply(key(1.0, drag(Point::new(260.0, 0.0)))).unwrap();
     // The same time again replaces the key instead of adding one.
-    doc.apply(key(1.0, drag([280.0, 10.0]))).unwrap();
+    doc.apply(key(1.0, drag(Point::new(280.0, 10.0)))).unwrap();
     let anim = animation_named(doc.state(), "wave");
     assert_eq!(key_times(&anim), vec![0.0, 1.0]);
     assert_eq!(anim.ik.len(), 1, "one timeline per rest point");
     let half = anim.sample(0.5, false);
-    assert_eq!(half.ik[0].to, [290.0, 25.0]);
+    assert_eq!(half.ik[0].to, Point::new(290.0, 25.0));
     assert_eq!(half.bones["upper"].rotate, 2.5);
     // Keys are undoable edits; weights stay current.
     assert!(doc.posable().is_some());
     doc.undo();
     let anim = animation_named(doc.state(), "wave");
-    assert_eq!(anim.sample(1.0, false).ik[0].to, [260.0, 0.0]);
+    assert_eq!(anim.sample(1.0, false).ik[0].to, Point::new(260.0, 0.0));
     doc.apply(Command::DeleteKeys {
         animation: "wave".into(),
         time_s: 0.0,
@@ -349,7 +353,12 @@ fn keys_set_replace_sample_and_delete() {
 fn cages_regions_and_proposed_handles_are_commands() {
     use sinew::rig::{Cage, Region};
     let mut doc = arm_document();
-    let around = vec![[5.0, 10.0], [315.0, 10.0], [315.0, 70.0], [5.0, 70.0]];
+    let around = vec![
+        Point::new(5.0, 10.0),
+        Point::new(315.0, 10.0),
+        Point::new(315.0, 70.0),
+        Point::new(5.0, 70.0),
+    ];
     doc.apply(Command::AddCage(Cage {
         name: "cage".into(),
         polygon: around.clone(),
@@ -357,7 +366,11 @@ fn cages_regions_and_proposed_handles_are_commands() {
     .unwrap();
     doc.apply(Command::AddRegion(Region {
         name: "grip".into(),
-        polygon: vec![[40.0, 30.0], [60.0, 30.0], [60.0, 50.0]],
+        polygon: vec![
+            Point::new(40.0, 30.0),
+            Point::new(60.0, 30.0),
+            Point::new(60.0, 50.0),
+        ],
     }))
     .unwrap();
     assert_eq!(doc.state().handles.cages.len(), 1);
@@ -368,7 +381,7 @@ fn cages_regions_and_proposed_handles_are_commands() {
     );
 
     // Moving a polygon keeps its vertex count.
-    let moved: Vec<[f64; 2]> = around.iter().map(|p| [p[0], p[1] + 2.0]).collect();
+    let moved: Vec<Point> = around.iter().map(|p| Point::new(p.x, p.y + 2.0)).collect();
     doc.apply(Command::SetPolygon {
         name: "cage".into(),
         polygon: moved.clone(),

@@ -80,8 +80,8 @@ fn inverted(meshes: &[SkinnedMesh], positions: &[Vec<Point>]) -> usize {
 
 fn drag(at: [f64; 2], to: [f64; 2]) -> IkDrag {
     IkDrag {
-        at,
-        to,
+        at: at.into(),
+        to: to.into(),
         weight: None,
     }
 }
@@ -144,13 +144,12 @@ fn mesh_drags(meshes: &[SkinnedMesh], drags: &[IkDrag]) -> Vec<MeshDrag> {
     drags
         .iter()
         .map(|d| {
-            let (mesh, triangle, barycentric) =
-                grip(meshes, Point::new(d.at[0], d.at[1]), 2.0).expect("grips");
+            let (mesh, triangle, barycentric) = grip(meshes, d.at, 2.0).expect("grips");
             MeshDrag {
                 mesh,
                 triangle,
                 barycentric,
-                target: Point::new(d.to[0], d.to[1]),
+                target: d.to,
             }
         })
         .collect()
@@ -160,7 +159,7 @@ fn mesh_drags(meshes: &[SkinnedMesh], drags: &[IkDrag]) -> Vec<MeshDrag> {
 fn naive(meshes: &[SkinnedMesh], drags: &[IkDrag], columns: usize) -> Vec<Affine> {
     let mut out = vec![Affine::identity(); columns];
     for d in drags {
-        let (m, t, b) = grip(meshes, Point::new(d.at[0], d.at[1]), 2.0).expect("grips");
+        let (m, t, b) = grip(meshes, d.at, 2.0).expect("grips");
         let mut weights = vec![0.0; columns];
         for (k, &v) in meshes[m].triangles[t].iter().enumerate() {
             for &(j, w) in &meshes[m].weights[v as usize] {
@@ -293,7 +292,7 @@ fn the_separate_arm_skeleton_follows_the_body() {
         .unwrap();
     for arm in ["arm_upper_l", "arm_upper_r"] {
         let bone = handles.bones.iter().find(|b| b.name == arm).unwrap();
-        let head = Point::new(bone.head[0], bone.head[1]);
+        let head = bone.head;
         let moved = solution.transforms[column(arm)].apply(head) - head;
         println!(
             "{arm}: shoulder moved by ({:.1}, {:.1}) px",
@@ -460,9 +459,9 @@ fn disjoint_skeletons_in_one_shape_move_together() {
 fn a_soft_drag_pulls_without_being_met() {
     let mut ik = scene().rig_ik().unwrap();
     let mut drags = pins();
-    let target = [180.0, 150.0];
+    let target = Point::new(180.0, 150.0);
     drags.push(IkDrag {
-        at: [256.0, 150.0],
+        at: Point::new(256.0, 150.0),
         to: target,
         weight: Some(0.05),
     });

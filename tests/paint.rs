@@ -5,6 +5,7 @@ mod common;
 
 use common::document::{bar_layer, bone, compute};
 use sinew::document::{Command, Document, DocumentError};
+use sinew::geom::Point;
 use sinew::weights::{BrushMode, BrushOptions, Falloff};
 
 fn scratch(name: &str) -> std::path::PathBuf {
@@ -60,7 +61,7 @@ fn column(rows: &[Vec<(u32, f64)>], c: u32) -> Vec<f64> {
         .collect()
 }
 
-fn vertices(doc: &Document) -> Vec<[f64; 2]> {
+fn vertices(doc: &Document) -> Vec<Point> {
     doc.state().rig.as_ref().expect("a rig").doc.parts[0]
         .mesh
         .vertices
@@ -85,7 +86,7 @@ fn limit_and_compute(doc: &mut Document, k: usize) {
 
 /// A stroke adding handle b's weight at full strength over discs of `radius_px` along
 /// `samples_px`.
-fn fill_b(samples_px: Vec<[f64; 2]>, radius_px: f64) -> Command {
+fn fill_b(samples_px: Vec<Point>, radius_px: f64) -> Command {
     Command::PaintWeights {
         part: "bar".into(),
         handle: "b".into(),
@@ -106,7 +107,11 @@ fn stroke(handle: &str, mode: BrushMode) -> Command {
         part: "bar".into(),
         handle: handle.into(),
         mode,
-        samples_px: vec![[130.0, 40.0], [160.0, 38.0], [190.0, 40.0]],
+        samples_px: vec![
+            Point::new(130.0, 40.0),
+            Point::new(160.0, 38.0),
+            Point::new(190.0, 40.0),
+        ],
         options: BrushOptions {
             radius_px: 30.0,
             strength: 0.6,
@@ -192,8 +197,8 @@ fn painting_keeps_locked_handles_and_undoes_in_one_step() {
     // Stale weights cannot be painted.
     doc.apply(Command::MoveBone {
         name: "a".into(),
-        head: [22.0, 40.0],
-        tail: [110.0, 40.0],
+        head: Point::new(22.0, 40.0),
+        tail: Point::new(110.0, 40.0),
     })
     .unwrap();
     assert!(matches!(
@@ -206,8 +211,11 @@ fn painting_keeps_locked_handles_and_undoes_in_one_step() {
 fn recomputing_with_a_lock_keeps_the_influence_limit() {
     let dir = scratch("limit");
     let mut doc = arm(&dir);
-    doc.apply(fill_b(vec![[230.0, 40.0], [280.0, 40.0]], 30.0))
-        .unwrap();
+    doc.apply(fill_b(
+        vec![Point::new(230.0, 40.0), Point::new(280.0, 40.0)],
+        30.0,
+    ))
+    .unwrap();
     doc.apply(Command::SetLocked {
         handle: "b".into(),
         locked: true,
@@ -216,7 +224,7 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
     // A point where b was painted: the fresh rows there pair it with c, beside the locked b.
     doc.apply(Command::AddPoint(sinew::rig::PointHandle {
         name: "p".into(),
-        at: [250.0, 40.0],
+        at: Point::new(250.0, 40.0),
     }))
     .unwrap();
     limit_and_compute(&mut doc, 2);
@@ -243,7 +251,7 @@ fn painting_keeps_the_influence_limit() {
         part: "bar".into(),
         handle: "c".into(),
         mode: BrushMode::Add,
-        samples_px: vec![[40.0, 40.0], [100.0, 40.0]],
+        samples_px: vec![Point::new(40.0, 40.0), Point::new(100.0, 40.0)],
         options: BrushOptions {
             radius_px: 30.0,
             strength,
@@ -281,8 +289,11 @@ fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     let mut doc = arm(&dir);
     let fresh = rows(&doc);
     // Paint b far into c's side, lock b, then edit a bone so the weights must be recomputed.
-    doc.apply(fill_b(vec![[230.0, 40.0], [280.0, 40.0]], 30.0))
-        .unwrap();
+    doc.apply(fill_b(
+        vec![Point::new(230.0, 40.0), Point::new(280.0, 40.0)],
+        30.0,
+    ))
+    .unwrap();
     let painted = rows(&doc);
     let v_old = vertices(&doc);
     doc.apply(Command::SetLocked {
@@ -292,8 +303,8 @@ fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     .unwrap();
     doc.apply(Command::MoveBone {
         name: "a".into(),
-        head: [20.0, 44.0],
-        tail: [110.0, 40.0],
+        head: Point::new(20.0, 44.0),
+        tail: Point::new(110.0, 40.0),
     })
     .unwrap();
     compute(&mut doc);
@@ -362,8 +373,8 @@ fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
     .unwrap();
     doc.apply(Command::MoveBone {
         name: "a".into(),
-        head: [20.0, 40.0],
-        tail: [110.0, 40.0],
+        head: Point::new(20.0, 40.0),
+        tail: Point::new(110.0, 40.0),
     })
     .unwrap();
     compute(&mut doc);
@@ -385,7 +396,8 @@ fn locks_are_saved_and_reopened() {
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(!text.contains("\"locked\""), "no locks, no field");
     // Paint b where c rules, lock it, rename it: the recompute keeps its weights.
-    doc.apply(fill_b(vec![[250.0, 40.0]], 20.0)).unwrap();
+    doc.apply(fill_b(vec![Point::new(250.0, 40.0)], 20.0))
+        .unwrap();
     let painted = column(&rows(&doc), 1);
     doc.apply(Command::SetLocked {
         handle: "b".into(),
@@ -432,7 +444,8 @@ fn locks_are_saved_and_reopened() {
 fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
     let dir = scratch("stale");
     let mut doc = arm(&dir);
-    doc.apply(fill_b(vec![[250.0, 40.0]], 20.0)).unwrap();
+    doc.apply(fill_b(vec![Point::new(250.0, 40.0)], 20.0))
+        .unwrap();
     let v = vertices(&doc);
     let near: Vec<usize> = (0..v.len())
         .filter(|&i| (v[i][0] - 250.0).hypot(v[i][1] - 40.0) < 18.0)
@@ -446,7 +459,7 @@ fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
     // A point handle added far from the stroke makes the weights stale; save and reopen.
     doc.apply(Command::AddPoint(sinew::rig::PointHandle {
         name: "tip".into(),
-        at: [40.0, 40.0],
+        at: Point::new(40.0, 40.0),
     }))
     .unwrap();
     let path = dir.join("stale.json");

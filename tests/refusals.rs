@@ -342,3 +342,27 @@ fn a_cage_crossing_the_outline_is_rigged_and_crossing_cages_are_named() {
     // The refused run left the first rig as it was.
     assert_eq!(std::fs::read(&out).unwrap(), rigged);
 }
+
+#[test]
+fn the_export_that_match_runtime_reproduces_must_be_one_sinew_writes() {
+    let dir = scratch("match");
+    let (_, rig) = rig(&dir);
+    let png = dir.join("out.png");
+    let pose = |extra: &[&str]| {
+        let mut args = vec!["pose", s(&rig), "--anim", "go", "--time", "0.1"];
+        args.extend(["--match-runtime", "spine", "-o", s(&png)]);
+        args.extend_from_slice(extra);
+        args.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    let args = pose(&["--spine-version", "5.0"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_bad_input(&args, "5.0");
+    let args = pose(&["--bake-fps", "0"]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    assert_bad_input(&args, "bake");
+    assert!(!png.exists());
+    // The export's options mean nothing without --match-runtime.
+    let out = command::sinew(&["pose", s(&rig), "--spine-version", "4.1", "-o", s(&png)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!png.exists());
+}

@@ -106,8 +106,8 @@ fn a_written_rig_validates() {
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head,
-        tail,
+        head: head.into(),
+        tail: tail.into(),
     };
     let handles = Handles {
         bones: vec![

@@ -153,7 +153,7 @@ fn deviation(
         for (k, &v) in mesh.vertex_source.iter().enumerate() {
             let c = export
                 .frame
-                .canvas_from_spine([vertices[2 * k], vertices[2 * k + 1]]);
+                .canvas_from_spine([vertices[2 * k], vertices[2 * k + 1]].into());
             let d = (Point::new(c[0], c[1]) - sinew[part][v]).norm();
             worst = worst.max(d);
         }
@@ -365,14 +365,16 @@ fn check_rig_in_skins(
     println!("{}: setup pose deviation {setup:.2e} px", rig.display());
     assert!(setup <= SETUP_TOLERANCE_PX, "setup pose off by {setup} px");
 
-    // `--match-runtime spine` reproduces the default export (4.2: physics simulated natively;
-    // 4.3 bakes it into keys); other options are reproduced in-process by the same function.
+    // `--match-runtime spine` reproduces the export of `--spine-version` and `--bake-fps` (4.2:
+    // physics simulated natively; 4.3 bakes it into keys); other options are reproduced
+    // in-process by the same function.
     let defaults = SpineOptions::default();
-    let cli_matches = options.version == defaults.version
-        && options.bake == defaults.bake
-        && options.bake_fps == defaults.bake_fps
+    let cli_matches = options.bake == defaults.bake
         && options.bake_tolerance_px == defaults.bake_tolerance_px
         && options.root_bone == defaults.root_bone;
+    let version = serde_json::to_value(options.version).unwrap();
+    let version = version.as_str().unwrap();
+    let bake_fps = format!("{}", options.bake_fps);
     let (mut worst_runtime, mut worst_exact) = (0.0_f64, 0.0_f64);
     let mut swaps_checked = 0;
     for (name, animation) in &animations {
@@ -458,6 +460,10 @@ fn check_rig_in_skins(
                     &time,
                     "--match-runtime",
                     "spine",
+                    "--spine-version",
+                    version,
+                    "--bake-fps",
+                    &bake_fps,
                     "--vertices",
                     s(&v),
                 ];

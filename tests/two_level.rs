@@ -8,6 +8,7 @@
 
 mod common;
 
+use sinew::geom::Point;
 use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer};
 use sinew::rig::{Bone, Handles, PointHandle};
@@ -32,13 +33,13 @@ fn critter(max_area_fraction: f64) -> (Vec<Layer>, Handles, BuildOptions) {
     let s = 2.0;
     let point = |name: &str, at: [f64; 2]| PointHandle {
         name: name.into(),
-        at: [at[0] * s, at[1] * s],
+        at: Point::new(at[0] * s, at[1] * s),
     };
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head: [head[0] * s, head[1] * s],
-        tail: [tail[0] * s, tail[1] * s],
+        head: Point::new(head[0] * s, head[1] * s),
+        tail: Point::new(tail[0] * s, tail[1] * s),
     };
     let handles = Handles {
         bones: vec![
@@ -127,8 +128,7 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
                     e.name, e.mesh.vertices[v], c, we.handles[c], de[v][c], dt[v][c]
                 );
             }
-            let points: Vec<[f64; 2]> = e.mesh.vertices.clone();
-            let q = Domain::new(&points, &e.mesh.triangles).bilaplacian();
+            let q = Domain::planar(&e.mesh.vertices, &e.mesh.triangles).bilaplacian();
             let energy = |d: &[Vec<f64>]| -> f64 {
                 (0..m)
                     .map(|j| {
@@ -138,7 +138,7 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
                     })
                     .sum()
             };
-            (points.len(), worst, energy(&dt) / energy(&de))
+            (e.mesh.vertices.len(), worst, energy(&dt) / energy(&de))
         })
         .collect()
 }
@@ -199,8 +199,7 @@ fn two_level_weights_match_the_exact_solve_on_the_benchmark_meshes() {
     let outline = main_outline();
     for target in [5_000, 20_000] {
         let (mesh, _) = mesh_near(&outline, target);
-        let points: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
-        let domain = Domain::new(&points, &mesh.triangles);
+        let domain = Domain::planar(&mesh.vertices, &mesh.triangles);
         let handles = farthest_points(&mesh, 10);
         let bc = point_conditions(&handles);
         let start = Instant::now();

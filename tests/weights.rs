@@ -67,14 +67,7 @@ fn character_weights_sum_to_one_stay_bounded_and_interpolate() {
                 .bones
                 .iter()
                 .enumerate()
-                .filter(|(_, b)| {
-                    segment_distance(
-                        p,
-                        Point::new(b.head[0], b.head[1]),
-                        Point::new(b.tail[0], b.tail[1]),
-                    )
-                    .0 < 1e-6
-                })
+                .filter(|(_, b)| segment_distance(p, b.head, b.tail).0 < 1e-6)
                 .map(|(j, _)| j)
                 .collect();
             if on.len() == 1 {
@@ -106,8 +99,8 @@ fn cross_bone(name: &str, x: f64) -> Bone {
     Bone {
         name: name.into(),
         parent: None,
-        head: [x, 10.0],
-        tail: [x, 70.0],
+        head: Point::new(x, 10.0),
+        tail: Point::new(x, 70.0),
     }
 }
 
@@ -118,13 +111,13 @@ fn cross_bone(name: &str, x: f64) -> Bone {
 fn a_bone_chain_on_the_critter_converges_on_every_handle() {
     let point = |name: &str, at: [f64; 2]| PointHandle {
         name: name.into(),
-        at,
+        at: at.into(),
     };
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head,
-        tail,
+        head: head.into(),
+        tail: tail.into(),
     };
     let handles = Handles {
         bones: vec![
@@ -279,11 +272,11 @@ fn content_aware_weights_change_fastest_across_a_color_edge() {
         points: vec![
             PointHandle {
                 name: "left".into(),
-                at: [40.0, 40.0],
+                at: Point::new(40.0, 40.0),
             },
             PointHandle {
                 name: "right".into(),
-                at: [280.0, 40.0],
+                at: Point::new(280.0, 40.0),
             },
         ],
         ..Default::default()
@@ -325,10 +318,10 @@ fn a_whole_rig_rigid_motion_moves_every_vertex_rigidly() {
     let scene = scene(&layers, rig(&layers, &handles, &BuildOptions::default()));
     let (angle_deg, shift) = (23.0, Vec2::new(-12.0, 7.5));
     let r = rotation(angle_deg);
-    let moved = |p: [f64; 2]| r * Vec2::new(p[0], p[1]) + shift;
+    let moved = |p: Point| r * p.coords + shift;
     let mut pose = Pose::default();
     for bone in handles.bones.iter().filter(|b| b.parent.is_none()) {
-        let head = moved(bone.head) - Vec2::new(bone.head[0], bone.head[1]);
+        let head = moved(bone.head) - bone.head.coords;
         pose.bones.insert(
             bone.name.clone(),
             BonePose {
@@ -339,7 +332,7 @@ fn a_whole_rig_rigid_motion_moves_every_vertex_rigidly() {
         );
     }
     for point in &handles.points {
-        let d = moved(point.at) - Vec2::new(point.at[0], point.at[1]);
+        let d = moved(point.at) - point.at.coords;
         pose.points.insert(
             point.name.clone(),
             PointPose {
@@ -352,7 +345,7 @@ fn a_whole_rig_rigid_motion_moves_every_vertex_rigidly() {
     let posed = scene.pose_positions(&pose).unwrap();
     for (rest, posed) in scene.rest_positions().iter().zip(&posed) {
         for (p, q) in rest.iter().zip(posed) {
-            let want = moved([p.x, p.y]);
+            let want = moved(Point::new(p.x, p.y));
             assert!(
                 (q.coords - want).norm() < F32_SKINNING_TOLERANCE_PX,
                 "{p:?} went to {q:?}, not {want:?}"
@@ -445,11 +438,21 @@ fn cages_reaching_past_the_shape_and_regions_get_weights() {
     let handles = Handles {
         cages: vec![Cage {
             name: "cage".into(),
-            polygon: vec![[0.0, 5.0], [320.0, 5.0], [320.0, 75.0], [0.0, 75.0]],
+            polygon: vec![
+                Point::new(0.0, 5.0),
+                Point::new(320.0, 5.0),
+                Point::new(320.0, 75.0),
+                Point::new(0.0, 75.0),
+            ],
         }],
         regions: vec![Region {
             name: "patch".into(),
-            polygon: vec![[140.0, 30.0], [170.0, 30.0], [170.0, 50.0], [140.0, 50.0]],
+            polygon: vec![
+                Point::new(140.0, 30.0),
+                Point::new(170.0, 30.0),
+                Point::new(170.0, 50.0),
+                Point::new(140.0, 50.0),
+            ],
         }],
         ..Default::default()
     };
@@ -476,12 +479,8 @@ fn cages_reaching_past_the_shape_and_regions_get_weights() {
     // Moving every cage vertex by the same offset (and the region with it) translates the bar.
     let scene = scene(&layers, doc.clone());
     let mut pose = Pose::default();
-    let shift = [6.0, -4.0];
-    let polygon = handles.cages[0]
-        .polygon
-        .iter()
-        .map(|p| [p[0] + shift[0], p[1] + shift[1]])
-        .collect();
+    let shift = Vec2::new(6.0, -4.0);
+    let polygon = handles.cages[0].polygon.iter().map(|p| p + shift).collect();
     pose.cages
         .insert("cage".into(), sinew::rig::pose::CagePose { polygon });
     let posed = scene.pose_positions(&pose).unwrap();
@@ -556,8 +555,8 @@ fn an_exact_rectangle_gets_weights_with_every_method() {
         bones: vec![Bone {
             name: "arm".into(),
             parent: None,
-            head: [40.0, 100.0],
-            tail: [110.0, 100.0],
+            head: Point::new(40.0, 100.0),
+            tail: Point::new(110.0, 100.0),
         }],
         ..Default::default()
     };

@@ -18,7 +18,7 @@ use super::AnimError;
 use std::collections::BTreeMap;
 
 /// One part's deform keys: per key, one offset per mesh vertex (canvas px).
-pub type DeformKeys = Vec<Key<Vec<[f64; 2]>>>;
+pub type DeformKeys = Vec<Key<Vec<crate::geom::Vec2>>>;
 
 /// Fails on the first deform timeline naming a part the rig lacks, or whose keys list a number
 /// of offsets other than the part's vertex count. `parts` lists each part's name and vertex

@@ -14,6 +14,7 @@
 //! alpha 0 the result is exactly the old pose and at alpha 1 exactly the new one.
 
 use super::timeline::Animation;
+use crate::geom::{Point, Vec2};
 use crate::rig::pose::{BonePose, CagePose, IkDrag, PartPose, PointPose, Pose};
 use crate::rig::Handles;
 use std::collections::BTreeSet;
@@ -65,6 +66,10 @@ fn lerp2(a: [f64; 2], b: [f64; 2], alpha: f64) -> [f64; 2] {
     [lerp(a[0], b[0], alpha), lerp(a[1], b[1], alpha)]
 }
 
+fn lerp_point(a: Point, b: Point, alpha: f64) -> Point {
+    a + (b - a) * alpha
+}
+
 /// `from` blended into `to` by `alpha` ∈ [0, 1].
 pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
     if alpha.is_nan() || alpha <= 0.0 {
@@ -112,9 +117,12 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
         let a = from.cages.get(name).map(|c| &c.polygon).or(rest_polygon);
         let b = to.cages.get(name).map(|c| &c.polygon).or(rest_polygon);
         let polygon = match (a, b) {
-            (Some(a), Some(b)) if a.len() == b.len() => {
-                Some(a.iter().zip(b).map(|(&p, &q)| lerp2(p, q, alpha)).collect())
-            }
+            (Some(a), Some(b)) if a.len() == b.len() => Some(
+                a.iter()
+                    .zip(b)
+                    .map(|(&p, &q)| lerp_point(p, q, alpha))
+                    .collect(),
+            ),
             _ if stepped_to_new => to.cages.get(name).map(|c| c.polygon.clone()),
             _ => from.cages.get(name).map(|c| c.polygon.clone()),
         };
@@ -128,10 +136,13 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
     for name in deform_names {
         let (a, b) = (from.deform.get(name), to.deform.get(name));
         let n = a.or(b).map_or(0, Vec::len);
-        let none = vec![[0.0, 0.0]; n];
+        let none = vec![Vec2::zeros(); n];
         let (a, b) = (a.unwrap_or(&none), b.unwrap_or(&none));
         let offsets = if a.len() == b.len() {
-            a.iter().zip(b).map(|(&p, &q)| lerp2(p, q, alpha)).collect()
+            a.iter()
+                .zip(b)
+                .map(|(&p, &q)| p + (q - p) * alpha)
+                .collect()
         } else if stepped_to_new {
             b.clone()
         } else {
@@ -167,12 +178,13 @@ pub fn mix_poses(from: &Pose, to: &Pose, alpha: f64, rest: &Handles) -> Pose {
     };
 
     // Drags pair up by their rest point; unpaired ones come and go at the threshold.
-    let same_at = |d: &IkDrag, e: &IkDrag| d.at.map(f64::to_bits) == e.at.map(f64::to_bits);
+    let bits = |p: Point| [p.x.to_bits(), p.y.to_bits()];
+    let same_at = |d: &IkDrag, e: &IkDrag| bits(d.at) == bits(e.at);
     for drag in &from.ik {
         match to.ik.iter().find(|e| same_at(drag, e)) {
             Some(target) => out.ik.push(IkDrag {
                 at: drag.at,
-                to: lerp2(drag.to, target.to, alpha),
+                to: lerp_point(drag.to, target.to, alpha),
                 weight: target.weight,
             }),
             None if !stepped_to_new => out.ik.push(drag.clone()),
@@ -297,31 +309,39 @@ mod tests {
             },
         );
         from.ik.push(IkDrag {
-            at: [0.0, 0.0],
-            to: [10.0, 0.0],
+            at: Point::new(0.0, 0.0),
+            to: Point::new(10.0, 0.0),
             weight: None,
         });
         let mut to = Pose::default();
         to.ik.push(IkDrag {
-            at: [0.0, 0.0],
-            to: [20.0, 0.0],
+            at: Point::new(0.0, 0.0),
+            to: Point::new(20.0, 0.0),
             weight: None,
         });
         to.ik.push(IkDrag {
-            at: [5.0, 5.0],
-            to: [6.0, 6.0],
+            at: Point::new(5.0, 5.0),
+            to: Point::new(6.0, 6.0),
             weight: None,
         });
         to.cages.insert(
             "c".into(),
             CagePose {
-                polygon: vec![[10.0, 0.0], [20.0, 0.0], [20.0, 10.0]],
+                polygon: vec![
+                    Point::new(10.0, 0.0),
+                    Point::new(20.0, 0.0),
+                    Point::new(20.0, 10.0),
+                ],
             },
         );
         let rest = Handles {
             cages: vec![Cage {
                 name: "c".into(),
-                polygon: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]],
+                polygon: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(10.0, 0.0),
+                    Point::new(10.0, 10.0),
+                ],
             }],
             ..Default::default()
         };

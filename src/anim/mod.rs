@@ -102,6 +102,7 @@ pub enum AnimError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::Point;
     use crate::rig::{Bone, Cage, Handles, PointHandle};
     use serde_json::json;
 
@@ -261,16 +262,21 @@ mod tests {
             bones: vec![Bone {
                 name: "leg".into(),
                 parent: None,
-                head: [0.0, 0.0],
-                tail: [0.0, 10.0],
+                head: Point::new(0.0, 0.0),
+                tail: Point::new(0.0, 10.0),
             }],
             points: vec![PointHandle {
                 name: "tip".into(),
-                at: [0.0, 0.0],
+                at: Point::new(0.0, 0.0),
             }],
             cages: vec![Cage {
                 name: "belly".into(),
-                polygon: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+                polygon: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(1.0, 0.0),
+                    Point::new(1.0, 1.0),
+                    Point::new(0.0, 1.0),
+                ],
             }],
             ..Default::default()
         };

@@ -315,6 +315,7 @@ impl Animation {
 mod tests {
     use super::super::timeline::{BoneTimelines, IkTimeline, PartTimelines, Rgba};
     use super::*;
+    use crate::geom::Point;
 
     fn key<V>(time: f64, value: V, curve: Curve) -> Key<V> {
         Key { time, value, curve }
@@ -420,10 +421,14 @@ mod tests {
         let keys = vec![
             key(
                 0.0,
-                vec![[0.0, 0.0], [10.0, 0.0]],
+                vec![Point::new(0.0, 0.0), Point::new(10.0, 0.0)],
                 Curve::Bezier(vec![0.5, 0.0, 0.5, 1.0]),
             ),
-            key(1.0, vec![[4.0, 8.0], [10.0, 20.0]], Curve::Linear),
+            key(
+                1.0,
+                vec![Point::new(4.0, 8.0), Point::new(10.0, 20.0)],
+                Curve::Linear,
+            ),
         ];
         let v = sample_keys(&keys, 0.5).unwrap();
         assert!(close(v[0][0], 2.0) && close(v[0][1], 4.0) && close(v[1][1], 10.0));
@@ -468,10 +473,10 @@ mod tests {
                 value: vec!["b".into(), "a".into()],
             }]),
             ik: vec![IkTimeline {
-                at: [1.0, 2.0],
+                at: Point::new(1.0, 2.0),
                 to: vec![
-                    key(0.0, [1.0, 2.0], Curve::Linear),
-                    key(1.0, [3.0, 2.0], Curve::Linear),
+                    key(0.0, Point::new(1.0, 2.0), Curve::Linear),
+                    key(1.0, Point::new(3.0, 2.0), Curve::Linear),
                 ],
                 weight: None,
             }],

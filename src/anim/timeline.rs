@@ -9,6 +9,7 @@
 
 use super::curve::{Curve, BEZIER_NUMBERS_PER_CHANNEL};
 use super::AnimError;
+use crate::geom::{point_numbers, point_numbers_mut, Point, Vec2};
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::collections::BTreeMap;
@@ -113,13 +114,32 @@ impl Channels for Rgba {
     }
 }
 
-impl Channels for Vec<[f64; 2]> {
-    const CURVE_PER_CHANNEL: bool = false;
+impl Channels for Point {
     fn numbers(&self) -> &[f64] {
-        self.as_flattened()
+        self.coords.as_slice()
     }
     fn numbers_mut(&mut self) -> &mut [f64] {
-        self.as_flattened_mut()
+        self.coords.as_mut_slice()
+    }
+}
+
+impl Channels for Vec<Vec2> {
+    const CURVE_PER_CHANNEL: bool = false;
+    fn numbers(&self) -> &[f64] {
+        bytemuck::cast_slice(self)
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        bytemuck::cast_slice_mut(self)
+    }
+}
+
+impl Channels for Vec<Point> {
+    const CURVE_PER_CHANNEL: bool = false;
+    fn numbers(&self) -> &[f64] {
+        point_numbers(self)
+    }
+    fn numbers_mut(&mut self) -> &mut [f64] {
+        point_numbers_mut(self)
     }
 }
 
@@ -179,8 +199,10 @@ pub struct PartTimelines {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IkTimeline {
-    pub at: [f64; 2],
-    pub to: Vec<Key<[f64; 2]>>,
+    #[schemars(with = "[f64; 2]")]
+    pub at: Point,
+    #[schemars(with = "Vec<Key<[f64; 2]>>")]
+    pub to: Vec<Key<Point>>,
     /// A soft drag's strength (see [`crate::rig::pose::IkDrag`]); none: a hard constraint.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weight: Option<f64>,
@@ -196,7 +218,8 @@ pub struct Animation {
     pub points: BTreeMap<String, PointTimelines>,
     /// Posed polygons (canvas px), the same vertex count on every key and as at rest.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-    pub cages: BTreeMap<String, Vec<Key<Vec<[f64; 2]>>>>,
+    #[schemars(with = "BTreeMap<String, Vec<Key<Vec<[f64; 2]>>>>")]
+    pub cages: BTreeMap<String, Vec<Key<Vec<Point>>>>,
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub parts: BTreeMap<String, PartTimelines>,
     /// Each key lists every part of the rig once, back to front.
@@ -211,6 +234,7 @@ pub struct Animation {
     /// Deform keys ([`super::deform`]): part name → per-vertex offsets of its mesh (canvas px,
     /// rest frame), added before skinning; the same count on every key as the part's vertices.
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    #[schemars(with = "BTreeMap<String, Vec<Key<Vec<[f64; 2]>>>>")]
     pub deform: BTreeMap<String, super::deform::DeformKeys>,
 }
 
@@ -361,7 +385,10 @@ fn check_color_keys(keys: &[Key<Rgba>]) -> Result<(), TimelineError> {
     }
 }
 
-fn check_cage_keys(keys: &[Key<Vec<[f64; 2]>>]) -> Result<(), TimelineError> {
+fn check_cage_keys<T>(keys: &[Key<Vec<T>>]) -> Result<(), TimelineError>
+where
+    Vec<T>: Channels,
+{
     check_keys(keys)?;
     let expected = keys.first().map_or(0, |k| k.value.len());
     match keys.iter().position(|k| k.value.len() != expected) {
@@ -479,7 +506,7 @@ impl Animation {
                     key: 0,
                 }));
             }
-            if let Some(value) = too_large(&drag.at) {
+            if let Some(value) = too_large(drag.at.coords.as_slice()) {
                 return Err(fail(format!("ik[{i}].at"))(TimelineError::ValueTooLarge {
                     key: 0,
                     value,
@@ -512,7 +539,10 @@ impl Animation {
                 see(keys.as_deref().map_or(0.0, |k| last(k, key2)));
             }
         }
-        for keys in self.cages.values().chain(self.deform.values()) {
+        for keys in self.cages.values() {
+            see(last(keys, |k| k.time));
+        }
+        for keys in self.deform.values() {
             see(last(keys, |k| k.time));
         }
         for t in self.parts.values() {
@@ -524,7 +554,7 @@ impl Animation {
             see(last(keys, |k| k.time));
         }
         for drag in &self.ik {
-            see(last(&drag.to, key2));
+            see(last(&drag.to, |k| k.time));
         }
         see(last(&self.events, |k| k.time));
         end
@@ -617,7 +647,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                     return Some(fail(section.clone(), NOT_A_MAP.into()));
                 };
                 for (cage, keys) in cages {
-                    if let Err((at, reason)) = probe_keys::<Key<Vec<[f64; 2]>>>(keys) {
+                    if let Err((at, reason)) = probe_keys::<Key<Vec<Point>>>(keys) {
                         return Some(fail(format!("{section}.{cage}{at}"), reason));
                     }
                 }
@@ -639,7 +669,7 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                 for (i, drag) in drags.iter().enumerate() {
                     if let Err(e) = IkTimeline::deserialize(drag) {
                         if let Some(Err((at, reason))) =
-                            drag.get("to").map(probe_keys::<Key<[f64; 2]>>)
+                            drag.get("to").map(probe_keys::<Key<Point>>)
                         {
                             return Some(fail(format!("ik[{i}].to{at}"), reason));
                         }

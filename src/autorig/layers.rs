@@ -130,7 +130,7 @@ fn pivot_of(part: &str, parent: Option<&str>, pivots: &[Pivot]) -> Option<Point>
         .iter()
         .filter(|p| in_group(part, &p.group) && !parent.is_some_and(|q| in_group(q, &p.group)))
         .max_by_key(|p| p.group.len())
-        .map(|p| Point::new(p.at_px[0], p.at_px[1]))
+        .map(|p| p.at_px)
 }
 
 /// The layered skeleton: bones (parents first) and, per bone, the index of its part. A part

@@ -233,7 +233,7 @@ pub fn autorig(
         .enumerate()
         .map(|(k, p)| PointHandle {
             name: format!("point_{}", k + 1),
-            at: [p.x, p.y],
+            at: p,
         })
         .collect();
     let cages = match options.cage_vertices {
@@ -241,7 +241,7 @@ pub fn autorig(
             let ring = cage::propose_cage(&union, options.trace.alpha_threshold, n, &options.cage)?;
             vec![Cage {
                 name: "cage".into(),
-                polygon: ring.iter().map(|p| [p.x, p.y]).collect(),
+                polygon: ring,
             }]
         }
         None => Vec::new(),
@@ -313,9 +313,6 @@ fn name_bones(bones: Vec<ProtoBone>) -> Vec<Bone> {
 
 /// Coordinates rounded to 1/1000 px, so files stay readable (and stay inside: the rounding is
 /// far below the distance of any axis point to the outline).
-fn round_px(p: Point) -> [f64; 2] {
-    [
-        (p.x * 1000.0).round() / 1000.0,
-        (p.y * 1000.0).round() / 1000.0,
-    ]
+fn round_px(p: Point) -> Point {
+    p.map(|v| (v * 1000.0).round() / 1000.0)
 }

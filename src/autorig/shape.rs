@@ -218,7 +218,7 @@ fn fill_even_odd<'a>(
 /// Outline edges bucketed on a grid, for segment–outline tests.
 #[derive(Clone, Debug, Default)]
 struct EdgeGrid {
-    origin: [f64; 2],
+    origin: Point,
     columns: usize,
     rows: usize,
     cells: Vec<Vec<u32>>,
@@ -243,7 +243,7 @@ impl EdgeGrid {
         let columns = ((hi[0] - lo[0]) / EDGE_CELL_PX) as usize + 1;
         let rows = ((hi[1] - lo[1]) / EDGE_CELL_PX) as usize + 1;
         let mut grid = EdgeGrid {
-            origin: lo,
+            origin: lo.into(),
             columns,
             rows,
             cells: vec![Vec::new(); columns * rows],
@@ -268,10 +268,10 @@ impl EdgeGrid {
             (((v - o) / EDGE_CELL_PX).floor().max(0.0) as usize).min(n - 1)
         };
         [
-            cell(a.x.min(b.x) - grow, self.origin[0], self.columns),
-            cell(a.y.min(b.y) - grow, self.origin[1], self.rows),
-            cell(a.x.max(b.x) + grow, self.origin[0], self.columns),
-            cell(a.y.max(b.y) + grow, self.origin[1], self.rows),
+            cell(a.x.min(b.x) - grow, self.origin.x, self.columns),
+            cell(a.y.min(b.y) - grow, self.origin.y, self.rows),
+            cell(a.x.max(b.x) + grow, self.origin.x, self.columns),
+            cell(a.y.max(b.y) + grow, self.origin.y, self.rows),
         ]
     }
 

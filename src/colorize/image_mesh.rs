@@ -16,6 +16,7 @@
 //! vertices. The discretization has O(lines + strokes + area / max_cell²) unknowns instead of
 //! one per pixel.
 
+use crate::geom::Point;
 use serde::{Deserialize, Serialize};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
@@ -165,10 +166,10 @@ impl ImageMesh {
     }
 
     /// Vertex positions, canvas px (pixel centers).
-    pub fn positions(&self) -> Vec<[f64; 2]> {
+    pub fn positions(&self) -> Vec<Point> {
         self.pixels
             .iter()
-            .map(|p| [p[0] as f64 + 0.5, p[1] as f64 + 0.5])
+            .map(|p| Point::new(p[0] as f64 + 0.5, p[1] as f64 + 0.5))
             .collect()
     }
 

@@ -17,6 +17,7 @@
 //! Points are in canvas px (pixel (i, j) covers [i, i+1) × [j, j+1)); a stroke of one point is
 //! a dot of diameter `width`. Later strokes paint over earlier ones.
 
+use crate::geom::Point;
 use image::RgbaImage;
 use lyon::math::point;
 use lyon::path::Path;
@@ -94,8 +95,8 @@ pub struct Stroke {
     /// Stroke width, px.
     pub width: f64,
     /// Polyline points, canvas px.
-    #[schemars(length(min = 1))]
-    pub points: Vec<[f64; 2]>,
+    #[schemars(length(min = 1), with = "Vec<[f64; 2]>")]
+    pub points: Vec<Point>,
 }
 
 /// `#rrggbb` → RGB8.
@@ -223,12 +224,23 @@ impl Scribbles {
             if stroke.points.is_empty() {
                 return Err(bad("has no points".into()));
             }
-            if stroke.points.iter().flatten().any(|c| !c.is_finite()) {
+            if stroke
+                .points
+                .iter()
+                .flat_map(|p| p.iter())
+                .any(|c| !c.is_finite())
+            {
                 return Err(bad("has a coordinate that is not a number".into()));
             }
             // lyon works in f32: keep coordinates where f32 still resolves a pixel.
             let limit = MAX_COORDINATE_PX;
-            if stroke.width > limit || stroke.points.iter().flatten().any(|c| c.abs() > limit) {
+            if stroke.width > limit
+                || stroke
+                    .points
+                    .iter()
+                    .flat_map(|p| p.iter())
+                    .any(|c| c.abs() > limit)
+            {
                 return Err(bad(format!(
                     "a coordinate or the width lies beyond ±{limit} px"
                 )));
@@ -274,7 +286,7 @@ impl Scribbles {
 /// The stroke's triangles (three points each), canvas px.
 fn tessellate(stroke: &Stroke, tolerance: f32) -> Result<Vec<[f32; 2]>, String> {
     let mut geometry: VertexBuffers<[f32; 2], u32> = VertexBuffers::new();
-    let p = |a: &[f64; 2]| point(a[0] as f32, a[1] as f32);
+    let p = |a: &Point| point(a.x as f32, a.y as f32);
     let distinct = stroke.points.windows(2).any(|w| w[0] != w[1]);
     if !distinct {
         // A dot: lyon strokes nothing for a zero-length path.

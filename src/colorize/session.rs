@@ -41,7 +41,7 @@ pub struct ScribbleStroke {
     pub width_px: f64,
     /// The brush's path, image px (pixel (i, j) covers [i, i+1) × [j, j+1)); one point is a
     /// dot.
-    pub points_px: Vec<[f64; 2]>,
+    pub points_px: Vec<Point>,
 }
 
 impl ScribbleStroke {
@@ -71,15 +71,13 @@ impl ScribbleStroke {
 
     /// Distance (px) from `at_px` to the painted area: to the path, less the brush radius;
     /// 0 or less on the paint.
-    pub fn distance_px(&self, at_px: [f64; 2]) -> f64 {
-        let p = Point::new(at_px[0], at_px[1]);
-        let q = |a: &[f64; 2]| Point::new(a[0], a[1]);
+    pub fn distance_px(&self, p: Point) -> f64 {
         let to_path = match self.points_px.as_slice() {
             [] => f64::INFINITY,
-            [only] => (p - q(only)).norm(),
+            [only] => (p - only).norm(),
             points => points
                 .windows(2)
-                .map(|w| segment_distance(p, q(&w[0]), q(&w[1])).0)
+                .map(|w| segment_distance(p, w[0], w[1]).0)
                 .fold(f64::INFINITY, f64::min),
         };
         to_path - self.width_px / 2.0
@@ -92,7 +90,7 @@ pub enum SessionCommand {
     /// Adds a stroke on top of the others (later strokes paint over earlier ones).
     AddStroke(ScribbleStroke),
     /// Removes every stroke whose paint passes within `radius_px` of `at_px`.
-    EraseNear { at_px: [f64; 2], radius_px: f64 },
+    EraseNear { at_px: Point, radius_px: f64 },
     /// Removes every stroke.
     Clear,
     /// Gives every stroke of color `from` the color `to` (`to` may be a color already used:
@@ -405,7 +403,7 @@ impl ColorizeSession {
             || stroke
                 .points_px
                 .iter()
-                .flatten()
+                .flat_map(|p| p.iter())
                 .any(|c| !c.is_finite() || c.abs() > limit)
         {
             return bad("has a coordinate or width that is not a number within ±1e6 px");
@@ -546,7 +544,7 @@ mod tests {
         let c = inside.points_px[0];
         session
             .apply(SessionCommand::EraseNear {
-                at_px: [c[0] + 1.0, c[1] + 0.5],
+                at_px: Point::new(c[0] + 1.0, c[1] + 0.5),
                 radius_px: 1.0,
             })
             .unwrap();
@@ -554,7 +552,7 @@ mod tests {
         // Nowhere near a stroke: refused, nothing changes.
         assert!(matches!(
             session.apply(SessionCommand::EraseNear {
-                at_px: [64.0, 100.0],
+                at_px: Point::new(64.0, 100.0),
                 radius_px: 2.0
             }),
             Err(SessionError::NothingToErase { .. })
@@ -603,8 +601,8 @@ mod tests {
             with(&|b| b.width_px = f64::NAN),
             with(&|b| b.points_px.clear()),
             with(&|b| b.points_px[0][1] = f64::INFINITY),
-            with(&|b| b.points_px = vec![[-50.0, 10.0], [-20.0, 10.0]]),
-            with(&|b| b.points_px = vec![[10.0, 500.0]]),
+            with(&|b| b.points_px = vec![Point::new(-50.0, 10.0), Point::new(-20.0, 10.0)]),
+            with(&|b| b.points_px = vec![Point::new(10.0, 500.0)]),
         ] {
             let e = session.apply(command.clone()).unwrap_err();
             assert!(
@@ -615,7 +613,9 @@ mod tests {
         assert!(session.strokes().is_empty() && !session.can_undo());
         // A stroke overhanging the border is fine.
         session
-            .apply(with(&|b| b.points_px = vec![[-1.0, 5.0], [20.0, 5.0]]))
+            .apply(with(&|b| {
+                b.points_px = vec![Point::new(-1.0, 5.0), Point::new(20.0, 5.0)]
+            }))
             .unwrap();
         // Too many colors.
         let mut few = ColorizeOptions::default();

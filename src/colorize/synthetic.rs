@@ -13,6 +13,7 @@
 //! the top and bottom margins, symmetric about the true boundary.
 
 use super::scribbles::{hex, Stroke};
+use crate::geom::Point;
 use image::RgbaImage;
 use tiny_skia::{
     BlendMode, Color, FillRule, Paint, PathBuilder, Pixmap, Rect, Shader, Stroke as SkStroke,
@@ -105,7 +106,7 @@ pub fn scene(spec: &SceneSpec) -> Scene {
     let mut truth = Pixmap::new(spec.size, spec.size).expect("a positive size");
     let mut lines = Pixmap::new(spec.size, spec.size).expect("a positive size");
     let mut strokes = Vec::new();
-    let stroke = |color: [u8; 3], points: Vec<[f64; 2]>| Stroke {
+    let stroke = |color: [u8; 3], points: Vec<Point>| Stroke {
         color: format!("#{}", hex(color)),
         width: scribble_width as f64,
         points,
@@ -136,9 +137,15 @@ pub fn scene(spec: &SceneSpec) -> Scene {
     );
     let (y_top, y_bottom) = (margin as f64 / 2.0, size as f64 - margin as f64 / 2.0);
     let (x0, x1) = (size as f64 * 0.3, size as f64 * 0.7);
-    strokes.push(stroke(top, vec![[x0, y_top], [x1, y_top]]));
+    strokes.push(stroke(
+        top,
+        vec![Point::new(x0, y_top), Point::new(x1, y_top)],
+    ));
     if spec.split_background {
-        strokes.push(stroke(bottom, vec![[x0, y_bottom], [x1, y_bottom]]));
+        strokes.push(stroke(
+            bottom,
+            vec![Point::new(x0, y_bottom), Point::new(x1, y_bottom)],
+        ));
     }
     let ink = |alpha: u8| {
         let mut paint = Paint::default();
@@ -198,7 +205,10 @@ pub fn scene(spec: &SceneSpec) -> Scene {
         let r = (rx.min(ry) * 0.3) as f64;
         strokes.push(stroke(
             color,
-            vec![[cx as f64 - r, cy as f64], [cx as f64 + r, cy as f64]],
+            vec![
+                Point::new(cx as f64 - r, cy as f64),
+                Point::new(cx as f64 + r, cy as f64),
+            ],
         ));
     }
     let is_line: Vec<bool> = lines.pixels().iter().map(|p| p.alpha() > 0).collect();

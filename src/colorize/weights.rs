@@ -10,6 +10,7 @@
 //! color, 0 for the others) and [`crate::weights::solve`] does the rest.
 
 use super::image_mesh::ImageMesh;
+use crate::geom::{as_coordinate_arrays, Point};
 use crate::weights::laplacian::{cotangent_stiffness, squared_edge_lengths, voronoi_mass};
 use crate::weights::lift::{content_aware_domain, lift_points, LiftError};
 use crate::weights::{
@@ -116,7 +117,7 @@ pub fn color_weights(
 /// squared stretch under the lift (negative flat weights, on obtuse boundary triangles, are
 /// dropped), and the lifted mesh's mixed-Voronoi mass.
 pub fn edge_stretch_domain(
-    positions: &[[f64; 2]],
+    positions: &[Point],
     colors: &[[f64; 3]],
     scale: f64,
     triangles: &[[u32; 3]],
@@ -125,8 +126,11 @@ pub fn edge_stretch_domain(
     let n = positions.len();
     let mass = voronoi_mass(n, triangles, &squared_edge_lengths(&lifted, triangles));
     // The flat stiffness's pattern, values rewritten in place (no second assembly and sort).
-    let mut stiffness =
-        cotangent_stiffness(n, triangles, &squared_edge_lengths(positions, triangles));
+    let mut stiffness = cotangent_stiffness(
+        n,
+        triangles,
+        &squared_edge_lengths(as_coordinate_arrays(positions), triangles),
+    );
     let d2 = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
     let indptr = stiffness.indptr().to_proper().into_owned();
     let indices = stiffness.indices().to_vec();
@@ -139,7 +143,8 @@ pub fn edge_stretch_domain(
             if j == i {
                 diagonal_at = Some(k);
             } else if data[k] < 0.0 {
-                data[k] /= d2(&lifted[i], &lifted[j]) / d2(&positions[i], &positions[j]);
+                data[k] /=
+                    d2(&lifted[i], &lifted[j]) / (positions[i] - positions[j]).norm_squared();
                 diagonal -= data[k];
             } else {
                 data[k] = 0.0;
@@ -158,7 +163,12 @@ mod tests {
 
     #[test]
     fn stretched_edges_conduct_less_and_rows_sum_to_zero() {
-        let positions = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        let positions = [
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(0.0, 1.0),
+            Point::new(1.0, 1.0),
+        ];
         let triangles = [[0, 1, 2], [1, 3, 2]];
         let colors = [[1.0; 3], [1.0; 3], [0.0; 3], [0.0; 3]];
         let d = edge_stretch_domain(&positions, &colors, 10.0, &triangles).unwrap();

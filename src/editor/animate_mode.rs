@@ -308,10 +308,7 @@ impl EditorApp {
                         continue;
                     };
                     shapes.push(Shape::line_segment(
-                        [
-                            placed.screen_from_canvas([p.x, p.y]),
-                            placed.screen_from_canvas([q.x, q.y]),
-                        ],
+                        [placed.screen_from_canvas(*p), placed.screen_from_canvas(*q)],
                         stroke,
                     ));
                 }

@@ -38,13 +38,13 @@ pub struct Placed {
 }
 
 impl Placed {
-    pub fn screen_from_canvas(&self, p: [f64; 2]) -> Pos2 {
-        self.origin + self.view.pan + Vec2::new(p[0] as f32, p[1] as f32) * self.view.zoom
+    pub fn screen_from_canvas(&self, p: Point) -> Pos2 {
+        self.origin + self.view.pan + Vec2::new(p.x as f32, p.y as f32) * self.view.zoom
     }
 
-    pub fn canvas_from_screen(&self, s: Pos2) -> [f64; 2] {
+    pub fn canvas_from_screen(&self, s: Pos2) -> Point {
         let v = (s - self.origin - self.view.pan) / self.view.zoom;
-        [v.x as f64, v.y as f64]
+        Point::new(v.x as f64, v.y as f64)
     }
 }
 
@@ -71,8 +71,11 @@ pub fn image_quad(
 ) -> Shape {
     let [x, y] = offset_px.map(f64::from);
     let rect = egui::Rect::from_two_pos(
-        placed.screen_from_canvas([x, y]),
-        placed.screen_from_canvas([x + f64::from(size_px[0]), y + f64::from(size_px[1])]),
+        placed.screen_from_canvas(Point::new(x, y)),
+        placed.screen_from_canvas(Point::new(
+            x + f64::from(size_px[0]),
+            y + f64::from(size_px[1]),
+        )),
     );
     let uv = egui::Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
     Shape::image(texture.id(), rect, uv, Color32::WHITE)
@@ -88,7 +91,7 @@ pub fn wireframe(placed: &Placed, positions: &[Point], triangles: &[[u32; 3]]) -
                 .iter()
                 .map(|&i| {
                     let p = positions[i as usize];
-                    placed.screen_from_canvas([p.x, p.y])
+                    placed.screen_from_canvas(p)
                 })
                 .collect();
             Shape::closed_line(pts, stroke)
@@ -112,7 +115,7 @@ pub fn heat_map(
             .find(|(j, _)| *j == column)
             .map_or(0.0, |(_, w)| *w);
         mesh.vertices.push(egui::epaint::Vertex {
-            pos: placed.screen_from_canvas([p.x, p.y]),
+            pos: placed.screen_from_canvas(*p),
             uv: egui::epaint::WHITE_UV,
             color: heat_color(w),
         });
@@ -200,22 +203,17 @@ pub fn pick(placed: &Placed, handles: &Handles, at: Pos2) -> Option<String> {
     use crate::geom::segment_distance;
     // Measured in canvas px, then compared in screen points: the view only scales.
     let c = placed.canvas_from_screen(at);
-    let c = Point::new(c[0], c[1]);
-    let pt = |p: [f64; 2]| Point::new(p[0], p[1]);
     let bones = handles
         .bones
         .iter()
-        .map(|b| (segment_distance(c, pt(b.head), pt(b.tail)).0, &b.name));
-    let points = handles
-        .points
-        .iter()
-        .map(|p| ((c - pt(p.at)).norm(), &p.name));
+        .map(|b| (segment_distance(c, b.head, b.tail).0, &b.name));
+    let points = handles.points.iter().map(|p| ((c - p.at).norm(), &p.name));
     // Cages and regions are picked by their outline.
-    let outline = |polygon: &[[f64; 2]]| {
+    let outline = |polygon: &[Point]| {
         (0..polygon.len())
             .map(|k| {
                 let (a, b) = (polygon[k], polygon[(k + 1) % polygon.len()]);
-                segment_distance(c, pt(a), pt(b)).0
+                segment_distance(c, a, b).0
             })
             .fold(f64::INFINITY, f64::min)
     };
@@ -247,7 +245,7 @@ mod tests {
             },
             origin: Pos2::new(100.0, 50.0),
         };
-        let c = [12.5, 40.0];
+        let c = Point::new(12.5, 40.0);
         let back = placed.canvas_from_screen(placed.screen_from_canvas(c));
         assert!((back[0] - c[0]).abs() < 1e-4 && (back[1] - c[1]).abs() < 1e-4);
     }

@@ -17,6 +17,7 @@ use crate::colorize::session::{
     ColorizeSession, ScribbleStroke, SessionCommand, SessionError, SolveJob,
 };
 use crate::colorize::{ColorizeError, ColorizeOptions, Colorized};
+use crate::geom::Point;
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Sense, TextureHandle};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -97,7 +98,7 @@ pub struct ColorizeEditor {
     /// This mode's pan and zoom (the line art has its own size); `None` fits it.
     view: Option<View>,
     /// The stroke being drawn, image px.
-    drawing: Option<Vec<[f64; 2]>>,
+    drawing: Option<Vec<Point>>,
     solve: Option<Solve>,
     /// The newest finished solve: its strokes and result, shown until a newer one arrives.
     latest: Option<(Arc<Vec<ScribbleStroke>>, Arc<Colorized>)>,
@@ -164,7 +165,7 @@ impl ColorizeEditor {
         Some(strokes)
     }
 
-    fn stroke(&self, points_px: Vec<[f64; 2]>) -> ScribbleStroke {
+    fn stroke(&self, points_px: Vec<Point>) -> ScribbleStroke {
         ScribbleStroke {
             color: self.color,
             width_px: self.width_px as f64,
@@ -668,8 +669,8 @@ impl EditorApp {
             if let (Some(result), ColorizeView::Result) = (texture.1, self.colorize.view_mode) {
                 let alpha = (self.colorize.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
                 let quad = egui::Rect::from_two_pos(
-                    placed.screen_from_canvas([0.0, 0.0]),
-                    placed.screen_from_canvas([size_px[0] as f64, size_px[1] as f64]),
+                    placed.screen_from_canvas(Point::origin()),
+                    placed.screen_from_canvas(Point::new(size_px[0] as f64, size_px[1] as f64)),
                 );
                 let uv = egui::Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
                 shapes.push(egui::Shape::image(

@@ -263,7 +263,7 @@ impl EditorApp {
                 tail: *tail,
             }),
             Some(Gesture::MoveHandle { name, from, to }) => {
-                super::rig_mode::move_handle(&mut handles, name, [to[0] - from[0], to[1] - from[1]])
+                super::rig_mode::move_handle(&mut handles, name, to - from)
             }
             _ => {}
         }

@@ -9,6 +9,7 @@
 //! pointer (Blender's modal way): a click confirms, Esc or a right click cancels.
 
 use super::canvas::Placed;
+use crate::geom::Point;
 use crate::rig::fk_edit::{self, FkEdit, FkEditError, FkTarget};
 use crate::rig::{Affine, Handles, Pose};
 use eframe::egui::{self, Color32, Pos2, Shape, Stroke};
@@ -43,8 +44,8 @@ pub struct FkGesture {
     base: Pose,
     shown: Vec<Affine>,
     pub target: FkTarget,
-    start_px: [f64; 2],
-    last_px: [f64; 2],
+    start_px: Point,
+    last_px: Point,
     /// Rotation so far, degrees: summed frame to frame, so turning past 180° keeps going.
     turned_deg: f64,
     pub preview: Pose,
@@ -58,7 +59,7 @@ impl FkGesture {
         shown: &[Affine],
         name: &str,
         kind: FkKind,
-        pointer_px: [f64; 2],
+        pointer_px: Point,
         modal: bool,
     ) -> Result<Self, FkEditError> {
         let target = fk_edit::target(handles, shown, name)?;
@@ -77,19 +78,16 @@ impl FkGesture {
     }
 
     /// Follows the pointer to `pointer_px` (canvas) and recomputes the preview.
-    pub fn update(&mut self, handles: &Handles, pointer_px: [f64; 2]) -> Result<(), FkEditError> {
+    pub fn update(&mut self, handles: &Handles, pointer_px: Point) -> Result<(), FkEditError> {
         let pivot = self.target.pivot_px;
-        let from_pivot = |p: [f64; 2]| [p[0] - pivot[0], p[1] - pivot[1]];
+        let from_pivot = |p: Point| p - pivot;
         let edit = match self.kind {
             FkKind::Grab => FkEdit::Grab {
-                delta_px: [
-                    pointer_px[0] - self.start_px[0],
-                    pointer_px[1] - self.start_px[1],
-                ],
+                delta_px: pointer_px - self.start_px,
             },
             FkKind::Rotate => {
                 let (a, b) = (from_pivot(self.last_px), from_pivot(pointer_px));
-                if a != [0.0, 0.0] && b != [0.0, 0.0] {
+                if a != crate::geom::Vec2::zeros() && b != crate::geom::Vec2::zeros() {
                     self.turned_deg += fk_edit::turn_deg(a, b);
                 }
                 FkEdit::Rotate {
@@ -97,10 +95,7 @@ impl FkGesture {
                 }
             }
             FkKind::Scale => {
-                let reach = |p: [f64; 2]| {
-                    let d = from_pivot(p);
-                    d[0].hypot(d[1]).max(MIN_SCALE_REACH_PX)
-                };
+                let reach = |p: Point| from_pivot(p).norm().max(MIN_SCALE_REACH_PX);
                 FkEdit::Scale {
                     factor: reach(pointer_px) / reach(self.start_px),
                 }
@@ -175,8 +170,8 @@ mod tests {
         h.bones.push(Bone {
             name: "b".into(),
             parent: None,
-            head: [100.0, 100.0],
-            tail: [200.0, 100.0],
+            head: Point::new(100.0, 100.0),
+            tail: Point::new(200.0, 100.0),
         });
         h
     }
@@ -193,7 +188,7 @@ mod tests {
             },
             origin: Pos2::ZERO,
         };
-        let c = placed.screen_from_canvas([100.0, 100.0]);
+        let c = placed.screen_from_canvas(Point::new(100.0, 100.0));
         assert_eq!(hit(&placed, &target, c), Some(FkKind::Grab));
         assert_eq!(
             hit(&placed, &target, c + egui::vec2(0.0, RING_RADIUS_PT)),
@@ -211,10 +206,22 @@ mod tests {
         let h = one_bone();
         let pose = Pose::default();
         let shown = handle_transforms(&h, &pose).unwrap();
-        let mut g =
-            FkGesture::start(&h, &pose, &shown, "b", FkKind::Rotate, [150.0, 100.0], true).unwrap();
+        let mut g = FkGesture::start(
+            &h,
+            &pose,
+            &shown,
+            "b",
+            FkKind::Rotate,
+            Point::new(150.0, 100.0),
+            true,
+        )
+        .unwrap();
         // Three quarter turns counter-clockwise on screen: right → up → left → down.
-        for p in [[100.0, 50.0], [50.0, 100.0], [100.0, 150.0]] {
+        for p in [
+            Point::new(100.0, 50.0),
+            Point::new(50.0, 100.0),
+            Point::new(100.0, 150.0),
+        ] {
             g.update(&h, p).unwrap();
         }
         assert!((g.turned_deg - 270.0).abs() < 1e-9);
@@ -226,9 +233,17 @@ mod tests {
         let h = one_bone();
         let pose = Pose::default();
         let shown = handle_transforms(&h, &pose).unwrap();
-        let mut g =
-            FkGesture::start(&h, &pose, &shown, "b", FkKind::Scale, [110.0, 100.0], false).unwrap();
-        g.update(&h, [100.0, 130.0]).unwrap();
+        let mut g = FkGesture::start(
+            &h,
+            &pose,
+            &shown,
+            "b",
+            FkKind::Scale,
+            Point::new(110.0, 100.0),
+            false,
+        )
+        .unwrap();
+        g.update(&h, Point::new(100.0, 130.0)).unwrap();
         assert!((g.preview.bones["b"].scale[0] - 3.0).abs() < 1e-12);
     }
 }

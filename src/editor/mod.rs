@@ -47,6 +47,7 @@ pub use pose_mode::rest_point_under;
 pub use rig_mode::Tool;
 
 use crate::document::{Command, Document};
+use crate::geom::Point;
 use crate::rig::Pose;
 use canvas::{Placed, View};
 use eframe::egui::{self, Key, Modifiers};
@@ -71,14 +72,14 @@ pub enum Mode {
 /// A pointer gesture in progress.
 enum Gesture {
     NewBone {
-        head: [f64; 2],
+        head: Point,
         parent: Option<String>,
-        tail: [f64; 2],
+        tail: Point,
     },
     MoveHandle {
         name: String,
-        from: [f64; 2],
-        to: [f64; 2],
+        from: Point,
+        to: Point,
     },
     PoseDrag {
         /// Index of the drag in the live pose's `ik` list.
@@ -86,14 +87,14 @@ enum Gesture {
         pose: Pose,
         /// From the pointer to the drag's target, canvas px (the target starts where the
         /// gripped point is shown, then follows the pointer's motion).
-        offset: [f64; 2],
+        offset: crate::geom::Vec2,
     },
     /// Grab, rotate or scale the selected handle by forward kinematics.
     Fk(Box<gizmo::FkGesture>),
     /// A cage or region being drawn, vertex by vertex (canvas px).
     NewPolygon {
         kind: rig_tools::PolygonKind,
-        points: Vec<[f64; 2]>,
+        points: Vec<Point>,
     },
     Pan,
     Paint(paint::PaintStroke),

@@ -12,6 +12,7 @@
 use super::canvas::{self, Placed};
 use super::{EditorApp, Gesture};
 use crate::document::{part_weights_for_painting, Command};
+use crate::geom::Point;
 use crate::pipeline::Scene;
 use crate::weights::{dab_centres, BrushMode, BrushOptions, PaintMesh};
 use eframe::egui::{self, Color32, Shape, Stroke as Pen};
@@ -22,10 +23,10 @@ pub struct PaintSettings {
     pub mode: BrushMode,
     pub options: BrushOptions,
     /// The canvas point under the pointer last frame, px; `None` off the canvas.
-    pub hover_px: Option<[f64; 2]>,
+    pub hover_px: Option<Point>,
     /// The last canvas point the pointer was over, px: the side panel reads out the weights of
     /// the vertex there (it stays while the pointer goes to the panel).
-    pub readout_px: Option<[f64; 2]>,
+    pub readout_px: Option<Point>,
 }
 
 /// A stroke under way: its samples and the painted part's weights with the dabs so far.
@@ -38,7 +39,7 @@ pub struct PaintStroke {
     /// The document's influence limit, as the committed stroke will apply it.
     max_influences: Option<usize>,
     mesh: PaintMesh,
-    pub samples_px: Vec<[f64; 2]>,
+    pub samples_px: Vec<Point>,
     dabs_done: usize,
     /// The part's weight rows as the stroke leaves them so far.
     pub rows: Vec<Vec<(u32, f64)>>,
@@ -46,7 +47,7 @@ pub struct PaintStroke {
 
 /// The part and vertex under `at_px` at rest: the frontmost part with a triangle containing
 /// it, and that triangle's corner nearest to it.
-pub fn vertex_under(scene: &Scene, at_px: [f64; 2]) -> Option<(usize, usize)> {
+pub fn vertex_under(scene: &Scene, at_px: Point) -> Option<(usize, usize)> {
     use crate::geom::{barycentric, Point};
     let p = Point::new(at_px[0], at_px[1]);
     for (k, part) in scene.doc.parts.iter().enumerate().rev() {
@@ -67,7 +68,7 @@ pub fn vertex_under(scene: &Scene, at_px: [f64; 2]) -> Option<(usize, usize)> {
 
 impl EditorApp {
     /// Starts a stroke at `at_px` on the frontmost part there, with the selected handle.
-    fn start_stroke(&mut self, at_px: [f64; 2]) -> Option<PaintStroke> {
+    fn start_stroke(&mut self, at_px: Point) -> Option<PaintStroke> {
         let Some(handle) = self.selected.clone() else {
             self.message = Some("select the handle to paint first".into());
             return None;
@@ -124,7 +125,7 @@ impl EditorApp {
     }
 
     /// Adds a sample to the stroke and paints the dabs it completes on the preview.
-    fn extend_stroke(&mut self, stroke: &mut PaintStroke, at_px: [f64; 2]) {
+    fn extend_stroke(&mut self, stroke: &mut PaintStroke, at_px: Point) {
         stroke.samples_px.push(at_px);
         let dabs = match dab_centres(&stroke.samples_px, &self.paint.options) {
             Ok(dabs) => dabs,

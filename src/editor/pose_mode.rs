@@ -57,10 +57,7 @@ impl Posed {
         positions: Vec<Vec<Point>>,
         transforms: Vec<crate::rig::Affine>,
     ) -> Self {
-        let map = |t: &crate::rig::Affine, p: [f64; 2]| {
-            let q = t.apply(Point::new(p[0], p[1]));
-            [q.x, q.y]
-        };
+        let map = |t: &crate::rig::Affine, p: Point| t.apply(p);
         let mut handles = scene.doc.handles.clone();
         let bone_count = handles.bones.len();
         for (b, t) in handles.bones.iter_mut().zip(&transforms) {
@@ -279,7 +276,7 @@ impl EditorApp {
         let pointer = response.interact_pointer_pos();
         let shift = ctx.input(|i| i.modifiers.shift);
         // The rest point of the drawing under the pointer and where it is shown now.
-        let grab = |app: &mut EditorApp, at: Pos2| -> Option<([f64; 2], [f64; 2])> {
+        let grab = |app: &mut EditorApp, at: Pos2| -> Option<(Point, Point)> {
             let posed = app.pose_mode.posed.as_ref().filter(|p| p.scene.is(scene))?;
             let rest = rest_point_under(
                 scene,
@@ -333,7 +330,7 @@ impl EditorApp {
                     self.gesture = Some(Gesture::PoseDrag {
                         index,
                         pose,
-                        offset: [to[0] - c[0], to[1] - c[1]],
+                        offset: to - c,
                     });
                 }
             }
@@ -346,7 +343,7 @@ impl EditorApp {
             }) = &mut self.gesture
             {
                 let c = placed.canvas_from_screen(at);
-                pose.ik[*index].to = [c[0] + offset[0], c[1] + offset[1]];
+                pose.ik[*index].to = c + *offset;
             }
         }
         if response.drag_stopped() {
@@ -561,8 +558,8 @@ pub fn rest_point_under(
     scene: &Scene,
     positions: &[Vec<Point>],
     pose: &Pose,
-    at_px: [f64; 2],
-) -> Option<[f64; 2]> {
+    at_px: Point,
+) -> Option<Point> {
     let p = Point::new(at_px[0], at_px[1]);
     let draws = crate::playback::pose_draws(scene, positions, pose);
     for draw in draws.iter().rev().filter(|d| d.visible) {
@@ -579,10 +576,9 @@ pub fn rest_point_under(
             };
             if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
                 let rest = t.map(|i| part.mesh.vertices[i as usize]);
-                return Some([
-                    wa * rest[0][0] + wb * rest[1][0] + wc * rest[2][0],
-                    wa * rest[0][1] + wb * rest[1][1] + wc * rest[2][1],
-                ]);
+                return Some(Point::from(
+                    wa * rest[0].coords + wb * rest[1].coords + wc * rest[2].coords,
+                ));
             }
         }
     }
@@ -595,7 +591,7 @@ pub fn rest_point_under(
 /// skeleton), when no bone weighs the point, or when the rig cannot say.
 pub fn implicit_root_pin(
     scene: &Scene,
-    at: [f64; 2],
+    at: Point,
     transforms: &[crate::rig::Affine],
 ) -> Option<IkDrag> {
     let ik = scene.rig_ik().ok()?;
@@ -631,9 +627,9 @@ pub fn implicit_root_pin(
 /// leaves the drawing where it is.
 pub fn shown_position(
     scene: &Scene,
-    at: [f64; 2],
+    at: Point,
     transforms: &[crate::rig::Affine],
-) -> Result<[f64; 2], String> {
+) -> Result<Point, String> {
     let ik = scene.rig_ik().map_err(|e| e.to_string())?;
     let grip = ik
         .drag_row(&IkDrag {
@@ -649,6 +645,5 @@ pub fn shown_position(
             grip.row.len() / 3
         ));
     }
-    let p = crate::ik::rig::skinned_position(&grip.row, transforms);
-    Ok([p.x, p.y])
+    Ok(crate::ik::rig::skinned_position(&grip.row, transforms))
 }

@@ -339,7 +339,7 @@ impl EditorApp {
                 }
                 Some(Gesture::MoveHandle { name, from, to }) if distance(from, to) > 0.0 => {
                     let mut handles = self.doc.state().handles.clone();
-                    move_handle(&mut handles, &name, [to[0] - from[0], to[1] - from[1]]);
+                    move_handle(&mut handles, &name, to - from);
                     if let Some(b) = handles.bones.iter().find(|b| b.name == name) {
                         self.apply(Command::MoveBone {
                             name,
@@ -397,16 +397,17 @@ impl EditorApp {
     }
 }
 
-pub(super) fn distance(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
+pub(super) fn distance(a: Point, b: impl Into<Point>) -> f64 {
+    (a - b.into()).norm()
 }
 
 /// Moves handle `name` by `delta_px`.
-pub(super) fn move_handle(handles: &mut crate::rig::Handles, name: &str, delta_px: [f64; 2]) {
-    let shift = |p: &mut [f64; 2]| {
-        p[0] += delta_px[0];
-        p[1] += delta_px[1];
-    };
+pub(super) fn move_handle(
+    handles: &mut crate::rig::Handles,
+    name: &str,
+    delta_px: crate::geom::Vec2,
+) {
+    let shift = |p: &mut Point| *p += delta_px;
     if let Some(b) = handles.bones.iter_mut().find(|b| b.name == name) {
         shift(&mut b.head);
         shift(&mut b.tail);

@@ -12,6 +12,7 @@ use super::identity::Identity;
 use super::{EditorApp, Gesture};
 use crate::autorig::{AutorigOptions, Proposal};
 use crate::document::Command;
+use crate::geom::Point;
 use crate::io::{BuildOptions, MeshDoc};
 use crate::pipeline::Layer;
 use crate::rig::{Cage, Handles, Region};
@@ -76,7 +77,7 @@ impl RigTools {
 impl EditorApp {
     /// A click of the cage or region tool at `at` (canvas px): starts a polygon, adds a vertex,
     /// or closes it on its first vertex.
-    pub(super) fn polygon_click(&mut self, kind: PolygonKind, at: [f64; 2], placed: &Placed) {
+    pub(super) fn polygon_click(&mut self, kind: PolygonKind, at: Point, placed: &Placed) {
         match &mut self.gesture {
             Some(Gesture::NewPolygon {
                 kind: current,

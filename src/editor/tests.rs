@@ -2,6 +2,7 @@
 //! against the document.
 
 use super::rig_mode::distance;
+use crate::geom::Point;
 
 use super::*;
 
@@ -94,7 +95,8 @@ fn open_character(name: &str) -> Harness<'static, EditorApp> {
     h
 }
 
-fn screen(h: &Harness<'_, EditorApp>, canvas_px: [f64; 2]) -> Pos2 {
+fn screen(h: &Harness<'_, EditorApp>, canvas_px: impl Into<Point>) -> Pos2 {
+    let canvas_px = canvas_px.into();
     h.state()
         .placed
         .expect("the canvas was drawn")
@@ -102,15 +104,13 @@ fn screen(h: &Harness<'_, EditorApp>, canvas_px: [f64; 2]) -> Pos2 {
 }
 
 /// Press at `from`, move in steps, release at `to` (canvas px).
-fn drag(h: &mut Harness<'_, EditorApp>, from: [f64; 2], to: [f64; 2]) {
+fn drag(h: &mut Harness<'_, EditorApp>, from: impl Into<Point>, to: impl Into<Point>) {
+    let (from, to) = (from.into(), to.into());
     h.drag_at(screen(h, from));
     h.step();
     for k in 1..=4 {
         let t = k as f64 / 4.0;
-        let p = [
-            from[0] + t * (to[0] - from[0]),
-            from[1] + t * (to[1] - from[1]),
-        ];
+        let p = from + t * (to - from);
         h.hover_at(screen(h, p));
         h.step();
     }
@@ -133,14 +133,14 @@ fn wait_for_weights(h: &mut Harness<'_, EditorApp>) {
 
 /// A point well inside the torso at rest and away from the bones (a drag there moves the
 /// drawing), canvas px.
-fn torso_point(h: &Harness<'_, EditorApp>) -> [f64; 2] {
+fn torso_point(h: &Harness<'_, EditorApp>) -> Point {
     off_bone_point(h, "torso")
 }
 
 /// A rest vertex of part `name` that lies on the drawing but away from every bone's line
 /// (more than twice the pick radius on screen), the one nearest the part's centroid: a drag
 /// there moves the drawing, not a bone.
-fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
+fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
     let scene = h.state().doc.posable().expect("posable").clone();
     let zoom = f64::from(h.state().placed.expect("drawn").view.zoom);
     let clear_px = 2.0 * f64::from(canvas::PICK_RADIUS_PT) / zoom;
@@ -150,8 +150,8 @@ fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
         .iter()
         .find(|p| p.name == name)
         .expect("part");
-    let from_bones = |p: [f64; 2]| {
-        let pt = |q: [f64; 2]| crate::geom::Point::new(q[0], q[1]);
+    let from_bones = |p: Point| {
+        let pt = |q: Point| crate::geom::Point::new(q[0], q[1]);
         scene
             .doc
             .handles
@@ -177,9 +177,7 @@ fn off_bone_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
     // The one nearest the part's centroid.
     let v = &part.mesh.vertices;
     let n = v.len() as f64;
-    let c = v
-        .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    let c = v.iter().fold(Point::origin(), |a, p| a + p.coords / n);
     (0..v.len() as u32)
         .filter(|i| !boundary.contains(i))
         .map(|i| v[i as usize])
@@ -314,7 +312,7 @@ fn key_a_nod_from_the_numbers_panel(h: &mut Harness<'_, EditorApp>) {
     type_into(h, "Rename to:", "nod");
     h.get_by_label("Rename animation").click();
     h.run();
-    click(h, [256.0, 150.0]);
+    click(h, Point::new(256.0, 150.0));
     assert_eq!(h.state().selected.as_deref(), Some("head"));
     for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
         for _ in 0..frames {
@@ -337,7 +335,8 @@ fn set_number(h: &mut Harness<'_, EditorApp>, label: &str, value: f64) {
 }
 
 /// Press and release at `at` (canvas px) without moving.
-fn click(h: &mut Harness<'_, EditorApp>, at: [f64; 2]) {
+fn click(h: &mut Harness<'_, EditorApp>, at: impl Into<Point>) {
+    let at = at.into();
     h.drag_at(screen(h, at));
     h.step();
     h.drop_at(screen(h, at));
@@ -346,7 +345,7 @@ fn click(h: &mut Harness<'_, EditorApp>, at: [f64; 2]) {
 }
 
 /// Where the document's pose shows `bone`'s head, canvas px.
-fn shown_head(h: &Harness<'_, EditorApp>, bone: &str) -> [f64; 2] {
+fn shown_head(h: &Harness<'_, EditorApp>, bone: &str) -> Point {
     let scene = h.state().doc.posable().expect("posable").clone();
     let shown = scene
         .handle_transforms(&h.state().doc.state().pose)
@@ -452,7 +451,8 @@ fn character_with_nod(name: &str) -> PathBuf {
 }
 
 /// Shift-click at `at` (canvas px) without moving: one frame per event, as a window sends them.
-fn shift_click(h: &mut Harness<'_, EditorApp>, at: [f64; 2]) {
+fn shift_click(h: &mut Harness<'_, EditorApp>, at: impl Into<Point>) {
+    let at = at.into();
     let pos = screen(h, at);
     h.hover_at(pos);
     h.step();
@@ -495,7 +495,7 @@ fn largest_move(a: &[Vec<crate::geom::Point>], b: &[Vec<crate::geom::Point>]) ->
 }
 
 /// A rest vertex of part `name` near its centroid (on the drawing), canvas px.
-fn part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
+fn part_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
     let (part, vertex) = central_vertex(h, name);
     h.state().doc.posable().expect("posable").doc.parts[part]
         .mesh
@@ -514,9 +514,7 @@ fn central_vertex(h: &Harness<'_, EditorApp>, name: &str) -> (usize, usize) {
         .expect("the part");
     let v = &scene.doc.parts[part].mesh.vertices;
     let n = v.len() as f64;
-    let c = v
-        .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / n, a[1] + p[1] / n]);
+    let c = v.iter().fold(Point::origin(), |a, p| a + p.coords / n);
     let vertex = (0..v.len())
         .min_by(|&a, &b| distance(v[a], c).total_cmp(&distance(v[b], c)))
         .expect("vertices");
@@ -524,8 +522,8 @@ fn central_vertex(h: &Harness<'_, EditorApp>, name: &str) -> (usize, usize) {
 }
 
 /// Where the canvas shows the vertex [`part_point`] picks, px.
-fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> [f64; 2] {
+fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
     let (part, vertex) = central_vertex(h, name);
     let shown = shown_vertices(h)[part][vertex];
-    [shown.x, shown.y]
+    Point::new(shown.x, shown.y)
 }

@@ -14,6 +14,7 @@ use super::curves::{CurveLayout, CURVE_GRAPH_PT};
 use super::{EditorApp, Mode};
 use crate::anim::edit::{self, CopiedKey, KeyRef, TimelineId, KEY_TIME_TOLERANCE_S};
 use crate::document::Command;
+use crate::geom::Point;
 use eframe::egui::{self, Color32, Key, Modifiers, Pos2, Rect, Sense, Shape, Stroke};
 
 /// Height of a dopesheet row (the ruler, the summary and each timeline), points.
@@ -167,8 +168,8 @@ pub fn row_names(
 }
 
 /// The bone (its segment) or point nearest `at_px` at rest.
-fn nearest_handle(handles: &crate::rig::Handles, at_px: [f64; 2]) -> Option<String> {
-    let distance = |a: [f64; 2], b: [f64; 2]| {
+fn nearest_handle(handles: &crate::rig::Handles, at_px: Point) -> Option<String> {
+    let distance = |a: Point, b: Point| {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let len2 = dx * dx + dy * dy;
         let f = if len2 > 0.0 {

@@ -7,6 +7,7 @@
 
 use super::canvas::{self, View};
 use super::{EditorApp, Mode};
+use crate::geom::Point;
 use eframe::egui::{self, Key, Modifiers, Vec2};
 
 /// Margin around what a view change fits, screen points.
@@ -23,7 +24,7 @@ pub enum ViewRequest {
     /// The whole canvas in the area.
     Fit,
     /// A box (canvas px, min and max corners) in the area, centred.
-    Frame([f64; 2], [f64; 2]),
+    Frame(Point, Point),
     /// One canvas px per screen point, about the area's centre.
     ActualSize,
 }
@@ -125,7 +126,7 @@ impl EditorApp {
 
 /// The view showing the box `min`..`max` (canvas px, grown to [`MIN_FRAMED_PX`]) centred in
 /// an area of `area` points.
-pub fn frame(min: [f64; 2], max: [f64; 2], area: Vec2) -> View {
+pub fn frame(min: Point, max: Point, area: Vec2) -> View {
     let centre = Vec2::new(
         ((min[0] + max[0]) / 2.0) as f32,
         ((min[1] + max[1]) / 2.0) as f32,
@@ -145,7 +146,7 @@ pub fn frame(min: [f64; 2], max: [f64; 2], area: Vec2) -> View {
 
 /// The points that outline handle `name`: a bone's head and tail, a point, a polygon's
 /// vertices.
-fn handle_corners(handles: &crate::rig::Handles, name: &str) -> Vec<[f64; 2]> {
+fn handle_corners(handles: &crate::rig::Handles, name: &str) -> Vec<Point> {
     if let Some(b) = handles.bones.iter().find(|b| b.name == name) {
         return vec![b.head, b.tail];
     }
@@ -161,12 +162,12 @@ fn handle_corners(handles: &crate::rig::Handles, name: &str) -> Vec<[f64; 2]> {
         .unwrap_or_default()
 }
 
-fn bounds(points: &[[f64; 2]]) -> Option<([f64; 2], [f64; 2])> {
+fn bounds(points: &[Point]) -> Option<(Point, Point)> {
     let first = *points.first()?;
     Some(points.iter().fold((first, first), |(lo, hi), p| {
         (
-            [lo[0].min(p[0]), lo[1].min(p[1])],
-            [hi[0].max(p[0]), hi[1].max(p[1])],
+            Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+            Point::new(hi.x.max(p.x), hi.y.max(p.y)),
         )
     }))
 }

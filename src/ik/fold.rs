@@ -23,7 +23,7 @@
 //! of them; every blended triangle is a candidate, and when there are more candidates than the
 //! budget, those whose weights change fastest (where linear blending creases) are kept.
 
-use crate::geom::{triangle_area2, Point};
+use crate::geom::{triangle_area2, Point, Vec2};
 use nalgebra::{DMatrix, Matrix2};
 
 use super::subspace::SkinnedMesh;
@@ -111,24 +111,22 @@ impl FoldCheck {
                 }
                 // Σⱼ |∇wⱼ| over the triangle (px⁻¹): how fast blending changes across it.
                 let inverse = edge_inverse(a, b, c);
-                let mut gradient = std::collections::BTreeMap::<u32, [f64; 2]>::new();
+                let mut gradient = std::collections::BTreeMap::<u32, Vec2>::new();
                 for (k, row) in rows.iter().enumerate() {
                     // ∇ of the hat function of corner k in the rest frame.
                     let g = match k {
-                        0 => [
+                        0 => Vec2::new(
                             -(inverse[(0, 0)] + inverse[(1, 0)]),
                             -(inverse[(0, 1)] + inverse[(1, 1)]),
-                        ],
-                        1 => [inverse[(0, 0)], inverse[(0, 1)]],
-                        _ => [inverse[(1, 0)], inverse[(1, 1)]],
+                        ),
+                        1 => Vec2::new(inverse[(0, 0)], inverse[(0, 1)]),
+                        _ => Vec2::new(inverse[(1, 0)], inverse[(1, 1)]),
                     };
                     for &(j, w) in row.iter() {
-                        let e = gradient.entry(j).or_insert([0.0, 0.0]);
-                        e[0] += w * g[0];
-                        e[1] += w * g[1];
+                        *gradient.entry(j).or_insert_with(Vec2::zeros) += w * g;
                     }
                 }
-                let risk: f64 = gradient.values().map(|g| g[0].hypot(g[1])).sum();
+                let risk: f64 = gradient.values().map(|g| g.norm()).sum();
                 blended.push((risk, mi, ti, base));
             }
             base += mesh.rest.len();
@@ -201,11 +199,13 @@ impl FoldCheck {
     pub fn folds(&self, t: &DMatrix<f64>, min_ratio: f64) -> Vec<Fold> {
         if let Some(rows) = &self.dense_rows {
             let p = rows * t;
-            let posed: Vec<[f64; 2]> = (0..p.nrows()).map(|i| [p[(i, 0)], p[(i, 1)]]).collect();
+            let posed: Vec<Point> = (0..p.nrows())
+                .map(|i| Point::new(p[(i, 0)], p[(i, 1)]))
+                .collect();
             return self.folds_at(&posed, min_ratio);
         }
         let (t0, t1) = t.as_slice().split_at(t.nrows());
-        let posed: Vec<[f64; 2]> = self
+        let posed: Vec<Point> = self
             .vertices
             .iter()
             .map(|v| {
@@ -216,20 +216,20 @@ impl FoldCheck {
                     x += a * t0[r] + b * t0[r + 1] + c * t0[r + 2];
                     y += a * t1[r] + b * t1[r + 1] + c * t1[r + 2];
                 }
-                [x, y]
+                Point::new(x, y)
             })
             .collect();
         self.folds_at(&posed, min_ratio)
     }
 
     /// The checked triangles below `min_ratio` with their vertices at `posed`.
-    fn folds_at(&self, posed: &[[f64; 2]], min_ratio: f64) -> Vec<Fold> {
+    fn folds_at(&self, posed: &[Point], min_ratio: f64) -> Vec<Fold> {
         self.triangles
             .iter()
             .enumerate()
             .filter_map(|(k, tri)| {
                 let [a, b, c] = tri.corners.map(|v| posed[v as usize]);
-                let now = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+                let now = (b - a).perp(&(c - a));
                 let ratio = now / tri.rest_area2;
                 (ratio < min_ratio).then_some(Fold {
                     triangle: k,

@@ -178,13 +178,13 @@ impl RigIk {
         pose.ik
             .iter()
             .map(|drag| {
-                let key = drag.at.map(f64::to_bits);
+                let key = [drag.at.x.to_bits(), drag.at.y.to_bits()];
                 // The same check as an uncached drag's: a cached grip is no licence.
                 check_drag(drag)?;
                 match self.gripped.get(&key) {
                     Some(row) => Ok(DragRow {
                         row: row.clone(),
-                        target: Point::new(drag.to[0], drag.to[1]),
+                        target: drag.to,
                         weight: drag.weight,
                     }),
                     _ => {
@@ -225,7 +225,7 @@ impl RigIk {
             if !keyed(i) {
                 columns.push(match options.bones {
                     BoneDofs::Rigid | BoneDofs::Uniform => ColumnDofs::Rigid {
-                        pivot: Point::new(bone.head[0], bone.head[1]),
+                        pivot: bone.head,
                         scale: options.bones == BoneDofs::Uniform
                             || options.stretch.contains(&bone.name),
                     },
@@ -237,7 +237,7 @@ impl RigIk {
                     joints.push(Joint {
                         child: i,
                         parent: p,
-                        at: Point::new(bone.head[0], bone.head[1]),
+                        at: bone.head,
                     });
                 }
                 continue;
@@ -351,7 +351,7 @@ impl RigIk {
     /// The skinning row of the material point a drag grips, and its target.
     pub fn drag_row(&self, drag: &IkDrag) -> Result<DragRow, IkError> {
         check_drag(drag)?;
-        let at = Point::new(drag.at[0], drag.at[1]);
+        let at = drag.at;
         let (mesh, triangle, barycentric) =
             grip(&self.meshes, at, self.solver.options.grip_tolerance_px)
                 .ok_or(IkError::DragOutside(at.x, at.y))?;
@@ -367,7 +367,7 @@ impl RigIk {
         }
         Ok(DragRow {
             row,
-            target: Point::new(drag.to[0], drag.to[1]),
+            target: drag.to,
             weight: drag.weight,
         })
     }

@@ -105,7 +105,8 @@ impl PartDoc {
     pub fn image_holds_mesh(&self, image_px: [u32; 2], reach_px: f64) -> bool {
         let [ox, oy] = self.offset_px.map(f64::from);
         let [w, h] = image_px.map(f64::from);
-        self.mesh.vertices.iter().all(|&[x, y]| {
+        self.mesh.vertices.iter().all(|&Point { coords: v }| {
+            let (x, y) = (v.x, v.y);
             x >= ox - reach_px
                 && y >= oy - reach_px
                 && x <= ox + w + reach_px
@@ -122,7 +123,8 @@ fn is_at_corner(offset_px: &[i32; 2]) -> bool {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct MeshDoc {
-    pub vertices: Vec<[f64; 2]>,
+    #[schemars(with = "Vec<[f64; 2]>")]
+    pub vertices: Vec<Point>,
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -200,7 +202,7 @@ fn deserialize_animations<'de, D: Deserializer<'de>>(
 impl From<&Mesh> for MeshDoc {
     fn from(mesh: &Mesh) -> Self {
         MeshDoc {
-            vertices: mesh.vertices.iter().map(|p| [p.x, p.y]).collect(),
+            vertices: mesh.vertices.clone(),
             triangles: mesh.triangles.clone(),
         }
     }
@@ -209,11 +211,7 @@ impl From<&Mesh> for MeshDoc {
 impl MeshDoc {
     pub fn to_mesh(&self) -> Mesh {
         Mesh {
-            vertices: self
-                .vertices
-                .iter()
-                .map(|v| Point::new(v[0], v[1]))
-                .collect(),
+            vertices: self.vertices.clone(),
             triangles: self.triangles.clone(),
         }
     }
@@ -480,7 +478,11 @@ mod tests {
             image: "body.png".into(),
             offset_px: [0, 0],
             mesh: MeshDoc {
-                vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+                vertices: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(1.0, 0.0),
+                    Point::new(0.0, 1.0),
+                ],
                 triangles: vec![[0, 1, 2]],
             },
             weights: None,
@@ -597,7 +599,7 @@ mod tests {
         let mut locked = doc.clone();
         locked.handles.points.push(crate::rig::PointHandle {
             name: "nose".into(),
-            at: [1.0, 1.0],
+            at: Point::new(1.0, 1.0),
         });
         locked.locked = vec!["nose".into()];
         let text = serde_json::to_string(&locked).unwrap();

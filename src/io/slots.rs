@@ -225,6 +225,7 @@ pub(super) fn validate_slots(doc: &RigDocument) -> Result<(), String> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::geom::Point;
     use crate::io::{MeshDoc, PartDoc};
     use std::path::Path;
 
@@ -237,7 +238,11 @@ pub(crate) mod tests {
             image: format!("{name}.png"),
             offset_px: [0, 0],
             mesh: MeshDoc {
-                vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+                vertices: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(1.0, 0.0),
+                    Point::new(0.0, 1.0),
+                ],
                 triangles: vec![[0, 1, 2]],
             },
             weights: None,

@@ -67,6 +67,8 @@ pub struct RenderSettings {
     pub blend: Blend,
     /// Exact curves, or as Spine's runtimes play them. Default exact.
     pub sampling: SampleOptions,
+    /// With the Spine runtime's sampling: the export it plays. Default: `sinew spine`'s defaults.
+    pub export: crate::export::spine::played::ExportPlayed,
 }
 
 /// The frame rate of [`RenderSettings::default`], frames per second.
@@ -81,6 +83,7 @@ impl Default for RenderSettings {
             background: None,
             blend: Blend::Linear,
             sampling: SampleOptions::default(),
+            export: Default::default(),
         }
     }
 }
@@ -130,7 +133,7 @@ pub fn render_events(
 /// The frames of `animation` (named `name`) at `times_s`: with exact curves, through the one
 /// pose path ([`crate::scene::frames`]); with [`CurveEvaluation::SpineRuntime`], as Spine's
 /// runtime plays the default Spine export ([`crate::export::spine::played`]: its curve
-/// evaluation, and the baked keys interpolated as it does).
+/// evaluation, and the baked keys interpolated as it does) of an export made with `export`.
 pub fn play(
     scene: &Scene,
     name: &str,
@@ -138,8 +141,9 @@ pub fn play(
     times_s: &[f64],
     looping: bool,
     sampling: &SampleOptions,
+    export: &crate::export::spine::played::ExportPlayed,
 ) -> Result<Vec<Frame>, RenderAnimationError> {
-    stream::Player::new(scene, name, animation, sampling, looping)?.frames(times_s)
+    stream::Player::new(scene, name, animation, sampling, export, looping)?.frames(times_s)
 }
 
 /// Why [`render_animation`] failed: its settings, or posing and drawing the rig.

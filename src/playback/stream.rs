@@ -11,7 +11,7 @@ use super::{
     frame_times, render_events, render_frames, FrameView, RenderAnimationError, RenderSettings,
 };
 use crate::anim::{Animation, CurveEvaluation, SampleOptions};
-use crate::export::spine::played::AsPlayed;
+use crate::export::spine::played::{AsPlayed, ExportPlayed};
 use crate::io::sequence::{self, FrameSource, SequenceError, SequenceOptions, SequenceReport};
 use crate::pipeline::Scene;
 use crate::scene::{Frame, PlayOptions, Playhead};
@@ -49,6 +49,7 @@ impl<'a> Player<'a> {
         name: &str,
         animation: &'a Animation,
         sampling: &SampleOptions,
+        export: &ExportPlayed,
         looping: bool,
     ) -> Result<Self, RenderAnimationError> {
         Ok(match sampling.curves {
@@ -61,15 +62,15 @@ impl<'a> Player<'a> {
                     scene, animation, options,
                 ))))
             }
-            CurveEvaluation::SpineRuntime => {
-                let options = crate::export::spine::SpineOptions::default();
-                Player::Runtime {
-                    played: Box::new(crate::export::spine::played::as_played(
-                        scene, name, animation, &options,
-                    )?),
-                    looping,
-                }
-            }
+            CurveEvaluation::SpineRuntime => Player::Runtime {
+                played: Box::new(crate::export::spine::played::as_played(
+                    scene,
+                    name,
+                    animation,
+                    &export.options(),
+                )?),
+                looping,
+            },
         })
     }
 
@@ -102,7 +103,14 @@ impl<'a> AnimationFrames<'a> {
     ) -> Result<Self, RenderAnimationError> {
         let view = settings.view(scene.doc.canvas)?;
         let times_s = frame_times(animation.duration_s(), settings.fps)?;
-        let player = Player::new(scene, name, animation, &settings.sampling, true)?;
+        let player = Player::new(
+            scene,
+            name,
+            animation,
+            &settings.sampling,
+            &settings.export,
+            true,
+        )?;
         Ok(AnimationFrames {
             scene,
             times_s,

@@ -36,7 +36,7 @@ use super::frames::{
 };
 pub use super::handles::BoneIk;
 use super::handles::Handles;
-use crate::geom::{Point, Vec2};
+use crate::geom::Point;
 
 /// FABRIK iterations for chains longer than two bones.
 pub const FABRIK_ITERATIONS: usize = 32;
@@ -122,7 +122,7 @@ fn bone_pose<'a>(
 
 fn bone_length(handles: &Handles, bone: usize) -> f64 {
     let b = &handles.bones[bone];
-    Vec2::new(b.tail[0] - b.head[0], b.tail[1] - b.head[1]).norm()
+    (b.tail - b.head).norm()
 }
 
 /// A bone's rest frame in its parent's rest frame (the canvas for a root bone), as
@@ -157,8 +157,8 @@ fn parent_world(handles: &Handles, frames: &[Affine], bone: usize) -> SpineWorld
 }
 
 /// A canvas point in Spine's axes (y flipped).
-fn spine_point(p: Point) -> [f64; 2] {
-    [p.x, -p.y]
+fn spine_point(p: Point) -> Point {
+    Point::new(p.x, -p.y)
 }
 
 /// A bone's applied local transform as spine-core holds it (`ax`, `ay`, `arotation`, …): in the
@@ -233,10 +233,10 @@ const SPINE_EPSILON: f64 = 1e-4;
 
 /// spine-core `apply1` (inheritance normal, no compress or stretch): the turn (degrees) to add
 /// to `bone`'s local rotation.
-fn apply1(bone: &SpineLocal, parent: &SpineWorld, target: [f64; 2], alpha: f64) -> f64 {
+fn apply1(bone: &SpineLocal, parent: &SpineWorld, target: Point, alpha: f64) -> f64 {
     let (pa, pb, pc, pd) = (parent.a, parent.b, parent.c, parent.d);
     let mut rotation_ik = -bone.shear_x - bone.rotation;
-    let (x, y) = (target[0] - parent.x, target[1] - parent.y);
+    let (x, y) = (target.x - parent.x, target.y - parent.y);
     let d = pa * pd - pb * pc;
     let (tx, ty) = if d.abs() <= SPINE_EPSILON {
         (0.0, 0.0)
@@ -271,7 +271,7 @@ fn apply2(
     parent_world: &SpineWorld,
     grandparent: &SpineWorld,
     child_length: f64,
-    target: [f64; 2],
+    target: Point,
     bend_positive: bool,
     softness: f64,
     alpha: f64,
@@ -327,7 +327,7 @@ fn apply2(
             child_y: Some(cy),
         };
     }
-    let (x, y) = (target[0] - pp.x, target[1] - pp.y);
+    let (x, y) = (target.x - pp.x, target.y - pp.y);
     let (mut tx, mut ty) = ((x * d - y * b) * id - px, (y * a - x * c) * id - py);
     let mut dd = tx * tx + ty * ty;
     if softness != 0.0 {
@@ -505,8 +505,8 @@ mod tests {
         let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
             name: name.into(),
             parent: parent.map(Into::into),
-            head,
-            tail,
+            head: head.into(),
+            tail: tail.into(),
         };
         Handles {
             bones: vec![
@@ -534,7 +534,7 @@ mod tests {
     fn end_of(handles: &Handles, pose: &Pose, bone: usize) -> Point {
         let frames = bone_world_frames(handles, pose).unwrap();
         let b = &handles.bones[bone];
-        let length = Vec2::new(b.tail[0] - b.head[0], b.tail[1] - b.head[1]).norm();
+        let length = (b.tail - b.head).norm();
         frames[bone].apply(Point::new(length, 0.0))
     }
 
@@ -567,7 +567,7 @@ mod tests {
     fn out_of_reach_straightens_and_mix_zero_is_forward_kinematics() {
         let mut c = two_bone_constraint(true);
         let mut handles = arm(c.clone());
-        handles.bones[3].head = [0.0, -400.0];
+        handles.bones[3].head = Point::new(0.0, -400.0);
         let pose = constrained_pose(&handles, &Pose::default()).unwrap();
         let end = end_of(&handles, &pose, 1);
         assert!((end - Point::new(0.0, -180.0)).norm() < 1e-9, "end {end:?}");
@@ -582,7 +582,7 @@ mod tests {
         let mut c = two_bone_constraint(true);
         c.softness_px = 20.0;
         let mut handles = arm(c);
-        handles.bones[3].head = [175.0, 0.0];
+        handles.bones[3].head = Point::new(175.0, 0.0);
         let pose = constrained_pose(&handles, &Pose::default()).unwrap();
         let reached = end_of(&handles, &pose, 1).coords.norm();
         assert!(reached < 175.0 && reached > 160.0, "soft reach {reached}");
@@ -598,7 +598,7 @@ mod tests {
             mix: 1.0,
             softness_px: 0.0,
         });
-        handles.bones[3].head = [60.0, -120.0];
+        handles.bones[3].head = Point::new(60.0, -120.0);
         let pose = constrained_pose(&handles, &Pose::default()).unwrap();
         let end = end_of(&handles, &pose, 2);
         assert!(
@@ -617,7 +617,7 @@ mod tests {
             mix: 1.0,
             softness_px: 0.0,
         });
-        handles.bones[3].head = [100.0, -50.0];
+        handles.bones[3].head = Point::new(100.0, -50.0);
         let mut keyed = Pose::default();
         keyed.bones.insert(
             "lower".into(),

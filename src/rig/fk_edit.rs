@@ -21,7 +21,7 @@ use crate::geom::{Point, Vec2};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FkEdit {
     /// Move by this offset, canvas px.
-    Grab { delta_px: [f64; 2] },
+    Grab { delta_px: Vec2 },
     /// Turn by this angle, degrees counter-clockwise on screen.
     Rotate { angle_deg: f64 },
     /// Multiply the scale by this factor (> 0), both axes.
@@ -49,17 +49,17 @@ pub struct FkTarget {
     pub is_bone: bool,
     /// The point edits turn and scale about: a bone's posed head, a point's posed position,
     /// canvas px.
-    pub pivot_px: [f64; 2],
+    pub pivot_px: Point,
     /// The handle's posed direction (a bone's head → tail; a point's x axis), canvas px, unit.
-    pub direction: [f64; 2],
+    pub direction: Vec2,
 }
 
 /// The on-screen counter-clockwise angle from `from` to `to` (vectors from a pivot), in
 /// (−180°, 180°].
-pub fn turn_deg(from: [f64; 2], to: [f64; 2]) -> f64 {
+pub fn turn_deg(from: Vec2, to: Vec2) -> f64 {
     // The canvas' y axis points down: counter-clockwise on screen is clockwise in (x, y).
-    let cross = from[0] * to[1] - from[1] * to[0];
-    let dot = from[0] * to[0] + from[1] * to[1];
+    let cross = from.perp(&to);
+    let dot = from.dot(&to);
     (-cross).atan2(dot).to_degrees()
 }
 
@@ -73,11 +73,7 @@ pub fn target(handles: &Handles, shown: &[Affine], name: &str) -> Result<FkTarge
             (i, true, bone_rest_frame(bone.head, bone.tail))
         } else if let Some(i) = handles.points.iter().position(|p| p.name == name) {
             let at = handles.points[i].at;
-            (
-                bone_count + i,
-                false,
-                Affine::translation(Vec2::new(at[0], at[1])),
-            )
+            (bone_count + i, false, Affine::translation(at.coords))
         } else {
             return Err(FkEditError::UnknownHandle(name.to_string()));
         };
@@ -85,14 +81,14 @@ pub fn target(handles: &Handles, shown: &[Affine], name: &str) -> Result<FkTarge
     let axis = world.linear.column(0);
     let length = axis.norm();
     let direction = if length > 0.0 {
-        [axis[0] / length, axis[1] / length]
+        axis / length
     } else {
-        [1.0, 0.0]
+        Vec2::x()
     };
     Ok(FkTarget {
         column,
         is_bone,
-        pivot_px: [world.translation.x, world.translation.y],
+        pivot_px: world.translation.into(),
         direction,
     })
 }
@@ -155,7 +151,7 @@ pub fn apply(
                 let inverse = world_from_parent
                     .inverse()
                     .ok_or_else(|| PoseError::Singular(bone.name.clone()))?;
-                let d = inverse.linear * Vec2::new(delta_px[0], delta_px[1]);
+                let d = inverse.linear * delta_px;
                 local.translate[0] += d.x;
                 local.translate[1] += d.y;
             }
@@ -189,9 +185,8 @@ pub fn apply(
 }
 
 /// Where `column`'s transform in `shown` puts a rest point, canvas px.
-pub fn shown_point(shown: &[Affine], column: usize, rest_px: [f64; 2]) -> [f64; 2] {
-    let p = shown[column].apply(Point::new(rest_px[0], rest_px[1]));
-    [p.x, p.y]
+pub fn shown_point(shown: &[Affine], column: usize, rest_px: Point) -> Point {
+    shown[column].apply(rest_px)
 }
 
 #[cfg(test)]
@@ -206,28 +201,29 @@ mod tests {
         h.bones.push(Bone {
             name: "upper".into(),
             parent: None,
-            head: [0.0, 0.0],
-            tail: [10.0, 0.0],
+            head: Point::new(0.0, 0.0),
+            tail: Point::new(10.0, 0.0),
         });
         h.bones.push(Bone {
             name: "fore".into(),
             parent: Some("upper".into()),
-            head: [10.0, 0.0],
-            tail: [20.0, 0.0],
+            head: Point::new(10.0, 0.0),
+            tail: Point::new(20.0, 0.0),
         });
         h.points.push(PointHandle {
             name: "p".into(),
-            at: [5.0, 5.0],
+            at: Point::new(5.0, 5.0),
         });
         h
     }
 
-    fn close(a: [f64; 2], b: [f64; 2]) -> bool {
-        (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9
+    fn close(a: Point, b: impl Into<Point>) -> bool {
+        let b = b.into();
+        (a.x - b.x).abs() < 1e-9 && (a.y - b.y).abs() < 1e-9
     }
 
     /// Where the pose puts a bone's head and tail.
-    fn ends(h: &Handles, pose: &Pose, bone: usize) -> ([f64; 2], [f64; 2]) {
+    fn ends(h: &Handles, pose: &Pose, bone: usize) -> (Point, Point) {
         let t = handle_transforms(h, pose).unwrap();
         let b = &h.bones[bone];
         (shown_point(&t, bone, b.head), shown_point(&t, bone, b.tail))
@@ -236,8 +232,8 @@ mod tests {
     #[test]
     fn turn_is_counter_clockwise_on_screen() {
         // +x to −y (up on screen) is a quarter turn counter-clockwise.
-        assert!((turn_deg([1.0, 0.0], [0.0, -1.0]) - 90.0).abs() < 1e-12);
-        assert!((turn_deg([1.0, 0.0], [0.0, 1.0]) + 90.0).abs() < 1e-12);
+        assert!((turn_deg(Vec2::new(1.0, 0.0), Vec2::new(0.0, -1.0)) - 90.0).abs() < 1e-12);
+        assert!((turn_deg(Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)) + 90.0).abs() < 1e-12);
     }
 
     #[test]
@@ -279,7 +275,7 @@ mod tests {
             &shown,
             "fore",
             FkEdit::Grab {
-                delta_px: [3.0, 4.0],
+                delta_px: Vec2::new(3.0, 4.0),
             },
         )
         .unwrap();
@@ -314,18 +310,18 @@ mod tests {
             &shown,
             "p",
             FkEdit::Grab {
-                delta_px: [1.0, 2.0],
+                delta_px: Vec2::new(1.0, 2.0),
             },
         )
         .unwrap();
         let t = handle_transforms(&h, &moved).unwrap();
-        assert!(close(shown_point(&t, 2, [5.0, 5.0]), [6.0, 7.0]));
+        assert!(close(shown_point(&t, 2, Point::new(5.0, 5.0)), [6.0, 7.0]));
         let turned = apply(&h, &moved, &t, "p", FkEdit::Rotate { angle_deg: 30.0 }).unwrap();
         let t = handle_transforms(&h, &turned).unwrap();
         // The pivot stays; a neighbour turns about it.
-        assert!(close(shown_point(&t, 2, [5.0, 5.0]), [6.0, 7.0]));
+        assert!(close(shown_point(&t, 2, Point::new(5.0, 5.0)), [6.0, 7.0]));
         let target = target(&h, &t, "p").unwrap();
-        assert!((turn_deg([1.0, 0.0], target.direction) - 30.0).abs() < 1e-9);
+        assert!((turn_deg(Vec2::new(1.0, 0.0), target.direction) - 30.0).abs() < 1e-9);
     }
 
     #[test]
@@ -352,8 +348,8 @@ mod tests {
         // The edited pose only has a drag: nothing keyed yet.
         let pose = Pose {
             ik: vec![IkDrag {
-                at: [20.0, 0.0],
-                to: [15.0, -12.0],
+                at: Point::new(20.0, 0.0),
+                to: Point::new(15.0, -12.0),
                 weight: None,
             }],
             ..Default::default()

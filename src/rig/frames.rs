@@ -131,7 +131,8 @@ impl Default for PointPose {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CagePose {
-    pub polygon: Vec<[f64; 2]>,
+    #[schemars(with = "Vec<[f64; 2]>")]
+    pub polygon: Vec<Point>,
 }
 
 /// A drag for skinning IK: the material point at rest position `at` goes to `to` (canvas px).
@@ -140,8 +141,10 @@ pub struct CagePose {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct IkDrag {
-    pub at: [f64; 2],
-    pub to: [f64; 2],
+    #[schemars(with = "[f64; 2]")]
+    pub at: Point,
+    #[schemars(with = "[f64; 2]")]
+    pub to: Point,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub weight: Option<f64>,
 }
@@ -186,7 +189,8 @@ pub struct Pose {
     /// Deform offsets by part: one per vertex of the part's mesh (canvas px, rest frame), added
     /// to the rest vertices before skinning ([`crate::anim::deform`]).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
-    pub deform: BTreeMap<String, Vec<[f64; 2]>>,
+    #[schemars(with = "BTreeMap<String, Vec<[f64; 2]>>")]
+    pub deform: BTreeMap<String, Vec<Vec2>>,
 }
 
 /// What is wrong with a pose for a given set of handles.
@@ -277,12 +281,10 @@ impl Pose {
             )?;
         }
         for (name, c) in &self.cages {
-            let numbers: Vec<f64> = c.polygon.iter().flatten().copied().collect();
-            bad(name, &numbers)?;
+            bad(name, crate::geom::point_numbers(&c.polygon))?;
         }
         for (name, offsets) in &self.deform {
-            let numbers: Vec<f64> = offsets.iter().flatten().copied().collect();
-            bad(name, &numbers)?;
+            bad(name, bytemuck::cast_slice(offsets))?;
         }
         for drag in &self.ik {
             drag.check()?;
@@ -312,11 +314,10 @@ pub(super) fn within_reach(transform: &Affine) -> bool {
 }
 
 /// A bone's rest frame: origin at the head, x axis along head → tail.
-pub fn bone_rest_frame(head: [f64; 2], tail: [f64; 2]) -> Affine {
-    let direction = Vec2::new(tail[0] - head[0], tail[1] - head[1]);
+pub fn bone_rest_frame(head: Point, tail: Point) -> Affine {
     Affine {
-        linear: rotation(screen_angle_deg(direction)),
-        translation: Vec2::new(head[0], head[1]),
+        linear: rotation(screen_angle_deg(tail - head)),
+        translation: head.coords,
     }
 }
 

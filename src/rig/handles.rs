@@ -6,6 +6,7 @@
 //! known and acyclic, bones of non-zero length, polygons of at least three points, every
 //! coordinate finite.
 
+use crate::geom::Point;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashMap, HashSet};
 
@@ -17,8 +18,10 @@ pub struct Bone {
     pub name: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub parent: Option<String>,
-    pub head: [f64; 2],
-    pub tail: [f64; 2],
+    #[schemars(with = "[f64; 2]")]
+    pub head: Point,
+    #[schemars(with = "[f64; 2]")]
+    pub tail: Point,
 }
 
 /// A loose point handle at `at` (canvas px).
@@ -26,7 +29,8 @@ pub struct Bone {
 #[serde(deny_unknown_fields)]
 pub struct PointHandle {
     pub name: String,
-    pub at: [f64; 2],
+    #[schemars(with = "[f64; 2]")]
+    pub at: Point,
 }
 
 /// A cage: a closed polygon (canvas px) whose vertices are handles.
@@ -34,7 +38,8 @@ pub struct PointHandle {
 #[serde(deny_unknown_fields)]
 pub struct Cage {
     pub name: String,
-    pub polygon: Vec<[f64; 2]>,
+    #[schemars(with = "Vec<[f64; 2]>")]
+    pub polygon: Vec<Point>,
 }
 
 /// A region: a closed polygon (canvas px) whose inside moves rigidly together.
@@ -42,7 +47,8 @@ pub struct Cage {
 #[serde(deny_unknown_fields)]
 pub struct Region {
     pub name: String,
-    pub polygon: Vec<[f64; 2]>,
+    #[schemars(with = "Vec<[f64; 2]>")]
+    pub polygon: Vec<Point>,
 }
 
 /// Every handle of a rig, in file order.
@@ -161,10 +167,9 @@ pub const MIN_POLYGON_AREA_PX2: f64 = 1e-6;
 
 /// What is wrong with a cage's or region's outline: a repeated vertex, edges that cross or
 /// double back, or no area. `None` for a simple polygon.
-pub fn polygon_problem(polygon: &[[f64; 2]]) -> Option<String> {
-    use crate::geom::{segments_touch, triangle_area2, Point};
-    let n = polygon.len();
-    let p: Vec<Point> = polygon.iter().map(|v| Point::new(v[0], v[1])).collect();
+pub fn polygon_problem(p: &[Point]) -> Option<String> {
+    use crate::geom::{segments_touch, triangle_area2};
+    let n = p.len();
     for i in 0..n {
         if p[i] == p[(i + 1) % n] {
             return Some(format!("vertex {} repeats vertex {i}", (i + 1) % n));
@@ -374,11 +379,11 @@ impl Handles {
             }
         }
         for b in &self.bones {
-            if !b.head.iter().chain(&b.tail).all(|v| v.is_finite()) {
+            if !b.head.iter().chain(b.tail.iter()).all(|v| v.is_finite()) {
                 return Err(HandleError::NonFinite(b.name.clone()));
             }
-            check_reach(&b.name, b.head.iter().chain(&b.tail))?;
-            if (b.tail[0] - b.head[0]).hypot(b.tail[1] - b.head[1]) < MIN_BONE_LENGTH_PX {
+            check_reach(&b.name, b.head.iter().chain(b.tail.iter()))?;
+            if (b.tail - b.head).norm() < MIN_BONE_LENGTH_PX {
                 return Err(HandleError::DegenerateBone(b.name.clone()));
             }
         }
@@ -392,7 +397,7 @@ impl Handles {
         for (kind, name, polygon) in
             polygons.chain(self.regions.iter().map(|r| ("region", &r.name, &r.polygon)))
         {
-            if !polygon.iter().flatten().all(|v| v.is_finite()) {
+            if !polygon.iter().flat_map(|p| p.iter()).all(|v| v.is_finite()) {
                 return Err(HandleError::NonFinite(name.clone()));
             }
             let distinct: HashSet<(u64, u64)> = polygon
@@ -405,7 +410,7 @@ impl Handles {
                     name: name.clone(),
                 });
             }
-            check_reach(name, polygon.iter().flatten())?;
+            check_reach(name, polygon.iter().flat_map(|p| p.iter()))?;
             if let Some(problem) = polygon_problem(polygon) {
                 return Err(HandleError::BadPolygon {
                     kind,
@@ -599,8 +604,8 @@ mod tests {
         Bone {
             name: name.into(),
             parent: parent.map(Into::into),
-            head: [0.0, 0.0],
-            tail: [0.0, 10.0],
+            head: Point::new(0.0, 0.0),
+            tail: Point::new(0.0, 10.0),
         }
     }
 
@@ -650,7 +655,7 @@ mod tests {
             bones: vec![bone("a", None)],
             points: vec![PointHandle {
                 name: "a".into(),
-                at: [1.0, 1.0],
+                at: Point::new(1.0, 1.0),
             }],
             ..Default::default()
         };
@@ -684,7 +689,7 @@ mod tests {
         let nan = Handles {
             points: vec![PointHandle {
                 name: "p".into(),
-                at: [f64::NAN, 0.0],
+                at: Point::new(f64::NAN, 0.0),
             }],
             ..Default::default()
         };
@@ -692,7 +697,11 @@ mod tests {
         let flat = Handles {
             cages: vec![Cage {
                 name: "c".into(),
-                polygon: vec![[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]],
+                polygon: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(1.0, 1.0),
+                    Point::new(0.0, 0.0),
+                ],
             }],
             ..Default::default()
         };
@@ -707,11 +716,15 @@ mod tests {
         let mut h = Handles {
             points: vec![PointHandle {
                 name: "p".into(),
-                at: [0.0, 0.0],
+                at: Point::new(0.0, 0.0),
             }],
             cages: vec![Cage {
                 name: "c".into(),
-                polygon: vec![[0.0, 0.0], [9.0, 0.0], [0.0, 9.0]],
+                polygon: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(9.0, 0.0),
+                    Point::new(0.0, 9.0),
+                ],
             }],
             ..Default::default()
         };
@@ -735,8 +748,8 @@ mod tests {
         let bone = |name: &str, x: f64| Bone {
             name: name.into(),
             parent: None,
-            head: [x, 0.0],
-            tail: [x, 10.0],
+            head: Point::new(x, 0.0),
+            tail: Point::new(x, 10.0),
         };
         let ik = |name: &str, chain: &str, target: &str| BoneIk {
             name: name.into(),

@@ -519,7 +519,10 @@ mod tests {
 
     #[test]
     fn canvas_frames_round_trip_through_spines_axes() {
-        let frame = crate::rig::pose::bone_rest_frame([3.0, 4.0], [13.0, -6.0]);
+        let frame = crate::rig::pose::bone_rest_frame(
+            crate::geom::Point::new(3.0, 4.0),
+            crate::geom::Point::new(13.0, -6.0),
+        );
         let spine = SpineWorld::from_canvas(&frame);
         // 45° up on screen: counter-clockwise in Spine's y-up axes too.
         assert!((spine.c.atan2(spine.a).to_degrees() - 45.0).abs() < 1e-12);

@@ -117,10 +117,7 @@ pub fn bone_stretches_under(
             translation: Vec2::zeros(),
         };
         let rigid = world.then_after(&unscale).then_after(&rest_inverse);
-        let (head, tail) = (
-            Point::new(bone.head[0], bone.head[1]),
-            Point::new(bone.tail[0], bone.tail[1]),
-        );
+        let (head, tail) = (bone.head, bone.tail);
         let axis = tail - head;
         out.push(Some(BoneStretch {
             rigid,
@@ -164,7 +161,7 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
             return Err(PoseError::NonFinite(point.name.clone()));
         }
         // About the rest position: move there, turn and scale, move back, then translate.
-        let at = Vec2::new(point.at[0], point.at[1]);
+        let at = point.at.coords;
         let linear = local_linear(p.rotate, p.scale, p.shear);
         out.push(Affine {
             linear,
@@ -186,7 +183,7 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
                         expected: cage.polygon.len(),
                     });
                 }
-                if !finite(&posed.polygon.iter().flatten().copied().collect::<Vec<_>>()) {
+                if !finite(crate::geom::point_numbers(&posed.polygon)) {
                     return Err(PoseError::NonFinite(cage.name.clone()));
                 }
                 for (rest, to) in cage.polygon.iter().zip(&posed.polygon) {
@@ -257,7 +254,7 @@ pub fn pose_from_transforms(handles: &Handles, transforms: &[Affine]) -> Result<
         let t = &transforms[j];
         let (rotate, scale, shear) =
             decompose_linear(&t.linear).ok_or_else(|| PoseError::Singular(point.name.clone()))?;
-        let at = Vec2::new(point.at[0], point.at[1]);
+        let at = point.at.coords;
         let translate = t.translation - at + t.linear * at;
         pose.points.insert(
             point.name.clone(),
@@ -275,10 +272,7 @@ pub fn pose_from_transforms(handles: &Handles, transforms: &[Affine]) -> Result<
             .polygon
             .iter()
             .enumerate()
-            .map(|(k, v)| {
-                let p = transforms[j + k].apply(Point::new(v[0], v[1]));
-                [p.x, p.y]
-            })
+            .map(|(k, &v)| transforms[j + k].apply(v))
             .collect();
         pose.cages.insert(cage.name.clone(), CagePose { polygon });
         j += cage.polygon.len();
@@ -335,19 +329,19 @@ mod tests {
                 Bone {
                     name: "upper".into(),
                     parent: None,
-                    head: [0.0, 0.0],
-                    tail: [10.0, 0.0],
+                    head: Point::new(0.0, 0.0),
+                    tail: Point::new(10.0, 0.0),
                 },
                 Bone {
                     name: "lower".into(),
                     parent: Some("upper".into()),
-                    head: [10.0, 0.0],
-                    tail: [20.0, 0.0],
+                    head: Point::new(10.0, 0.0),
+                    tail: Point::new(20.0, 0.0),
                 },
             ],
             points: vec![PointHandle {
                 name: "p".into(),
-                at: [5.0, 5.0],
+                at: Point::new(5.0, 5.0),
             }],
             ..Default::default()
         }
@@ -396,8 +390,8 @@ mod tests {
             bones: vec![Bone {
                 name: "b".into(),
                 parent: None,
-                head: [0.0, 0.0],
-                tail: [0.0, 10.0],
+                head: Point::new(0.0, 0.0),
+                tail: Point::new(0.0, 10.0),
             }],
             ..Default::default()
         };

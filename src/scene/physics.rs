@@ -60,7 +60,7 @@ impl PhysicsRun {
             .filter_map(|c| {
                 let bone = handles.bones.iter().position(|b| b.name == c.bone)?;
                 let b = &handles.bones[bone];
-                let length_px = (b.tail[0] - b.head[0]).hypot(b.tail[1] - b.head[1]);
+                let length_px = (b.tail - b.head).norm();
                 let mut carried = vec![bone];
                 // Parents are acyclic: grow the set until no bone joins.
                 loop {

@@ -17,17 +17,13 @@ use crate::rig::Handles;
 /// handle vertices on the geometry up to floating-point rounding of edge splits.
 pub const ON_HANDLE_TOLERANCE_PX: f64 = 1e-6;
 
-fn pt(a: [f64; 2]) -> Point {
-    Point::new(a[0], a[1])
-}
-
 /// Per vertex, each handle's claim: (column, weight) lists summing to one.
 fn claims(vertices: &[Point], handles: &Handles, columns: usize) -> Vec<Vec<Vec<(usize, f64)>>> {
     let tol = ON_HANDLE_TOLERANCE_PX;
     let mut claims: Vec<Vec<Vec<(usize, f64)>>> = vec![Vec::new(); vertices.len()];
     let mut column = 0;
     for bone in &handles.bones {
-        let (a, b) = (pt(bone.head), pt(bone.tail));
+        let (a, b) = (bone.head, bone.tail);
         for (i, &p) in vertices.iter().enumerate() {
             if segment_distance(p, a, b).0 <= tol {
                 claims[i].push(vec![(column, 1.0)]);
@@ -37,7 +33,7 @@ fn claims(vertices: &[Point], handles: &Handles, columns: usize) -> Vec<Vec<Vec<
     }
     for point in &handles.points {
         for (i, &p) in vertices.iter().enumerate() {
-            if (p - pt(point.at)).norm() <= tol {
+            if (p - point.at).norm() <= tol {
                 claims[i].push(vec![(column, 1.0)]);
             }
         }
@@ -48,7 +44,7 @@ fn claims(vertices: &[Point], handles: &Handles, columns: usize) -> Vec<Vec<Vec<
         for (i, &p) in vertices.iter().enumerate() {
             // A cage corner lies on two edges; take the first edge that holds the vertex.
             for k in 0..n {
-                let (a, b) = (pt(cage.polygon[k]), pt(cage.polygon[(k + 1) % n]));
+                let (a, b) = (cage.polygon[k], cage.polygon[(k + 1) % n]);
                 let (d, t) = segment_distance(p, a, b);
                 if d <= tol {
                     claims[i].push(vec![(column + k, 1.0 - t), (column + (k + 1) % n, t)]);
@@ -59,11 +55,11 @@ fn claims(vertices: &[Point], handles: &Handles, columns: usize) -> Vec<Vec<Vec<
         column += n;
     }
     for region in &handles.regions {
-        let ring: Vec<Point> = region.polygon.iter().map(|&a| pt(a)).collect();
+        let ring = &region.polygon;
         let n = ring.len();
         for (i, &p) in vertices.iter().enumerate() {
             let on_edge = (0..n).any(|k| segment_distance(p, ring[k], ring[(k + 1) % n]).0 <= tol);
-            if on_edge || point_in_ring(p, &ring) {
+            if on_edge || point_in_ring(p, ring) {
                 claims[i].push(vec![(column, 1.0)]);
             }
         }
@@ -138,22 +134,22 @@ pub fn distance_to_column(p: Point, handles: &Handles, column: usize) -> f64 {
     let mut c = column;
     if c < handles.bones.len() {
         let b = &handles.bones[c];
-        return segment_distance(p, pt(b.head), pt(b.tail)).0;
+        return segment_distance(p, b.head, b.tail).0;
     }
     c -= handles.bones.len();
     if c < handles.points.len() {
-        return (p - pt(handles.points[c].at)).norm();
+        return (p - handles.points[c].at).norm();
     }
     c -= handles.points.len();
     for cage in &handles.cages {
         if c < cage.polygon.len() {
-            return (p - pt(cage.polygon[c])).norm();
+            return (p - cage.polygon[c]).norm();
         }
         c -= cage.polygon.len();
     }
     let region = &handles.regions[c];
-    let ring: Vec<Point> = region.polygon.iter().map(|&a| pt(a)).collect();
-    if point_in_ring(p, &ring) {
+    let ring = &region.polygon;
+    if point_in_ring(p, ring) {
         return 0.0;
     }
     (0..ring.len())
@@ -180,29 +176,38 @@ mod tests {
                 Bone {
                     name: "a".into(),
                     parent: None,
-                    head: [0.0, 0.0],
-                    tail: [10.0, 0.0],
+                    head: Point::new(0.0, 0.0),
+                    tail: Point::new(10.0, 0.0),
                 },
                 Bone {
                     name: "b".into(),
                     parent: Some("a".into()),
-                    head: [10.0, 0.0],
-                    tail: [20.0, 0.0],
+                    head: Point::new(10.0, 0.0),
+                    tail: Point::new(20.0, 0.0),
                 },
             ],
             points: vec![PointHandle {
                 name: "p".into(),
-                at: [5.0, 5.0],
+                at: Point::new(5.0, 5.0),
             }],
             bind: Default::default(),
             ik: Vec::new(),
             cages: vec![Cage {
                 name: "c".into(),
-                polygon: vec![[30.0, 0.0], [40.0, 0.0], [40.0, 10.0]],
+                polygon: vec![
+                    Point::new(30.0, 0.0),
+                    Point::new(40.0, 0.0),
+                    Point::new(40.0, 10.0),
+                ],
             }],
             regions: vec![Region {
                 name: "r".into(),
-                polygon: vec![[0.0, 20.0], [4.0, 20.0], [4.0, 24.0], [0.0, 24.0]],
+                polygon: vec![
+                    Point::new(0.0, 20.0),
+                    Point::new(4.0, 20.0),
+                    Point::new(4.0, 24.0),
+                    Point::new(0.0, 24.0),
+                ],
             }],
         };
         let vertices = [

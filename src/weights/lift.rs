@@ -11,6 +11,7 @@
 //! (`colorize`) both build their domain here, so the two cannot drift apart.
 
 use super::solve::Domain;
+use crate::geom::Point;
 
 /// What is wrong with a lift request.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -23,7 +24,7 @@ pub enum LiftError {
 
 /// The points (x, y, s·r, s·g, s·b), one per vertex.
 pub fn lift_points(
-    positions: &[[f64; 2]],
+    positions: &[Point],
     colors: &[[f64; 3]],
     scale: f64,
 ) -> Result<Vec<[f64; 5]>, LiftError> {
@@ -36,13 +37,13 @@ pub fn lift_points(
     Ok(positions
         .iter()
         .zip(colors)
-        .map(|(p, c)| [p[0], p[1], scale * c[0], scale * c[1], scale * c[2]])
+        .map(|(p, c)| [p.x, p.y, scale * c[0], scale * c[1], scale * c[2]])
         .collect())
 }
 
 /// The weight domain of the mesh measured on its lifted points.
 pub fn content_aware_domain(
-    positions: &[[f64; 2]],
+    positions: &[Point],
     colors: &[[f64; 3]],
     scale: f64,
     triangles: &[[u32; 3]],
@@ -60,9 +61,14 @@ mod tests {
     #[test]
     fn a_color_edge_weakens_the_stiffness_across_it() {
         // Two triangles sharing the edge 1–2; vertex 3 has another color.
-        let positions = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+        let positions = [
+            Point::new(0.0, 0.0),
+            Point::new(1.0, 0.0),
+            Point::new(0.0, 1.0),
+            Point::new(1.0, 1.0),
+        ];
         let triangles = [[0, 1, 2], [1, 3, 2]];
-        let flat = Domain::new(&positions, &triangles);
+        let flat = Domain::planar(&positions, &triangles);
         let same = content_aware_domain(&positions, &[[0.5; 3]; 4], 100.0, &triangles).unwrap();
         // One color everywhere: the lift changes nothing.
         assert_eq!(flat.stiffness.to_dense(), same.stiffness.to_dense());
@@ -76,15 +82,15 @@ mod tests {
     #[test]
     fn bad_requests_are_errors() {
         assert!(matches!(
-            lift_points(&[[0.0, 0.0]], &[[0.0; 3]], f64::NAN),
+            lift_points(&[Point::new(0.0, 0.0)], &[[0.0; 3]], f64::NAN),
             Err(LiftError::InvalidScale(_))
         ));
         assert!(matches!(
-            lift_points(&[[0.0, 0.0]], &[[0.0; 3]], -1.0),
+            lift_points(&[Point::new(0.0, 0.0)], &[[0.0; 3]], -1.0),
             Err(LiftError::InvalidScale(_))
         ));
         assert_eq!(
-            lift_points(&[[0.0, 0.0]], &[], 1.0),
+            lift_points(&[Point::new(0.0, 0.0)], &[], 1.0),
             Err(LiftError::ColorCount(0, 1))
         );
     }

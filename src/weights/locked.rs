@@ -119,10 +119,10 @@ pub fn keep_locked(
 /// outline grew) gets the row of the nearest old vertex. Rows that sum to one blend to rows
 /// that sum to one.
 pub fn transfer_rows(
-    from_vertices: &[[f64; 2]],
+    from_vertices: &[Point],
     from_triangles: &[[u32; 3]],
     from_rows: &[Vec<(u32, f64)>],
-    to_px: &[[f64; 2]],
+    to_px: &[Point],
 ) -> Result<Vec<Vec<(u32, f64)>>, LockError> {
     let n = from_vertices.len();
     check_row_count(from_rows, n)?;
@@ -131,13 +131,12 @@ pub fn transfer_rows(
     }
     check_triangles(from_triangles, n)?;
     let grid = TriangleGrid::new(from_vertices, from_triangles);
-    let pt = |p: [f64; 2]| Point::new(p[0], p[1]);
     Ok(to_px
         .iter()
         .map(|&p| {
             let inside = grid.candidates(p).find_map(|t| {
-                let [a, b, c] = from_triangles[t].map(|v| pt(from_vertices[v as usize]));
-                let w = barycentric(pt(p), a, b, c)?;
+                let [a, b, c] = from_triangles[t].map(|v| from_vertices[v as usize]);
+                let w = barycentric(p, a, b, c)?;
                 // A hair of slack so points on shared edges are not lost between triangles.
                 w.iter()
                     .all(|&x| x >= -1e-9)
@@ -164,10 +163,7 @@ pub fn transfer_rows(
                 None => {
                     let nearest = (0..n)
                         .min_by(|&i, &j| {
-                            let d = |k: usize| {
-                                let q = from_vertices[k];
-                                (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)
-                            };
+                            let d = |k: usize| (from_vertices[k] - p).norm_squared();
                             d(i).total_cmp(&d(j))
                         })
                         .unwrap_or(0);
@@ -180,14 +176,14 @@ pub fn transfer_rows(
 
 /// Triangles bucketed by the grid cells their bounding boxes overlap, for point location.
 struct TriangleGrid {
-    origin: [f64; 2],
+    origin: Point,
     cell_px: f64,
     size: [usize; 2],
     cells: Vec<Vec<usize>>,
 }
 
 impl TriangleGrid {
-    fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Self {
+    fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> Self {
         let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
         for v in vertices {
             for k in 0..2 {
@@ -205,7 +201,7 @@ impl TriangleGrid {
         ];
         let cell_px = (extent[0] / size[0] as f64).max(extent[1] / size[1] as f64);
         let mut grid = TriangleGrid {
-            origin: lo,
+            origin: lo.into(),
             cell_px,
             size,
             cells: vec![Vec::new(); size[0] * size[1]],
@@ -214,7 +210,7 @@ impl TriangleGrid {
             let ps = tri.map(|v| vertices[v as usize]);
             let min = [0, 1].map(|k| ps.iter().map(|p| p[k]).fold(f64::MAX, f64::min));
             let max = [0, 1].map(|k| ps.iter().map(|p| p[k]).fold(f64::MIN, f64::max));
-            let (c0, c1) = (grid.cell(min), grid.cell(max));
+            let (c0, c1) = (grid.cell(min.into()), grid.cell(max.into()));
             for y in c0[1]..=c1[1] {
                 for x in c0[0]..=c1[0] {
                     grid.cells[y * size[0] + x].push(t);
@@ -225,7 +221,7 @@ impl TriangleGrid {
     }
 
     /// The cell holding `p`, clamped to the grid.
-    fn cell(&self, p: [f64; 2]) -> [usize; 2] {
+    fn cell(&self, p: Point) -> [usize; 2] {
         [0, 1].map(|k| {
             let i = ((p[k] - self.origin[k]) / self.cell_px).floor();
             if i.is_nan() {
@@ -237,7 +233,7 @@ impl TriangleGrid {
     }
 
     /// Triangles whose bounding box may contain `p`.
-    fn candidates(&self, p: [f64; 2]) -> impl Iterator<Item = usize> + '_ {
+    fn candidates(&self, p: Point) -> impl Iterator<Item = usize> + '_ {
         let c = self.cell(p);
         self.cells[c[1] * self.size[0] + c[0]].iter().copied()
     }
@@ -334,7 +330,12 @@ mod tests {
     #[test]
     fn rows_carry_over_to_a_new_mesh() {
         // Old mesh: the unit square (10 px) as two triangles, column 0 at x = 0, 1 at x = 10.
-        let from = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let from = [
+            Point::new(0.0, 0.0),
+            Point::new(10.0, 0.0),
+            Point::new(10.0, 10.0),
+            Point::new(0.0, 10.0),
+        ];
         let tris = [[0, 1, 2], [0, 2, 3]];
         let rows = vec![
             vec![(0, 1.0)],
@@ -342,7 +343,12 @@ mod tests {
             vec![(1, 1.0)],
             vec![(0, 1.0)],
         ];
-        let to = [[2.5, 5.0], [10.0, 10.0], [5.0, 5.0], [14.0, 3.0]];
+        let to = [
+            Point::new(2.5, 5.0),
+            Point::new(10.0, 10.0),
+            Point::new(5.0, 5.0),
+            Point::new(14.0, 3.0),
+        ];
         let carried = transfer_rows(&from, &tris, &rows, &to).unwrap();
         sums_to_one(&carried);
         let w1 = |r: &Vec<(u32, f64)>| r.iter().find(|e| e.0 == 1).map_or(0.0, |e| e.1);

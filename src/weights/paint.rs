@@ -31,6 +31,7 @@
 //! stroke dab by dab and commit the whole stroke once, getting the same weights.
 
 use super::rows::{check_columns, check_row_count, check_triangles, RowsError};
+use crate::geom::Point;
 use serde::{Deserialize, Serialize};
 
 /// What a dab does to the painted column.
@@ -111,7 +112,7 @@ pub enum PaintError {
     #[error("invalid brush option: {0}")]
     InvalidOptions(String),
     #[error("a brush position is not finite: {0:?}")]
-    NotFinite([f64; 2]),
+    NotFinite(Point),
     #[error("column {column} is painted, but the weights have {columns} columns")]
     UnknownColumn { column: usize, columns: usize },
     #[error("column {0} is locked")]
@@ -126,13 +127,13 @@ pub enum PaintError {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PaintMesh {
     /// Rest positions, canvas px.
-    pub vertices: Vec<[f64; 2]>,
+    pub vertices: Vec<Point>,
     /// Per vertex, the vertices sharing an edge with it, sorted.
     pub neighbours: Vec<Vec<u32>>,
 }
 
 impl PaintMesh {
-    pub fn new(vertices: &[[f64; 2]], triangles: &[[u32; 3]]) -> Result<Self, PaintError> {
+    pub fn new(vertices: &[Point], triangles: &[[u32; 3]]) -> Result<Self, PaintError> {
         let n = vertices.len();
         check_triangles(triangles, n)?;
         Ok(PaintMesh {
@@ -189,14 +190,11 @@ pub fn check_options(options: &BrushOptions) -> Result<(), PaintError> {
 /// The dab centres of a stroke through `samples_px`: its first sample, then every
 /// `spacing × radius` px of arc length along the polyline (the last partial step gets no dab,
 /// so a longer stroke only appends dabs). No samples: no dabs.
-pub fn dab_centres(
-    samples_px: &[[f64; 2]],
-    options: &BrushOptions,
-) -> Result<Vec<[f64; 2]>, PaintError> {
+pub fn dab_centres(samples_px: &[Point], options: &BrushOptions) -> Result<Vec<Point>, PaintError> {
     check_options(options)?;
     if let Some(bad) = samples_px
         .iter()
-        .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+        .find(|p| !(p.x.is_finite() && p.y.is_finite()))
     {
         return Err(PaintError::NotFinite(*bad));
     }
@@ -209,12 +207,12 @@ pub fn dab_centres(
     let mut to_next = step_px;
     for pair in samples_px.windows(2) {
         let (a, b) = (pair[0], pair[1]);
-        let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+        let length = (b - a).norm();
         let mut at = 0.0;
         while length - at >= to_next {
             at += to_next;
             let t = at / length;
-            dabs.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            dabs.push(a + t * (b - a));
             to_next = step_px;
         }
         to_next -= length - at;
@@ -267,7 +265,7 @@ pub fn paint_stroke(
     rows: &mut [Vec<(u32, f64)>],
     target: &PaintTarget,
     mode: BrushMode,
-    samples_px: &[[f64; 2]],
+    samples_px: &[Point],
     options: &BrushOptions,
 ) -> Result<StrokeReport, PaintError> {
     check_target(mesh, rows, target)?;
@@ -286,12 +284,12 @@ pub fn paint_dab(
     rows: &mut [Vec<(u32, f64)>],
     target: &PaintTarget,
     mode: BrushMode,
-    centre_px: [f64; 2],
+    centre_px: Point,
     options: &BrushOptions,
 ) -> Result<StrokeReport, PaintError> {
     check_target(mesh, rows, target)?;
     check_options(options)?;
-    if !(centre_px[0].is_finite() && centre_px[1].is_finite()) {
+    if !(centre_px.x.is_finite() && centre_px.y.is_finite()) {
         return Err(PaintError::NotFinite(centre_px));
     }
     Ok(apply_dab(mesh, rows, target, mode, centre_px, options))
@@ -310,7 +308,7 @@ fn apply_dab(
     rows: &mut [Vec<(u32, f64)>],
     target: &PaintTarget,
     mode: BrushMode,
-    centre: [f64; 2],
+    centre: Point,
     options: &BrushOptions,
 ) -> StrokeReport {
     let PaintTarget {
@@ -323,7 +321,7 @@ fn apply_dab(
     // not see half a dab, and the fallback spread reads the neighbours as they were.
     let mut changes: Vec<(usize, f64, Vec<f64>)> = Vec::new();
     for (i, p) in mesh.vertices.iter().enumerate() {
-        let d = (p[0] - centre[0]).hypot(p[1] - centre[1]);
+        let d = (p - centre).norm();
         let a = options.strength * options.falloff.factor(d, r);
         if a <= 0.0 {
             continue;
@@ -522,11 +520,11 @@ mod tests {
     use super::*;
 
     /// A grid of `n × n` vertices, `step` px apart, two triangles per cell.
-    fn grid(n: usize, step: f64) -> (Vec<[f64; 2]>, Vec<[u32; 3]>) {
+    fn grid(n: usize, step: f64) -> (Vec<Point>, Vec<[u32; 3]>) {
         let mut vertices = Vec::new();
         for y in 0..n {
             for x in 0..n {
-                vertices.push([x as f64 * step, y as f64 * step]);
+                vertices.push(Point::new(x as f64 * step, y as f64 * step));
             }
         }
         let mut triangles = Vec::new();
@@ -542,7 +540,7 @@ mod tests {
     }
 
     /// Three columns varying smoothly over the grid: left, right, and a bump in the middle.
-    fn rows_for(vertices: &[[f64; 2]], width: f64) -> Vec<Vec<(u32, f64)>> {
+    fn rows_for(vertices: &[Point], width: f64) -> Vec<Vec<(u32, f64)>> {
         vertices
             .iter()
             .map(|p| {
@@ -587,7 +585,7 @@ mod tests {
             strength: 0.4,
             ..Default::default()
         };
-        let stroke = [[20.0, 50.0], [80.0, 50.0]];
+        let stroke = [Point::new(20.0, 50.0), Point::new(80.0, 50.0)];
         let mut rows = before.clone();
         let report = paint_stroke(
             &mesh,
@@ -696,7 +694,7 @@ mod tests {
             strength: 0.8,
             ..Default::default()
         };
-        let stroke = [[50.0, 20.0], [50.0, 80.0]];
+        let stroke = [Point::new(50.0, 20.0), Point::new(50.0, 80.0)];
         paint_stroke(
             &mesh,
             &mut rows,
@@ -750,7 +748,7 @@ mod tests {
                 max_influences: None,
             },
             BrushMode::Add,
-            &[[20.0, 20.0]],
+            &[Point::new(20.0, 20.0)],
             &options,
         )
         .unwrap();
@@ -758,7 +756,7 @@ mod tests {
         assert_eq!(same, rows);
         // Painting a locked column is refused, as are bad options and rows.
         let mut copy = rows.clone();
-        let mut add_at = |locked: &[bool], column: usize, at: [f64; 2], options: &BrushOptions| {
+        let mut add_at = |locked: &[bool], column: usize, at: Point, options: &BrushOptions| {
             paint_stroke(
                 &mesh,
                 &mut copy,
@@ -773,7 +771,7 @@ mod tests {
             )
         };
         assert_eq!(
-            add_at(&[true, false, false], 0, [0.0, 0.0], &options),
+            add_at(&[true, false, false], 0, Point::new(0.0, 0.0), &options),
             Err(PaintError::LockedColumn(0))
         );
         let bad = BrushOptions {
@@ -781,19 +779,19 @@ mod tests {
             ..options
         };
         assert!(matches!(
-            add_at(&[false; 3], 0, [0.0, 0.0], &bad),
+            add_at(&[false; 3], 0, Point::new(0.0, 0.0), &bad),
             Err(PaintError::InvalidOptions(_))
         ));
         assert!(matches!(
-            add_at(&[false; 3], 3, [0.0, 0.0], &options),
+            add_at(&[false; 3], 3, Point::new(0.0, 0.0), &options),
             Err(PaintError::UnknownColumn { .. })
         ));
         assert!(matches!(
-            add_at(&[false; 2], 0, [0.0, 0.0], &options),
+            add_at(&[false; 2], 0, Point::new(0.0, 0.0), &options),
             Err(PaintError::Rows(RowsError::Column { .. }))
         ));
         assert!(matches!(
-            add_at(&[false; 3], 0, [f64::NAN, 0.0], &options),
+            add_at(&[false; 3], 0, Point::new(f64::NAN, 0.0), &options),
             Err(PaintError::NotFinite(_))
         ));
         assert_eq!(copy, rows);
@@ -803,12 +801,12 @@ mod tests {
     fn subtracting_a_sole_influence_spreads_to_the_neighbours_columns() {
         // A strip: vertices 0..3 weigh column 0 only, the last column 1 only.
         let v = [
-            [0.0, 0.0],
-            [10.0, 0.0],
-            [20.0, 0.0],
-            [0.0, 10.0],
-            [10.0, 10.0],
-            [20.0, 10.0],
+            Point::new(0.0, 0.0),
+            Point::new(10.0, 0.0),
+            Point::new(20.0, 0.0),
+            Point::new(0.0, 10.0),
+            Point::new(10.0, 10.0),
+            Point::new(20.0, 10.0),
         ];
         let t = [[0, 1, 3], [1, 4, 3], [1, 2, 4], [2, 5, 4]];
         let mesh = PaintMesh::new(&v, &t).unwrap();
@@ -836,7 +834,7 @@ mod tests {
                 max_influences: None,
             },
             BrushMode::Subtract,
-            [0.0, 10.0],
+            Point::new(0.0, 10.0),
             &options,
         )
         .unwrap();
@@ -851,7 +849,7 @@ mod tests {
                 max_influences: None,
             },
             BrushMode::Subtract,
-            [10.0, 0.0],
+            Point::new(10.0, 0.0),
             &options,
         )
         .unwrap();
@@ -865,11 +863,16 @@ mod tests {
             spacing: 0.5,
             ..Default::default()
         };
-        let stroke = [[0.0, 0.0], [3.0, 0.0], [10.0, 0.0], [10.0, 9.0]];
+        let stroke = [
+            Point::new(0.0, 0.0),
+            Point::new(3.0, 0.0),
+            Point::new(10.0, 0.0),
+            Point::new(10.0, 9.0),
+        ];
         let dabs = dab_centres(&stroke, &options).unwrap();
         // Length 19, a dab every 4 px from 0: 0, 4, 8, 12, 16.
         assert_eq!(dabs.len(), 5, "{dabs:?}");
-        assert_eq!(dabs[2], [8.0, 0.0]);
+        assert_eq!(dabs[2], Point::new(8.0, 0.0));
         assert!((dabs[3][0] - 10.0).abs() < 1e-12 && (dabs[3][1] - 2.0).abs() < 1e-12);
         for k in 1..stroke.len() {
             let prefix = dab_centres(&stroke[..k], &options).unwrap();
@@ -877,8 +880,8 @@ mod tests {
         }
         assert!(dab_centres(&[], &options).unwrap().is_empty());
         assert_eq!(
-            dab_centres(&[[1.0, 2.0]], &options).unwrap(),
-            vec![[1.0, 2.0]]
+            dab_centres(&[Point::new(1.0, 2.0)], &options).unwrap(),
+            vec![Point::new(1.0, 2.0)]
         );
     }
 
@@ -982,7 +985,7 @@ mod tests {
             strength: 0.3,
             ..Default::default()
         };
-        let stroke = [[10.0, 20.0], [90.0, 80.0]];
+        let stroke = [Point::new(10.0, 20.0), Point::new(90.0, 80.0)];
         let paint = |rows: &mut Vec<Vec<(u32, f64)>>, limit| {
             paint_stroke(
                 &mesh,

@@ -193,8 +193,8 @@ fn pieces(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<usize> {
 /// The pieces the solve sees: a piece index per vertex, vertices joined by the triangles that
 /// are not degenerate ([`super::laplacian::is_degenerate`]) in `vertices` (canvas px).
 fn solved_pieces(vertices: &[crate::geom::Point], triangles: &[[u32; 3]]) -> Vec<usize> {
-    let points: Vec<[f64; 2]> = vertices.iter().map(|p| [p.x, p.y]).collect();
-    let l2 = super::laplacian::squared_edge_lengths(&points, triangles);
+    let points = crate::geom::as_coordinate_arrays(vertices);
+    let l2 = super::laplacian::squared_edge_lengths(points, triangles);
     let solid: Vec<[u32; 3]> = triangles
         .iter()
         .zip(&l2)
@@ -430,12 +430,12 @@ pub fn weight_domain(
     colors: Option<&[[f64; 3]]>,
     options: &WeightOptions,
 ) -> Result<Domain, WeightError> {
-    let positions: Vec<[f64; 2]> = mesh.vertices.iter().map(|p| [p.x, p.y]).collect();
+    let positions = &mesh.vertices;
     match options.content_aware {
-        None => Ok(Domain::new(&positions, &mesh.triangles)),
+        None => Ok(Domain::planar(positions, &mesh.triangles)),
         Some(scale) => {
             let colors = colors.ok_or(WeightError::ColorCount(0, mesh.vertices.len()))?;
-            content_aware_domain(&positions, colors, scale, &mesh.triangles).map_err(|e| match e {
+            content_aware_domain(positions, colors, scale, &mesh.triangles).map_err(|e| match e {
                 LiftError::InvalidScale(_) => WeightError::InvalidOptions(e.to_string()),
                 LiftError::ColorCount(c, n) => WeightError::ColorCount(c, n),
             })
@@ -548,8 +548,8 @@ mod tests {
             bones: vec![Bone {
                 name: "a".into(),
                 parent: None,
-                head: [0.0, 0.0],
-                tail: [0.0, 10.0],
+                head: Point::new(0.0, 0.0),
+                tail: Point::new(0.0, 10.0),
             }],
             ..Default::default()
         };

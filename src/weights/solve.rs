@@ -49,6 +49,11 @@ impl Domain {
         }
     }
 
+    /// [`Domain::new`] of canvas positions (px).
+    pub fn planar(points: &[crate::geom::Point], triangles: &[[u32; 3]]) -> Self {
+        Domain::new(crate::geom::as_coordinate_arrays(points), triangles)
+    }
+
     pub fn vertex_count(&self) -> usize {
         self.mass.len()
     }

@@ -28,8 +28,8 @@ pub fn bone(name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]) ->
     Bone {
         name: name.into(),
         parent: parent.map(Into::into),
-        head,
-        tail,
+        head: head.into(),
+        tail: tail.into(),
     }
 }
 

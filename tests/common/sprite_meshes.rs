@@ -200,8 +200,7 @@ pub fn two_level(
     let (solved, solver) = rayon::join(
         || {
             let (coarse, coarse_bc) = coarse_mesh(outline, fine, handles, options.coarse_vertices);
-            let points: Vec<[f64; 2]> = coarse.vertices.iter().map(|p| [p.x, p.y]).collect();
-            let coarse_domain = Domain::new(&points, &coarse.triangles);
+            let coarse_domain = Domain::planar(&coarse.vertices, &coarse.triangles);
             let (solved, _) =
                 bounded_biharmonic_weights(&coarse_domain, &coarse_bc, &BbwOptions::default())
                     .expect("coarse bbw solve");

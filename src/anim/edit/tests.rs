@@ -1,6 +1,7 @@
 //! [`super`]'s edits on typed animations: what they do, what they refuse.
 
 use super::*;
+use crate::geom::Point;
 use serde_json::json;
 
 fn parsed(name: &str, v: Value) -> Animation {
@@ -195,7 +196,7 @@ fn emptying_several_ik_drags_in_one_edit_removes_each() {
     // Drag 1 is still drag 1 after drag 0 lost its last key.
     let left = delete_keys("walk", &three, &keys).unwrap();
     assert_eq!(left.ik.len(), 1);
-    assert_eq!(left.ik[0].at, [9.0, 9.0]);
+    assert_eq!(left.ik[0].at, Point::new(9.0, 9.0));
 }
 
 #[test]

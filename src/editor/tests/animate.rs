@@ -69,7 +69,7 @@ fn the_numbers_panel_poses_the_selected_bone_in_pose_mode() {
     h.key_press(Key::Num2);
     h.run();
     h.get_by_label_contains("Click a bone or point");
-    click(&mut h, [256.0, 225.0]);
+    click(&mut h, Point::new(256.0, 225.0));
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
     set_number(&mut h, "Rotation", 30.0);
     set_number(&mut h, "Translation x", 4.0);
@@ -81,7 +81,7 @@ fn the_numbers_panel_poses_the_selected_bone_in_pose_mode() {
     // The canvas shows it: the chest's head moved by the translation (in the hip's frame).
     let head = shown_head(&h, "chest");
     assert!(
-        (distance(head, [256.0, 262.0]) - 4.0).abs() < 1e-6,
+        (distance(head, Point::new(256.0, 262.0)) - 4.0).abs() < 1e-6,
         "{head:?}"
     );
     // Each entered number is one undo step.
@@ -122,7 +122,7 @@ fn auto_key_keys_each_edit_at_the_playhead_and_rows_are_named_by_handle() {
     assert!(h.state().timeline.auto_key);
 
     // Turning the head in the numbers panel keys its rotation only, at once.
-    click(&mut h, [256.0, 150.0]);
+    click(&mut h, Point::new(256.0, 150.0));
     assert_eq!(h.state().selected.as_deref(), Some("head"));
     set_number(&mut h, "Rotation", 15.0);
     let anim = crate::document::animation_named(h.state().doc.state(), "animation");

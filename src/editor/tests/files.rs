@@ -123,7 +123,7 @@ fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_
     h.key_press(Key::Num1);
     h.get_by_label("Point").click();
     h.run();
-    click(&mut h, [40.0, 24.0]);
+    click(&mut h, Point::new(40.0, 24.0));
     assert!(h.state().doc.dirty());
     h.key_press_modifiers(Modifiers::COMMAND, Key::N);
     h.run();
@@ -143,7 +143,7 @@ fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_
     h.run();
     h.get_by_label("Point").click();
     h.run();
-    click(&mut h, [40.0, 24.0]);
+    click(&mut h, Point::new(40.0, 24.0));
     assert!(h.state().doc.dirty());
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
@@ -158,9 +158,9 @@ fn a_quick_ctrl_s_in_pose_mode_saves_and_never_scales() {
     let path = h.state().doc.path.clone().expect("a file");
     h.key_press(Key::Num2);
     h.run();
-    click(&mut h, [256.0, 225.0]);
+    click(&mut h, Point::new(256.0, 225.0));
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
-    h.hover_at(screen(&h, [300.0, 240.0]));
+    h.hover_at(screen(&h, Point::new(300.0, 240.0)));
     h.step();
     // Ctrl down, S down and up, Ctrl up, all within one frame (as a quick press arrives from
     // the window system; the harness' own chord spreads them over frames).
@@ -178,7 +178,7 @@ fn a_quick_ctrl_s_in_pose_mode_saves_and_never_scales() {
         egui::Event::ModifiersChanged(Modifiers::NONE),
     ]);
     h.step();
-    h.hover_at(screen(&h, [330.0, 260.0]));
+    h.hover_at(screen(&h, Point::new(330.0, 260.0)));
     h.step();
     h.run();
     assert!(h.state().gesture.is_none(), "Ctrl+S started a scale");

@@ -23,7 +23,7 @@ fn exports_for_spine_from_the_file_menu_function() {
     // Without current weights there is nothing to export, and nothing is written.
     app.apply(Command::AddPoint(PointHandle {
         name: "extra".into(),
-        at: [10.0, 10.0],
+        at: Point::new(10.0, 10.0),
     }));
     let empty = path.parent().expect("a folder").join("none");
     let message = app.export_spine(&empty);

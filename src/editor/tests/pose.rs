@@ -9,7 +9,7 @@ fn rotate_with_r_and_grab_with_the_gizmo_in_pose_mode() {
     h.run();
     // The chest bone runs up from (256, 262) to (256, 198): click its middle to select it.
     let pivot = [256.0, 262.0];
-    click(&mut h, [256.0, 225.0]);
+    click(&mut h, Point::new(256.0, 225.0));
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
 
     // R, then a quarter turn counter-clockwise on screen about the head, then a click.
@@ -38,11 +38,11 @@ fn rotate_with_r_and_grab_with_the_gizmo_in_pose_mode() {
     assert!(h.state().doc.state().pose.bones.is_empty());
 
     // Escape cancels a modal grab.
-    h.hover_at(screen(&h, [300.0, 300.0]));
+    h.hover_at(screen(&h, Point::new(300.0, 300.0)));
     h.step();
     h.key_press(Key::G);
     h.step();
-    h.hover_at(screen(&h, [320.0, 280.0]));
+    h.hover_at(screen(&h, Point::new(320.0, 280.0)));
     h.step();
     h.key_press(Key::Escape);
     h.run();
@@ -102,9 +102,7 @@ fn pins_leave_the_drawing_where_it_is() {
     // drawing shown before, interpolated in the rest triangle the skinning IK grips.
     let scene = h.state().doc.posable().expect("posable").clone();
     let meshes = scene.skinned_meshes().expect("meshes");
-    let (m, t, w) =
-        crate::ik::rig::grip(&meshes, crate::geom::Point::new(pin.at[0], pin.at[1]), 0.0)
-            .expect("gripped");
+    let (m, t, w) = crate::ik::rig::grip(&meshes, pin.at, 0.0).expect("gripped");
     assert_eq!(meshes.len(), dragged.len(), "every part is weighted");
     let shown = meshes[m].triangles[t]
         .iter()
@@ -302,7 +300,11 @@ fn a_drag_on_a_bone_turns_it_and_a_first_drag_of_the_drawing_holds_the_skeletons
     let ik = h.state().doc.state().pose.ik.clone();
     assert_eq!(ik.len(), 2, "{:?}", h.state().message);
     assert!(distance(ik[0].to, to) < 1e-3, "the drag comes first");
-    assert_eq!(ik[1].at, [256.0, 318.0], "the pin is at the hip's head");
+    assert_eq!(
+        ik[1].at,
+        Point::new(256.0, 318.0),
+        "the pin is at the hip's head"
+    );
     assert!(distance(ik[1].to, hip) < 1e-6);
     assert!(
         distance(shown_head(&h, "hip"), hip) < 0.5,
@@ -311,7 +313,7 @@ fn a_drag_on_a_bone_turns_it_and_a_first_drag_of_the_drawing_holds_the_skeletons
     );
     let foot = shown_head(&h, "leg_lower_l");
     assert!(
-        distance(foot, [296.0, 392.0]) > 5.0,
+        distance(foot, Point::new(296.0, 392.0)) > 5.0,
         "the knee stayed at {foot:?}"
     );
 }

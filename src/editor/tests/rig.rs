@@ -49,7 +49,7 @@ fn rig_weigh_pose_undo_through_the_ui() {
     // The new bone is still selected, and its gizmo sits where the torso will be gripped: a
     // click on empty canvas deselects it.
     assert!(h.state().selected.is_some());
-    click(&mut h, [4.0, 4.0]);
+    click(&mut h, Point::new(4.0, 4.0));
     assert_eq!(h.state().selected, None);
     let grip = torso_point(&h);
     drag(&mut h, grip, [grip[0] + 25.0, grip[1] - 15.0]);
@@ -127,7 +127,10 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     h.run();
     drag(&mut h, [255.0, 150.0], [265.0, 140.0]);
     let moved = &h.state().doc.state().handles.cages[0].polygon;
-    assert!(distance(moved[0], [160.0, 140.0]) < 0.5, "{moved:?}");
+    assert!(
+        distance(moved[0], Point::new(160.0, 140.0)) < 0.5,
+        "{moved:?}"
+    );
 
     // The traced mesh, rebuilt live when a meshing option changes.
     h.get_by_label("Show the traced mesh").scroll_to_me();
@@ -235,7 +238,7 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     let (chest0, chest1) = (column(&before, "chest"), column(&after, "chest"));
     let v = &scene.doc.parts[index].mesh.vertices;
     let raised = (0..v.len())
-        .filter(|&i| distance(v[i], [256.0, 262.0]) < 12.0)
+        .filter(|&i| distance(v[i], Point::new(256.0, 262.0)) < 12.0)
         .map(|i| chest1[i] - chest0[i])
         .fold(0.0, f64::max);
     assert!(

@@ -62,7 +62,7 @@ fn the_tree_selects_with_the_canvas_renames_in_place_and_hides_parts() {
     wait_for_weights(&mut h);
     h.key_press(Key::Num2);
     h.run();
-    click(&mut h, [256.0, 225.0]);
+    click(&mut h, Point::new(256.0, 225.0));
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
     assert!(tree_selected(&h, "chest"));
     assert!(!tree_selected(&h, "lamp"));
@@ -125,7 +125,7 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
     assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
 
     // F frames the selected bone: its middle at the area's centre, zoomed in on it.
-    click(&mut h, [256.0, 225.0]);
+    click(&mut h, Point::new(256.0, 225.0));
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
     h.key_press(Key::F);
     h.run();
@@ -136,7 +136,7 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
         view.zoom,
         fitted.zoom
     );
-    let middle = screen(&h, [256.0, 230.0]);
+    let middle = screen(&h, Point::new(256.0, 230.0));
     assert!(
         middle.distance(area.center()) < 0.5,
         "{middle:?} vs {:?}",

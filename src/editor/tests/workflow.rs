@@ -6,7 +6,7 @@ use super::*;
 use crate::anim::edit::TimelineId;
 
 /// The IK drag's keys (time, target) in the document's animation "animation".
-fn drag_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, [f64; 2])> {
+fn drag_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, Point)> {
     let anim = crate::document::animation_named(h.state().doc.state(), "animation");
     anim.ik
         .first()

@@ -116,6 +116,7 @@ mod tests {
     use super::*;
     use crate::export::spine::frame::SpineFrame;
     use crate::export::spine::skeleton::build_skeleton;
+    use crate::geom::Point;
     use crate::rig::bone_ik::BoneIk;
     use crate::rig::Bone;
 
@@ -123,8 +124,8 @@ mod tests {
         let bone = |name: &str, parent: Option<&str>, x: f64| Bone {
             name: name.into(),
             parent: parent.map(Into::into),
-            head: [x, 0.0],
-            tail: [x + 10.0, 0.0],
+            head: Point::new(x, 0.0),
+            tail: Point::new(x + 10.0, 0.0),
         };
         let ik = |name: &str, bones: &[&str]| BoneIk {
             name: name.into(),

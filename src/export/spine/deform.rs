@@ -45,10 +45,10 @@ pub fn deform_timeline(
     for k in with_start(keys) {
         let mut vertices = Vec::new();
         for (source, influences) in mesh.vertex_source.iter().zip(&mesh.influences) {
-            let o = k.value.get(*source).copied().unwrap_or([0.0, 0.0]);
+            let o = k.value.get(*source).copied().unwrap_or_else(Vec2::zeros);
             let o = frame.spine_vector(o);
             for i in influences {
-                let local = inverses[i.bone] * Vec2::new(o[0], o[1]);
+                let local = inverses[i.bone] * o;
                 vertices.extend([num(local.x), num(local.y)]);
             }
         }

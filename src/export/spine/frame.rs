@@ -13,7 +13,7 @@
 //! `c = sin(rotation + shearX)·scaleX`, `d = sin(rotation + 90 + shearY)·scaleY`, and a child's
 //! world transform is its parent's times its local one.
 
-use crate::geom::Vec2;
+use crate::geom::{Point, Vec2};
 use crate::rig::Affine;
 use nalgebra::Matrix2;
 use serde::{Deserialize, Serialize};
@@ -22,30 +22,30 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpineFrame {
     /// The canvas point (px) that becomes Spine's (0, 0).
-    pub origin_px: [f64; 2],
+    pub origin_px: Point,
 }
 
 impl SpineFrame {
     /// Spine's origin at the bottom centre of a canvas of `canvas_px`.
     pub fn for_canvas(canvas_px: [u32; 2]) -> Self {
         SpineFrame {
-            origin_px: [f64::from(canvas_px[0]) / 2.0, f64::from(canvas_px[1])],
+            origin_px: Point::new(f64::from(canvas_px[0]) / 2.0, f64::from(canvas_px[1])),
         }
     }
 
     /// A canvas position (px, y down) in Spine world units (y up).
-    pub fn spine_from_canvas(&self, p: [f64; 2]) -> [f64; 2] {
-        [p[0] - self.origin_px[0], self.origin_px[1] - p[1]]
+    pub fn spine_from_canvas(&self, p: Point) -> Point {
+        Point::new(p.x - self.origin_px.x, self.origin_px.y - p.y)
     }
 
     /// A Spine world position back on the canvas.
-    pub fn canvas_from_spine(&self, q: [f64; 2]) -> [f64; 2] {
-        [q[0] + self.origin_px[0], self.origin_px[1] - q[1]]
+    pub fn canvas_from_spine(&self, q: Point) -> Point {
+        Point::new(q.x + self.origin_px.x, self.origin_px.y - q.y)
     }
 
     /// A canvas displacement (px) as a Spine displacement.
-    pub fn spine_vector(&self, v: [f64; 2]) -> [f64; 2] {
-        [v[0], -v[1]]
+    pub fn spine_vector(&self, v: Vec2) -> Vec2 {
+        Vec2::new(v.x, -v.y)
     }
 
     /// A map of the canvas (rest canvas → posed canvas) as the same map of Spine's world.
@@ -53,11 +53,11 @@ impl SpineFrame {
         let flip = Matrix2::new(1.0, 0.0, 0.0, -1.0);
         let to_spine = Affine {
             linear: flip,
-            translation: Vec2::new(-self.origin_px[0], self.origin_px[1]),
+            translation: Vec2::new(-self.origin_px.x, self.origin_px.y),
         };
         let from_spine = Affine {
             linear: flip,
-            translation: Vec2::new(self.origin_px[0], self.origin_px[1]),
+            translation: self.origin_px.coords,
         };
         to_spine.then_after(canvas).then_after(&from_spine)
     }
@@ -157,16 +157,17 @@ mod tests {
     #[test]
     fn canvas_round_trip_and_flip() {
         let f = SpineFrame::for_canvas([100, 50]);
-        assert_eq!(f.spine_from_canvas([50.0, 50.0]), [0.0, 0.0]);
-        assert_eq!(f.spine_from_canvas([60.0, 40.0]), [10.0, 10.0]);
-        assert_eq!(f.canvas_from_spine([10.0, 10.0]), [60.0, 40.0]);
+        let p = Point::new;
+        assert_eq!(f.spine_from_canvas(p(50.0, 50.0)), p(0.0, 0.0));
+        assert_eq!(f.spine_from_canvas(p(60.0, 40.0)), p(10.0, 10.0));
+        assert_eq!(f.canvas_from_spine(p(10.0, 10.0)), p(60.0, 40.0));
     }
 
     #[test]
     fn a_bone_pointing_up_on_screen_points_up_in_spine() {
         // Head (50, 50) → tail (50, 30) on the canvas: up on screen, 90° counter-clockwise.
         let f = SpineFrame::for_canvas([100, 100]);
-        let rest = bone_rest_frame([50.0, 50.0], [50.0, 30.0]);
+        let rest = bone_rest_frame(Point::new(50.0, 50.0), Point::new(50.0, 30.0));
         // Bone-local (u, v) in Spine is (u, −v) in sinew's bone frame; through the canvas into
         // Spine's world that is Spine's bone matrix of rotation 90° at (0, 50).
         let bone_local_flip = Affine {
@@ -175,7 +176,7 @@ mod tests {
         };
         let spine_world = {
             let to_spine = |p: Point| {
-                let q = f.spine_from_canvas([p.x, p.y]);
+                let q = f.spine_from_canvas(p);
                 Point::new(q[0], q[1])
             };
             move |u: f64, v: f64| to_spine(rest.apply(bone_local_flip.apply(Point::new(u, v))))

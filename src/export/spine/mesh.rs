@@ -21,7 +21,7 @@ pub struct Influence {
     /// Index into the skeleton's bones.
     pub bone: usize,
     /// The rest vertex in the bone's setup-pose frame (Spine units, y up).
-    pub bind: [f64; 2],
+    pub bind: Point,
     pub weight: f64,
 }
 
@@ -31,7 +31,7 @@ pub struct MeshAttachment {
     /// For each exported vertex, its index in the part's mesh.
     pub vertex_source: Vec<usize>,
     /// Per vertex, 0..1 over the region, v down.
-    pub uvs: Vec<[f64; 2]>,
+    pub uvs: Vec<Point>,
     /// Vertex indices, 3 per triangle (into the exported order).
     pub triangles: Vec<u32>,
     /// The first `hull` vertices are the hull loop, in order.
@@ -78,11 +78,11 @@ impl RegionRect {
         }
     }
 
-    pub fn uv(&self, p: Point) -> [f64; 2] {
-        [
+    pub fn uv(&self, p: Point) -> Point {
+        Point::new(
             (p.x - self.x as f64) / f64::from(self.width),
             (p.y - self.y as f64) / f64::from(self.height),
-        ]
+        )
     }
 }
 
@@ -182,7 +182,7 @@ pub fn mesh_attachment(
                 vertex: v,
             });
         }
-        let rest = frame.spine_from_canvas([vertices[v].x, vertices[v].y]);
+        let rest = frame.spine_from_canvas(vertices[v]);
         let mut out = Vec::with_capacity(row.len());
         for (column, w) in row {
             let bone = skeleton.column_bone[column];
@@ -190,10 +190,10 @@ pub fn mesh_attachment(
                 .setup_world
                 .inverse()
                 .ok_or_else(|| SpineError::Singular(skeleton.bones[bone].name.clone()))?;
-            let bind = inverse.apply(Point::new(rest[0], rest[1]));
+            let bind = inverse.apply(rest);
             out.push(Influence {
                 bone,
-                bind: [bind.x, bind.y],
+                bind,
                 weight: w / total,
             });
         }
@@ -241,6 +241,6 @@ mod tests {
                 height: 9
             }
         );
-        assert_eq!(r.uv(Point::new(-4.0, 9.0)), [0.0, 1.0]);
+        assert_eq!(r.uv(Point::new(-4.0, 9.0)), Point::new(0.0, 1.0));
     }
 }

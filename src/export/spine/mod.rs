@@ -301,6 +301,15 @@ fn check_name(kind: &'static str, name: &str, in_atlas: bool) -> Result<(), Spin
     Ok(())
 }
 
+/// Refuses a bake rate outside (0, [`MAX_BAKE_FPS`]] keys per second.
+fn check_bake_fps(bake_fps: f64) -> Result<(), SpineError> {
+    if bake_fps.is_finite() && bake_fps > 0.0 && bake_fps <= MAX_BAKE_FPS {
+        Ok(())
+    } else {
+        Err(SpineError::Fps(bake_fps))
+    }
+}
+
 /// What the export bakes of one animation: the bake times, the animation's frames there (pose
 /// and transformations, through the one pose path), the skeleton bones whose keys are baked, and
 /// the exported IK constraints switched off because a bone of their chain is baked.
@@ -320,6 +329,7 @@ pub fn plan_bake(
     options: &SpineOptions,
 ) -> Result<BakePlan, SpineError> {
     let doc = &scene.doc;
+    check_bake_fps(options.bake_fps)?;
     let samples = animation.duration_s() * options.bake_fps;
     if samples.is_nan() || samples > MAX_BAKE_SAMPLES {
         return Err(SpineError::TooLong {
@@ -362,10 +372,7 @@ pub fn export_spine(
     options: &SpineOptions,
 ) -> Result<SpineExport, SpineError> {
     let doc = &scene.doc;
-    if !(options.bake_fps.is_finite() && options.bake_fps > 0.0 && options.bake_fps <= MAX_BAKE_FPS)
-    {
-        return Err(SpineError::Fps(options.bake_fps));
-    }
+    check_bake_fps(options.bake_fps)?;
     if options.max_influences == Some(0) {
         return Err(SpineError::MaxInfluences);
     }

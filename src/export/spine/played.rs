@@ -29,6 +29,39 @@ use crate::rig::{handle_transforms, Handles};
 use crate::scene::Frame;
 use std::collections::BTreeSet;
 
+/// The options of `sinew spine` that change what the runtime plays: what `--match-runtime
+/// spine` reproduces. Meshes decimated by `--preset game` are not reproduced (sinew poses its
+/// own meshes; the runtime's decimated ones stay within the preset's tolerance).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExportPlayed {
+    /// The Spine line exported for (4.1 has no physics: it is baked). Default 4.2.
+    pub version: super::SpineVersion,
+    /// Keys per second of baked motion, in (0, [`super::MAX_BAKE_FPS`]]. Default 30.
+    pub bake_fps: f64,
+}
+
+impl Default for ExportPlayed {
+    fn default() -> Self {
+        let options = SpineOptions::default();
+        ExportPlayed {
+            version: options.version,
+            bake_fps: options.bake_fps,
+        }
+    }
+}
+
+impl ExportPlayed {
+    /// The export options these settings stand for (the rest at their defaults).
+    pub fn options(&self) -> SpineOptions {
+        SpineOptions {
+            version: self.version,
+            bake_fps: self.bake_fps,
+            ..SpineOptions::default()
+        }
+    }
+}
+
 /// An animation as Spine's runtime plays its export (see the module doc).
 #[derive(Clone, Debug)]
 pub struct AsPlayed {

@@ -14,6 +14,7 @@
 
 use super::frame::{BoneLocal, SpineFrame};
 use super::SpineError;
+use crate::geom::Point;
 use crate::rig::pose::bone_rest_frame;
 use crate::rig::{handle_columns, Affine, Handles};
 use std::collections::HashMap;
@@ -153,7 +154,7 @@ pub fn build_skeleton(
         }
     }
 
-    let mut point_bone = |name: String, at: [f64; 2], source: BoneSource| {
+    let mut point_bone = |name: String, at: Point, source: BoneSource| {
         let p = frame.spine_from_canvas(at);
         let setup = BoneLocal {
             x: p[0],
@@ -185,7 +186,11 @@ pub fn build_skeleton(
         }
     }
     for (i, region) in handles.regions.iter().enumerate() {
-        let at = region.polygon.first().copied().unwrap_or([0.0, 0.0]);
+        let at = region
+            .polygon
+            .first()
+            .copied()
+            .unwrap_or_else(Point::origin);
         point_bone(region.name.clone(), at, BoneSource::Region(i));
     }
     if let Some(j) = column_bone.iter().position(|&b| b == usize::MAX) {
@@ -210,29 +215,33 @@ mod tests {
                 Bone {
                     name: "lower".into(),
                     parent: Some("upper".into()),
-                    head: [60.0, 40.0],
-                    tail: [60.0, 80.0],
+                    head: Point::new(60.0, 40.0),
+                    tail: Point::new(60.0, 80.0),
                 },
                 Bone {
                     name: "upper".into(),
                     parent: None,
-                    head: [20.0, 40.0],
-                    tail: [60.0, 40.0],
+                    head: Point::new(20.0, 40.0),
+                    tail: Point::new(60.0, 40.0),
                 },
                 Bone {
                     name: "other".into(),
                     parent: None,
-                    head: [90.0, 90.0],
-                    tail: [80.0, 70.0],
+                    head: Point::new(90.0, 90.0),
+                    tail: Point::new(80.0, 70.0),
                 },
             ],
             points: vec![PointHandle {
                 name: "p".into(),
-                at: [5.0, 6.0],
+                at: Point::new(5.0, 6.0),
             }],
             cages: vec![Cage {
                 name: "c".into(),
-                polygon: vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0]],
+                polygon: vec![
+                    Point::new(0.0, 0.0),
+                    Point::new(10.0, 0.0),
+                    Point::new(10.0, 10.0),
+                ],
             }],
             ..Default::default()
         }
@@ -290,7 +299,7 @@ mod tests {
             if let BoneSource::Bone(i) = b.source {
                 if let Some(p) = pose.bones.get(&h.bones[i].name) {
                     local.rotation_deg += p.rotate;
-                    let v = frame.spine_vector(p.translate);
+                    let v = frame.spine_vector(p.translate.into());
                     local.x += v[0];
                     local.y += v[1];
                     local.scale_x *= p.scale[0];
@@ -302,16 +311,16 @@ mod tests {
             let parent = b.parent.map_or(Affine::identity(), |p| world[p]);
             world.push(parent.then_after(&local.matrix()));
         }
-        let rest_point = [63.0, 70.0];
+        let rest_point = Point::new(63.0, 70.0);
         for (bone, column) in [(1, 1), (2, 0)] {
             let bind = s.bones[bone]
                 .setup_world
                 .inverse()
                 .unwrap()
-                .apply(Point::from(frame.spine_from_canvas(rest_point)));
+                .apply(frame.spine_from_canvas(rest_point));
             let spine = world[bone].apply(bind);
             let sinew = t[column].apply(Point::from(rest_point));
-            let back = frame.canvas_from_spine([spine.x, spine.y]);
+            let back = frame.canvas_from_spine(spine);
             assert!((back[0] - sinew.x).abs() < 1e-9 && (back[1] - sinew.y).abs() < 1e-9);
         }
     }

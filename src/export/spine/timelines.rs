@@ -25,6 +25,7 @@
 use super::frame::SpineFrame;
 use super::skeleton::Skeleton;
 use crate::anim::{Animation, Curve, Key, StepKey};
+use crate::geom::Point;
 use crate::rig::Handles;
 use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
@@ -149,15 +150,15 @@ pub fn timeline2(keys: &[Key<[f64; 2]>], flip_y: bool) -> Value {
 /// One cage vertex's `translate` timeline: posed − rest (y flipped); the cage's 0..1 curve in
 /// each channel's own units.
 fn cage_vertex_timeline(
-    keys: &[Key<Vec<[f64; 2]>>],
+    keys: &[Key<Vec<Point>>],
     vertex: usize,
-    rest: [f64; 2],
+    rest: Point,
     frame: &SpineFrame,
 ) -> Value {
     let keys = with_start(keys);
-    let delta = |k: &Key<Vec<[f64; 2]>>| {
+    let delta = |k: &Key<Vec<Point>>| {
         let p = k.value.get(vertex).copied().unwrap_or(rest);
-        frame.spine_vector([p[0] - rest[0], p[1] - rest[1]])
+        frame.spine_vector(p - rest)
     };
     Value::Array(
         keys.iter()
@@ -367,17 +368,17 @@ mod tests {
         let keys = vec![
             Key {
                 time: 0.0,
-                value: vec![[10.0, 10.0]],
+                value: vec![Point::new(10.0, 10.0)],
                 curve: Curve::Bezier(vec![0.25, 0.0, 0.75, 1.0]),
             },
             Key {
                 time: 1.0,
-                value: vec![[14.0, 2.0]],
+                value: vec![Point::new(14.0, 2.0)],
                 curve: Curve::Stepped,
             },
         ];
         let frame = SpineFrame::for_canvas([20, 20]);
-        let v = cage_vertex_timeline(&keys, 0, [10.0, 10.0], &frame);
+        let v = cage_vertex_timeline(&keys, 0, Point::new(10.0, 10.0), &frame);
         assert_eq!(v[0]["x"], json!(0.0));
         // x: 0 → 4, handles at 0 and 4; y: 0 → +8 (canvas −8, flipped), handles 0 and 8.
         assert_eq!(

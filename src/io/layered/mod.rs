@@ -81,7 +81,7 @@ pub enum TreeNode {
 pub struct Pivot {
     /// The path of the group it is in (empty at the top level).
     pub group: String,
-    pub at_px: [f64; 2],
+    pub at_px: crate::geom::Point,
 }
 
 /// A layered file read into memory.

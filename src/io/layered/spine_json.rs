@@ -12,6 +12,7 @@
 
 use super::tree::{build_layers, RawLayer, RawNode};
 use super::{check_size, read_limited, BlendMode, LayeredError, LayeredImage, LayeredLimits};
+use crate::geom::{Point, Vec2};
 use image::codecs::png::PngDecoder;
 use image::{DynamicImage, ImageDecoder};
 use serde_json::Value;
@@ -44,7 +45,7 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
     struct Placed {
         name: String,
         visible: bool,
-        center: [f64; 2],
+        center: Point,
         image: image::RgbaImage,
     }
     let mut placed = Vec::new();
@@ -98,7 +99,7 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
         placed.push(Placed {
             name: name.clone(),
             visible,
-            center: [bone_at[0] + f("x", 0.0), bone_at[1] + f("y", 0.0)],
+            center: bone_at + Vec2::new(f("x", 0.0), f("y", 0.0)),
             image,
         });
     }
@@ -108,8 +109,8 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
     let corner = |p: &Placed| {
         let (w, h) = (p.image.width() as f64, p.image.height() as f64);
         [
-            (p.center[0] - w / 2.0 + 0.5).floor(),
-            (-p.center[1] - h / 2.0 + 0.5).floor(),
+            (p.center.x - w / 2.0 + 0.5).floor(),
+            (-p.center.y - h / 2.0 + 0.5).floor(),
         ]
     };
     let left = placed
@@ -145,8 +146,8 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
 }
 
 /// Each bone's world position (the sum of its and its parents' `x`, `y`).
-fn bone_positions(json: &Value) -> Result<HashMap<String, [f64; 2]>, LayeredError> {
-    let mut at: HashMap<String, [f64; 2]> = HashMap::new();
+fn bone_positions(json: &Value) -> Result<HashMap<String, Point>, LayeredError> {
+    let mut at: HashMap<String, Point> = HashMap::new();
     let bones = json
         .get("bones")
         .and_then(Value::as_array)
@@ -168,14 +169,11 @@ fn bone_positions(json: &Value) -> Result<HashMap<String, [f64; 2]>, LayeredErro
             Some(p) => *at
                 .get(p)
                 .ok_or_else(|| bad(format!("bone '{name}': parent '{p}' not listed before it")))?,
-            None => [0.0, 0.0],
+            None => Point::origin(),
         };
-        at.insert(
-            name.to_string(),
-            [base[0] + f("x", 0.0), base[1] + f("y", 0.0)],
-        );
+        at.insert(name.to_string(), base + Vec2::new(f("x", 0.0), f("y", 0.0)));
     }
-    at.entry("root".into()).or_insert([0.0, 0.0]);
+    at.entry("root".into()).or_insert_with(Point::origin);
     Ok(at)
 }
 

@@ -222,10 +222,10 @@ impl Builder<'_> {
         }
         self.out.pivots.push(Pivot {
             group: at.prefix.clone(),
-            at_px: [
+            at_px: crate::geom::Point::new(
                 layer.offset_px[0] as f64 + sx / n,
                 layer.offset_px[1] as f64 + sy / n,
-            ],
+            ),
         });
     }
 
