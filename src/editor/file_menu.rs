@@ -501,5 +501,30 @@ fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderS
             CurveEvaluation::Exact
         };
         ui.end_row();
+        if spine {
+            // The export those runtimes play (`sinew spine --spine-version`, `--fps`).
+            use crate::export::spine::SpineVersion;
+            let export = &mut settings.export;
+            let label = ui.label("Spine version");
+            let name = |v: SpineVersion| &v.version_string()[..3];
+            egui::ComboBox::from_id_salt("render spine version")
+                .selected_text(name(export.version))
+                .show_ui(ui, |ui| {
+                    for v in [SpineVersion::V4_1, SpineVersion::V4_2, SpineVersion::V4_3] {
+                        ui.selectable_value(&mut export.version, v, name(v));
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
+            let label = ui.label("Bake keys per second");
+            ui.add(
+                egui::DragValue::new(&mut export.bake_fps)
+                    .range(1.0..=crate::export::spine::MAX_BAKE_FPS)
+                    .speed(0.2),
+            )
+            .labelled_by(label.id);
+            ui.end_row();
+        }
     });
 }

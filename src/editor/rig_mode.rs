@@ -78,28 +78,76 @@ impl EditorApp {
             return shapes;
         };
         for (k, part) in scene.doc.parts.iter().enumerate() {
-            let rest: Vec<Point> = part
-                .mesh
-                .vertices
-                .iter()
-                .map(|p| Point::new(p[0], p[1]))
-                .collect();
-            shapes.extend(canvas::wireframe(placed, &rest, &part.mesh.triangles));
-            if let (Some(weights), true) = (&part.weights, weighted) {
-                shapes.extend(match self.shown_rows(k) {
-                    Some(rows) => super::paint::heat_map_rows(
-                        placed,
-                        weights,
-                        rows,
-                        name,
-                        &rest,
-                        &part.mesh.triangles,
-                    ),
-                    None => canvas::heat_map(placed, weights, name, &rest, &part.mesh.triangles),
-                });
-            }
+            let rest = &part.mesh.vertices;
+            let Some(weights) = part.weights.as_ref().filter(|_| weighted) else {
+                shapes.extend(canvas::wireframe(placed, rest, &part.mesh.triangles));
+                continue;
+            };
+            // The heat map alone: a white wireframe under translucent colour showed as bright
+            // starbursts where the outline's small triangles fan out.
+            shapes.extend(match self.shown_rows(k) {
+                Some(rows) => super::paint::heat_map_rows(
+                    placed,
+                    weights,
+                    rows,
+                    name,
+                    rest,
+                    &part.mesh.triangles,
+                ),
+                None => canvas::heat_map(placed, weights, name, rest, &part.mesh.triangles),
+            });
         }
         shapes
+    }
+
+    /// The heat map's legend in the canvas' lower left corner (`canvas`, screen points): whose
+    /// weights are shown and the colours of 0, ½ and 1. Shown while the selected handle's current
+    /// weights are drawn.
+    fn heat_legend(&self, ctx: &egui::Context, canvas: egui::Rect) {
+        let (Some(scene), Some(name)) = (self.doc.posable(), &self.selected) else {
+            return;
+        };
+        let weighs = scene.doc.parts.iter().any(|p| {
+            p.weights
+                .as_ref()
+                .is_some_and(|w| w.handles.iter().any(|h| h == name))
+        });
+        if !weighs {
+            return;
+        }
+        egui::Area::new(egui::Id::new("heat map legend"))
+            .fixed_pos(canvas.left_bottom() + egui::vec2(8.0, -LEGEND_HEIGHT_PT))
+            .interactable(false)
+            .show(ctx, |ui| {
+                egui::Frame::popup(ui.style()).show(ui, |ui| {
+                    ui.label(format!("weights of {name}"));
+                    ui.horizontal(|ui| {
+                        ui.label("0");
+                        let (rect, _) = ui.allocate_exact_size(
+                            egui::vec2(LEGEND_BAR_PT, 10.0),
+                            egui::Sense::hover(),
+                        );
+                        let mut bar = egui::Mesh::default();
+                        let steps = 16;
+                        for k in 0..=steps {
+                            let w = k as f64 / steps as f64;
+                            let x = rect.left() + rect.width() * w as f32;
+                            // Opaque: the legend shows the hue, the canvas shows the drawing.
+                            let [r, g, b, _] = canvas::heat_color(w).to_srgba_unmultiplied();
+                            let color = egui::Color32::from_rgb(r, g, b);
+                            bar.colored_vertex(egui::pos2(x, rect.top()), color);
+                            bar.colored_vertex(egui::pos2(x, rect.bottom()), color);
+                            if k > 0 {
+                                let i = 2 * k as u32;
+                                bar.add_triangle(i - 2, i - 1, i);
+                                bar.add_triangle(i - 1, i + 1, i);
+                            }
+                        }
+                        ui.painter().add(Shape::mesh(bar));
+                        ui.label("1");
+                    });
+                });
+            });
     }
 
     /// Starts computing the weights for the current handles (a no-op while one runs).
@@ -270,6 +318,7 @@ impl EditorApp {
         response: &egui::Response,
         placed: Placed,
     ) {
+        self.heat_legend(ctx, response.rect);
         if self.rig_mode.tool == Tool::Paint {
             self.paint_gestures(ctx, response, placed);
             return;
@@ -396,6 +445,11 @@ impl EditorApp {
             .unwrap_or_else(|| stem.to_string())
     }
 }
+
+/// Height of the heat map legend above the canvas' bottom edge, screen points.
+const LEGEND_HEIGHT_PT: f32 = 64.0;
+/// Length of the legend's colour bar, screen points.
+const LEGEND_BAR_PT: f32 = 120.0;
 
 pub(super) fn distance(a: Point, b: impl Into<Point>) -> f64 {
     (a - b.into()).norm()

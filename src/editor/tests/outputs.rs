@@ -101,3 +101,38 @@ fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
         std::thread::sleep(std::time::Duration::from_millis(pause_ms));
     }
 }
+
+#[test]
+fn the_render_dialog_names_the_spine_export_its_runtime_curves_reproduce() {
+    let path = character_rig("render-spine");
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.get_by_label("File").click();
+    h.run();
+    h.get_by_label("Render…").click();
+    h.run();
+    assert!(h.query_by_label("Spine version").is_none());
+    h.get_by_label("Curves as Spine's runtimes play them")
+        .click();
+    h.run();
+    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Spine version");
+    assert_eq!(picker.value().as_deref(), Some("4.2"));
+    picker.click();
+    h.run();
+    h.get_by_label("4.1").click();
+    h.run();
+    type_into(&mut h, "Bake keys per second", "20");
+    h.key_press(Key::Enter);
+    h.run();
+    let settings = &h.state().render_settings;
+    assert_eq!(
+        settings.sampling.curves,
+        crate::anim::CurveEvaluation::SpineRuntime
+    );
+    assert_eq!(
+        settings.export,
+        crate::export::spine::played::ExportPlayed {
+            version: crate::export::spine::SpineVersion::V4_1,
+            bake_fps: 20.0,
+        }
+    );
+}

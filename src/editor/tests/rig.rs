@@ -282,3 +282,26 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
         assert!((sum - 1.0).abs() < 1e-9, "{row:?}");
     }
 }
+
+#[test]
+fn the_heat_map_has_a_legend_naming_the_handle_whose_weights_it_shows() {
+    let mut h = open_character("legend");
+    h.get_by_label("Weights are up to date");
+    assert!(h.query_by_label_contains("weights of").is_none());
+    // Selecting a bone in the tree shows its weights and the legend says whose they are.
+    h.get_by_label("chest").click();
+    h.run();
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    h.get_by_label("weights of chest");
+    h.get_by_label("head").click();
+    h.run();
+    h.get_by_label("weights of head");
+    assert!(h.query_by_label("weights of chest").is_none());
+    // Stale weights draw no heat map, so no legend either.
+    h.get_by_label("Bone").click();
+    h.run();
+    let inside = torso_point(&h);
+    drag(&mut h, inside, [inside[0] + 12.0, inside[1] + 8.0]);
+    h.get_by_label("Weights need computing");
+    assert!(h.query_by_label_contains("weights of").is_none());
+}
