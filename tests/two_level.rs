@@ -3,6 +3,8 @@
 //! bones and point handles. Per mesh: the largest weight difference, the ratio of the
 //! bi-Laplacian energies (Σ_j w_jᵀ K M⁻¹ K w_j over the drawn mesh), bounds and partition of
 //! unity, and both solves' times (printed, not asserted: speed lives in benches/weights.rs).
+//! The two-level weights use the default [`TwoLevelOptions`]: a 500-vertex coarse mesh and
+//! one solve per handle on the carried weights' support (`sinew::weights::support`).
 
 mod common;
 
@@ -10,16 +12,17 @@ use sinew::geom::Point;
 use sinew::io::{BuildOptions, RigDocument};
 use sinew::pipeline::{self, Layer};
 use sinew::rig::{Bone, Handles, PointHandle};
-use sinew::weights::{Domain, WeightOptions};
+use sinew::weights::{Domain, TwoLevelOptions, WeightOptions};
 use std::time::Instant;
 
-/// The quality bars. The issue asks for max |Δw| ≤ 0.03; the active-set polish does not reach
-/// it within its iteration limit on the critter (0.066 at 5k, see docs/two-level-weights.md),
-/// so this bar is what is met, not what was asked.
-const MAX_WEIGHT_DIFFERENCE: f64 = 0.08;
+/// The largest weight difference the issue asks for; met on the benchmark's meshes (point
+/// handles on the outline), asserted there.
+const MAX_WEIGHT_DIFFERENCE: f64 = 0.03;
+/// What the rigs with bones meet (measured 0.075 on the critter, 0.041 on the character, see
+/// docs/two-level-weights.md): the issue's bar is not met there, this one guards the figure.
+const MAX_WEIGHT_DIFFERENCE_RIG: f64 = 0.08;
 const MAX_ENERGY_RATIO: f64 = 1.05;
 const EXACT: f64 = 1e-9;
-const COARSE_VERTICES: usize = 1000;
 
 fn character() -> (Vec<Layer>, Handles) {
     common::character_layers()
@@ -107,12 +110,24 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
                 assert!((row.iter().sum::<f64>() - 1.0).abs() < EXACT, "{row:?}");
                 assert!(row.iter().all(|&w| (-EXACT..=1.0 + EXACT).contains(&w)));
             }
-            let worst = de
+            // The largest difference and where it is (vertex, column).
+            let (worst, at) = de
                 .iter()
                 .flatten()
                 .zip(dt.iter().flatten())
                 .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max);
+                .enumerate()
+                .fold(
+                    (0.0, 0),
+                    |(w, at), (k, d)| if d > w { (d, k) } else { (w, at) },
+                );
+            if worst > 0.0 {
+                let (v, c) = (at / m, at % m);
+                println!(
+                    "  {}: worst at vertex {v} {:?}, column {} ({}): exact {:.4}, two-level {:.4}",
+                    e.name, e.mesh.vertices[v], c, we.handles[c], de[v][c], dt[v][c]
+                );
+            }
             let q = Domain::planar(&e.mesh.vertices, &e.mesh.triangles).bilaplacian();
             let energy = |d: &[Vec<f64>]| -> f64 {
                 (0..m)
@@ -131,10 +146,7 @@ fn compare(exact: &RigDocument, two: &RigDocument) -> Vec<(usize, f64, f64)> {
 fn two_level(options: &BuildOptions) -> BuildOptions {
     let mut two = options.clone();
     two.weights = WeightOptions {
-        two_level: Some(sinew::weights::part::TwoLevelOptions {
-            coarse_vertices: COARSE_VERTICES,
-            ..Default::default()
-        }),
+        two_level: Some(TwoLevelOptions::default()),
         ..options.weights.clone()
     };
     two
@@ -152,7 +164,10 @@ fn check(name: &str, layers: &[Layer], handles: &Handles, options: &BuildOptions
          (worst part) {ratio:.4}; whole rig exact {t_exact:.2} s, two-level {t_two:.2} s",
         rows.len()
     );
-    assert!(worst <= MAX_WEIGHT_DIFFERENCE, "{name}: max |Δw| {worst}");
+    assert!(
+        worst <= MAX_WEIGHT_DIFFERENCE_RIG,
+        "{name}: max |Δw| {worst}"
+    );
     assert!(ratio <= MAX_ENERGY_RATIO, "{name}: energy ratio {ratio}");
 }
 
@@ -171,4 +186,58 @@ fn two_level_weights_match_the_exact_solve_on_the_character() {
     // The bundled parts are small: a finer mesh makes the fine/coarse ratio worth it.
     options.mesh.max_area_fraction /= 8.0;
     check("character", &layers, &handles, &options);
+}
+
+/// The benchmark's meshes (benches/weights.rs, `two_level` against `bbw`): the critter's
+/// outline at about 5k and 20k vertices, 10 point handles by farthest-point sampling.
+#[test]
+fn two_level_weights_match_the_exact_solve_on_the_benchmark_meshes() {
+    use common::sprite_meshes::{
+        farthest_points, main_outline, mesh_near, point_conditions, two_level,
+    };
+    use sinew::weights::{bounded_biharmonic_weights, BbwOptions};
+    let outline = main_outline();
+    for target in [5_000, 20_000] {
+        let (mesh, _) = mesh_near(&outline, target);
+        let domain = Domain::planar(&mesh.vertices, &mesh.triangles);
+        let handles = farthest_points(&mesh, 10);
+        let bc = point_conditions(&handles);
+        let start = Instant::now();
+        let (mut exact, _) =
+            bounded_biharmonic_weights(&domain, &bc, &BbwOptions::default()).unwrap();
+        exact.normalize_rows();
+        let t_exact = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let two = two_level(&outline, &mesh, &domain, &handles, &bc);
+        let t_two = start.elapsed().as_secs_f64();
+        for i in 0..two.vertex_count {
+            let row = two.row(i);
+            assert!((row.iter().sum::<f64>() - 1.0).abs() < EXACT, "{row:?}");
+            assert!(row.iter().all(|&w| (0.0..=1.0).contains(&w)));
+        }
+        let worst = exact
+            .data
+            .iter()
+            .zip(&two.data)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        let q = domain.bilaplacian();
+        let energy = |w: &sinew::weights::WeightMatrix| -> f64 {
+            (0..w.handle_count)
+                .map(|j| {
+                    let c = w.column(j);
+                    let qc = sinew::weights::sparse::mat_vec(&q, &c);
+                    c.iter().zip(&qc).map(|(a, b)| a * b).sum::<f64>()
+                })
+                .sum()
+        };
+        let ratio = energy(&two) / energy(&exact);
+        println!(
+            "benchmark mesh {} vertices × 10 handles: max |Δw| {worst:.4}, energy ratio \
+             {ratio:.4}; exact {t_exact:.2} s, two-level {t_two:.2} s",
+            mesh.vertices.len()
+        );
+        assert!(worst <= MAX_WEIGHT_DIFFERENCE, "{target}: max |Δw| {worst}");
+        assert!(ratio <= MAX_ENERGY_RATIO, "{target}: energy ratio {ratio}");
+    }
 }

@@ -5,6 +5,7 @@
 //! - [`sparse`]: principal sub-matrix Cholesky (faer) and products shared by the solvers.
 //! - [`solve`]: harmonic, biharmonic and bounded biharmonic weights (interior point).
 //! - [`active_set`]: the same bounded solve by active-set iterations from a close guess.
+//! - [`support`]: the same bounded solve by one solve per handle on a close guess's support.
 //! - [`monotone`]: bounded biharmonic weights without spurious extrema (Jacobson et al. 2012).
 //! - [`reference`]: the same bounded QP by clarabel, the yardstick in tests.
 //! - [`boundary`]: handles → fixed weights on the mesh vertices that carry their geometry.
@@ -28,6 +29,7 @@ pub mod rigid;
 pub mod rows;
 pub mod solve;
 pub mod sparse;
+pub mod support;
 pub mod two_level;
 
 pub use locked::{keep_locked, transfer_rows, LockError};
@@ -39,7 +41,8 @@ pub use paint::{
     PaintTarget,
 };
 pub use part::{
-    part_weights, PartWeights, TwoLevelOptions, WeightError, WeightMethod, WeightOptions,
+    part_weights, PartWeights, TwoLevelOptions, TwoLevelPolish, WeightError, WeightMethod,
+    WeightOptions,
 };
 pub use solve::{
     biharmonic_weights, bounded_biharmonic_weights, harmonic_weights, BbwOptions, BbwReport,

@@ -75,18 +75,42 @@ pub struct WeightOptions {
 #[serde(default, deny_unknown_fields)]
 pub struct TwoLevelOptions {
     /// About how many vertices the coarse mesh has. Two-level weights are used only where the
-    /// fine mesh has more than [`TWO_LEVEL_MIN_RATIO`] times as many. Default 1000.
+    /// fine mesh has more than [`TWO_LEVEL_MIN_RATIO`] times as many. Default 500.
     pub coarse_vertices: usize,
-    /// With bounded biharmonic weights: active-set iterations on the fine mesh from the carried
-    /// weights ([`super::active_set`]), each one numeric factorization per handle; 0 keeps the
-    /// carried weights as they are. Default 4.
+    /// With bounded biharmonic weights: how the carried weights are brought to the fine mesh's
+    /// solution. Default `support`.
+    pub polish: TwoLevelPolish,
+    /// With polish `support`: free vertices whose carried weight exceeds this are solved for,
+    /// the others held at zero. Default [`super::support::SUPPORT_FLOOR`] (1e-3).
+    pub support_floor: f64,
+    /// With polish `active_set`: iterations on the fine mesh, each one numeric factorization
+    /// of the whole mesh per handle. Default 4.
     pub polish_iterations: usize,
+}
+
+/// The fine-mesh step of two-level bounded biharmonic weights.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum TwoLevelPolish {
+    /// The carried weights as they are.
+    None,
+    /// One solve per handle on the carried weights' support ([`super::support`]).
+    #[default]
+    Support,
+    /// Primal–dual active-set iterations from the carried weights' bound sets
+    /// ([`super::active_set`]); slower and further from the exact solve than `support`
+    /// (docs/two-level-weights.md).
+    ActiveSet,
 }
 
 impl Default for TwoLevelOptions {
     fn default() -> Self {
         TwoLevelOptions {
-            coarse_vertices: 1000,
+            coarse_vertices: 500,
+            polish: TwoLevelPolish::Support,
+            support_floor: super::support::SUPPORT_FLOOR,
             polish_iterations: 4,
         }
     }
@@ -317,6 +341,15 @@ pub fn check_options(
         return Err(WeightError::InvalidOptions(format!(
             "coarse_vertices must be at least {MIN_COARSE_VERTICES}"
         )));
+    }
+    if options
+        .two_level
+        .as_ref()
+        .is_some_and(|t| !(t.support_floor.is_finite() && (0.0..1.0).contains(&t.support_floor)))
+    {
+        return Err(WeightError::InvalidOptions(
+            "support_floor must lie in [0, 1)".into(),
+        ));
     }
     if options.max_influences == Some(0) {
         return Err(WeightError::InvalidOptions(

@@ -108,6 +108,18 @@ pub struct SharedPattern {
 impl SharedPattern {
     /// Analyzes A[keep, keep] (A symmetric; every kept diagonal entry must be stored).
     pub fn new(a: &CsMat<f64>, keep: &[usize]) -> Result<Self, SolveError> {
+        Self::analyze(a, keep, None)
+    }
+
+    /// [`SharedPattern::new`] with the fill-reducing order taken from `rank` (one entry per row
+    /// of `a`; kept indices are eliminated by increasing rank) instead of computed: for many
+    /// principal sub-matrices of one matrix, one order of the whole ([`fill_reducing_rank`])
+    /// restricted to each saves a minimum-degree analysis per sub-matrix.
+    pub fn with_rank(a: &CsMat<f64>, keep: &[usize], rank: &[usize]) -> Result<Self, SolveError> {
+        Self::analyze(a, keep, Some(rank))
+    }
+
+    fn analyze(a: &CsMat<f64>, keep: &[usize], rank: Option<&[usize]>) -> Result<Self, SolveError> {
         use faer::sparse::linalg::cholesky::{
             factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
         };
@@ -144,20 +156,33 @@ impl SharedPattern {
         let symbolic =
             faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
         let assembly = |e: faer::sparse::FaerError| SolveError::Assembly(format!("{e:?}"));
-        // The fill-reducing order, from faer's own analysis of the caller's order.
-        let amd = factorize_symbolic_cholesky(
-            symbolic.as_ref(),
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            CholeskySymbolicParams::default(),
-        )
-        .map_err(assembly)?;
-        let (order, inverse): (Vec<usize>, Vec<usize>) = match amd.perm() {
-            Some(perm) => {
-                let (fwd, inv) = perm.arrays();
-                (fwd.to_vec(), inv.to_vec())
+        let (order, inverse): (Vec<usize>, Vec<usize>) = match rank {
+            Some(rank) => {
+                let mut order: Vec<usize> = (0..len).collect();
+                order.sort_unstable_by_key(|&k| rank[keep[k]]);
+                let mut inverse = vec![0; len];
+                for (at, &k) in order.iter().enumerate() {
+                    inverse[k] = at;
+                }
+                (order, inverse)
             }
-            None => ((0..len).collect(), (0..len).collect()),
+            // The fill-reducing order, from faer's own analysis of the caller's order.
+            None => {
+                let amd = factorize_symbolic_cholesky(
+                    symbolic.as_ref(),
+                    Side::Lower,
+                    SymmetricOrdering::Amd,
+                    CholeskySymbolicParams::default(),
+                )
+                .map_err(assembly)?;
+                match amd.perm() {
+                    Some(perm) => {
+                        let (fwd, inv) = perm.arrays();
+                        (fwd.to_vec(), inv.to_vec())
+                    }
+                    None => ((0..len).collect(), (0..len).collect()),
+                }
+            }
         };
         // Entry (r, c) of the lower triangle moves to (inverse[r], inverse[c]), mirrored into
         // the lower triangle; then columns are sorted by row.
@@ -291,6 +316,18 @@ impl SharedPattern {
         }
         y
     }
+}
+
+/// A fill-reducing elimination rank for A[keep, keep] (A symmetric): `rank[i]` is kept index
+/// i's position in the order faer's minimum-degree analysis chooses, `usize::MAX` elsewhere.
+/// For [`SharedPattern::with_rank`].
+pub fn fill_reducing_rank(a: &CsMat<f64>, keep: &[usize]) -> Result<Vec<usize>, SolveError> {
+    let pattern = SharedPattern::new(a, keep)?;
+    let mut rank = vec![usize::MAX; a.rows()];
+    for (at, &k) in pattern.order.iter().enumerate() {
+        rank[keep[k]] = at;
+    }
+    Ok(rank)
 }
 
 /// The pattern of an n × n matrix from its (column, row) entries, sorted by column then row.

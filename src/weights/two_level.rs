@@ -18,9 +18,11 @@
 use super::active_set::active_set_bbw;
 use super::part::{
     boundary_conditions, check_options, domain_weights, normalize_rows, shape_rows, weight_domain,
-    DomainWeights, PartWeights, TwoLevelOptions, WeightMethod,
+    DomainWeights, PartWeights, TwoLevelOptions, TwoLevelPolish, WeightMethod,
 };
-use super::solve::WeightMatrix;
+use super::solve::{BoundaryConditions, Domain, WeightMatrix};
+use super::sparse::SolveError;
+use super::support::{support_bbw, SupportSolver};
 use super::{WeightError, WeightOptions};
 use crate::geom::Point;
 use crate::mesh::{EmbeddedMesh, Mesh};
@@ -31,7 +33,7 @@ use crate::rig::Handles;
 pub const INSIDE_BARYCENTRIC: f64 = -1e-9;
 
 /// Solves `coarse` and carries the weights to `fine` (see the module doc), then, with bounded
-/// biharmonic weights, polishes them on `fine` ([`TwoLevelOptions::polish_iterations`]).
+/// biharmonic weights, polishes them on `fine` ([`TwoLevelOptions::polish`]).
 /// `fine_colors` and `coarse_colors`: one premultiplied RGB per domain vertex of each mesh,
 /// needed only with content-aware weights.
 pub fn two_level_weights(
@@ -44,21 +46,35 @@ pub fn two_level_weights(
     options: &WeightOptions,
 ) -> Result<PartWeights, WeightError> {
     check_options(handles, binding, options)?;
-    let polish = options
-        .two_level
-        .as_ref()
-        .map_or(TwoLevelOptions::default().polish_iterations, |t| {
-            t.polish_iterations
-        });
-    let solved = domain_weights(coarse, handles, binding, coarse_colors, options)?;
-    let mut matrix = carry_to(&coarse.domain, &solved.matrix, &fine.domain.vertices);
+    let two_level = options.two_level.clone().unwrap_or_default();
     let (bc, touched, _) = boundary_conditions(fine, handles, binding);
-    if polish > 0 && options.method == WeightMethod::Bbw && !options.monotone {
+    let polished = two_level.polish != TwoLevelPolish::None
+        && options.method == WeightMethod::Bbw
+        && !options.monotone;
+    // The fine mesh's support solver does not need the coarse weights: it is prepared while
+    // the coarse mesh solves.
+    let prepare = || -> Result<Option<(Domain, Option<SupportSolver>)>, WeightError> {
+        if !polished {
+            return Ok(None);
+        }
         let domain = weight_domain(&fine.domain, fine_colors, options)?;
-        // The polish is a fixed number of steps toward the fine solution: sets that have not
-        // settled by then are expected, not a failure (only the coarse solve's are reported).
-        let (polished, _unsettled) = active_set_bbw(&domain, &bc, &matrix, polish)?;
-        matrix = polished;
+        let solver = match two_level.polish {
+            TwoLevelPolish::Support => Some(SupportSolver::new(&domain, &bc)?),
+            _ => None,
+        };
+        Ok(Some((domain, solver)))
+    };
+    let (solved, prepared) = rayon::join(
+        || domain_weights(coarse, handles, binding, coarse_colors, options),
+        prepare,
+    );
+    let solved = solved?;
+    let mut matrix = carry_to(&coarse.domain, &solved.matrix, &fine.domain.vertices);
+    if let Some((domain, solver)) = prepared? {
+        matrix = match solver {
+            Some(solver) => solver.solve(&matrix, two_level.support_floor)?,
+            None => polish(&domain, &bc, &matrix, &two_level)?,
+        };
         normalize_rows(&mut matrix, &fine.domain, handles, binding);
     }
     // The handles' own vertices keep exactly what the handles give them.
@@ -77,6 +93,26 @@ pub fn two_level_weights(
         },
         options,
     ))
+}
+
+/// The fine mesh's bounded biharmonic weights from `carried` (weights carried from a coarse
+/// solve, one row per vertex of `domain`) by the polish `options.polish` names, clamped to
+/// [0, 1], rows not normalized; `carried` itself with [`TwoLevelPolish::None`].
+pub fn polish(
+    domain: &Domain,
+    bc: &BoundaryConditions,
+    carried: &WeightMatrix,
+    options: &TwoLevelOptions,
+) -> Result<WeightMatrix, SolveError> {
+    match options.polish {
+        TwoLevelPolish::None => Ok(carried.clone()),
+        TwoLevelPolish::Support => support_bbw(domain, bc, carried, options.support_floor),
+        // The polish is a fixed number of steps toward the fine solution: sets that have not
+        // settled by then are expected, not a failure (only the coarse solve's are reported).
+        TwoLevelPolish::ActiveSet => {
+            active_set_bbw(domain, bc, carried, options.polish_iterations).map(|(w, _)| w)
+        }
+    }
 }
 
 /// The weights `w` (one row per vertex of `mesh`) at `points`, interpolated linearly in the

@@ -5,6 +5,7 @@
 
 pub mod document;
 pub mod golden;
+pub mod sprite_meshes;
 
 use image::RgbaImage;
 use tiny_skia::{
