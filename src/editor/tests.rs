@@ -530,3 +530,28 @@ fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
     let shown = shown_vertices(h)[part][vertex];
     Point::new(shown.x, shown.y)
 }
+
+/// The character with its skins, in animate mode on a new empty animation (made with the *New
+/// animation* button); its harness and the animation's name.
+fn new_animation_on_skinned_character(name: &str) -> (Harness<'static, EditorApp>, String) {
+    let path = character_rig_with(name, true);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    h.get_by_label("New animation").click();
+    h.run();
+    let animation = h.state().animate.animation.clone();
+    (h, animation)
+}
+
+/// The bag slot's attachment keys in `animation`: (time, attachment shown).
+fn bag_attachment_keys(h: &Harness<'_, EditorApp>, animation: &str) -> Vec<(f64, Option<String>)> {
+    let anim = crate::document::animation_named(h.state().doc.state(), animation);
+    let swaps = anim.parts.get("bag").and_then(|p| p.attachment.clone());
+    swaps
+        .unwrap_or_default()
+        .into_iter()
+        .map(|k| (k.time, k.value))
+        .collect()
+}

@@ -157,16 +157,8 @@ fn solve_handle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::weights::solve::tests::three_points;
+    use crate::weights::solve::tests::{largest_difference, three_points};
     use crate::weights::solve::{bounded_biharmonic_weights, BbwOptions};
-
-    fn largest_difference(a: &WeightMatrix, b: &WeightMatrix) -> f64 {
-        a.data
-            .iter()
-            .zip(&b.data)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max)
-    }
 
     #[test]
     fn from_a_rough_guess_the_sets_settle_on_the_interior_point_answer() {

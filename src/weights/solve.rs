@@ -523,6 +523,15 @@ pub(crate) mod tests {
         (v, t)
     }
 
+    /// The largest difference between two weight matrices' entries.
+    pub(crate) fn largest_difference(a: &WeightMatrix, b: &WeightMatrix) -> f64 {
+        a.data
+            .iter()
+            .zip(&b.data)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    }
+
     /// Three point handles on a 20×20 grid: two close together, one far.
     pub(crate) fn three_points() -> (Domain, BoundaryConditions, usize) {
         let n = 20;

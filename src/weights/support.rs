@@ -120,16 +120,8 @@ impl SupportSolver {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::weights::solve::tests::three_points;
+    use crate::weights::solve::tests::{largest_difference, three_points};
     use crate::weights::solve::{bounded_biharmonic_weights, BbwOptions};
-
-    fn largest_difference(a: &WeightMatrix, b: &WeightMatrix) -> f64 {
-        a.data
-            .iter()
-            .zip(&b.data)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max)
-    }
 
     #[test]
     fn on_the_exact_support_one_solve_gives_the_exact_weights() {

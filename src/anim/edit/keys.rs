@@ -18,13 +18,19 @@ pub(super) trait EditKey: Clone + Serialize + DeserializeOwned {
     const SHARES_TIMES: bool = false;
     fn time(&self) -> f64;
     fn set_time(&mut self, time_s: f64);
-    /// How it travels to the next key; `None` for the stepped-only kinds.
-    fn curve(&self) -> Option<&Curve>;
-    fn curve_mut(&mut self) -> Option<&mut Curve>;
+    /// How it travels to the next key; `None` (the default) for the stepped-only kinds.
+    fn curve(&self) -> Option<&Curve> {
+        None
+    }
+    fn curve_mut(&mut self) -> Option<&mut Curve> {
+        None
+    }
     /// The numbers its curve interpolates, one per curve channel; a kind with one curve for all
     /// its numbers (a cage polygon) has one channel, `fraction` of the way (0 at a segment's
-    /// start, 1 at its end: its Bézier `cy` are fractions).
-    fn curve_values(&self, fraction: f64) -> Vec<f64>;
+    /// start, 1 at its end: its Bézier `cy` are fractions). None for the stepped-only kinds.
+    fn curve_values(&self, _fraction: f64) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 impl<V: Channels + Serialize + DeserializeOwned> EditKey for Key<V> {
@@ -56,15 +62,6 @@ impl<V: Clone + Serialize + DeserializeOwned> EditKey for StepKey<V> {
     fn set_time(&mut self, time_s: f64) {
         self.time = time_s;
     }
-    fn curve(&self) -> Option<&Curve> {
-        None
-    }
-    fn curve_mut(&mut self) -> Option<&mut Curve> {
-        None
-    }
-    fn curve_values(&self, _fraction: f64) -> Vec<f64> {
-        Vec::new()
-    }
 }
 
 impl EditKey for EventKey {
@@ -74,15 +71,6 @@ impl EditKey for EventKey {
     }
     fn set_time(&mut self, time_s: f64) {
         self.time = time_s;
-    }
-    fn curve(&self) -> Option<&Curve> {
-        None
-    }
-    fn curve_mut(&mut self) -> Option<&mut Curve> {
-        None
-    }
-    fn curve_values(&self, _fraction: f64) -> Vec<f64> {
-        Vec::new()
     }
 }
 

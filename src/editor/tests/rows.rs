@@ -16,23 +16,8 @@ fn key_at(h: &Harness<'_, EditorApp>, timeline: &TimelineId, time_s: f64) -> Pos
 
 #[test]
 fn attachment_keys_move_copy_paste_and_delete_in_their_row() {
-    let path = character_rig_with("attachment-row", true);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
-    h.key_press(Key::Num3);
-    h.run();
-    h.get_by_label("New animation").click();
-    h.run();
-    let animation = h.state().animate.animation.clone();
-    let keys = |h: &Harness<'_, EditorApp>| -> Vec<(f64, Option<String>)> {
-        let anim = crate::document::animation_named(h.state().doc.state(), &animation);
-        let swaps = anim.parts.get("bag").and_then(|p| p.attachment.clone());
-        swaps
-            .unwrap_or_default()
-            .into_iter()
-            .map(|k| (k.time, k.value))
-            .collect()
-    };
+    let (mut h, animation) = new_animation_on_skinned_character("attachment-row");
+    let keys = |h: &Harness<'_, EditorApp>| bag_attachment_keys(h, &animation);
     h.get_by_label("bag shows bag_pail").scroll_to_me();
     h.run();
     h.get_by_label("bag shows bag_pail").click();

@@ -229,24 +229,8 @@ fn a_bone_dragged_onto_another_in_the_tree_hangs_from_it_undoably_and_loops_are_
 
 #[test]
 fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
-    let path = character_rig_with("attachment-list", true);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.run();
-    h.key_press(Key::Num3);
-    h.run();
-    h.get_by_label("New animation").click();
-    h.run();
-    let animation = h.state().animate.animation.clone();
-    let keys = |h: &Harness<'_, EditorApp>| -> Vec<(f64, Option<String>)> {
-        let anim = crate::document::animation_named(h.state().doc.state(), &animation);
-        anim.parts
-            .get("bag")
-            .and_then(|p| p.attachment.clone())
-            .unwrap_or_default()
-            .into_iter()
-            .map(|k| (k.time, k.value))
-            .collect()
-    };
+    let (mut h, animation) = new_animation_on_skinned_character("attachment-list");
+    let keys = |h: &Harness<'_, EditorApp>| bag_attachment_keys(h, &animation);
     let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
         let picture = h.state().drawing.picture.as_ref().expect("a picture");
         let draws = picture.draws.iter().filter(|d| d.visible);
