@@ -20,7 +20,7 @@
 //! [`compute_rig`] keeps them from the previous rig while it recomputes the others.
 
 use crate::anim::edit::{self, put_key, CopiedKey, KeyRef};
-use crate::anim::{Animation, BoneTimelines, Curve, IkTimeline, Key, PointTimelines};
+use crate::anim::{Animation, Curve, IkTimeline, Key};
 use crate::geom::Point;
 use crate::io::{self, BuildOptions, DocumentError as RigFileError, RigDocument};
 use crate::pipeline::{self, Layer, PipelineError, Scene};
@@ -37,6 +37,19 @@ pub use animations::{unused_animation_name, AnimationEdit};
 #[path = "document_events.rs"]
 pub mod events;
 pub use events::EventEdit;
+#[path = "document_keys.rs"]
+mod keys;
+pub(crate) use keys::key_drag;
+pub use keys::{animation_named, key_times};
+use keys::{check_key_time, edit_animation, key_pose, keys_at, store_animation};
+#[path = "document_paint.rs"]
+mod paint;
+use paint::paint_weights;
+pub use paint::part_weights_for_painting;
+#[path = "document_save.rs"]
+mod save;
+pub use save::{autosave_path, side_file, SaveJob};
+use save::{rig_document, same_layers, swap_in};
 
 /// Undo steps kept; older ones are forgotten.
 pub const UNDO_LIMIT: usize = 200;
@@ -625,103 +638,6 @@ impl Document {
     }
 }
 
-/// The rig document of `state` as it would be saved at `path` (see
-/// [`Document::to_rig_document`]). Traces and meshes the layers when `state` has no rig of
-/// them yet, which takes long on large images: [`SaveJob`] runs it off the UI thread.
-fn rig_document(state: &State, path: &Path) -> Result<RigDocument, DocumentError> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut doc = match &state.rig {
-        Some(scene) if same_layers(&scene.doc, &state.layers) => scene.doc.clone(),
-        _ => {
-            if state.layers.is_empty() {
-                return Err(DocumentError::NothingToSave);
-            }
-            pipeline::build_rig(&state.layers, dir, &state.options, &Handles::default())?.0
-        }
-    };
-    for part in &mut doc.parts {
-        // A stale rig's weights are not saved as weights (reopening must not pose with
-        // weights of other handles), but kept aside while locked handles need them.
-        let stale = if state.rig_current {
-            None
-        } else {
-            part.weights.take().or(part.stale_weights.take())
-        };
-        part.stale_weights = stale.filter(|_| !state.locked.is_empty());
-    }
-    for (part, layer) in doc.parts.iter_mut().zip(&state.layers) {
-        part.image = pipeline::relative_path(dir, &layer.path);
-    }
-    doc.handles = state.handles.clone();
-    doc.options = state.options.clone();
-    doc.animations = state.animations.clone();
-    doc.events = state.events.clone();
-    doc.locked = state.locked.iter().cloned().collect();
-    state.slots.apply_to(&mut doc)?;
-    Ok(doc)
-}
-
-/// A snapshot of a document to save or autosave, possibly on another thread:
-/// [`Document::save_job`] and [`Document::autosave_job`] copy the state (layers and rig are
-/// shared), [`SaveJob::run`] writes it.
-#[derive(Clone)]
-pub struct SaveJob {
-    state: State,
-    target: PathBuf,
-    /// The document's revision when the snapshot was taken.
-    revision: u64,
-    /// An autosave: [`Document::saved`] ignores it.
-    autosave: bool,
-}
-
-impl SaveJob {
-    /// Where the file goes.
-    pub fn target(&self) -> &Path {
-        &self.target
-    }
-
-    /// Writes the snapshot to its file (atomically); returns where it went.
-    pub fn run(&self) -> Result<PathBuf, DocumentError> {
-        rig_document(&self.state, &self.target)?.save(&self.target)?;
-        Ok(self.target.clone())
-    }
-}
-
-/// Makes the last state of `from` current (with its revision), pushing the current one onto
-/// `to`.
-fn swap_in(
-    (state, revision): (&mut State, &mut u64),
-    from: &mut Vec<(State, u64)>,
-    to: &mut Vec<(State, u64)>,
-) -> bool {
-    match from.pop() {
-        Some((other, other_revision)) => {
-            let previous = std::mem::replace(state, other);
-            to.push((previous, std::mem::replace(revision, other_revision)));
-            true
-        }
-        None => false,
-    }
-}
-
-/// The side file autosaves go to: `NAME.autosave.json` beside `NAME.json`.
-pub fn autosave_path(path: &Path) -> PathBuf {
-    side_file(path, "autosave")
-}
-
-/// `NAME.KIND.json` beside the document `NAME.json` (autosaves, the editor's view).
-pub fn side_file(path: &Path, kind: &str) -> PathBuf {
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "untitled".into());
-    path.with_file_name(format!("{stem}.{kind}.json"))
-}
-
-fn same_layers(doc: &RigDocument, layers: &[Arc<Layer>]) -> bool {
-    doc.parts.len() == layers.len() && doc.parts.iter().zip(layers).all(|(p, l)| p.name == l.name)
-}
-
 /// Builds the rig (trace, mesh, weights) for `inputs`. Meant for a background thread:
 /// `progress(parts_done, parts_total)` reports each part, and setting `cancel` stops the build
 /// before the next part with [`DocumentError::Cancelled`]. `dir` is the folder image paths are
@@ -757,18 +673,6 @@ pub fn compute_rig(
         .set_skins(&inputs.slots.shown)
         .map_err(|e| DocumentError::Slots(e.to_string()))?;
     Ok(scene)
-}
-
-/// Replaces animation `name` of `state` (an empty one when there is none) by `apply(name, it)`
-/// (a key edit: `anim::edit`, which checks what it returns).
-fn edit_animation(
-    state: &mut State,
-    name: String,
-    apply: impl FnOnce(&str, &Animation) -> Result<Animation, edit::EditError>,
-) -> Result<(), DocumentError> {
-    let edited = apply(&name, &animation_named(state, &name))?;
-    state.animations.insert(name, edited);
-    Ok(())
 }
 
 /// The state after `command`, or why it cannot apply.
@@ -938,9 +842,10 @@ fn apply_to(state: &State, command: Command) -> Result<State, DocumentError> {
         }
         Command::DeleteKeys { animation, time_s } => {
             check_key_time(time_s)?;
-            let mut anim = animation_named(state, &animation);
-            delete_keys(&mut anim, time_s);
-            store_animation(&mut next, &animation, anim)?;
+            let keys = keys_at(&animation_named(state, &animation), time_s);
+            edit_animation(&mut next, animation, |name, anim| {
+                edit::delete_keys(name, anim, &keys)
+            })?;
             inputs_changed = false;
         }
         Command::SetPose(pose) => {
@@ -1117,81 +1022,6 @@ fn rig_inputs_of(state: &State) -> RigInputs {
     }
 }
 
-/// The weight columns of `part` in the current rig with their locked flags, and the rig.
-pub fn part_weights_for_painting<'a>(
-    state: &'a State,
-    part: &str,
-) -> Result<(&'a Arc<Scene>, usize, Vec<bool>), DocumentError> {
-    let scene = state
-        .rig
-        .as_ref()
-        .filter(|_| state.rig_current && !state.handles.is_empty())
-        .ok_or(DocumentError::NoWeights)?;
-    let index = scene
-        .doc
-        .parts
-        .iter()
-        .position(|p| p.name == part)
-        .ok_or_else(|| DocumentError::UnknownLayer(part.to_string()))?;
-    let weights = scene.doc.parts[index]
-        .weights
-        .as_ref()
-        .ok_or(DocumentError::NoWeights)?;
-    let locked = pipeline::locked_columns(&state.handles, &state.locked, &weights.handles);
-    Ok((scene, index, locked))
-}
-
-/// The rig after one stroke of [`Command::PaintWeights`].
-fn paint_weights(
-    state: &State,
-    part: &str,
-    handle: &str,
-    mode: BrushMode,
-    samples_px: &[Point],
-    options: &BrushOptions,
-) -> Result<Scene, DocumentError> {
-    let (scene, index, locked) = part_weights_for_painting(state, part)?;
-    let part_doc = &scene.doc.parts[index];
-    let Some(weights) = &part_doc.weights else {
-        return Err(DocumentError::NoWeights);
-    };
-    let column = weights
-        .handles
-        .iter()
-        .position(|h| h == handle)
-        .ok_or_else(|| DocumentError::UnknownHandle(handle.to_string()))?;
-    if locked[column] {
-        return Err(DocumentError::LockedHandle(handle.to_string()));
-    }
-    let mesh = PaintMesh::new(&part_doc.mesh.vertices, &part_doc.mesh.triangles)?;
-    let mut rows = weights.rows.clone();
-    let limit = scene.doc.options.weights.max_influences;
-    let report = crate::weights::paint_stroke(
-        &mesh,
-        &mut rows,
-        &PaintTarget {
-            column,
-            locked: &locked,
-            max_influences: limit,
-        },
-        mode,
-        samples_px,
-        options,
-    )?;
-    // A stroke that changed nothing is no undo step.
-    if report.vertex_changes == 0 {
-        return Err(DocumentError::NothingPainted {
-            at_limit: report.at_limit,
-            limit,
-        });
-    }
-    let painted = crate::io::WeightsDoc {
-        handles: weights.handles.clone(),
-        rows,
-    };
-    Ok(scene.with_part_weights(index, painted)?)
-}
-
 fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {
     if let Some(v) = pose.bones.remove(from) {
         pose.bones.insert(to.to_string(), v);
@@ -1202,129 +1032,6 @@ fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {
     if let Some(v) = pose.cages.remove(from) {
         pose.cages.insert(to.to_string(), v);
     }
-}
-
-fn check_key_time(time_s: f64) -> Result<(), DocumentError> {
-    if time_s.is_finite() && time_s >= 0.0 {
-        Ok(())
-    } else {
-        Err(DocumentError::KeyTime(time_s))
-    }
-}
-
-/// The animation stored under `name`, or a new empty one.
-pub fn animation_named(state: &State, name: &str) -> Animation {
-    state.animations.get(name).cloned().unwrap_or_default()
-}
-
-fn store_animation(next: &mut State, name: &str, anim: Animation) -> Result<(), DocumentError> {
-    anim.validate(name)?;
-    next.animations.insert(name.to_string(), anim);
-    Ok(())
-}
-
-/// Keys every bone and point channel and every IK drag of `pose` at `time_s` ([`put_key`]: a key
-/// inside a segment splits its curve, so the motion around it stays as it was).
-fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
-    for (name, b) in &pose.bones {
-        let t = anim.bones.entry(name.clone()).or_default();
-        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate);
-        put_key(
-            t.translate.get_or_insert_with(Vec::new),
-            time_s,
-            b.translate,
-        );
-        put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale);
-        put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear);
-    }
-    for (name, p) in &pose.points {
-        let t = anim.points.entry(name.clone()).or_default();
-        put_key(
-            t.translate.get_or_insert_with(Vec::new),
-            time_s,
-            p.translate,
-        );
-        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate);
-        put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale);
-        put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear);
-    }
-    for drag in &pose.ik {
-        key_drag(anim, drag, time_s);
-    }
-}
-
-/// Keys `drag`'s target at `time_s` on the IK timeline of its rest point and weight (made,
-/// with a linear key, when the animation has none).
-pub(crate) fn key_drag(anim: &mut Animation, drag: &crate::rig::pose::IkDrag, time_s: f64) {
-    match anim
-        .ik
-        .iter_mut()
-        .find(|t| t.at == drag.at && t.weight == drag.weight)
-    {
-        Some(t) => put_key(&mut t.to, time_s, drag.to),
-        None => anim.ik.push(IkTimeline {
-            at: drag.at,
-            to: vec![Key {
-                time: time_s,
-                value: drag.to,
-                curve: Curve::Linear,
-            }],
-            weight: drag.weight,
-        }),
-    }
-}
-
-fn delete_keys(anim: &mut Animation, time_s: f64) {
-    fn drop_at<V>(keys: &mut Option<Vec<Key<V>>>, time_s: f64) {
-        if let Some(k) = keys {
-            k.retain(|k| (k.time - time_s).abs() > KEY_TIME_TOLERANCE_S);
-            if k.is_empty() {
-                *keys = None;
-            }
-        }
-    }
-    for t in anim.bones.values_mut() {
-        drop_at(&mut t.rotate, time_s);
-        drop_at(&mut t.translate, time_s);
-        drop_at(&mut t.scale, time_s);
-        drop_at(&mut t.shear, time_s);
-    }
-    anim.bones.retain(|_, t| *t != BoneTimelines::default());
-    for t in anim.points.values_mut() {
-        drop_at(&mut t.translate, time_s);
-        drop_at(&mut t.rotate, time_s);
-        drop_at(&mut t.scale, time_s);
-        drop_at(&mut t.shear, time_s);
-    }
-    anim.points.retain(|_, t| *t != PointTimelines::default());
-    for t in &mut anim.ik {
-        t.to.retain(|k| (k.time - time_s).abs() > KEY_TIME_TOLERANCE_S);
-    }
-    anim.ik.retain(|t| !t.to.is_empty());
-}
-
-/// Every key time of `anim`, sorted, duplicates (within [`KEY_TIME_TOLERANCE_S`]) merged.
-pub fn key_times(anim: &Animation) -> Vec<f64> {
-    let mut times: Vec<f64> = Vec::new();
-    let mut add = |t: f64| times.push(t);
-    for b in anim.bones.values() {
-        b.rotate.iter().flatten().for_each(|k| add(k.time));
-        b.translate.iter().flatten().for_each(|k| add(k.time));
-        b.scale.iter().flatten().for_each(|k| add(k.time));
-        b.shear.iter().flatten().for_each(|k| add(k.time));
-    }
-    for p in anim.points.values() {
-        p.translate.iter().flatten().for_each(|k| add(k.time));
-        p.rotate.iter().flatten().for_each(|k| add(k.time));
-        p.scale.iter().flatten().for_each(|k| add(k.time));
-        p.shear.iter().flatten().for_each(|k| add(k.time));
-    }
-    for t in &anim.ik {
-        t.to.iter().for_each(|k| add(k.time));
-    }
-    times.sort_by(f64::total_cmp);
-    times.dedup_by(|a, b| (*a - *b).abs() <= KEY_TIME_TOLERANCE_S);
-    times
 }
 
 #[cfg(test)]

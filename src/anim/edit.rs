@@ -252,6 +252,23 @@ impl Segment {
     }
 }
 
+/// The key of each of `timelines` (as [`timelines`] lists them) at `time_s`, within
+/// [`KEY_TIME_TOLERANCE_S`].
+pub fn keys_at(timelines: &[(TimelineId, Vec<f64>)], time_s: f64) -> Vec<KeyRef> {
+    timelines
+        .iter()
+        .filter_map(|(timeline, times)| {
+            let &at = times
+                .iter()
+                .find(|&&t| (t - time_s).abs() <= KEY_TIME_TOLERANCE_S)?;
+            Some(KeyRef {
+                timeline: timeline.clone(),
+                time_s: at,
+            })
+        })
+        .collect()
+}
+
 /// Every timeline of `animation` with its key times, in a stable order: bones, points, cages,
 /// deform keys, IK drags, part colors, visibility and attachments, draw order, events (names
 /// alphabetical, channels as [`TransformChannel::ALL`]; the events' times once each).

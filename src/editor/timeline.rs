@@ -465,21 +465,6 @@ impl EditorApp {
         }
     }
 
-    fn keys_at(timelines: &[(TimelineId, Vec<f64>)], time_s: f64) -> Vec<KeyRef> {
-        timelines
-            .iter()
-            .filter_map(|(t, times)| {
-                times
-                    .iter()
-                    .find(|&&s| (s - time_s).abs() <= KEY_TIME_TOLERANCE_S)
-                    .map(|&s| KeyRef {
-                        timeline: t.clone(),
-                        time_s: s,
-                    })
-            })
-            .collect()
-    }
-
     fn dopesheet(&mut self, ui: &mut egui::Ui, width: f32, timelines: &[(TimelineId, Vec<f64>)]) {
         let height = ROW_HEIGHT_PT * (timelines.len() as f32 + 2.0);
         let (response, painter) =
@@ -649,7 +634,7 @@ impl EditorApp {
                         if !shift {
                             self.timeline.selection.clear();
                         }
-                        for key in Self::keys_at(timelines, time_s) {
+                        for key in crate::anim::edit::keys_at(timelines, time_s) {
                             self.select(key);
                         }
                         SheetGesture::Move {
@@ -752,7 +737,7 @@ impl EditorApp {
                         self.timeline.selection.clear();
                         self.set_time(time_s);
                     }
-                    for key in Self::keys_at(timelines, time_s) {
+                    for key in crate::anim::edit::keys_at(timelines, time_s) {
                         self.select(key);
                     }
                 }
