@@ -9,6 +9,8 @@ use eframe::egui::{self, Color32};
 
 /// Seconds a message stays in the status bar.
 pub const MESSAGE_SHOWN_S: f64 = 8.0;
+/// How long after a message expires the frame that takes it away is asked for, seconds.
+const EXPIRY_REPAINT_MARGIN_S: f64 = 0.1;
 
 /// Messages the log keeps; older ones are dropped.
 pub const MAX_LOGGED: usize = 500;
@@ -94,12 +96,16 @@ impl EditorApp {
                 ui.label(message);
             }
         }
-        // One more frame when the message expires, to take it off the status bar.
+        // One more frame when the message expires, to take it off the status bar: a little
+        // after, never "now" (egui takes a frame off the delay, and a delay within a frame of the
+        // expiry would become a repaint loop until the clock passes it).
         if self.message.is_some() {
             let left = MESSAGE_SHOWN_S - (now - self.log.since_s);
             if left > 0.0 {
                 ui.ctx()
-                    .request_repaint_after(std::time::Duration::from_secs_f64(left));
+                    .request_repaint_after(std::time::Duration::from_secs_f64(
+                        left + EXPIRY_REPAINT_MARGIN_S,
+                    ));
             }
         }
     }

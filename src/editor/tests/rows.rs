@@ -157,30 +157,27 @@ fn deform_keys_have_a_row_with_curves_and_move_copy_and_paste() {
 #[test]
 fn delete_key_removes_every_kind_of_key_at_the_playhead() {
     let (mut h, animation) = new_animation_on_skinned_character("delete-key");
-    let events = |h: &Harness<'_, EditorApp>| {
-        crate::document::animation_named(h.state().doc.state(), &animation)
-            .events
-            .len()
-    };
-    // An attachment swap and an event at 0 s, through the tree and the side panel.
+    // An attachment swap at 0 s, through the tree.
     h.get_by_label("bag shows bag_pail").scroll_to_me();
     h.run();
     h.get_by_label("bag shows bag_pail").click();
-    h.run();
-    h.get_by_label("Add event").click();
     h.run();
     assert_eq!(
         bag_attachment_keys(&h, &animation),
         [(0.0, Some("bag_pail".into()))]
     );
-    assert_eq!(events(&h), 1, "{:?}", h.state().message);
-    // *Delete key* takes both, as one undo step.
+    let keyed = |h: &Harness<'_, EditorApp>| {
+        let anim = crate::document::animation_named(h.state().doc.state(), &animation);
+        crate::anim::edit::timelines(&anim).len()
+    };
+    assert_eq!(keyed(&h), 1, "{:?}", h.state().message);
+    // *Delete key* takes every key at the playhead, the swap included, as one undo step.
     h.get_by_label("Delete key").click();
     h.run();
     assert!(bag_attachment_keys(&h, &animation).is_empty());
-    assert_eq!(events(&h), 0);
+    assert_eq!(keyed(&h), 0);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
     assert_eq!(bag_attachment_keys(&h, &animation).len(), 1);
-    assert_eq!(events(&h), 1);
+    assert_eq!(keyed(&h), 1);
 }
