@@ -16,6 +16,7 @@ use crate::document::Command;
 use crate::geom::{Point, Vec2};
 use crate::pipeline::Scene;
 use eframe::egui::{self, Color32, Pos2, Stroke};
+use nalgebra::Matrix2;
 use std::sync::Arc;
 
 /// Default radius of the deform tool, canvas px.
@@ -172,15 +173,15 @@ impl EditorApp {
             if w == 0.0 {
                 continue;
             }
-            // Solve [jx jy] · d = w · delta for the offset's change d.
-            let (jx, jy) = (along_x[v] - at[v], along_y[v] - at[v]);
-            let det = jx.x * jy.y - jy.x * jx.y;
-            if det.abs() < 1e-9 {
+            // Solve J · d = w · delta for the offset's change d, J = [jx jy] the skinning's
+            // local map (a vertex it collapses keeps its offset).
+            let jacobian = Matrix2::from_columns(&[along_x[v] - at[v], along_y[v] - at[v]]);
+            if jacobian.determinant().abs() < 1e-9 {
                 continue;
             }
-            let (mx, my) = (w * delta.x, w * delta.y);
-            offset.x += (mx * jy.y - jy.x * my) / det;
-            offset.y += (jx.x * my - mx * jx.y) / det;
+            if let Some(inverse) = jacobian.try_inverse() {
+                *offset += inverse * (w * delta);
+            }
         }
         let (name, time_s) = (part.name.clone(), self.animate.time_s);
         if self.apply(Command::KeyDeform {
