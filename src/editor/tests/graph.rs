@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::anim::edit::TransformChannel::*;
+use crate::editor::graph_view::GraphLayout;
 
 fn rotate_numbers(h: &Harness<'_, EditorApp>) -> Vec<f64> {
     serde_json::from_value(head_rotate_keys(h)[0].2.clone()).expect("a Bézier")
@@ -94,4 +95,82 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();
     assert_eq!(rotate_numbers(&h), numbers);
+}
+
+#[test]
+fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request() {
+    let mut h = open_character("graph-axes");
+    h.key_press(Key::Num3);
+    h.run();
+    // The head keyed at 0° at 0 s and 20° at 0.5 s.
+    key_a_nod_from_the_numbers_panel(&mut h);
+    h.get_by_label("Graph view").click();
+    h.run();
+    let layout =
+        |h: &Harness<'_, EditorApp>| h.state().timeline.graph.layout.clone().expect("the graph");
+
+    // Seven curves, each over its own range: the time axis is labelled, the value axis not
+    // (its numbers would mean seven things).
+    let first = layout(&h);
+    assert_eq!(first.curves.len(), 7);
+    assert!(first.value_ticks.is_empty(), "{:?}", first.value_ticks);
+    let times: Vec<f64> = first.time_ticks.iter().map(|t| t.0).collect();
+    assert!(times.first() == Some(&0.0) && times.len() >= 2, "{times:?}");
+    for (t, x) in &first.time_ticks {
+        let f = (x - first.rect.left()) / first.rect.width();
+        assert!((f64::from(f) - (t - first.start_s) / (first.end_s - first.start_s)).abs() < 1e-3);
+    }
+    assert!(
+        first
+            .curves
+            .iter()
+            .any(|c| (c.low, c.high) != (first.curves[0].low, first.curves[0].high)),
+        "rotate (degrees) and scale (factors) have different ranges"
+    );
+
+    // Same scale: one range for every curve, and value ticks that mean it. The rotate key's
+    // 20° sits on the tick labelled 20.
+    h.get_by_label("Same scale").click();
+    h.run();
+    let shared = layout(&h);
+    let (low, high) = (shared.curves[0].low, shared.curves[0].high);
+    assert!(shared.curves.iter().all(|c| (c.low, c.high) == (low, high)));
+    assert!(low <= 0.0 && high >= 20.0, "{low}..{high}");
+    let tick = |value: f64, l: &GraphLayout| {
+        l.value_ticks
+            .iter()
+            .find(|t| (t.0 - value).abs() < 1e-9)
+            .map(|t| t.1)
+    };
+    let y20 = tick(20.0, &shared).expect("a tick at 20");
+    let y0 = tick(0.0, &shared).expect("a tick at 0");
+    let expect =
+        |v: f64| shared.rect.bottom() - ((v - low) / (high - low)) as f32 * shared.rect.height();
+    assert!((y20 - expect(20.0)).abs() < 0.01 && (y0 - expect(0.0)).abs() < 0.01);
+    assert!(y20 < y0, "larger values higher up");
+
+    // Back to a range per curve, every curve but the rotation hidden: the axis is labelled
+    // in the rotation's own range.
+    h.get_by_label("Same scale").click();
+    h.run();
+    for name in [
+        "head translate x",
+        "head translate y",
+        "head scale x",
+        "head scale y",
+        "head shear x",
+        "head shear y",
+    ] {
+        h.get_by_label(name).click();
+        h.run();
+    }
+    let rotate = layout(&h);
+    assert_eq!(rotate.curves.len(), 1);
+    let (low, high) = (rotate.curves[0].low, rotate.curves[0].high);
+    assert!(
+        low > -5.0 && high < 25.0,
+        "the rotation's own range: {low}..{high}"
+    );
+    assert!(tick(20.0, &rotate).is_some() && tick(0.0, &rotate).is_some());
+    assert!(rotate.value_ticks.iter().all(|t| t.0 >= low && t.0 <= high));
 }
