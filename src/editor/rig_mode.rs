@@ -208,7 +208,7 @@ impl EditorApp {
         ui.heading("Tree");
         egui::ScrollArea::vertical()
             .id_salt("tree")
-            .max_height(260.0)
+            .max_height(TREE_HEIGHT_PT)
             .show(ui, |ui| self.tree_view(ui));
         if let Some(name) = self.selected.clone() {
             ui.separator();
@@ -448,6 +448,8 @@ impl EditorApp {
 
 /// Height of the heat map legend above the canvas' bottom edge, screen points.
 const LEGEND_HEIGHT_PT: f32 = 64.0;
+/// The tree's height in rig mode's side panel at most (it scrolls beyond), points.
+pub const TREE_HEIGHT_PT: f32 = 260.0;
 /// Length of the legend's colour bar, screen points.
 const LEGEND_BAR_PT: f32 = 120.0;
 

@@ -3,7 +3,8 @@
 //! points, cages and regions, and the parts (slots) front to back.
 //!
 //! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
-//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row), the
+//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row; a
+//! drag held near the tree's top or bottom edge scrolls it, so any row can be reached), the
 //! parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename` and
 //! `Reparent` commands (undoable; a loop is refused with a message), and which parts the canvas hides (a view setting, not part of the document: the
 //! posed picture drops them from the library's draw list; rig mode leaves their images out).
@@ -15,6 +16,13 @@ use std::collections::BTreeSet;
 
 /// A bone being dragged in the tree (egui's drag-and-drop payload).
 struct DraggedBone(String);
+
+/// While a bone is dragged, a pointer within this distance of the tree's visible top or
+/// bottom edge (inside or out) scrolls the tree that way, points.
+pub const AUTOSCROLL_BAND_PT: f32 = 24.0;
+/// The scrolling speed with the pointer at the edge or beyond, points per second; it falls
+/// linearly to zero at the band's inner side.
+pub const AUTOSCROLL_SPEED_PT_PER_S: f32 = 480.0;
 
 /// The tree's own state.
 #[derive(Default)]
@@ -44,6 +52,7 @@ impl EditorApp {
                 self.start_rename(&name);
             }
         }
+        scroll_while_dragging(ui);
         let handles = self.doc.state().handles.clone();
         egui::CollapsingHeader::new("Skeletons")
             .default_open(true)
@@ -353,4 +362,38 @@ impl EditorApp {
         }
         pose
     }
+}
+
+/// Scrolls the tree (the scroll area `ui` is in) while a bone is dragged with the pointer near
+/// its visible top or bottom edge: [`AUTOSCROLL_BAND_PT`], [`AUTOSCROLL_SPEED_PT_PER_S`].
+fn scroll_while_dragging(ui: &egui::Ui) {
+    if !egui::DragAndDrop::has_payload_of_type::<DraggedBone>(ui.ctx()) {
+        return;
+    }
+    let Some(at) = ui.ctx().pointer_latest_pos() else {
+        return;
+    };
+    let visible = ui.clip_rect();
+    let band = AUTOSCROLL_BAND_PT;
+    if !visible.x_range().contains(at.x)
+        || at.y < visible.top() - band
+        || at.y > visible.bottom() + band
+    {
+        return;
+    }
+    // How far into the band, 0 at its inner side, 1 at the edge and beyond.
+    let up = ((visible.top() + band - at.y) / band).clamp(0.0, 1.0);
+    let down = ((at.y - (visible.bottom() - band)) / band).clamp(0.0, 1.0);
+    if up == 0.0 && down == 0.0 {
+        return;
+    }
+    let dt_s = ui.input(|i| i.stable_dt).min(0.1);
+    // Positive y moves the content down, showing rows above.
+    let delta_pt = (up - down) * AUTOSCROLL_SPEED_PT_PER_S * dt_s;
+    ui.scroll_with_delta_animation(
+        egui::vec2(0.0, delta_pt),
+        egui::style::ScrollAnimation::none(),
+    );
+    // Keep scrolling while the pointer rests there: no input event arrives to draw a frame.
+    ui.ctx().request_repaint();
 }
