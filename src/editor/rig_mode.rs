@@ -64,7 +64,7 @@ impl EditorApp {
         let mut shapes = Vec::new();
         let hidden = &self.tree.hidden_parts;
         for (texture, layer) in textures.iter().zip(&self.doc.state().layers) {
-            if !hidden.contains(&layer.name) {
+            if !hidden.contains(&layer.name) && self.rig_shows_part(&layer.name) {
                 let size_px = [layer.image.width(), layer.image.height()];
                 shapes.push(canvas::image_quad(
                     placed,
@@ -78,6 +78,9 @@ impl EditorApp {
             return shapes;
         };
         for (k, part) in scene.doc.parts.iter().enumerate() {
+            if !self.rig_shows_part(&part.name) {
+                continue;
+            }
             let rest = &part.mesh.vertices;
             let Some(weights) = part.weights.as_ref().filter(|_| weighted) else {
                 shapes.extend(canvas::wireframe(placed, rest, &part.mesh.triangles));

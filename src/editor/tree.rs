@@ -12,7 +12,7 @@
 use super::{EditorApp, Mode};
 use crate::document::Command;
 use eframe::egui::{self, Key};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A bone being dragged in the tree (egui's drag-and-drop payload).
 struct DraggedBone(String);
@@ -29,6 +29,10 @@ pub const AUTOSCROLL_SPEED_PT_PER_S: f32 = 480.0;
 pub struct TreeState {
     /// Parts the canvas does not draw (by name).
     pub hidden_parts: BTreeSet<String>,
+    /// Rig mode's choice, per slot with several attachments, of the one the canvas shows
+    /// (`None`: nothing). A view setting: the setup pose keys no attachment. A slot not listed
+    /// shows the attachment its skins give it, else its own part.
+    pub rig_attachments: BTreeMap<String, Option<String>>,
     /// The handle being renamed in place, and the name typed so far.
     renaming: Option<(String, String)>,
     /// The rename field wants the keyboard (it just appeared).
@@ -270,30 +274,32 @@ impl EditorApp {
                             self.tree.hidden_parts.insert(part.clone());
                         }
                     }
-                    if matches!(self.mode, Mode::Pose | Mode::Animate) {
-                        self.attachment_list(ui, &part);
-                    }
+                    self.attachment_list(ui, &part);
                 }
             });
     }
 
-    /// A slot's attachments (when it has more than its own part), the one shown at the
-    /// playhead ticked; a click shows another: keyed at the playhead in animate mode (an
-    /// attachment key), the pose's in pose mode.
+    /// A slot's attachments (when it has more than its own part), the one shown ticked; a
+    /// click shows another: keyed at the playhead in animate mode (an attachment key), the
+    /// pose's in pose mode, a view setting in rig mode (to see and weigh each attachment).
     fn attachment_list(&mut self, ui: &mut egui::Ui, slot: &str) {
         let names = crate::document::animations::slot_attachments(self.doc.state(), slot);
         if names.len() < 2 || self.doc.state().slots.attachments.contains_key(slot) {
             return;
         }
-        let pose = self.edited_pose();
-        let shown = match pose.parts.get(slot) {
-            Some(p) if !p.visible => None,
-            Some(p) => Some(
-                p.attachment
-                    .clone()
-                    .unwrap_or_else(|| self.default_attachment(slot)),
-            ),
-            None => Some(self.default_attachment(slot)),
+        let shown = if self.mode == Mode::Rig {
+            self.rig_attachment(slot)
+        } else {
+            let pose = self.edited_pose();
+            match pose.parts.get(slot) {
+                Some(p) if !p.visible => None,
+                Some(p) => Some(
+                    p.attachment
+                        .clone()
+                        .unwrap_or_else(|| self.default_attachment(slot)),
+                ),
+                None => Some(self.default_attachment(slot)),
+            }
         };
         let mut chosen = None;
         ui.indent(("attachments", slot), |ui| {
@@ -323,9 +329,44 @@ impl EditorApp {
             .unwrap_or_else(|| slot.to_string())
     }
 
+    /// The attachment rig mode shows in `slot` (`None`: nothing): the one picked in the tree,
+    /// else [`Self::default_attachment`].
+    fn rig_attachment(&self, slot: &str) -> Option<String> {
+        match self.tree.rig_attachments.get(slot) {
+            Some(picked) => picked.clone(),
+            None => Some(self.default_attachment(slot)),
+        }
+    }
+
+    /// Whether rig mode draws part `name` (its image, mesh and weights): every part but the
+    /// attachments a slot does not show ([`Self::rig_attachment`]). The eye boxes hide images
+    /// on top of this.
+    pub fn rig_shows_part(&self, name: &str) -> bool {
+        let state = self.doc.state();
+        let slot = state
+            .slots
+            .attachments
+            .get(name)
+            .map_or(name, String::as_str);
+        if crate::document::animations::slot_attachments(state, slot).len() < 2 {
+            return true;
+        }
+        self.rig_attachment(slot).as_deref() == Some(name)
+    }
+
     /// Shows `attachment` (none: nothing) in `slot`: an attachment key at the playhead in
-    /// animate mode, the document's pose in pose mode.
+    /// animate mode, the document's pose in pose mode, the canvas's view in rig mode.
     pub fn show_attachment(&mut self, slot: &str, attachment: Option<String>) {
+        if self.mode == Mode::Rig {
+            self.message = Some(format!(
+                "'{slot}' shows {} while rigging",
+                attachment.as_deref().unwrap_or("nothing")
+            ));
+            self.tree
+                .rig_attachments
+                .insert(slot.to_string(), attachment);
+            return;
+        }
         let part = |pose: &mut crate::rig::Pose| {
             let p = pose.parts.entry(slot.to_string()).or_default();
             p.visible = attachment.is_some();

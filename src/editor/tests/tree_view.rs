@@ -342,3 +342,41 @@ fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
     assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
     assert!(drawn(&h).contains(&"bag_pail".to_string()));
 }
+
+#[test]
+fn rig_mode_draws_one_attachment_per_slot_and_the_tree_picks_which() {
+    let path = character_rig_with("rig-attachments", true);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    assert_eq!(h.state().mode, Mode::Rig);
+    let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
+        let app = h.state();
+        let layers = &app.doc.state().layers;
+        let names = layers.iter().map(|l| l.name.clone());
+        names.filter(|n| app.rig_shows_part(n)).collect()
+    };
+    let has = |h: &Harness<'_, EditorApp>, part: &str| drawn(h).iter().any(|n| n == part);
+    // Each slot shows its own part, not every attachment stacked: the lantern, the closed hand.
+    assert!(has(&h, "bag") && !has(&h, "bag_pail"), "{:?}", drawn(&h));
+    assert!(has(&h, "arm_lower_l") && !has(&h, "arm_lower_l_open"));
+    assert!(tree_selected(&h, "bag shows bag"));
+
+    // The tree shows the pail instead, to see and weigh it: a view, not an edit.
+    click_label(&mut h, "bag shows bag_pail");
+    assert!(has(&h, "bag_pail") && !has(&h, "bag"), "{:?}", drawn(&h));
+    assert!(tree_selected(&h, "bag shows bag_pail"));
+    assert!(
+        !h.state().doc.can_undo(),
+        "viewing an attachment is not an edit"
+    );
+    click_label(&mut h, "bag shows nothing");
+    assert!(!has(&h, "bag_pail") && !has(&h, "bag"));
+
+    // Pose mode shows what the pose shows (the lantern): rig mode's choice is its own.
+    h.key_press(Key::Num2);
+    h.run();
+    assert!(tree_selected(&h, "bag shows bag"));
+    h.key_press(Key::Num1);
+    h.run();
+    assert!(tree_selected(&h, "bag shows nothing"));
+}
