@@ -5,17 +5,28 @@ use super::*;
 use crate::anim::edit::TransformChannel::*;
 use crate::editor::graph_view::GraphLayout;
 
+/// The bundled character in animate mode with the head keyed at 0° at 0 s and 20° at 0.5 s
+/// from the numbers panel (every transform channel gets keys).
+fn nodding_head(name: &str) -> Harness<'static, EditorApp> {
+    let mut h = open_character(name);
+    h.key_press(Key::Num3);
+    h.run();
+    key_a_nod_from_the_numbers_panel(&mut h);
+    h
+}
+
+/// Where the graph view drew last frame.
+fn graph(h: &Harness<'_, EditorApp>) -> GraphLayout {
+    h.state().timeline.graph.layout.clone().expect("the graph")
+}
+
 fn rotate_numbers(h: &Harness<'_, EditorApp>) -> Vec<f64> {
     serde_json::from_value(head_rotate_keys(h)[0].2.clone()).expect("a Bézier")
 }
 
 #[test]
 fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() {
-    let mut h = open_character("graph-view");
-    h.key_press(Key::Num3);
-    h.run();
-    // The head keyed at 0° at 0 s and 20° at 0.5 s (every transform channel gets keys).
-    key_a_nod_from_the_numbers_panel(&mut h);
+    let mut h = nodding_head("graph-view");
     // The rotate key at 0 s made a Bézier in the one-segment curve editor.
     let at = key_on_sheet(&h, Rotate, 0.0);
     click_screen(&mut h, at);
@@ -38,7 +49,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     for name in names {
         h.get_by_label(name);
     }
-    let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+    let layout = graph(&h);
     let drawn: Vec<&str> = layout.curves.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(drawn, names);
     // Only the rotate curve is a Bézier: its two handles are drawn, no other curve has any.
@@ -49,14 +60,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     let before = layout.rect;
     let corner = before.right_bottom() + egui::vec2(16.0, 16.0);
     drag_screen(&mut h, corner, corner + egui::vec2(160.0, 100.0));
-    let after = h
-        .state()
-        .timeline
-        .graph
-        .layout
-        .clone()
-        .expect("the graph")
-        .rect;
+    let after = graph(&h).rect;
     assert!(
         after.width() > before.width() + 100.0 && after.height() > before.height() + 60.0,
         "{before:?} → {after:?}"
@@ -66,7 +70,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     h.get_by_label("head translate x").click();
     h.run();
     let shown = |h: &Harness<'_, EditorApp>| {
-        let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+        let layout = graph(h);
         layout
             .curves
             .iter()
@@ -80,7 +84,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     assert_eq!(shown(&h).len(), 7);
 
     // The rotate curve's first handle dragged right and down: a later, lower handle.
-    let layout = h.state().timeline.graph.layout.clone().expect("the graph");
+    let layout = graph(&h);
     let first = layout.curves[0].handles[0].2;
     drag_screen(&mut h, first, first + egui::vec2(30.0, 25.0));
     let dragged = rotate_numbers(&h);
@@ -99,19 +103,13 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
 
 #[test]
 fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request() {
-    let mut h = open_character("graph-axes");
-    h.key_press(Key::Num3);
-    h.run();
-    // The head keyed at 0° at 0 s and 20° at 0.5 s.
-    key_a_nod_from_the_numbers_panel(&mut h);
+    let mut h = nodding_head("graph-axes");
     h.get_by_label("Graph view").click();
     h.run();
-    let layout =
-        |h: &Harness<'_, EditorApp>| h.state().timeline.graph.layout.clone().expect("the graph");
 
     // Seven curves, each over its own range: the time axis is labelled, the value axis not
     // (its numbers would mean seven things).
-    let first = layout(&h);
+    let first = graph(&h);
     assert_eq!(first.curves.len(), 7);
     assert!(first.value_ticks.is_empty(), "{:?}", first.value_ticks);
     let times: Vec<f64> = first.time_ticks.iter().map(|t| t.0).collect();
@@ -132,7 +130,7 @@ fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request(
     // 20° sits on the tick labelled 20.
     h.get_by_label("Same scale").click();
     h.run();
-    let shared = layout(&h);
+    let shared = graph(&h);
     let (low, high) = (shared.curves[0].low, shared.curves[0].high);
     assert!(shared.curves.iter().all(|c| (c.low, c.high) == (low, high)));
     assert!(low <= 0.0 && high >= 20.0, "{low}..{high}");
@@ -164,7 +162,7 @@ fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request(
         h.get_by_label(name).click();
         h.run();
     }
-    let rotate = layout(&h);
+    let rotate = graph(&h);
     assert_eq!(rotate.curves.len(), 1);
     let (low, high) = (rotate.curves[0].low, rotate.curves[0].high);
     assert!(
