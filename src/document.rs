@@ -357,6 +357,11 @@ pub enum Command {
         key: KeyRef,
         curve: Curve,
     },
+    /// Sets the curves of several keys' outgoing segments: one undo step, all or none.
+    SetCurves {
+        animation: String,
+        curves: Vec<(KeyRef, Curve)>,
+    },
     /// Adds, renames, duplicates or deletes an animation.
     Animations(AnimationEdit),
     /// Defines events, adds event keys, sets their payloads.

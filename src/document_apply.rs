@@ -310,6 +310,16 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
             })?;
             inputs_changed = false;
         }
+        Command::SetCurves { animation, curves } => {
+            edit_animation(&mut next, animation, |name, json| {
+                let mut edited = json.clone();
+                for (key, curve) in &curves {
+                    edited = edit::set_curve(name, &edited, key, curve)?;
+                }
+                Ok(edited)
+            })?;
+            inputs_changed = false;
+        }
         Command::Animations(edit) => {
             animations::apply(&mut next, edit)?;
             inputs_changed = false;

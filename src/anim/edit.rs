@@ -225,6 +225,24 @@ impl Segment {
             .collect()
     }
 
+    /// A Bézier that eases out of the start and into the end: each channel's handles at the
+    /// thirds of the time, level with their key (zero slope at both keys).
+    pub fn ease_bezier(&self) -> Vec<f64> {
+        let dt = self.end_s - self.start_s;
+        self.start
+            .iter()
+            .zip(&self.end)
+            .flat_map(|(&v0, &v1)| {
+                [
+                    self.start_s + dt / 3.0,
+                    v0,
+                    self.start_s + 2.0 * dt / 3.0,
+                    v1,
+                ]
+            })
+            .collect()
+    }
+
     /// Channel `channel`'s value at `time_s` (clamped to the segment).
     pub fn value_at(&self, channel: usize, time_s: f64) -> f64 {
         let (t0, t1) = (self.start_s, self.end_s);

@@ -29,6 +29,7 @@ pub mod file_menu;
 pub mod gizmo;
 pub mod graph_view;
 mod identity;
+pub mod key_menu;
 pub mod messages;
 pub mod native_dialog;
 pub mod numbers;

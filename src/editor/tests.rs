@@ -25,6 +25,7 @@ mod documents;
 mod events;
 mod files;
 mod graph;
+mod key_menu;
 mod outputs;
 mod physics;
 mod pose;

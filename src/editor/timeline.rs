@@ -66,7 +66,7 @@ impl SheetLayout {
 }
 
 /// What a press in the dopesheet landed on.
-enum Hit {
+pub(super) enum Hit {
     Ruler,
     Key(KeyRef),
     /// A key of the row of all keys: every key at that time.
@@ -416,7 +416,12 @@ impl EditorApp {
         });
     }
 
-    fn hit(&self, layout: &SheetLayout, p: Pos2, timelines: &[(TimelineId, Vec<f64>)]) -> Hit {
+    pub(super) fn hit(
+        &self,
+        layout: &SheetLayout,
+        p: Pos2,
+        timelines: &[(TimelineId, Vec<f64>)],
+    ) -> Hit {
         if layout.ruler.contains(p) {
             return Hit::Ruler;
         }
@@ -452,7 +457,7 @@ impl EditorApp {
             .unwrap_or(Hit::Empty)
     }
 
-    fn is_selected(&self, timeline: &TimelineId, time_s: f64) -> bool {
+    pub(super) fn is_selected(&self, timeline: &TimelineId, time_s: f64) -> bool {
         self.timeline
             .selection
             .iter()
@@ -495,6 +500,7 @@ impl EditorApp {
             ),
         };
         self.dopesheet_input(ui, &response, &layout, timelines);
+        self.key_context_menu(&response, &layout, timelines);
 
         // Background, ruler with a tick per frame (when they are far enough apart) and seconds.
         painter.rect_filled(rect, 2.0, Color32::from_gray(30));

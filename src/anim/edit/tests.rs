@@ -330,6 +330,34 @@ fn curves_are_set_and_checked() {
 }
 
 #[test]
+fn an_ease_bezier_leaves_and_reaches_its_keys_flat_and_passes_the_middle_halfway() {
+    let segment = Segment {
+        start_s: 1.0,
+        end_s: 2.0,
+        start: vec![0.0, 10.0],
+        end: vec![30.0, -10.0],
+        curve: Curve::Linear,
+    };
+    let eased = Segment {
+        curve: Curve::Bezier(segment.ease_bezier()),
+        ..segment.clone()
+    };
+    for c in 0..2 {
+        let (v0, v1) = (segment.start[c], segment.end[c]);
+        // Symmetric handles: halfway in time is halfway in value.
+        assert!((eased.value_at(c, 1.5) - (v0 + v1) / 2.0).abs() < 1e-6);
+        // Flat at both ends: after 2 % of the time it has moved under 1 % of the way.
+        let near_start = (eased.value_at(c, 1.02) - v0) / (v1 - v0);
+        let near_end = (v1 - eased.value_at(c, 1.98)) / (v1 - v0);
+        assert!(
+            near_start < 0.01 && near_end < 0.01,
+            "{near_start} {near_end}"
+        );
+        assert!(near_start > 0.0 && near_end > 0.0);
+    }
+}
+
+#[test]
 fn a_segment_and_its_linear_bezier_play_alike() {
     let ik = TimelineId::Ik { index: 0 };
     let walk = walk();
