@@ -33,10 +33,8 @@ impl EditorApp {
         if response.secondary_clicked() {
             if let Some(at) = response.interact_pointer_pos() {
                 match self.hit(layout, at, timelines) {
-                    Hit::Key(key) => {
-                        if !self.is_selected(&key.timeline, key.time_s) {
-                            self.timeline.selection = vec![key];
-                        }
+                    Hit::Key(key) if !self.is_selected(&key.timeline, key.time_s) => {
+                        self.timeline.selection = vec![key];
                     }
                     Hit::Summary(time_s) => {
                         self.timeline.selection = edit::keys_at(timelines, time_s);
