@@ -257,6 +257,67 @@ fn a_gap_is_cut_at_its_opening() {
     }
 }
 
+#[test]
+fn a_wide_gap_is_closed_by_joining_the_line_ends() {
+    // The wall open over 10 px, too wide for the ridge (4 px): its two ends face each other,
+    // the end-point join draws the missing piece, and the colors meet exactly on the wall.
+    let art = box_and_wall(10);
+    let (red, blue) = ([220, 40, 40], [40, 40, 220]);
+    let sc = layer_scribbles(64, 32, &[([2, 30], red), ([62, 2], blue)]);
+    let line = LineArt::new(&art).line_mask(0.5);
+    let wrong = |options: &ColorizeOptions| {
+        let result = colorize::colorize(&art, &sc, options, false).expect("colorizes");
+        let mut wrong = 0;
+        for y in 0..32u32 {
+            for x in (0..64u32).filter(|&x| x != 44) {
+                if line[(y * 64 + x) as usize] {
+                    continue;
+                }
+                let expected = if x < 44 { red } else { blue };
+                wrong += usize::from(result.fill_only.get_pixel(x, y).0[..3] != expected[..]);
+            }
+        }
+        wrong
+    };
+    let joined = wrong(&ColorizeOptions::default());
+    println!("wrong pixels with the join: {joined}");
+    assert_eq!(joined, 0);
+    // The stage itself: one curve across the opening, on the wall's column.
+    let joins = colorize::end_point_join::join_end_points(&line, 64, 32, &Default::default());
+    assert_eq!((joins.splines, joins.segments), (1, 0));
+    for y in 14..24 {
+        assert!(joins.mask[y * 64 + 44], "row {y} of the opening left open");
+    }
+}
+
+#[test]
+fn a_closed_drawing_is_unchanged_by_the_end_point_join() {
+    let off = ColorizeOptions {
+        end_point_join: colorize::EndPointJoinOptions {
+            enabled: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let s = scene(&SceneSpec::default());
+    let art = box_and_wall(0);
+    let (red, green, blue) = ([220, 40, 40], [40, 200, 40], [40, 40, 220]);
+    let dots = layer_scribbles(
+        64,
+        32,
+        &[([2, 2], red), ([12, 22], green), ([16, 16], blue)],
+    );
+    for (lineart, sc) in [(&s.lineart, scribbles(&s)), (&art, dots)] {
+        let on = colorize::colorize(lineart, &sc, &ColorizeOptions::default(), false)
+            .expect("colorizes");
+        let without = colorize::colorize(lineart, &sc, &off, false).expect("colorizes");
+        assert!(
+            on.image == without.image,
+            "the join changed a closed drawing"
+        );
+    }
+}
+
 fn gapped(gap_px: f32) -> (f64, f64) {
     let s = scene(&SceneSpec {
         gap_px: Some(gap_px),

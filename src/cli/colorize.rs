@@ -34,6 +34,14 @@ pub struct ColorizeArgs {
     /// px wide are closed (0: off).
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().gap_closing_px)]
     pub gap_closing: f64,
+    /// End-point joins: line ends up to PX apart that face each other are joined by a curve
+    /// before the ridge (0: no curves).
+    #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().end_point_join.spline_max_px)]
+    pub join_curve: f64,
+    /// End-point joins: a free line end reaching a line within PX along its direction is
+    /// joined to it by a segment (0: no segments).
+    #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().end_point_join.segment_max_px)]
+    pub join_segment: f64,
     /// How a region holding several colors is split: depth (boundaries where it is
     /// narrowest) or weights (the content-aware weights).
     #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "depth")]
@@ -52,6 +60,11 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         gap_closing_px: args.gap_closing,
         split: args.split,
         split_depth_px: args.split_depth,
+        end_point_join: colorize::EndPointJoinOptions {
+            spline_max_px: args.join_curve,
+            segment_max_px: args.join_segment,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let files = sinew::jobs::ColorizeFiles {

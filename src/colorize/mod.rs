@@ -28,6 +28,7 @@
 //! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
 //! [`synthetic`] draws test line art with known true colorings.
 
+pub mod end_point_join;
 pub mod fill;
 pub mod flood;
 pub mod gap_closing;
@@ -40,6 +41,7 @@ pub mod session;
 pub mod synthetic;
 pub mod weights;
 
+pub use end_point_join::EndPointJoinOptions;
 pub use fill::FillMode;
 pub use image_mesh::{ImageMesh, MeshOptions};
 pub use ink_regions::{InkRegions, RegionSplit};
@@ -67,6 +69,9 @@ pub struct ColorizeOptions {
     /// ([`gap_closing`]): a gap of g px keeps 1 − g / (2·fade) of the line's ink, so it
     /// separates colors instead of letting one flood through. 0 = off. Default 4.
     pub gap_closing_px: f64,
+    /// Gaps closed first by joining line end points with curves ([`end_point_join`]), before
+    /// the ridge. Default: on, with its defaults.
+    pub end_point_join: EndPointJoinOptions,
     /// How the lifted mesh is measured. Default: edge stretch.
     pub stiffness: LiftedStiffness,
     /// Default: harmonic.
@@ -97,6 +102,7 @@ impl Default for ColorizeOptions {
             scale: DEFAULT_LIFT_SCALE,
             line_threshold: 0.5,
             gap_closing_px: 4.0,
+            end_point_join: EndPointJoinOptions::default(),
             stiffness: LiftedStiffness::EdgeStretch,
             weights: ColorWeights::Harmonic,
             fill: FillMode::Flat,
@@ -286,14 +292,27 @@ impl PreparedLineArt {
                 options.gap_closing_px
             )));
         }
+        options
+            .end_point_join
+            .check()
+            .map_err(ColorizeError::InvalidOptions)?;
         let art = LineArt::new(&lineart);
-        // The lift and the mesh see the drawing with its gaps closed.
-        let closed = gap_closing::close_gaps(
-            &art.over_white,
+        // The lift and the mesh see the drawing with its gaps closed: end points joined by
+        // curves of full ink, then every line's ridge.
+        let joins = end_point_join::join_end_points(
+            &art.line_mask(options.line_threshold),
             art.width,
             art.height,
-            options.gap_closing_px,
+            &options.end_point_join,
         );
+        let mut joined = art.over_white.clone();
+        for (c, &j) in joined.iter_mut().zip(&joins.mask) {
+            if j {
+                *c = [0; 3];
+            }
+        }
+        let closed =
+            gap_closing::close_gaps(&joined, art.width, art.height, options.gap_closing_px);
         let regions = InkRegions::new(
             &closed,
             art.width,
