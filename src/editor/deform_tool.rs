@@ -7,8 +7,8 @@
 //! distance d, follows the pointer's motion by the falloff `(1 − (d/r)²)²` (1 at the press, 0
 //! at the radius, smooth at both ends). Deform offsets live in the rest frame, before
 //! skinning: the motion on screen is taken back through the skinning's local map at each
-//! vertex, measured by posing the offsets through the scene itself (one path; skinning is
-//! linear in an offset under LBS, so the map is exact there). While dragging, the canvas shows
+//! vertex, measured by posing the offsets through the scene itself (one path), with Newton
+//! steps where the skinning is not affine in the offset ([`offsets_reaching`]). While dragging, the canvas shows
 //! the circle of the radius and the motion.
 
 use super::{canvas, EditorApp, Gesture};
@@ -46,6 +46,70 @@ pub(super) struct DeformDrag {
     part: usize,
     from: Point,
     to: Point,
+}
+
+/// Newton steps at most when taking the pointer's motion back to rest-frame offsets.
+pub const MAX_DEFORM_STEPS: usize = 6;
+/// The steps stop when every moved vertex is this close to where it should be, canvas px.
+pub const DEFORM_TOLERANCE_PX: f64 = 1e-6;
+/// The shift of every offset that measures the skinning's local map, canvas px.
+pub const DEFORM_PROBE_PX: f64 = 1e-3;
+
+/// The rest-frame offsets that pose each vertex `v` at `targets[v]` (canvas px; `None`: the
+/// vertex keeps `base[v]`), given `posed_with` (offsets → posed positions: the scene's
+/// skinning, where a vertex's position depends on its own offset only). Newton's method per
+/// vertex: its 2×2 local map is measured by shifting every offset [`DEFORM_PROBE_PX`] along x
+/// and along y. One step is exact where skinning is affine in the offset (LBS, and DQS, whose
+/// blended motion depends on the weights only); stretchable bones clamp along the bone, and
+/// the further steps (at most [`MAX_DEFORM_STEPS`], until [`DEFORM_TOLERANCE_PX`]) cross the
+/// kink. The best iterate is kept; a vertex whose map collapses (|det| < 1e-9) keeps its offset.
+pub fn offsets_reaching(
+    base: &[Vec2],
+    targets: &[Option<Point>],
+    posed_with: impl Fn(&[Vec2]) -> Result<Vec<Point>, String>,
+) -> Result<Vec<Vec2>, String> {
+    let worst_px = |now: &[Point]| {
+        let misses = targets
+            .iter()
+            .zip(now)
+            .filter_map(|(t, p)| t.map(|t| (t - p).norm()));
+        misses.fold(0.0, f64::max)
+    };
+    let mut offsets = base.to_vec();
+    let mut now = posed_with(&offsets)?;
+    let mut best = (worst_px(&now), offsets.clone());
+    for _ in 0..MAX_DEFORM_STEPS {
+        if best.0 <= DEFORM_TOLERANCE_PX {
+            break;
+        }
+        let probe = |shift: Vec2| {
+            let shifted: Vec<Vec2> = offsets.iter().map(|o| o + shift).collect();
+            posed_with(&shifted)
+        };
+        let along_x = probe(Vec2::new(DEFORM_PROBE_PX, 0.0))?;
+        let along_y = probe(Vec2::new(0.0, DEFORM_PROBE_PX))?;
+        for (v, target) in targets.iter().enumerate() {
+            let Some(target) = target else {
+                continue;
+            };
+            let jacobian = Matrix2::from_columns(&[
+                (along_x[v] - now[v]) / DEFORM_PROBE_PX,
+                (along_y[v] - now[v]) / DEFORM_PROBE_PX,
+            ]);
+            if jacobian.determinant().abs() < 1e-9 {
+                continue;
+            }
+            if let Some(inverse) = jacobian.try_inverse() {
+                offsets[v] += inverse * (target - now[v]);
+            }
+        }
+        now = posed_with(&offsets)?;
+        let worst = worst_px(&now);
+        if worst < best.0 {
+            best = (worst, offsets.clone());
+        }
+    }
+    Ok(best.1)
 }
 
 /// How much a vertex at `distance_px` from the press follows the pointer: `(1 − (d/r)²)²`
@@ -149,40 +213,25 @@ impl EditorApp {
         let n = part.mesh.vertices.len();
         let base = posed.pose.deform.get(&part.name).cloned();
         let base = base.unwrap_or_else(|| vec![Vec2::zeros(); n]);
-        // Each vertex's posed position as a function of its offset, measured through the one
-        // pose path: with every offset moved by a unit along x, then y.
+        // Each vertex's posed position as a function of the offsets, through the one pose path.
         let blend = self.render_settings.blend;
-        let posed_with = |shift: Vec2| -> Result<Vec<Point>, String> {
+        let posed_with = |offsets: &[Vec2]| -> Result<Vec<Point>, String> {
             let mut pose = posed.pose.clone();
-            let offsets = base.iter().map(|o| o + shift).collect();
-            pose.deform.insert(part.name.clone(), offsets);
+            pose.deform.insert(part.name.clone(), offsets.to_vec());
             let mut all = scene
                 .positions_from_transforms(&posed.transforms, &pose, blend)
                 .map_err(|e| e.to_string())?;
             Ok(std::mem::take(&mut all[drag.part]))
         };
-        let (at, along_x, along_y) = (
-            posed_with(Vec2::zeros())?,
-            posed_with(Vec2::x())?,
-            posed_with(Vec2::y())?,
-        );
-        let from = drag.from;
-        let mut offsets = base.clone();
-        for (v, offset) in offsets.iter_mut().enumerate() {
-            let w = falloff((at[v] - from).norm(), self.deform.radius_px);
-            if w == 0.0 {
-                continue;
-            }
-            // Solve J · d = w · delta for the offset's change d, J = [jx jy] the skinning's
-            // local map (a vertex it collapses keeps its offset).
-            let jacobian = Matrix2::from_columns(&[along_x[v] - at[v], along_y[v] - at[v]]);
-            if jacobian.determinant().abs() < 1e-9 {
-                continue;
-            }
-            if let Some(inverse) = jacobian.try_inverse() {
-                *offset += inverse * (w * delta);
-            }
-        }
+        let now = posed_with(&base)?;
+        let targets: Vec<Option<Point>> = now
+            .iter()
+            .map(|&at| {
+                let w = falloff((at - drag.from).norm(), self.deform.radius_px);
+                (w > 0.0).then(|| at + w * delta)
+            })
+            .collect();
+        let offsets = offsets_reaching(&base, &targets, posed_with)?;
         let (name, time_s) = (part.name.clone(), self.animate.time_s);
         if self.apply(Command::KeyDeform {
             animation: self.animate.animation.clone(),
@@ -231,7 +280,91 @@ impl EditorApp {
 
 #[cfg(test)]
 mod tests {
-    use super::falloff;
+    use super::*;
+    use std::cell::Cell;
+
+    /// A part skinned by a rotation and a bone stretched along x that clamps past its tail at
+    /// x = 10 (as stretchable bones do): not affine in the offset.
+    fn clamped_stretch(p: Point) -> Point {
+        let (sin, cos) = 0.3f64.sin_cos();
+        let rotated = Point::new(cos * p.x - sin * p.y, sin * p.x + cos * p.y);
+        rotated + Vec2::new(6.0 * (p.x / 10.0).clamp(0.0, 1.0), 0.0)
+    }
+
+    #[test]
+    fn newton_steps_put_vertices_on_their_targets_past_a_clamp() {
+        let rest = [
+            Point::new(9.5, 1.0),
+            Point::new(3.0, -2.0),
+            Point::new(20.0, 0.0),
+        ];
+        let base = vec![Vec2::new(0.2, 0.0), Vec2::zeros(), Vec2::zeros()];
+        let posed_with = |offsets: &[Vec2]| -> Result<Vec<Point>, String> {
+            Ok(rest
+                .iter()
+                .zip(offsets)
+                .map(|(p, o)| clamped_stretch(p + o))
+                .collect())
+        };
+        let now = posed_with(&base).expect("posed");
+        // The first vertex crosses the clamp at x = 10; the second stays inside; the third
+        // keeps its offset.
+        let targets = [
+            Some(now[0] + Vec2::new(3.0, 1.0)),
+            Some(now[1] + Vec2::new(-1.0, 2.0)),
+            None,
+        ];
+        let offsets = offsets_reaching(&base, &targets, posed_with).expect("offsets");
+        let reached = posed_with(&offsets).expect("posed");
+        for v in 0..2 {
+            let target = targets[v].expect("a target");
+            assert!(
+                (reached[v] - target).norm() < DEFORM_TOLERANCE_PX,
+                "{v}: {:?}",
+                reached[v]
+            );
+        }
+        assert_eq!(offsets[2], base[2]);
+        // One step with the map measured by unit shifts (the old way) misses: the kink.
+        let jacobian_step = {
+            let shifted: Vec<Vec2> = base.iter().map(|o| o + Vec2::x()).collect();
+            let x = posed_with(&shifted).expect("posed")[0] - now[0];
+            let shifted: Vec<Vec2> = base.iter().map(|o| o + Vec2::y()).collect();
+            let y = posed_with(&shifted).expect("posed")[0] - now[0];
+            Matrix2::from_columns(&[x, y])
+                .try_inverse()
+                .expect("invertible")
+                * Vec2::new(3.0, 1.0)
+        };
+        let one_step = clamped_stretch(rest[0] + base[0] + jacobian_step);
+        assert!(
+            (one_step - targets[0].expect("a target")).norm() > 0.1,
+            "{one_step:?}"
+        );
+    }
+
+    #[test]
+    fn an_affine_skinning_takes_one_step() {
+        let rest = [Point::new(1.0, 2.0), Point::new(-3.0, 4.0)];
+        let calls = Cell::new(0);
+        let posed_with = |offsets: &[Vec2]| -> Result<Vec<Point>, String> {
+            calls.set(calls.get() + 1);
+            let affine = |p: Point| Point::new(1.5 * p.x - 0.4 * p.y + 7.0, 0.2 * p.x + 0.8 * p.y);
+            Ok(rest
+                .iter()
+                .zip(offsets)
+                .map(|(p, o)| affine(p + o))
+                .collect())
+        };
+        let base = vec![Vec2::zeros(); 2];
+        let targets = [Some(Point::new(10.0, 3.0)), Some(Point::new(0.0, 0.0))];
+        let offsets = offsets_reaching(&base, &targets, posed_with).expect("offsets");
+        let reached = posed_with(&offsets).expect("posed");
+        assert!((reached[0] - targets[0].expect("a target")).norm() < 1e-9);
+        assert!((reached[1] - targets[1].expect("a target")).norm() < 1e-9);
+        // One pose to start, two to measure the map, one after the step; one to check above.
+        assert_eq!(calls.get(), 5);
+    }
 
     #[test]
     fn the_falloff_is_one_at_the_press_and_fades_to_zero_at_the_radius() {

@@ -6,8 +6,10 @@
 //! In: the animation edited, the selected handle, pointer input. Out: `SetCurve` commands
 //! (undoable, checked by [`crate::anim::edit::set_curve`]) and the picture.
 //!
-//! Channels have different units (degrees, px, factors), so each curve is drawn over its own
-//! value range, scaled to the plot's height; the legend gives each range.
+//! Channels have different units (degrees, px, factors), so by default each curve is drawn
+//! over its own value range, scaled to the plot's height, and the legend gives each range;
+//! the value axis is labelled when one curve is shown. "Same scale" draws every shown curve
+//! over one range with a labelled value axis. The time axis is labelled in seconds.
 
 use super::EditorApp;
 use crate::anim::edit::{self, KeyRef, TimelineId};
@@ -20,6 +22,14 @@ use std::collections::BTreeSet;
 pub const GRAPH_DEFAULT_PT: [f32; 2] = [640.0, 380.0];
 /// Screen distance within which a press grabs a Bézier handle, points.
 const HANDLE_PICK_PT: f32 = 9.0;
+/// Margins of the plot inside its frame, points: room for the value labels on the left and
+/// the time labels below.
+const PLOT_MARGIN_LEFT_PT: f32 = 44.0;
+const PLOT_MARGIN_BOTTOM_PT: f32 = 18.0;
+const PLOT_MARGIN_PT: f32 = 12.0;
+/// Screen distance wanted between value ticks and between time ticks, points.
+const VALUE_TICK_SPACING_PT: f32 = 36.0;
+const TIME_TICK_SPACING_PT: f32 = 70.0;
 /// Points sampled per segment when drawing a curve.
 const SAMPLES_PER_SEGMENT: usize = 48;
 /// Curve colours, one per channel in legend order (cycled).
@@ -55,6 +65,10 @@ pub struct GraphLayout {
     pub start_s: f64,
     pub end_s: f64,
     pub curves: Vec<GraphCurve>,
+    /// The value axis' labelled ticks (value, screen y), when it is labelled.
+    pub value_ticks: Vec<(f64, f32)>,
+    /// The time axis' labelled ticks (seconds, screen x).
+    pub time_ticks: Vec<(f64, f32)>,
 }
 
 impl GraphLayout {
@@ -96,6 +110,8 @@ pub struct GraphView {
     pub open: bool,
     /// Curves hidden from the legend, by name.
     pub hidden: BTreeSet<String>,
+    /// Every shown curve drawn over one value range (off: each over its own).
+    pub same_scale: bool,
     /// Where the graph was drawn last frame (tests find handles by it).
     pub layout: Option<GraphLayout>,
     drag: Option<HandleDrag>,
@@ -210,16 +226,50 @@ impl EditorApp {
                 }
             }
         });
+        ui.checkbox(&mut self.timeline.graph.same_scale, "Same scale")
+            .on_hover_text("every shown curve over one value range, with its values on the axis");
+        let shown: Vec<usize> = (0..curves.len())
+            .filter(|&i| !self.timeline.graph.hidden.contains(&curves[i].0))
+            .collect();
+        if self.timeline.graph.same_scale {
+            // While a handle is dragged, the range the drag began with: no rescaling under
+            // the pointer.
+            let shared = match &self.timeline.graph.drag {
+                Some(drag) => (drag.low, drag.high),
+                None => shown
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |r, &i| {
+                        (r.0.min(ranges[i].0), r.1.max(ranges[i].1))
+                    }),
+            };
+            if shared.0 < shared.1 {
+                ranges.iter_mut().for_each(|r| *r = shared);
+            }
+        }
         // The plot takes what the window has left: resizing the window resizes it.
         let size = ui.available_size().max(egui::vec2(160.0, 100.0));
         let (response, painter) = ui.allocate_painter(size, Sense::drag());
         painter.rect_filled(response.rect, 2.0, Color32::from_gray(28));
+        let frame = response.rect;
         let mut layout = GraphLayout {
-            rect: response.rect.shrink(12.0),
+            rect: Rect::from_min_max(
+                frame.min + egui::vec2(PLOT_MARGIN_LEFT_PT, PLOT_MARGIN_PT),
+                frame.max - egui::vec2(PLOT_MARGIN_PT, PLOT_MARGIN_BOTTOM_PT),
+            ),
             start_s: 0.0,
             end_s: length_s,
             curves: Vec::new(),
+            value_ticks: Vec::new(),
+            time_ticks: Vec::new(),
         };
+        // The value axis is labelled when its numbers mean one thing: one curve shown, or
+        // every shown curve on the same scale.
+        let labelled = match shown.as_slice() {
+            [one] => Some(ranges[*one]),
+            [first, ..] if self.timeline.graph.same_scale => Some(ranges[*first]),
+            _ => None,
+        };
+        draw_axes(&painter, &mut layout, labelled);
         // The playhead.
         let x = layout.x_of(self.animate.time_s);
         painter.line_segment(
@@ -348,6 +398,53 @@ impl EditorApp {
                 });
             }
         }
+    }
+}
+
+/// The grid and labels of both axes: time in seconds below the plot, values (when
+/// `value_range` is given) on its left. Records the ticks in `layout`.
+fn draw_axes(painter: &egui::Painter, layout: &mut GraphLayout, value_range: Option<(f64, f64)>) {
+    use super::ticks::{nice_ticks, tick_label};
+    let rect = layout.rect;
+    let font = egui::FontId::proportional(11.0);
+    let grid = Stroke::new(1.0, Color32::from_gray(48));
+    let text = Color32::from_gray(170);
+    let count = (rect.width() / TIME_TICK_SPACING_PT).floor().max(1.0) as usize;
+    let (step, times) = nice_ticks(layout.start_s, layout.end_s, count);
+    for t in times {
+        let x = layout.x_of(t);
+        painter.line_segment(
+            [egui::pos2(x, rect.top()), egui::pos2(x, rect.bottom())],
+            grid,
+        );
+        painter.text(
+            egui::pos2(x, rect.bottom() + 3.0),
+            egui::Align2::CENTER_TOP,
+            format!("{} s", tick_label(t, step)),
+            font.clone(),
+            text,
+        );
+        layout.time_ticks.push((t, x));
+    }
+    let Some((low, high)) = value_range else {
+        return;
+    };
+    let count = (rect.height() / VALUE_TICK_SPACING_PT).floor().max(1.0) as usize;
+    let (step, values) = nice_ticks(low, high, count);
+    for v in values {
+        let y = y_of(rect, low, high, v);
+        painter.line_segment(
+            [egui::pos2(rect.left(), y), egui::pos2(rect.right(), y)],
+            grid,
+        );
+        painter.text(
+            egui::pos2(rect.left() - 4.0, y),
+            egui::Align2::RIGHT_CENTER,
+            tick_label(v, step),
+            font.clone(),
+            text,
+        );
+        layout.value_ticks.push((v, y));
     }
 }
 

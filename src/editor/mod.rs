@@ -37,6 +37,7 @@ pub mod physics_fields;
 pub mod pose_mode;
 pub mod rig_mode;
 pub mod rig_tools;
+pub mod ticks;
 pub mod timeline;
 pub mod tree;
 pub mod view;

@@ -45,11 +45,18 @@ pub struct PaintStroke {
     pub rows: Vec<Vec<(u32, f64)>>,
 }
 
-/// The part and vertex under `at_px` at rest: the frontmost part with a triangle containing
-/// it, and that triangle's corner nearest to it.
-pub fn vertex_under(scene: &Scene, p: Point) -> Option<(usize, usize)> {
+/// The part and vertex under `at_px` at rest: the frontmost part `drawn` accepts (by name)
+/// with a triangle containing it, and that triangle's corner nearest to it.
+pub fn vertex_under(
+    scene: &Scene,
+    p: Point,
+    drawn: impl Fn(&str) -> bool,
+) -> Option<(usize, usize)> {
     use crate::geom::barycentric;
     for (k, part) in scene.doc.parts.iter().enumerate().rev() {
+        if !drawn(&part.name) {
+            continue;
+        }
         let v = &part.mesh.vertices;
         let pt = |i: u32| Point::new(v[i as usize][0], v[i as usize][1]);
         for t in &part.mesh.triangles {
@@ -76,7 +83,8 @@ impl EditorApp {
             self.message = Some(crate::document::DocumentError::NoWeights.to_string());
             return None;
         };
-        let Some((part_index, _)) = vertex_under(&scene, at_px) else {
+        let Some((part_index, _)) = vertex_under(&scene, at_px, |name| self.rig_shows_part(name))
+        else {
             self.message = Some("paint on the drawing: no part is there".into());
             return None;
         };
@@ -276,7 +284,8 @@ impl EditorApp {
         let (Some(scene), Some(at)) = (self.doc.posable().cloned(), self.paint.readout_px) else {
             return;
         };
-        let Some((part_index, vertex)) = vertex_under(&scene, at) else {
+        let Some((part_index, vertex)) = vertex_under(&scene, at, |name| self.rig_shows_part(name))
+        else {
             return;
         };
         let part = &scene.doc.parts[part_index];

@@ -64,7 +64,7 @@ impl EditorApp {
         let mut shapes = Vec::new();
         let hidden = &self.tree.hidden_parts;
         for (texture, layer) in textures.iter().zip(&self.doc.state().layers) {
-            if !hidden.contains(&layer.name) {
+            if !hidden.contains(&layer.name) && self.rig_shows_part(&layer.name) {
                 let size_px = [layer.image.width(), layer.image.height()];
                 shapes.push(canvas::image_quad(
                     placed,
@@ -78,6 +78,9 @@ impl EditorApp {
             return shapes;
         };
         for (k, part) in scene.doc.parts.iter().enumerate() {
+            if !self.rig_shows_part(&part.name) {
+                continue;
+            }
             let rest = &part.mesh.vertices;
             let Some(weights) = part.weights.as_ref().filter(|_| weighted) else {
                 shapes.extend(canvas::wireframe(placed, rest, &part.mesh.triangles));
@@ -208,7 +211,7 @@ impl EditorApp {
         ui.heading("Tree");
         egui::ScrollArea::vertical()
             .id_salt("tree")
-            .max_height(260.0)
+            .max_height(TREE_HEIGHT_PT)
             .show(ui, |ui| self.tree_view(ui));
         if let Some(name) = self.selected.clone() {
             ui.separator();
@@ -448,6 +451,8 @@ impl EditorApp {
 
 /// Height of the heat map legend above the canvas' bottom edge, screen points.
 const LEGEND_HEIGHT_PT: f32 = 64.0;
+/// The tree's height in rig mode's side panel at most (it scrolls beyond), points.
+pub const TREE_HEIGHT_PT: f32 = 260.0;
 /// Length of the legend's colour bar, screen points.
 const LEGEND_BAR_PT: f32 = 120.0;
 

@@ -3,7 +3,8 @@
 //! points, cages and regions, and the parts (slots) front to back.
 //!
 //! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
-//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row), the
+//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row; a
+//! drag held near the tree's top or bottom edge scrolls it, so any row can be reached), the
 //! parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename` and
 //! `Reparent` commands (undoable; a loop is refused with a message), and which parts the canvas hides (a view setting, not part of the document: the
 //! posed picture drops them from the library's draw list; rig mode leaves their images out).
@@ -11,16 +12,27 @@
 use super::{EditorApp, Mode};
 use crate::document::Command;
 use eframe::egui::{self, Key};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// A bone being dragged in the tree (egui's drag-and-drop payload).
 struct DraggedBone(String);
+
+/// While a bone is dragged, a pointer within this distance of the tree's visible top or
+/// bottom edge (inside or out) scrolls the tree that way, points.
+pub const AUTOSCROLL_BAND_PT: f32 = 24.0;
+/// The scrolling speed with the pointer at the edge or beyond, points per second; it falls
+/// linearly to zero at the band's inner side.
+pub const AUTOSCROLL_SPEED_PT_PER_S: f32 = 480.0;
 
 /// The tree's own state.
 #[derive(Default)]
 pub struct TreeState {
     /// Parts the canvas does not draw (by name).
     pub hidden_parts: BTreeSet<String>,
+    /// Rig mode's choice, per slot with several attachments, of the one the canvas shows
+    /// (`None`: nothing). A view setting: the setup pose keys no attachment. A slot not listed
+    /// shows the attachment its skins give it, else its own part.
+    pub rig_attachments: BTreeMap<String, Option<String>>,
     /// The handle being renamed in place, and the name typed so far.
     renaming: Option<(String, String)>,
     /// The rename field wants the keyboard (it just appeared).
@@ -44,6 +56,7 @@ impl EditorApp {
                 self.start_rename(&name);
             }
         }
+        scroll_while_dragging(ui);
         let handles = self.doc.state().handles.clone();
         egui::CollapsingHeader::new("Skeletons")
             .default_open(true)
@@ -261,30 +274,32 @@ impl EditorApp {
                             self.tree.hidden_parts.insert(part.clone());
                         }
                     }
-                    if matches!(self.mode, Mode::Pose | Mode::Animate) {
-                        self.attachment_list(ui, &part);
-                    }
+                    self.attachment_list(ui, &part);
                 }
             });
     }
 
-    /// A slot's attachments (when it has more than its own part), the one shown at the
-    /// playhead ticked; a click shows another: keyed at the playhead in animate mode (an
-    /// attachment key), the pose's in pose mode.
+    /// A slot's attachments (when it has more than its own part), the one shown ticked; a
+    /// click shows another: keyed at the playhead in animate mode (an attachment key), the
+    /// pose's in pose mode, a view setting in rig mode (to see and weigh each attachment).
     fn attachment_list(&mut self, ui: &mut egui::Ui, slot: &str) {
         let names = crate::document::animations::slot_attachments(self.doc.state(), slot);
         if names.len() < 2 || self.doc.state().slots.attachments.contains_key(slot) {
             return;
         }
-        let pose = self.edited_pose();
-        let shown = match pose.parts.get(slot) {
-            Some(p) if !p.visible => None,
-            Some(p) => Some(
-                p.attachment
-                    .clone()
-                    .unwrap_or_else(|| self.default_attachment(slot)),
-            ),
-            None => Some(self.default_attachment(slot)),
+        let shown = if self.mode == Mode::Rig {
+            self.rig_attachment(slot)
+        } else {
+            let pose = self.edited_pose();
+            match pose.parts.get(slot) {
+                Some(p) if !p.visible => None,
+                Some(p) => Some(
+                    p.attachment
+                        .clone()
+                        .unwrap_or_else(|| self.default_attachment(slot)),
+                ),
+                None => Some(self.default_attachment(slot)),
+            }
         };
         let mut chosen = None;
         ui.indent(("attachments", slot), |ui| {
@@ -314,9 +329,44 @@ impl EditorApp {
             .unwrap_or_else(|| slot.to_string())
     }
 
+    /// The attachment rig mode shows in `slot` (`None`: nothing): the one picked in the tree,
+    /// else [`Self::default_attachment`].
+    fn rig_attachment(&self, slot: &str) -> Option<String> {
+        match self.tree.rig_attachments.get(slot) {
+            Some(picked) => picked.clone(),
+            None => Some(self.default_attachment(slot)),
+        }
+    }
+
+    /// Whether rig mode draws part `name` (its image, mesh and weights): every part but the
+    /// attachments a slot does not show ([`Self::rig_attachment`]). The eye boxes hide images
+    /// on top of this.
+    pub fn rig_shows_part(&self, name: &str) -> bool {
+        let state = self.doc.state();
+        let slot = state
+            .slots
+            .attachments
+            .get(name)
+            .map_or(name, String::as_str);
+        if crate::document::animations::slot_attachments(state, slot).len() < 2 {
+            return true;
+        }
+        self.rig_attachment(slot).as_deref() == Some(name)
+    }
+
     /// Shows `attachment` (none: nothing) in `slot`: an attachment key at the playhead in
-    /// animate mode, the document's pose in pose mode.
+    /// animate mode, the document's pose in pose mode, the canvas's view in rig mode.
     pub fn show_attachment(&mut self, slot: &str, attachment: Option<String>) {
+        if self.mode == Mode::Rig {
+            self.message = Some(format!(
+                "'{slot}' shows {} while rigging",
+                attachment.as_deref().unwrap_or("nothing")
+            ));
+            self.tree
+                .rig_attachments
+                .insert(slot.to_string(), attachment);
+            return;
+        }
         let part = |pose: &mut crate::rig::Pose| {
             let p = pose.parts.entry(slot.to_string()).or_default();
             p.visible = attachment.is_some();
@@ -353,4 +403,38 @@ impl EditorApp {
         }
         pose
     }
+}
+
+/// Scrolls the tree (the scroll area `ui` is in) while a bone is dragged with the pointer near
+/// its visible top or bottom edge: [`AUTOSCROLL_BAND_PT`], [`AUTOSCROLL_SPEED_PT_PER_S`].
+fn scroll_while_dragging(ui: &egui::Ui) {
+    if !egui::DragAndDrop::has_payload_of_type::<DraggedBone>(ui.ctx()) {
+        return;
+    }
+    let Some(at) = ui.ctx().pointer_latest_pos() else {
+        return;
+    };
+    let visible = ui.clip_rect();
+    let band = AUTOSCROLL_BAND_PT;
+    if !visible.x_range().contains(at.x)
+        || at.y < visible.top() - band
+        || at.y > visible.bottom() + band
+    {
+        return;
+    }
+    // How far into the band, 0 at its inner side, 1 at the edge and beyond.
+    let up = ((visible.top() + band - at.y) / band).clamp(0.0, 1.0);
+    let down = ((at.y - (visible.bottom() - band)) / band).clamp(0.0, 1.0);
+    if up == 0.0 && down == 0.0 {
+        return;
+    }
+    let dt_s = ui.input(|i| i.stable_dt).min(0.1);
+    // Positive y moves the content down, showing rows above.
+    let delta_pt = (up - down) * AUTOSCROLL_SPEED_PT_PER_S * dt_s;
+    ui.scroll_with_delta_animation(
+        egui::vec2(0.0, delta_pt),
+        egui::style::ScrollAnimation::none(),
+    );
+    // Keep scrolling while the pointer rests there: no input event arrives to draw a frame.
+    ui.ctx().request_repaint();
 }

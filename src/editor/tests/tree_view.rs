@@ -163,9 +163,12 @@ fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
     h.hover_at(start + egui::vec2(0.0, 12.0));
     h.step();
     h.step();
-    let end = h.get_by_label(onto).rect().center();
-    assert!(end.y > 0.0, "the row {onto} is scrolled out of view");
+    // The target row is found again at every step, as an eye follows it: a drag near the
+    // tree's edge scrolls it.
+    let mut end = h.get_by_label(onto).rect().center();
     for k in 1..=4 {
+        end = h.get_by_label(onto).rect().center();
+        assert!(end.y > 0.0, "the row {onto} is scrolled out of view");
         h.hover_at(start + (end - start) * (k as f32 / 4.0));
         h.step();
     }
@@ -228,6 +231,76 @@ fn a_bone_dragged_onto_another_in_the_tree_hangs_from_it_undoably_and_loops_are_
 }
 
 #[test]
+fn a_drag_held_at_the_trees_bottom_edge_scrolls_it_to_rows_below() {
+    let mut h = open_character("tree-autoscroll");
+    assert_eq!(h.state().mode, Mode::Rig);
+    // The tree's visible part: from under its heading, TREE_HEIGHT_PT tall.
+    let top = h.get_by_label("Tree").rect().bottom();
+    let bottom = top + crate::editor::rig_mode::TREE_HEIGHT_PT;
+    let start = h.get_by_label("head").rect().center();
+    assert!(start.y > top && start.y < bottom, "the head's row shows");
+    let lantern = |h: &Harness<'_, EditorApp>| h.get_by_label("lantern").rect().center();
+    assert!(
+        lantern(&h).y > bottom + 20.0,
+        "the lantern's row starts out of view"
+    );
+
+    // The head's row pressed and dragged down to the tree's bottom edge, held there.
+    h.drag_at(start);
+    h.step();
+    h.hover_at(start + egui::vec2(0.0, 12.0));
+    h.step();
+    let edge = egui::pos2(start.x, bottom - 4.0);
+    h.hover_at(edge);
+    let mut steps = 0;
+    while lantern(&h).y > bottom - 30.0 {
+        h.step();
+        steps += 1;
+        assert!(
+            steps < 240,
+            "the tree did not scroll: lantern at {:?}",
+            lantern(&h)
+        );
+    }
+    // The pointer off the edge: the scrolling stops (the rows' places reach the test a frame
+    // or two late, so wait until they stand still), then the drop on the lantern's row, now in
+    // view: the head hangs from it.
+    h.hover_at(egui::pos2(start.x, (top + bottom) / 2.0));
+    let mut was = lantern(&h);
+    for _ in 0..10 {
+        h.step();
+        if lantern(&h) == was {
+            break;
+        }
+        was = lantern(&h);
+    }
+    let end = lantern(&h);
+    assert!(
+        end.y > top && end.y < bottom,
+        "the lantern's row shows: {end:?}"
+    );
+    h.hover_at(end);
+    h.step();
+    h.drop_at(end);
+    h.step();
+    h.run();
+    assert_eq!(
+        parent_of(&h, "head").as_deref(),
+        Some("lantern"),
+        "{:?}",
+        h.state().message
+    );
+
+    // Without a drag, resting the pointer at the edge scrolls nothing.
+    let before = lantern(&h);
+    h.hover_at(edge);
+    for _ in 0..10 {
+        h.step();
+    }
+    assert_eq!(lantern(&h), before);
+}
+
+#[test]
 fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
     let (mut h, animation) = new_animation_on_skinned_character("attachment-list");
     let keys = |h: &Harness<'_, EditorApp>| bag_attachment_keys(h, &animation);
@@ -268,4 +341,42 @@ fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
     h.run();
     assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
     assert!(drawn(&h).contains(&"bag_pail".to_string()));
+}
+
+#[test]
+fn rig_mode_draws_one_attachment_per_slot_and_the_tree_picks_which() {
+    let path = character_rig_with("rig-attachments", true);
+    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    h.run();
+    assert_eq!(h.state().mode, Mode::Rig);
+    let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
+        let app = h.state();
+        let layers = &app.doc.state().layers;
+        let names = layers.iter().map(|l| l.name.clone());
+        names.filter(|n| app.rig_shows_part(n)).collect()
+    };
+    let has = |h: &Harness<'_, EditorApp>, part: &str| drawn(h).iter().any(|n| n == part);
+    // Each slot shows its own part, not every attachment stacked: the lantern, the closed hand.
+    assert!(has(&h, "bag") && !has(&h, "bag_pail"), "{:?}", drawn(&h));
+    assert!(has(&h, "arm_lower_l") && !has(&h, "arm_lower_l_open"));
+    assert!(tree_selected(&h, "bag shows bag"));
+
+    // The tree shows the pail instead, to see and weigh it: a view, not an edit.
+    click_label(&mut h, "bag shows bag_pail");
+    assert!(has(&h, "bag_pail") && !has(&h, "bag"), "{:?}", drawn(&h));
+    assert!(tree_selected(&h, "bag shows bag_pail"));
+    assert!(
+        !h.state().doc.can_undo(),
+        "viewing an attachment is not an edit"
+    );
+    click_label(&mut h, "bag shows nothing");
+    assert!(!has(&h, "bag_pail") && !has(&h, "bag"));
+
+    // Pose mode shows what the pose shows (the lantern): rig mode's choice is its own.
+    h.key_press(Key::Num2);
+    h.run();
+    assert!(tree_selected(&h, "bag shows bag"));
+    h.key_press(Key::Num1);
+    h.run();
+    assert!(tree_selected(&h, "bag shows nothing"));
 }
