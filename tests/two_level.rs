@@ -15,12 +15,12 @@ use sinew::rig::{Bone, Handles, PointHandle};
 use sinew::weights::{Domain, TwoLevelOptions, WeightOptions};
 use std::time::Instant;
 
-/// The largest weight difference the issue asks for; met on the benchmark's meshes (point
-/// handles on the outline), asserted there.
+/// The largest weight difference the issue asks for: met on the benchmark's meshes (point
+/// handles on the outline, measured 0.009–0.010) and on the rigs with bones (measured 0.024
+/// and 0.016 on the critter, 0.027 on the character, docs/two-level-weights.md).
 const MAX_WEIGHT_DIFFERENCE: f64 = 0.03;
-/// What the rigs with bones meet (measured 0.075 on the critter, 0.041 on the character, see
-/// docs/two-level-weights.md): the issue's bar is not met there, this one guards the figure.
-const MAX_WEIGHT_DIFFERENCE_RIG: f64 = 0.08;
+/// The benchmark meshes' figure with margin (measured 0.0093 and 0.0098).
+const MAX_WEIGHT_DIFFERENCE_BENCHMARK: f64 = 0.015;
 const MAX_ENERGY_RATIO: f64 = 1.05;
 const EXACT: f64 = 1e-9;
 
@@ -164,10 +164,7 @@ fn check(name: &str, layers: &[Layer], handles: &Handles, options: &BuildOptions
          (worst part) {ratio:.4}; whole rig exact {t_exact:.2} s, two-level {t_two:.2} s",
         rows.len()
     );
-    assert!(
-        worst <= MAX_WEIGHT_DIFFERENCE_RIG,
-        "{name}: max |Δw| {worst}"
-    );
+    assert!(worst <= MAX_WEIGHT_DIFFERENCE, "{name}: max |Δw| {worst}");
     assert!(ratio <= MAX_ENERGY_RATIO, "{name}: energy ratio {ratio}");
 }
 
@@ -237,7 +234,10 @@ fn two_level_weights_match_the_exact_solve_on_the_benchmark_meshes() {
              {ratio:.4}; exact {t_exact:.2} s, two-level {t_two:.2} s",
             mesh.vertices.len()
         );
-        assert!(worst <= MAX_WEIGHT_DIFFERENCE, "{target}: max |Δw| {worst}");
+        assert!(
+            worst <= MAX_WEIGHT_DIFFERENCE_BENCHMARK,
+            "{target}: max |Δw| {worst}"
+        );
         assert!(ratio <= MAX_ENERGY_RATIO, "{target}: energy ratio {ratio}");
     }
 }

@@ -8,10 +8,13 @@
 //! solve of the same domain ([`super::two_level`]) give that region closely: where the carried
 //! weight is more than a small floor ([`SUPPORT_FLOOR`]) inside both bounds (interpolation
 //! smears a thin fringe past the true edge, which the floor cuts), it is solved once, with
-//! zero held below the floor and one above one minus the floor, and the result is clamped to
-//! [0, 1]. Unlike active-set iterations ([`super::active_set`]),
-//! nothing has to settle: the error left is where the carried support's edge misses the
-//! fine solution's, where the weight is near its bound anyway.
+//! zero held below the floor and one above one minus the floor. Where that solve leaves
+//! [0, 1] (the plateau at one around an interior point handle or a bone, which the coarse
+//! solve does not resolve, and dips below zero near bones), the bounded problem on the support
+//! is solved exactly by a Schur complement over the same factorization ([`super::bounds`]),
+//! then the result is clamped to [0, 1]. Unlike active-set iterations on the whole mesh
+//! ([`super::active_set`]), nothing has to settle: the error left is where the carried
+//! support's edge misses the fine solution's, where the weight is near zero anyway.
 //!
 //! Cost per handle: one numeric factorization of its support only (about half the mesh on the
 //! benchmark sprites with 10 handles), over a fill-reducing order computed once for the whole
@@ -20,6 +23,7 @@
 //! In: the fine [`Domain`], its [`BoundaryConditions`], the guess (one row per vertex), and
 //! the support floor. Out: the weight columns clamped to [0, 1] (rows not yet normalized).
 
+use super::bounds::hold_bounds;
 use super::solve::{check_reachable, fixed_column, free_vertices};
 use super::solve::{BoundaryConditions, Domain, WeightMatrix};
 use super::sparse::{fill_reducing_rank, mat_vec, SharedPattern, SolveError};
@@ -103,9 +107,11 @@ impl SupportSolver {
                 let qw = mat_vec(q, &w);
                 let mut x: Vec<f64> = support.iter().map(|&i| -qw[i]).collect();
                 let pattern = SharedPattern::with_rank(q, &support, rank)?;
-                pattern
-                    .factor_regularized(&pattern.values)?
-                    .solve_in_place(&mut x);
+                let factor = pattern.factor_regularized(&pattern.values)?;
+                factor.solve_in_place(&mut x);
+                // Where the solve leaves its bounds, hold it at them (the bounded problem on
+                // this support, solved exactly); when the steps run out, clamped as it is.
+                hold_bounds(&factor, &mut x);
                 for (&i, v) in support.iter().zip(x) {
                     w[i] = v.clamp(0.0, 1.0);
                 }
