@@ -210,34 +210,29 @@ impl Segment {
 
     /// A Bézier that plays exactly as the linear segment: handles at the thirds.
     pub fn linear_bezier(&self) -> Vec<f64> {
-        let dt = self.end_s - self.start_s;
-        self.start
-            .iter()
-            .zip(&self.end)
-            .flat_map(|(&v0, &v1)| {
-                [
-                    self.start_s + dt / 3.0,
-                    v0 + (v1 - v0) / 3.0,
-                    self.start_s + 2.0 * dt / 3.0,
-                    v0 + 2.0 * (v1 - v0) / 3.0,
-                ]
-            })
-            .collect()
+        self.bezier_at_thirds(|v0, v1| (v0 + (v1 - v0) / 3.0, v0 + 2.0 * (v1 - v0) / 3.0))
     }
 
     /// A Bézier that eases out of the start and into the end: each channel's handles at the
     /// thirds of the time, level with their key (zero slope at both keys).
     pub fn ease_bezier(&self) -> Vec<f64> {
+        self.bezier_at_thirds(|v0, v1| (v0, v1))
+    }
+
+    /// Bézier numbers with both handles at the thirds of the segment's time and values
+    /// `handle_values(start, end)` per channel.
+    fn bezier_at_thirds(&self, handle_values: impl Fn(f64, f64) -> (f64, f64)) -> Vec<f64> {
         let dt = self.end_s - self.start_s;
         self.start
             .iter()
             .zip(&self.end)
             .flat_map(|(&v0, &v1)| {
+                let (c1, c2) = handle_values(v0, v1);
                 [
                     self.start_s + dt / 3.0,
-                    v0,
+                    c1,
                     self.start_s + 2.0 * dt / 3.0,
-                    v1,
+                    c2,
                 ]
             })
             .collect()

@@ -5,6 +5,17 @@ use super::*;
 use crate::anim::edit::TransformChannel::*;
 use crate::editor::graph_view::GraphLayout;
 
+/// The legend's curves of a head keyed in every transform channel, in order.
+const HEAD_CURVES: [&str; 7] = [
+    "head rotate",
+    "head translate x",
+    "head translate y",
+    "head scale x",
+    "head scale y",
+    "head shear x",
+    "head shear y",
+];
+
 /// The bundled character in animate mode with the head keyed at 0° at 0 s and 20° at 0.5 s
 /// from the numbers panel (every transform channel gets keys).
 fn nodding_head(name: &str) -> Harness<'static, EditorApp> {
@@ -37,15 +48,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     // The graph view: seven curves, each named in the legend.
     h.get_by_label("Graph view").click();
     h.run();
-    let names = [
-        "head rotate",
-        "head translate x",
-        "head translate y",
-        "head scale x",
-        "head scale y",
-        "head shear x",
-        "head shear y",
-    ];
+    let names = HEAD_CURVES;
     for name in names {
         h.get_by_label(name);
     }
@@ -151,14 +154,7 @@ fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request(
     // in the rotation's own range.
     h.get_by_label("Same scale").click();
     h.run();
-    for name in [
-        "head translate x",
-        "head translate y",
-        "head scale x",
-        "head scale y",
-        "head shear x",
-        "head shear y",
-    ] {
+    for name in &HEAD_CURVES[1..] {
         h.get_by_label(name).click();
         h.run();
     }
