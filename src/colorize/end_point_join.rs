@@ -23,6 +23,7 @@
 //! The curves are drawn 8-connected, which stops a 4-connected region flood
 //! ([`super::ink_regions`]): a gap closed by a join separates the regions on both sides.
 
+use crate::geom::{Point, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// The end-point join's tolerances. Every field has a documented default.
@@ -104,7 +105,14 @@ pub const MAX_JOIN_PX: f64 = 256.0;
 pub struct EndPoint {
     pub x_px: usize,
     pub y_px: usize,
-    pub direction: [f64; 2],
+    pub direction: Vec2,
+}
+
+impl EndPoint {
+    /// The end point's pixel as a position, px.
+    pub fn at_px(&self) -> Point {
+        Point::new(self.x_px as f64, self.y_px as f64)
+    }
 }
 
 /// The joins drawn.
@@ -147,14 +155,14 @@ pub fn join_end_points(
     for a in 0..ends.len() {
         for b in a + 1..ends.len() {
             let (s, t) = (ends[a], ends[b]);
-            let d = [t.x_px as f64 - s.x_px as f64, t.y_px as f64 - s.y_px as f64];
-            let dist = (d[0] * d[0] + d[1] * d[1]).sqrt();
+            let d = t.at_px() - s.at_px();
+            let dist = d.norm();
             if dist == 0.0 || dist > options.spline_max_px {
                 continue;
             }
-            let u = [d[0] / dist, d[1] / dist];
-            let leave = s.direction[0] * u[0] + s.direction[1] * u[1];
-            let enter = -(t.direction[0] * u[0] + t.direction[1] * u[1]);
+            let u = d / dist;
+            let leave = s.direction.dot(&u);
+            let enter = -t.direction.dot(&u);
             if leave < cos_max || enter < cos_max {
                 continue;
             }
@@ -187,11 +195,7 @@ pub fn join_end_points(
             continue;
         }
         let reach = options.segment_max_px.max(0.0);
-        let far = [
-            e.x_px as f64 + e.direction[0] * reach,
-            e.y_px as f64 + e.direction[1] * reach,
-        ];
-        let path = raster_line([e.x_px as f64, e.y_px as f64], far, w, h);
+        let path = raster_line(e.at_px(), e.at_px() + e.direction * reach, w, h);
         // Walk: on the own stroke, then paper, then the first line pixel ends the segment.
         let mut left_stroke = false;
         let mut end = None;
@@ -240,11 +244,10 @@ fn crosses_once(path: &[usize], blocked: impl Fn(usize) -> bool) -> bool {
 /// The pixels of the cubic Hermite curve from `s` to `t` (tangents `roundness`·distance along
 /// `s`'s direction and against `t`'s), 8-connected, without repeats.
 fn hermite(s: &EndPoint, t: &EndPoint, roundness: f64, w: usize, h: usize) -> Vec<usize> {
-    let p0 = [s.x_px as f64, s.y_px as f64];
-    let p1 = [t.x_px as f64, t.y_px as f64];
-    let dist = ((p1[0] - p0[0]).powi(2) + (p1[1] - p0[1]).powi(2)).sqrt();
-    let m0 = s.direction.map(|v| v * roundness * dist);
-    let m1 = t.direction.map(|v| -v * roundness * dist);
+    let (p0, p1) = (s.at_px(), t.at_px());
+    let dist = (p1 - p0).norm();
+    let m0 = s.direction * roundness * dist;
+    let m1 = -t.direction * roundness * dist;
     let at = |u: f64| {
         let (u2, u3) = (u * u, u * u * u);
         let (h00, h10, h01, h11) = (
@@ -253,7 +256,7 @@ fn hermite(s: &EndPoint, t: &EndPoint, roundness: f64, w: usize, h: usize) -> Ve
             -2.0 * u3 + 3.0 * u2,
             u3 - u2,
         );
-        [0, 1].map(|k| h00 * p0[k] + h10 * m0[k] + h01 * p1[k] + h11 * m1[k])
+        Point::from(p0.coords * h00 + m0 * h10 + p1.coords * h01 + m1 * h11)
     };
     // Samples close enough that consecutive ones are at most a pixel apart, joined by lines.
     let steps = (4.0 * dist * (1.0 + roundness)).ceil().max(1.0) as usize;
@@ -273,17 +276,13 @@ fn hermite(s: &EndPoint, t: &EndPoint, roundness: f64, w: usize, h: usize) -> Ve
 
 /// The pixels of the segment from `a` to `b` (px, rounded), 8-connected (one per step along the
 /// longer axis), clipped to the image.
-fn raster_line(a: [f64; 2], b: [f64; 2], w: usize, h: usize) -> Vec<usize> {
-    let n = (b[0] - a[0])
-        .abs()
-        .max((b[1] - a[1]).abs())
-        .round()
-        .max(0.0) as usize;
+fn raster_line(a: Point, b: Point, w: usize, h: usize) -> Vec<usize> {
+    let n = (b.x - a.x).abs().max((b.y - a.y).abs()).round().max(0.0) as usize;
     let mut out = Vec::with_capacity(n + 1);
     for k in 0..=n {
         let u = if n == 0 { 0.0 } else { k as f64 / n as f64 };
-        let x = (a[0] + u * (b[0] - a[0])).round();
-        let y = (a[1] + u * (b[1] - a[1])).round();
+        let x = (a.x + u * (b.x - a.x)).round();
+        let y = (a.y + u * (b.y - a.y)).round();
         if x < 0.0 || y < 0.0 || x >= w as f64 || y >= h as f64 {
             break;
         }
@@ -409,15 +408,14 @@ fn end_points(skel: &[bool], w: usize, h: usize, options: &EndPointJoinOptions) 
         if spur || walked < options.branch_min_px || back == i {
             continue;
         }
-        let d = [
+        let d = Vec2::new(
             (i % w) as f64 - (back % w) as f64,
             (i / w) as f64 - (back / w) as f64,
-        ];
-        let n = (d[0] * d[0] + d[1] * d[1]).sqrt();
+        );
         out.push(EndPoint {
             x_px: i % w,
             y_px: i / w,
-            direction: [d[0] / n, d[1] / n],
+            direction: d / d.norm(),
         });
     }
     out
