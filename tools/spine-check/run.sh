@@ -20,11 +20,17 @@ if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends nodejs npm >&2
 fi
 
-# Reinstall when the lock file changed since the last install, or the package is gone.
+# Reinstall when the lock file changed since the last install, or the package is gone. Tests
+# run this script in parallel: the check and the install hold an exclusive lock, so one
+# process installs while the others wait (npm ci deletes node_modules first, which a
+# concurrent `node` would read half-written), and the others then find the stamp.
 stamp="$here/node_modules/.sinew-lock"
 installed="$here/node_modules/@esotericsoftware/spine-core/package.json"
+exec 9>"$here/.install.lock"
+flock 9
 if ! cmp -s "$here/package-lock.json" "$stamp" 2>/dev/null || [ ! -f "$installed" ]; then
   (cd "$here" && npm ci --no-audit --no-fund --loglevel=error >&2) || { echo "spine-check: npm ci failed" >&2; exit 3; }
   cp "$here/package-lock.json" "$stamp"
 fi
+exec 9>&-
 exec node "$here/check.mjs" "$@"
