@@ -94,9 +94,11 @@ pub struct SharedPattern {
     /// The lower triangle of P A Pᵀ, P the fill-reducing order.
     permuted: faer::sparse::SymbolicSparseColMat<usize>,
     /// The analysis of `permuted`, in its own (identity) order.
-    cholesky: faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
+    pub(super) cholesky: faer::sparse::linalg::cholesky::SymbolicCholesky<usize>,
     /// `order[k]`: the caller's index at permuted position k.
-    order: Vec<usize>,
+    pub(super) order: Vec<usize>,
+    /// `position[i]`: the permuted position of the caller's index i (the inverse of `order`).
+    pub(super) position: Vec<usize>,
     /// Where each entry of `values` goes in `permuted`'s values.
     scatter: Vec<usize>,
     /// A's values in the pattern's order.
@@ -123,39 +125,9 @@ impl SharedPattern {
         use faer::sparse::linalg::cholesky::{
             factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
         };
-        let pos = positions(a.rows(), keep);
-        let len = keep.len();
-        let mut col_ptr = Vec::with_capacity(len + 1);
-        let mut row_idx = Vec::new();
-        let mut values = Vec::new();
-        let mut diagonal = Vec::with_capacity(len);
-        col_ptr.push(0);
-        for (k, &i) in keep.iter().enumerate() {
-            // Column k of the lower triangle = row k's entries at or below the diagonal.
-            let mut column: Vec<(usize, f64)> = a
-                .outer_view(i)
-                .map(|row| {
-                    row.iter()
-                        .filter_map(|(j, &v)| {
-                            (pos[j] != usize::MAX && pos[j] >= k).then_some((pos[j], v))
-                        })
-                        .collect()
-                })
-                .unwrap_or_default();
-            column.sort_unstable_by_key(|e| e.0);
-            if column.first().map(|e| e.0) != Some(k) {
-                column.insert(0, (k, 0.0));
-            }
-            diagonal.push(row_idx.len());
-            for (r, v) in column {
-                row_idx.push(r);
-                values.push(v);
-            }
-            col_ptr.push(row_idx.len());
-        }
-        let symbolic =
-            faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
         let assembly = |e: faer::sparse::FaerError| SolveError::Assembly(format!("{e:?}"));
+        let len = keep.len();
+        let (symbolic, values, diagonal) = lower_triangle(a, keep);
         let (order, inverse): (Vec<usize>, Vec<usize>) = match rank {
             Some(rank) => {
                 let mut order: Vec<usize> = (0..len).collect();
@@ -166,52 +138,67 @@ impl SharedPattern {
                 }
                 (order, inverse)
             }
-            // The fill-reducing order, from faer's own analysis of the caller's order.
-            None => {
-                let amd = factorize_symbolic_cholesky(
-                    symbolic.as_ref(),
-                    Side::Lower,
-                    SymmetricOrdering::Amd,
-                    CholeskySymbolicParams::default(),
-                )
-                .map_err(assembly)?;
-                match amd.perm() {
-                    Some(perm) => {
-                        let (fwd, inv) = perm.arrays();
-                        (fwd.to_vec(), inv.to_vec())
-                    }
-                    None => ((0..len).collect(), (0..len).collect()),
-                }
-            }
+            None => minimum_degree_order(&symbolic)?,
         };
         // Entry (r, c) of the lower triangle moves to (inverse[r], inverse[c]), mirrored into
-        // the lower triangle; then columns are sorted by row.
+        // the lower triangle: bucketed by its new column (a counting sort, linear in the
+        // entries: a global sort was most of the analysis), then each column's few rows sorted.
         let (col_ptr, row_idx) = (symbolic.col_ptr(), symbolic.row_idx());
-        let mut entries: Vec<(usize, usize, usize)> = Vec::with_capacity(values.len());
+        let moved = |c: usize, k: usize| {
+            let (pr, pc) = (inverse[row_idx[k]], inverse[c]);
+            (pr.min(pc), pr.max(pc))
+        };
+        let mut lower_ptr = vec![0usize; len + 1];
         for c in 0..len {
-            for (k, &r) in row_idx
-                .iter()
-                .enumerate()
-                .take(col_ptr[c + 1])
-                .skip(col_ptr[c])
-            {
-                let (pr, pc) = (inverse[r], inverse[c]);
-                entries.push((pr.min(pc), pr.max(pc), k));
+            for k in col_ptr[c]..col_ptr[c + 1] {
+                lower_ptr[moved(c, k).0 + 1] += 1;
             }
         }
-        entries.sort_unstable();
+        for c in 0..len {
+            lower_ptr[c + 1] += lower_ptr[c];
+        }
+        let mut next = lower_ptr.clone();
+        let mut slots = vec![(0usize, 0usize); values.len()];
+        for c in 0..len {
+            for k in col_ptr[c]..col_ptr[c + 1] {
+                let (column, row) = moved(c, k);
+                slots[next[column]] = (row, k);
+                next[column] += 1;
+            }
+        }
+        for c in 0..len {
+            slots[lower_ptr[c]..lower_ptr[c + 1]].sort_unstable();
+        }
         let mut scatter = vec![0usize; values.len()];
-        for (at, &(_, _, k)) in entries.iter().enumerate() {
+        for (at, &(_, k)) in slots.iter().enumerate() {
             scatter[k] = at;
         }
-        let permuted = compressed_columns(len, entries.iter().map(|&(c, r, _)| (c, r)));
-        // faer's analysis without reordering reads the upper triangle as given. Supernodal is
-        // forced: faer's flop-ratio heuristic picks the simplicial factorization for meshes of
-        // about 1k vertices and for some sub-meshes, where it is 2–4× slower per numeric
-        // factorization, and every interior-point iteration pays for one.
-        let mut upper: Vec<(usize, usize)> = entries.iter().map(|&(c, r, _)| (r, c)).collect();
-        upper.sort_unstable();
-        let upper = compressed_columns(len, upper.into_iter());
+        let lower_rows: Vec<usize> = slots.iter().map(|&(r, _)| r).collect();
+        // faer's analysis without reordering reads the upper triangle as given: the transpose,
+        // bucketed by row; reading the lower triangle column by column leaves each upper
+        // column's rows sorted.
+        let mut upper_ptr = vec![0usize; len + 1];
+        for &r in &lower_rows {
+            upper_ptr[r + 1] += 1;
+        }
+        for c in 0..len {
+            upper_ptr[c + 1] += upper_ptr[c];
+        }
+        let mut next = upper_ptr.clone();
+        let mut upper_rows = vec![0usize; lower_rows.len()];
+        for c in 0..len {
+            for &r in &lower_rows[lower_ptr[c]..lower_ptr[c + 1]] {
+                upper_rows[next[r]] = c;
+                next[r] += 1;
+            }
+        }
+        let permuted =
+            faer::sparse::SymbolicSparseColMat::new_checked(len, len, lower_ptr, None, lower_rows);
+        let upper =
+            faer::sparse::SymbolicSparseColMat::new_checked(len, len, upper_ptr, None, upper_rows);
+        // Supernodal is forced: faer's flop-ratio heuristic picks the simplicial factorization
+        // for meshes of about 1k vertices and for some sub-meshes, where it is 2–4× slower per
+        // numeric factorization, and every interior-point iteration pays for one.
         let cholesky = factorize_symbolic_cholesky(
             upper.as_ref(),
             Side::Upper,
@@ -228,6 +215,7 @@ impl SharedPattern {
             permuted,
             cholesky,
             order,
+            position: inverse,
             scatter,
             values,
             diagonal,
@@ -322,59 +310,130 @@ impl SharedPattern {
 /// i's position in the order faer's minimum-degree analysis chooses, `usize::MAX` elsewhere.
 /// For [`SharedPattern::with_rank`].
 pub fn fill_reducing_rank(a: &CsMat<f64>, keep: &[usize]) -> Result<Vec<usize>, SolveError> {
-    let pattern = SharedPattern::new(a, keep)?;
+    let (symbolic, _, _) = lower_triangle(a, keep);
+    let (order, _) = minimum_degree_order(&symbolic)?;
     let mut rank = vec![usize::MAX; a.rows()];
-    for (at, &k) in pattern.order.iter().enumerate() {
+    for (at, &k) in order.iter().enumerate() {
         rank[keep[k]] = at;
     }
     Ok(rank)
 }
 
-/// The pattern of an n × n matrix from its (column, row) entries, sorted by column then row.
-fn compressed_columns(
-    n: usize,
-    entries: impl ExactSizeIterator<Item = (usize, usize)>,
-) -> faer::sparse::SymbolicSparseColMat<usize> {
-    let mut col_ptr = vec![0usize; n + 1];
-    let mut row_idx = Vec::with_capacity(entries.len());
-    for (col, row) in entries {
-        col_ptr[col + 1] += 1;
-        row_idx.push(row);
+/// The lower triangle of A[keep, keep] (A symmetric, CSR; `keep` ascending) in compressed
+/// columns, every diagonal entry stored (zero where A stores none): its pattern, its values,
+/// and where each column's diagonal entry sits in the values.
+fn lower_triangle(
+    a: &CsMat<f64>,
+    keep: &[usize],
+) -> (
+    faer::sparse::SymbolicSparseColMat<usize>,
+    Vec<f64>,
+    Vec<usize>,
+) {
+    debug_assert!(
+        keep.windows(2).all(|w| w[0] < w[1]),
+        "keep must be ascending"
+    );
+    let pos = positions(a.rows(), keep);
+    let len = keep.len();
+    let mut col_ptr = Vec::with_capacity(len + 1);
+    let mut row_idx = Vec::new();
+    let mut values = Vec::new();
+    let mut diagonal = Vec::with_capacity(len);
+    col_ptr.push(0);
+    for (k, &i) in keep.iter().enumerate() {
+        // Column k of the lower triangle = row k's entries at or below the diagonal, in
+        // order (a CSR row's columns are sorted, and `keep` is).
+        diagonal.push(row_idx.len());
+        row_idx.push(k);
+        values.push(0.0);
+        if let Some(row) = a.outer_view(i) {
+            for (j, &v) in row.iter() {
+                let p = pos[j];
+                if p == k {
+                    values[diagonal[k]] = v;
+                } else if p != usize::MAX && p > k {
+                    row_idx.push(p);
+                    values.push(v);
+                }
+            }
+        }
+        col_ptr.push(row_idx.len());
     }
-    for c in 0..n {
-        col_ptr[c + 1] += col_ptr[c];
-    }
-    faer::sparse::SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
+    let symbolic =
+        faer::sparse::SymbolicSparseColMat::new_checked(len, len, col_ptr, None, row_idx);
+    (symbolic, values, diagonal)
+}
+
+/// faer's approximate minimum degree order of a symmetric pattern given by its lower triangle:
+/// (`order[k]`: the index eliminated k-th, its inverse). The order alone, without the
+/// symbolic factorization a full analysis would add (a third of the analysis' time).
+fn minimum_degree_order(
+    lower: &faer::sparse::SymbolicSparseColMat<usize>,
+) -> Result<(Vec<usize>, Vec<usize>), SolveError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let n = lower.nrows();
+    let (mut order, mut inverse) = (vec![0usize; n], vec![0usize; n]);
+    let nnz = lower.row_idx().len();
+    let mut memory = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<usize>(n, nnz))
+        .map_err(|e| SolveError::Assembly(format!("{e:?}")))?;
+    amd::order_maybe_unsorted(
+        &mut order,
+        &mut inverse,
+        lower.as_ref(),
+        amd::Control::default(),
+        MemStack::new(&mut memory),
+    )
+    .map_err(|e| SolveError::Assembly(format!("{e:?}")))?;
+    Ok((order, inverse))
 }
 
 /// A numeric Cholesky factorization over a [`SharedPattern`].
 pub struct PatternCholesky<'a> {
-    pattern: &'a SharedPattern,
+    pub(super) pattern: &'a SharedPattern,
     /// The factor's values, in the pattern's fill-reducing order.
-    l_values: Vec<f64>,
+    pub(super) l_values: Vec<f64>,
 }
 
 impl PatternCholesky<'_> {
     /// Solves in place for one right-hand side (in the caller's order).
     pub fn solve_in_place(&self, b: &mut [f64]) {
+        self.solve_columns_in_place(b, 1);
+    }
+
+    /// Solves in place for `columns` right-hand sides stored one after another in `b` (each
+    /// of the pattern's length, in the caller's order). One solve with many columns runs the
+    /// supernodal triangular solves as matrix products: several times faster per column than
+    /// as many single solves.
+    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
         use faer::dyn_stack::{MemBuffer, MemStack};
         let n = self.pattern.len();
-        if n == 0 {
+        if n == 0 || columns == 0 {
             return;
         }
+        debug_assert_eq!(b.len(), n * columns);
         let order = &self.pattern.order;
-        let mut x: Vec<f64> = order.iter().map(|&i| b[i]).collect();
+        let mut x = vec![0.0; n * columns];
+        for (xc, bc) in x.chunks_mut(n).zip(b.chunks(n)) {
+            for (xk, &i) in xc.iter_mut().zip(order) {
+                *xk = bc[i];
+            }
+        }
         let cholesky = &self.pattern.cholesky;
-        let mut memory = MemBuffer::new(cholesky.solve_in_place_scratch::<f64>(1, faer::Par::Seq));
+        let mut memory =
+            MemBuffer::new(cholesky.solve_in_place_scratch::<f64>(columns, faer::Par::Seq));
         faer::sparse::linalg::cholesky::LltRef::new(cholesky, &self.l_values)
             .solve_in_place_with_conj(
                 faer::Conj::No,
-                MatMut::from_column_major_slice_mut(&mut x, n, 1),
+                MatMut::from_column_major_slice_mut(&mut x, n, columns),
                 faer::Par::Seq,
                 MemStack::new(&mut memory),
             );
-        for (k, &i) in order.iter().enumerate() {
-            b[i] = x[k];
+        for (xc, bc) in x.chunks(n).zip(b.chunks_mut(n)) {
+            for (&xk, &i) in xc.iter().zip(order) {
+                bc[i] = xk;
+            }
         }
     }
 }
