@@ -20,8 +20,10 @@
 //! In: the factored support matrix, x₀ (in the support's order). Out: x within the bounds up
 //! to [`BOUND_SLACK`], the held vertices exactly on theirs, and how many are held.
 
+use super::inverse_entries::{ForwardColumn, InverseEntries};
 use super::sparse::PatternCholesky;
 use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
 
 /// A solved vertex is held at a bound when it is past it by more than this.
 pub const BOUND_SLACK: f64 = 1e-9;
@@ -31,84 +33,181 @@ pub const BOUND_SLACK: f64 = 1e-9;
 /// clamped by the caller).
 pub const MAX_BOUND_STEPS: usize = 2000;
 
+/// The most violating vertices added to the held set at once. Lawson and Hanson add one per
+/// step, and each step costs a backward solve over the whole support; the vertices around a
+/// handle overshoot together (a plateau at one), so adding the worst of them in one step and
+/// letting the step-back release those that do not belong takes a few steps instead of one per
+/// held vertex. When no vertex of a block stays held, the next step adds one, as Lawson and
+/// Hanson do, which is what guarantees progress.
+pub const BLOCK_ADD: usize = 64;
+
 /// Holds `x` (the unconstrained solution on the factored support, in the support's order) at
 /// its bounds where it leaves them (see the module doc); returns how many vertices are held,
 /// or `None` when the steps ran out or the held set's matrix lost definiteness (then `x` is
 /// left as it was).
 pub fn hold_bounds(factor: &PatternCholesky<'_>, x: &mut [f64]) -> Option<usize> {
     let n = x.len();
+    let inverse = InverseEntries::new(factor)?;
     let x0 = x.to_vec();
-    // Held vertices (support positions), the bound each is held at (+1: one, −1: zero),
-    // their columns of H⁻¹ and their multipliers (sign-free).
-    let mut held: Vec<usize> = Vec::new();
-    let mut signs: Vec<f64> = Vec::new();
-    let mut columns: Vec<Vec<f64>> = Vec::new();
-    let mut mu: Vec<f64> = Vec::new();
+    let past = |v: f64| (v - 1.0).max(-v);
+    let mut held = Held::default();
     let mut is_held = vec![false; n];
+    // Forward columns L⁻¹ eₖ and entries of H⁻¹, kept once computed: a vertex the step-back
+    // releases is often held again.
+    let mut forward: HashMap<usize, ForwardColumn> = HashMap::new();
+    let mut entries: HashMap<(usize, usize), f64> = HashMap::new();
     let mut current = x0.clone();
-    for _ in 0..MAX_BOUND_STEPS {
-        let (mut worst, mut at) = (BOUND_SLACK, usize::MAX);
-        for (k, &v) in current.iter().enumerate() {
-            let past = (v - 1.0).max(-v);
-            if past > worst && !is_held[k] {
-                (worst, at) = (past, k);
-            }
-        }
-        if at == usize::MAX {
+    let (mut steps, mut one_at_a_time) = (0, false);
+    while steps < MAX_BOUND_STEPS {
+        let mut violators: Vec<usize> = (0..n)
+            .filter(|&k| !is_held[k] && past(current[k]) > BOUND_SLACK)
+            .collect();
+        if violators.is_empty() {
             x.copy_from_slice(&current);
-            return Some(held.len());
+            return Some(held.vertex.len());
         }
-        let mut column = vec![0.0; n];
-        column[at] = 1.0;
-        factor.solve_in_place(&mut column);
-        held.push(at);
-        signs.push(if current[at] > 0.5 { 1.0 } else { -1.0 });
-        is_held[at] = true;
-        columns.push(column);
-        mu.push(0.0);
-        // The multipliers of the held set, stepping back while one would turn negative.
-        while !held.is_empty() {
-            let p = held.len();
-            let m = DMatrix::from_fn(p, p, |r, c| signs[r] * signs[c] * columns[c][held[r]]);
-            // The bound is 1 for sign +1, 0 for sign −1: (1 + sign) / 2.
-            let rhs = DVector::from_fn(p, |r, _| signs[r] * (x0[held[r]] - 0.5 * (1.0 + signs[r])));
-            let z = m.cholesky()?.solve(&rhs);
+        violators.sort_by(|&a, &b| {
+            past(current[b])
+                .total_cmp(&past(current[a]))
+                .then(a.cmp(&b))
+        });
+        violators.truncate(if one_at_a_time { 1 } else { BLOCK_ADD });
+        steps += violators.len();
+        let before = held.vertex.len();
+        for &k in &violators {
+            forward.entry(k).or_insert_with(|| inverse.forward(k));
+            held.push(k, if current[k] > 0.5 { 1.0 } else { -1.0 });
+            is_held[k] = true;
+        }
+        // Added vertices whose multiplier comes out negative would leave their bound at once:
+        // they are not added.
+        let mut z = loop {
+            let z = held.multipliers(&x0, &forward, &mut entries)?;
+            let keep: Vec<bool> = (0..z.len()).map(|r| r < before || z[r] > 0.0).collect();
+            if keep.iter().all(|&k| k) {
+                break z;
+            }
+            for (r, _) in keep.iter().enumerate().filter(|(_, &k)| !k) {
+                is_held[held.vertex[r]] = false;
+            }
+            held.retain(&keep);
+        };
+        if held.vertex.len() == before {
+            if one_at_a_time {
+                // Rounding: the worst violator's multiplier is not positive; what is held so
+                // far stands and the caller clamps the rest.
+                x.copy_from_slice(&current);
+                return Some(held.vertex.len());
+            }
+            one_at_a_time = true;
+            continue;
+        }
+        one_at_a_time = false;
+        // Step back while a multiplier would turn negative (Lawson and Hanson).
+        loop {
             if z.iter().all(|&v| v > 0.0) {
-                mu.copy_from_slice(z.as_slice());
+                held.mu.copy_from_slice(&z);
                 break;
             }
             let alpha = z
                 .iter()
-                .zip(&mu)
+                .zip(&held.mu)
                 .filter(|(&zk, _)| zk <= 0.0)
                 .map(|(&zk, &mk)| mk / (mk - zk))
                 .fold(1.0, f64::min);
-            for (mk, &zk) in mu.iter_mut().zip(z.iter()) {
+            for (mk, &zk) in held.mu.iter_mut().zip(&z) {
                 *mk += alpha * (zk - *mk);
             }
-            let mut k = 0;
-            while k < held.len() {
-                if mu[k] <= 0.0 {
-                    is_held[held[k]] = false;
-                    held.swap_remove(k);
-                    signs.swap_remove(k);
-                    columns.swap_remove(k);
-                    mu.swap_remove(k);
-                } else {
-                    k += 1;
-                }
+            let keep: Vec<bool> = held.mu.iter().map(|&m| m > 0.0).collect();
+            for (r, _) in keep.iter().enumerate().filter(|(_, &k)| !k) {
+                is_held[held.vertex[r]] = false;
             }
+            held.retain(&keep);
+            if held.vertex.is_empty() {
+                break;
+            }
+            z = held.multipliers(&x0, &forward, &mut entries)?;
         }
-        // x = x₀ − Σ λ_k H⁻¹ e_k.
-        current.copy_from_slice(&x0);
-        for ((column, &m), &s) in columns.iter().zip(&mu).zip(&signs) {
-            let lambda = s * m;
-            for (v, &c) in current.iter_mut().zip(column) {
-                *v -= lambda * c;
-            }
+        // x = x₀ − H⁻¹ Σ λₖ eₖ, one backward solve.
+        let terms: Vec<(&ForwardColumn, f64)> = held
+            .vertex
+            .iter()
+            .zip(held.sign.iter().zip(&held.mu))
+            .filter_map(|(k, (s, m))| Some((forward.get(k)?, s * m)))
+            .collect();
+        let shift = inverse.combination(&terms);
+        for ((c, &x0k), &d) in current.iter_mut().zip(&x0).zip(&shift) {
+            *c = x0k - d;
         }
     }
     None
+}
+
+/// The held vertices (support positions), the bound each is held at (+1: one, −1: zero) and
+/// their multipliers (sign-free, positive).
+#[derive(Default)]
+struct Held {
+    vertex: Vec<usize>,
+    sign: Vec<f64>,
+    mu: Vec<f64>,
+}
+
+impl Held {
+    fn push(&mut self, k: usize, sign: f64) {
+        self.vertex.push(k);
+        self.sign.push(sign);
+        self.mu.push(0.0);
+    }
+
+    fn retain(&mut self, keep: &[bool]) {
+        let mut at = 0;
+        for (r, &k) in keep.iter().enumerate() {
+            if k {
+                self.vertex[at] = self.vertex[r];
+                self.sign[at] = self.sign[r];
+                self.mu[at] = self.mu[r];
+                at += 1;
+            }
+        }
+        self.vertex.truncate(at);
+        self.sign.truncate(at);
+        self.mu.truncate(at);
+    }
+
+    /// The multipliers that put every held vertex exactly on its bound: the solution z of
+    /// (S E_Pᵀ H⁻¹ E_P S) z = S (x₀[P] − bound), S the signs; `None` when that matrix is not
+    /// positive definite.
+    fn multipliers(
+        &self,
+        x0: &[f64],
+        forward: &HashMap<usize, ForwardColumn>,
+        entries: &mut HashMap<(usize, usize), f64>,
+    ) -> Option<Vec<f64>> {
+        let p = self.vertex.len();
+        let mut m = DMatrix::zeros(p, p);
+        for r in 0..p {
+            for c in 0..=r {
+                let (a, b) = (self.vertex[r], self.vertex[c]);
+                let key = (a.min(b), a.max(b));
+                let entry = match entries.get(&key) {
+                    Some(&e) => e,
+                    None => {
+                        let e = forward.get(&a)?.dot(forward.get(&b)?);
+                        entries.insert(key, e);
+                        e
+                    }
+                };
+                m[(r, c)] = self.sign[r] * self.sign[c] * entry;
+                m[(c, r)] = m[(r, c)];
+            }
+        }
+        // The bound is 1 for sign +1, 0 for sign −1: (1 + sign) / 2.
+        let rhs = DVector::from_fn(p, |r, _| {
+            let (k, s) = (self.vertex[r], self.sign[r]);
+            s * (x0[k] - 0.5 * (1.0 + s))
+        });
+        Some(m.cholesky()?.solve(&rhs).as_slice().to_vec())
+    }
 }
 
 #[cfg(test)]

@@ -7,6 +7,7 @@
 //! - [`active_set`]: the same bounded solve by active-set iterations from a close guess.
 //! - [`support`]: the same bounded solve by one solve per handle on a close guess's support.
 //! - [`bounds`]: the bounds on such a support, held by a Schur complement over its factor.
+//! - [`inverse_entries`]: entries of H⁻¹ by forward solves along the elimination tree.
 //! - [`monotone`]: bounded biharmonic weights without spurious extrema (Jacobson et al. 2012).
 //! - [`reference`]: the same bounded QP by clarabel, the yardstick in tests.
 //! - [`boundary`]: handles → fixed weights on the mesh vertices that carry their geometry.
@@ -20,6 +21,7 @@
 pub mod active_set;
 pub mod boundary;
 pub mod bounds;
+pub mod inverse_entries;
 pub mod laplacian;
 pub mod lift;
 pub mod locked;
