@@ -13,9 +13,11 @@
 //! as the set P, x = x₀ − H⁻¹ E_P λ, and the multipliers λ (signed: positive at the upper
 //! bound, negative at the lower) solve the small dense system (E_Pᵀ H⁻¹ E_P) λ = x₀[P] − bound.
 //! P is found by Lawson and Hanson's active-set method for non-negative multipliers: add the
-//! most violating vertex, step back while a multiplier would change sign (its vertex leaves
-//! P), so it ends in finitely many steps. Each vertex added costs one solve with the existing
-//! factor (its column of H⁻¹) and a dense Cholesky factorization of |P|², |P| a few dozen.
+//! most violating vertices (a block of up to [`BLOCK_ADD`], or one when a block makes no
+//! progress), step back while a multiplier would change sign (its vertex leaves P), so it ends
+//! in finitely many steps. The entries of H⁻¹ come from forward solves along the elimination
+//! tree ([`super::inverse_entries`], a few percent of a solve per vertex), and each step's
+//! new x from one backward solve; the dense system is |P|², |P| a few dozen.
 //!
 //! In: the factored support matrix, x₀ (in the support's order). Out: x within the bounds up
 //! to [`BOUND_SLACK`], the held vertices exactly on theirs, and how many are held.
@@ -28,9 +30,9 @@ use std::collections::HashMap;
 /// A solved vertex is held at a bound when it is past it by more than this.
 pub const BOUND_SLACK: f64 = 1e-9;
 
-/// The most active-set steps per handle (each adds or removes one held vertex); measured
-/// 3–270 on the critter rigs at 5k–20k vertices. Past it the solve is left unconstrained (and
-/// clamped by the caller).
+/// The most vertices added per handle over all active-set steps (one vertex per step took
+/// 3–270 steps on the critter rigs at 5k–20k vertices). Past it the solve is left
+/// unconstrained (and clamped by the caller).
 pub const MAX_BOUND_STEPS: usize = 2000;
 
 /// The most violating vertices added to the held set at once. Lawson and Hanson add one per
