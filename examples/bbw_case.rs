@@ -28,7 +28,8 @@
 //! Cases: `critter` (a generated sprite, five point handles and a two-bone chain),
 //! `character_torso` (the bundled character's torso layer with the bones of
 //! `assets/character/handles.json` that touch it) and `critter_large` (the sprite at 512 px,
-//! meshed finely, ten point handles).
+//! meshed finely, ten point handles); named only: `bench_5k`, `bench_20k`, `bench_50k` (the
+//! weights benchmark's meshes and handles, `benches/weights.rs`).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -407,6 +408,30 @@ fn main() {
     }
     if wanted("character_torso") {
         solve_and_write(&character_torso(&assets), &out_dir, &settings);
+    }
+    // The weights benchmark's meshes (benches/weights.rs: the same outline, meshes and ten
+    // farthest-point handles), for libigl's timings beside the benchmark's; written only when
+    // named.
+    for (name, target) in [
+        ("bench_5k", 5_000),
+        ("bench_20k", 20_000),
+        ("bench_50k", 50_000),
+    ] {
+        if only.iter().any(|o| o == name) {
+            let (mesh, _) = common::sprite_meshes::mesh_near(
+                &common::sprite_meshes::main_outline(),
+                target,
+            );
+            let handles = common::sprite_meshes::farthest_points(&mesh, 10);
+            let case = Case {
+                name,
+                vertices: mesh.vertices,
+                triangles: mesh.triangles,
+                columns: (0..handles.len()).map(|j| format!("point{j}")).collect(),
+                bc: common::sprite_meshes::point_conditions(&handles),
+            };
+            solve_and_write(&case, &out_dir, &settings);
+        }
     }
     if wanted("critter_large") {
         // About 5k vertices: triangles of at most ~13 px² on the 512² canvas.

@@ -9,6 +9,9 @@
 #        CASE_ARGS="..."    extra arguments for the example (e.g. "--max-iterations 500",
 #                           "--reference", or case names)
 #        PYTHON=python3     the interpreter that creates the environment
+#        CARGO_PROFILE_ARGS the example's build profile (default "--release"; "" for the dev
+#                           profile, whose dependencies are optimized: no release build of
+#                           every dependency when only libigl's figures are wanted)
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -20,7 +23,7 @@ cases="$(mktemp -d "${TMPDIR:-/tmp}/sinew-bbw-cases.XXXXXX")"
 trap 'rm -rf "$cases"' EXIT
 
 echo "== building and running examples/bbw_case.rs" >&2
-(cd "$root" && cargo run --quiet --release --example bbw_case -- "$cases" ${CASE_ARGS:-})
+(cd "$root" && cargo run --quiet ${CARGO_PROFILE_ARGS---release} --example bbw_case -- "$cases" ${CASE_ARGS:-})
 
 if [[ ! -x "$venv/bin/python" ]]; then
   echo "== creating $venv" >&2
