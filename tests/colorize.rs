@@ -15,6 +15,7 @@
 mod command;
 mod common;
 
+#[cfg(feature = "cli")]
 use command::{s, scratch, sinew};
 use image::{Rgba, RgbaImage};
 use sinew::colorize::flood::flood_fill;
@@ -24,7 +25,6 @@ use sinew::colorize::{
     self, ColorWeights, ColorizeError, ColorizeOptions, FillMode, LiftedStiffness, LineArt,
     RegionSplit, ScribbleOptions, Scribbles,
 };
-#[cfg(feature = "cli")]
 use sinew::geom::Point;
 #[cfg(feature = "cli")]
 use sinew::io::{load_png, save_png};

@@ -12,6 +12,7 @@
 //! the newest strokes win.
 
 use super::canvas::{self, Placed, View};
+use super::number_field::{number_field, slider};
 use super::{EditorApp, Mode};
 use crate::colorize::session::{
     ColorizeSession, ScribbleStroke, SessionCommand, SessionError, SolveJob,
@@ -522,12 +523,8 @@ impl EditorApp {
         });
         ui.horizontal(|ui| {
             let label = ui.label("Brush px:");
-            ui.add(
-                egui::DragValue::new(&mut c.width_px)
-                    .range(1.0..=64.0)
-                    .speed(0.25),
-            )
-            .labelled_by(label.id);
+            ui.add(number_field(&mut c.width_px).range(1.0..=64.0).speed(0.25))
+                .labelled_by(label.id);
         });
         ui.separator();
         ui.horizontal(|ui| {
@@ -538,7 +535,7 @@ impl EditorApp {
                 "Scribbles only",
             );
         });
-        ui.add(egui::Slider::new(&mut c.opacity, 0.0..=1.0).text("result opacity"));
+        ui.add(slider(&mut c.opacity, 0.0..=1.0).text("result opacity"));
         ui.separator();
         ui.label(format!("{strokes} strokes, {} colors", palette.len()));
         let mut command = None;

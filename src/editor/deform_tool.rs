@@ -11,6 +11,7 @@
 //! steps where the skinning is not affine in the offset ([`offsets_reaching`]). While dragging, the canvas shows
 //! the circle of the radius and the motion.
 
+use super::number_field::number_field;
 use super::{canvas, EditorApp, Gesture};
 use crate::document::Command;
 use crate::geom::{Point, Vec2};
@@ -129,7 +130,7 @@ impl EditorApp {
             .on_hover_text("drag mesh vertices; the offsets are keyed at the playhead");
         let label = ui.label("Deform radius");
         ui.add(
-            egui::DragValue::new(&mut self.deform.radius_px)
+            number_field(&mut self.deform.radius_px)
                 .range(1.0..=2000.0)
                 .suffix(" px"),
         )

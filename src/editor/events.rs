@@ -9,6 +9,7 @@
 //! of that event plays it), `Add` at the playhead (on its frame), `Define` from the *Define
 //! event* window. Moving, copying and deleting event keys are the dopesheet's.
 
+use super::number_field::number_field;
 use super::EditorApp;
 use crate::anim::edit::{KeyRef, TimelineId};
 use crate::anim::{EventDef, EventKey};
@@ -180,7 +181,7 @@ impl EditorApp {
             let shown = key.int.unwrap_or(def.int);
             let mut int = shown;
             let label = ui.label("Event int");
-            let field = ui.add(egui::DragValue::new(&mut int).update_while_editing(false));
+            let field = ui.add(number_field(&mut int).update_while_editing(false));
             if field.labelled_by(label.id).changed() && int != shown {
                 edited.int = Some(int);
             }
@@ -189,7 +190,7 @@ impl EditorApp {
             let mut float = shown;
             let label = ui.label("Event float");
             let field = ui.add(
-                egui::DragValue::new(&mut float)
+                number_field(&mut float)
                     .speed(0.01)
                     .max_decimals(6)
                     .update_while_editing(false),
@@ -212,7 +213,7 @@ impl EditorApp {
                     let mut v = shown;
                     let label = ui.label(name);
                     let field = ui.add(
-                        egui::DragValue::new(&mut v)
+                        number_field(&mut v)
                             .speed(0.01)
                             .range(range)
                             .update_while_editing(false),
@@ -271,11 +272,11 @@ impl EditorApp {
                         .labelled_by(label.id);
                     ui.end_row();
                     let label = ui.label("Default int");
-                    ui.add(egui::DragValue::new(&mut panel.new_def.int))
+                    ui.add(number_field(&mut panel.new_def.int))
                         .labelled_by(label.id);
                     ui.end_row();
                     let label = ui.label("Default float");
-                    ui.add(egui::DragValue::new(&mut panel.new_def.float).speed(0.01))
+                    ui.add(number_field(&mut panel.new_def.float).speed(0.01))
                         .labelled_by(label.id);
                     ui.end_row();
                     let label = ui.label("Default string");

@@ -12,6 +12,7 @@
 //! ([`super::native_dialog`]).
 
 use super::native_dialog::DialogFor;
+use super::number_field::number_field;
 use super::EditorApp;
 use crate::skin::Blend;
 use eframe::egui::{self, Key, Modifiers};
@@ -394,7 +395,7 @@ fn spine_options_ui(ui: &mut egui::Ui, options: &mut crate::export::spine::Spine
         ui.end_row();
         ui.label("Bake keys per second");
         ui.add(
-            egui::DragValue::new(&mut options.bake_fps)
+            number_field(&mut options.bake_fps)
                 .range(1.0..=crate::playback::MAX_FPS)
                 .speed(0.2),
         );
@@ -441,7 +442,7 @@ fn optional_count(
         let mut on = value.is_some();
         let mut n = value.unwrap_or(default);
         ui.checkbox(&mut on, "");
-        ui.add_enabled(on, egui::DragValue::new(&mut n).range(range));
+        ui.add_enabled(on, number_field(&mut n).range(range));
         *value = on.then_some(n);
     });
     ui.end_row();
@@ -453,7 +454,7 @@ fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderS
     egui::Grid::new("render settings").show(ui, |ui| {
         let label = ui.label("Frames per second");
         ui.add(
-            egui::DragValue::new(&mut settings.fps)
+            number_field(&mut settings.fps)
                 .range(1.0..=crate::playback::MAX_FPS)
                 .speed(0.2),
         )
@@ -461,7 +462,7 @@ fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderS
         ui.end_row();
         let label = ui.label("Scale (output px per canvas px)");
         ui.add(
-            egui::DragValue::new(&mut settings.scale)
+            number_field(&mut settings.scale)
                 .range(super::file::RENDER_SCALE_RANGE.0..=super::file::RENDER_SCALE_RANGE.1)
                 .speed(0.01),
         )
@@ -519,7 +520,7 @@ fn render_settings_ui(ui: &mut egui::Ui, settings: &mut crate::playback::RenderS
             ui.end_row();
             let label = ui.label("Bake keys per second");
             ui.add(
-                egui::DragValue::new(&mut export.bake_fps)
+                number_field(&mut export.bake_fps)
                     .range(1.0..=crate::export::spine::MAX_BAKE_FPS)
                     .speed(0.2),
             )

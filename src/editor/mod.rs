@@ -32,6 +32,7 @@ mod identity;
 pub mod key_menu;
 pub mod messages;
 pub mod native_dialog;
+pub mod number_field;
 pub mod numbers;
 pub mod paint;
 pub mod physics_fields;

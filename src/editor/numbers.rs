@@ -7,6 +7,7 @@
 //! auto-key is on). A typed number commits on Enter; a drag shows its pose live and commits
 //! once, on release (one undo step).
 
+use super::number_field::number_field;
 use super::{EditorApp, Gesture};
 use crate::rig::Pose;
 use eframe::egui;
@@ -123,7 +124,7 @@ impl EditorApp {
                 let label = ui.label(field.label);
                 let response = ui
                     .add(
-                        egui::DragValue::new(value)
+                        number_field(value)
                             .speed(field.speed)
                             .suffix(field.suffix)
                             .max_decimals(3)

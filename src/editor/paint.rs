@@ -10,6 +10,7 @@
 //! prefix-stable), so the preview is what the command produces, and the stroke is one undo step.
 
 use super::canvas::{self, Placed};
+use super::number_field::number_field;
 use super::{EditorApp, Gesture};
 use crate::document::{part_weights_for_painting, Command};
 use crate::geom::Point;
@@ -250,7 +251,7 @@ impl EditorApp {
         ] {
             ui.horizontal(|ui| {
                 let label = ui.label(text);
-                ui.add(egui::DragValue::new(value).range(range).speed(speed))
+                ui.add(number_field(value).range(range).speed(speed))
                     .labelled_by(label.id);
             });
         }

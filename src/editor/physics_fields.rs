@@ -8,6 +8,7 @@
 //! are refused with its one-line message and the constraint stays as it was. The rig stays
 //! posable: constraints move no weights.
 
+use super::number_field::number_field;
 use super::EditorApp;
 use crate::document::Command;
 use crate::rig::PhysicsConstraint;
@@ -134,7 +135,7 @@ impl EditorApp {
                 let label = ui.label(field.label);
                 let response = ui
                     .add(
-                        egui::DragValue::new(&mut value)
+                        number_field(&mut value)
                             .speed(field.speed)
                             .max_decimals(4)
                             .update_while_editing(false),

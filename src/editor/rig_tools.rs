@@ -9,6 +9,7 @@
 
 use super::canvas::{self, Placed};
 use super::identity::Identity;
+use super::number_field::{number_field, slider};
 use super::{EditorApp, Gesture};
 use crate::autorig::{AutorigOptions, Proposal};
 use crate::document::Command;
@@ -177,26 +178,21 @@ impl EditorApp {
             .unwrap_or_else(|| current.clone());
         let mut responses = Vec::new();
         let mut alpha = f64::from(draft.trace.alpha_threshold);
-        responses.push(ui.add(egui::Slider::new(&mut alpha, 1.0..=255.0).text("alpha threshold")));
+        responses.push(ui.add(slider(&mut alpha, 1.0..=255.0).text("alpha threshold")));
         draft.trace.alpha_threshold = alpha.round().clamp(1.0, 255.0) as u8;
-        responses.push(
-            ui.add(egui::Slider::new(&mut draft.trace.padding_px, 0.0..=16.0).text("padding px")),
-        );
+        responses.push(ui.add(slider(&mut draft.trace.padding_px, 0.0..=16.0).text("padding px")));
         responses.push(
             ui.add(
-                egui::Slider::new(&mut draft.trace.simplify_tolerance_px, 0.05..=8.0)
+                slider(&mut draft.trace.simplify_tolerance_px, 0.05..=8.0)
                     .logarithmic(true)
                     .text("simplify px"),
             ),
         );
+        responses
+            .push(ui.add(slider(&mut draft.mesh.min_angle_deg, 0.0..=30.0).text("min angle °")));
         responses.push(
             ui.add(
-                egui::Slider::new(&mut draft.mesh.min_angle_deg, 0.0..=30.0).text("min angle °"),
-            ),
-        );
-        responses.push(
-            ui.add(
-                egui::Slider::new(&mut draft.mesh.max_area_fraction, 1e-5..=1e-1)
+                slider(&mut draft.mesh.max_area_fraction, 1e-5..=1e-1)
                     .logarithmic(true)
                     .text("max triangle area (of canvas)"),
             ),
@@ -210,7 +206,7 @@ impl EditorApp {
         let mut strength = draft.weights.content_aware.unwrap_or(DEFAULT_CONTENT_AWARE);
         ui.horizontal(|ui| {
             responses.push(ui.checkbox(&mut content, "content-aware, color scale"));
-            responses.push(ui.add(egui::DragValue::new(&mut strength).range(0.0..=1000.0)));
+            responses.push(ui.add(number_field(&mut strength).range(0.0..=1000.0)));
         });
         draft.weights.content_aware = content.then_some(strength);
         let mut limit = draft.weights.max_influences.is_some();
@@ -220,7 +216,7 @@ impl EditorApp {
             .unwrap_or(DEFAULT_MAX_INFLUENCES);
         ui.horizontal(|ui| {
             responses.push(ui.checkbox(&mut limit, "at most"));
-            responses.push(ui.add(egui::DragValue::new(&mut k).range(1..=16)));
+            responses.push(ui.add(number_field(&mut k).range(1..=16)));
             ui.label("influences per vertex");
         });
         draft.weights.max_influences = limit.then_some(k);
@@ -264,16 +260,16 @@ impl EditorApp {
         ui.horizontal(|ui| {
             ui.checkbox(&mut limit, "at most");
             let mut n = options.skeleton.max_bones.unwrap_or(16);
-            ui.add(egui::DragValue::new(&mut n).range(1..=128));
+            ui.add(number_field(&mut n).range(1..=128));
             ui.label("bones");
             options.skeleton.max_bones = limit.then_some(n);
         });
-        ui.add(egui::Slider::new(&mut options.point_count, 0..=32).text("points"));
+        ui.add(slider(&mut options.point_count, 0..=32).text("points"));
         let mut cage = options.cage_vertices.is_some();
         ui.horizontal(|ui| {
             ui.checkbox(&mut cage, "cage of at most");
             let mut n = options.cage_vertices.unwrap_or(12);
-            ui.add(egui::DragValue::new(&mut n).range(3..=64));
+            ui.add(number_field(&mut n).range(3..=64));
             options.cage_vertices = cage.then_some(n);
         });
         if self.rig_tools.proposing() {

@@ -13,6 +13,7 @@
 
 use super::animate_mode::{OnionOptions, MAX_ONION_FRAMES};
 use super::curves::{CurveLayout, CURVE_GRAPH_PT};
+use super::number_field::{number_field, slider};
 use super::{EditorApp, Mode};
 use crate::anim::edit::{self, CopiedKey, KeyRef, TimelineId, KEY_TIME_TOLERANCE_S};
 use crate::document::Command;
@@ -320,17 +321,14 @@ impl EditorApp {
                 self.set_time(t);
             }
             ui.add(
-                egui::DragValue::new(&mut self.render_settings.fps)
+                number_field(&mut self.render_settings.fps)
                     .range(1.0..=crate::playback::MAX_FPS)
                     .speed(0.1)
                     .suffix(" fps"),
             );
             let mut t = self.animate.time_s;
             let length = self.timeline_length_s();
-            if ui
-                .add(egui::Slider::new(&mut t, 0.0..=length).text("s"))
-                .changed()
-            {
+            if ui.add(slider(&mut t, 0.0..=length).text("s")).changed() {
                 self.set_time(t);
             }
             if ui
@@ -375,11 +373,11 @@ impl EditorApp {
             let onion = &mut self.timeline.onion;
             ui.checkbox(&mut onion.enabled, "Onion skin");
             ui.add(
-                egui::DragValue::new(&mut onion.frames)
+                number_field(&mut onion.frames)
                     .range(1..=MAX_ONION_FRAMES)
                     .suffix(" frames"),
             );
-            ui.add(egui::Slider::new(&mut onion.opacity, 0.05..=1.0).text("opacity"));
+            ui.add(slider(&mut onion.opacity, 0.05..=1.0).text("opacity"));
         });
         let animation = crate::document::animation_named(self.doc.state(), &self.animate.animation);
         let timelines = edit::timelines(&animation);

@@ -228,7 +228,7 @@ impl Scene {
         self.doc
             .parts
             .iter()
-            .map(|p| p.mesh.to_mesh().vertices)
+            .map(|p| p.mesh.vertices.clone())
             .collect()
     }
 
@@ -385,28 +385,34 @@ impl Scene {
                 .iter()
                 .map(|&j| stretches.get(j).copied().flatten())
                 .collect();
-            let mut rest = positions.clone();
-            if let Some(offsets) = pose.deform.get(&part.name) {
-                if offsets.len() != rest.len() {
-                    return Err(PipelineError::DeformSize {
-                        part: part.name.clone(),
-                        got: offsets.len(),
-                        expected: rest.len(),
-                    });
+            // The rest mesh skinned: the document's own vertices, read in place (no copy per
+            // frame), or, under deform offsets, this pose's moved copy.
+            let deformed_rest: Vec<Point>;
+            let rest: &[Point] = match pose.deform.get(&part.name) {
+                Some(offsets) => {
+                    if offsets.len() != positions.len() {
+                        return Err(PipelineError::DeformSize {
+                            part: part.name.clone(),
+                            got: offsets.len(),
+                            expected: positions.len(),
+                        });
+                    }
+                    // Deform offsets move the rest mesh before skinning (crate::anim::deform).
+                    for (p, o) in positions.iter_mut().zip(offsets) {
+                        *p += *o;
+                    }
+                    deformed_rest = positions.clone();
+                    &deformed_rest
                 }
-                // Deform offsets move the rest mesh before skinning (crate::anim::deform).
-                for (p, o) in rest.iter_mut().zip(offsets) {
-                    *p += *o;
-                }
-                *positions = rest.clone();
-            }
+                None => &part.mesh.vertices,
+            };
             match blend {
                 Blend::Linear => {
                     let deformed;
                     let plan = if pose.deform.contains_key(&part.name) {
                         // The deformed rest is this pose's alone: plan it for this call.
                         let skin_weights = SkinWeights::from_rows(&weights.rows);
-                        deformed = LbsPlan::precompute_exact(&rest, &skin_weights)
+                        deformed = LbsPlan::precompute_exact(rest, &skin_weights)
                             .map_err(|source| skin_error(part, source))?;
                         &deformed
                     } else {
@@ -421,7 +427,7 @@ impl Scene {
                     // The f32 displacement on the f64 rest point: identity transforms give
                     // back the rest positions exactly (the plan returns its f32 rest bit for
                     // bit, so the displacement is exactly zero).
-                    for ((p, r), q) in positions.iter_mut().zip(&rest).zip(&posed) {
+                    for ((p, r), q) in positions.iter_mut().zip(rest).zip(&posed) {
                         let moved = |rest: f64, posed: f32| {
                             rest + (f64::from(posed) - f64::from(rest as f32))
                         };
@@ -429,14 +435,14 @@ impl Scene {
                     }
                 }
                 Blend::Stretch => stretchable_blend(
-                    &rest,
+                    rest,
                     &SkinWeights::from_rows(&weights.rows),
                     &part_transforms,
                     &part_stretches,
                     positions,
                 ),
                 Blend::Dqs => skin(
-                    &rest,
+                    rest,
                     &SkinWeights::from_rows(&weights.rows),
                     &part_transforms,
                     blend,

@@ -1,5 +1,6 @@
 //! Physics constraints in the tree view: listed under their bone, their numbers edited as
-//! undoable commands, bad numbers refused with a message, the rig kept posable.
+//! undoable commands, non-finite numbers refused by the fields, bad numbers by the document
+//! with a message, the rig kept posable.
 
 use super::*;
 
@@ -57,14 +58,24 @@ fn a_physics_constraints_fields_in_the_tree_edit_it_and_refuse_bad_numbers() {
         .physics;
     assert_eq!(scene_physics, &h.state().doc.state().handles.physics);
 
-    // NaN (egui's field clamps it to infinity) and a mass of 0 are refused with the
-    // document's message; nothing changes.
-    enter(&mut h, "Physics damping", "NaN");
-    let message = h.state().message.clone().unwrap_or_default();
-    assert!(
-        message.contains("damping is inf, not a finite number"),
-        "{message}"
-    );
+    // Non-finite numbers (NaN, which egui's own field clamped to infinity, infinities, an
+    // overflow) are refused by the field: it keeps its value and makes no command.
+    let message = h.state().message.clone();
+    for text in ["NaN", "inf", "-infinity", "1e999"] {
+        enter(&mut h, "Physics damping", text);
+        assert_eq!(tail_sway(&h), after, "{text}");
+        assert_eq!(h.state().message, message, "{text}");
+        let shown = h
+            .get_by_label("Physics damping")
+            .value()
+            .unwrap_or_default();
+        assert_eq!(
+            shown.parse::<f64>().ok(),
+            Some(after.damping),
+            "{text}: {shown}"
+        );
+    }
+    // A mass of 0 is refused with the document's message; nothing changes.
     enter(&mut h, "Physics mass", "0");
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("mass must be > 0"), "{message}");

@@ -348,3 +348,36 @@ fn the_skin_picker_draws_the_chosen_skin_and_undo_takes_it_back() {
     assert!(h.state().doc.posable().expect("posable").skins().is_empty());
     assert!(drawn(&h).contains(&"bag".to_string()));
 }
+
+#[test]
+fn the_numbers_panel_refuses_non_finite_numbers_and_keeps_the_pose() {
+    let mut h = open_character("numbers-finite");
+    h.key_press(Key::Num2);
+    h.run();
+    click(&mut h, Point::new(256.0, 225.0));
+    assert_eq!(h.state().selected.as_deref(), Some("chest"));
+    set_number(&mut h, "Rotation", 30.0);
+    let posed = h.state().doc.state().pose.clone();
+    assert_eq!(posed.bones["chest"].rotate, 30.0, "{:?}", h.state().message);
+    // Refused by the field itself: no command, so not even the document's refusal message.
+    let message = h.state().message.clone();
+    for label in ["Rotation", "Translation y", "Scale x"] {
+        for text in ["NaN", "inf", "-infinity", "1e999"] {
+            type_into(&mut h, label, text);
+            h.key_press(Key::Enter);
+            h.run();
+            assert_eq!(h.state().doc.state().pose, posed, "{label}: {text}");
+            assert_eq!(h.state().message, message, "{label}: {text}");
+        }
+    }
+    let shown = h.get_by_label("Rotation").value().unwrap_or_default();
+    assert_eq!(
+        shown.trim_end_matches('°').parse::<f64>().ok(),
+        Some(30.0),
+        "{shown}"
+    );
+    // No command was made: one undo takes back the 30°.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run();
+    assert!(h.state().doc.state().pose.bones.is_empty());
+}
