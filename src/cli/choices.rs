@@ -101,6 +101,8 @@ mirror!(FillModeArg => FillMode {
 });
 
 mirror!(RegionSplitArg => RegionSplit {
+    /// An ink-density flood: boundaries where ink crowds (G'MIC Smart Coloring's order).
+    Density,
     /// A depth flood: boundaries where the region is narrowest; a scribble in the middle
     /// claims more than one in a corner.
     Depth,

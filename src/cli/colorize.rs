@@ -43,12 +43,16 @@ pub struct ColorizeArgs {
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().end_point_join.segment_max_px)]
     pub join_segment: f64,
     /// How a region holding several colors is split: depth (boundaries where it is
-    /// narrowest) or weights (the content-aware weights).
+    /// narrowest), density (where ink crowds, G'MIC Smart Coloring's order) or weights (the
+    /// content-aware weights).
     #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "depth")]
     pub split: RegionSplit,
     /// With --split depth: distances to the lines beyond PX count as PX.
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_depth_px)]
     pub split_depth: f64,
+    /// With --split density: σ in px of the Gaussian that measures the ink around a pixel.
+    #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_blur_px)]
+    pub split_blur: f64,
 }
 
 pub fn run(args: &ColorizeArgs) -> Result<()> {
@@ -60,6 +64,7 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         gap_closing_px: args.gap_closing,
         split: args.split,
         split_depth_px: args.split_depth,
+        split_blur_px: args.split_blur,
         end_point_join: colorize::EndPointJoinOptions {
             spline_max_px: args.join_curve,
             segment_max_px: args.join_segment,
