@@ -347,18 +347,6 @@ fn an_undrawn_color_boundary_splits_between_the_scribbles() {
         ..Default::default()
     });
     let (ours, flood) = scores(&s, &ColorizeOptions::default());
-    for d in [8.0, 16.0, 32.0, 64.0, 128.0] {
-        let o = ColorizeOptions {
-            split_depth_px: d,
-            ..Default::default()
-        };
-        println!("XX depth {d}: {:.4}", scores(&s, &o).0);
-    }
-    let o = ColorizeOptions {
-        split: colorize::RegionSplit::Weights,
-        ..Default::default()
-    };
-    println!("XX weights: {:.4}", scores(&s, &o).0);
     println!("undrawn boundary: weights {ours:.4}, flood fill {flood:.4}");
     assert!(
         ours >= flood + 0.2 && ours >= 0.9,
