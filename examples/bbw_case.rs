@@ -418,10 +418,8 @@ fn main() {
         ("bench_50k", 50_000),
     ] {
         if only.iter().any(|o| o == name) {
-            let (mesh, _) = common::sprite_meshes::mesh_near(
-                &common::sprite_meshes::main_outline(),
-                target,
-            );
+            let (mesh, _) =
+                common::sprite_meshes::mesh_near(&common::sprite_meshes::main_outline(), target);
             let handles = common::sprite_meshes::farthest_points(&mesh, 10);
             let case = Case {
                 name,

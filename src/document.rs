@@ -269,13 +269,19 @@ pub enum Command {
     SetPose(Pose),
     /// Draws the posed rig in these skins, combined in order (none: each slot's own part).
     ShowSkins(Vec<String>),
-    /// Keys `pose` into `animation` at `time_s` (creating the animation): every bone and point
-    /// the pose names gets rotate, translate, scale and shear keys, every IK drag a key of the
-    /// drag timeline with the same rest point. A key already at that time is replaced.
+    /// *Set key*: keys `pose` into `animation` at `time_s` (creating the animation). Keyed are
+    /// the bone and point channels (rotate, translate, scale, shear) where `pose` differs, by
+    /// more than [`animations::KEY_CHANGE_TOLERANCE`], from what the animation shows there
+    /// (sampled with `sampling`), every channel of each handle in `keep` (the selection, so a
+    /// selected handle gets an explicit hold key; an unposed one its rest values), and every
+    /// IK drag of `pose` (a key of the drag timeline with the same rest point). A key already at
+    /// that time is replaced; nothing to key in an existing animation is refused.
     SetKey {
         animation: String,
         time_s: f64,
         pose: Pose,
+        keep: Vec<String>,
+        sampling: crate::anim::SampleOptions,
     },
     /// Keys which attachment slot `slot` shows from `time_s` on in `animation` (a stepped
     /// key of `parts.SLOT.attachment`; `None`: the slot shows nothing). A key already at that

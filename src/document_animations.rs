@@ -91,11 +91,30 @@ pub fn unused_animation_name(state: &State, base: &str) -> String {
         .unwrap_or_else(|| base.to_string())
 }
 
+/// How far (in each number's own unit: degrees, px, scale factor) a channel of the pose edited
+/// may be from the animation's own value before it counts as changed and gets a key.
+pub const KEY_CHANGE_TOLERANCE: f64 = 1e-6;
+
+/// Whether `a` and `b` differ by more than [`KEY_CHANGE_TOLERANCE`] in any number.
+fn changed(a: &[f64], b: &[f64]) -> bool {
+    a.len() != b.len()
+        || a.iter()
+            .zip(b)
+            .any(|(x, y)| (x - y).abs() > KEY_CHANGE_TOLERANCE)
+}
+
 /// Keys at `time_s` each channel where `pose` differs from `before` (the animation's own pose
-/// there): a bone's or point's rotate, translate, scale and shear one by one, and each IK drag
-/// that is new or moved. Returns how many channels were keyed. Keys go in with
-/// [`put_key`], so a key inside a segment splits its curve.
-pub fn key_changes(anim: &mut Animation, time_s: f64, before: &Pose, pose: &Pose) -> usize {
+/// there) by more than [`KEY_CHANGE_TOLERANCE`], and every channel of the bones and points
+/// `pose` names that are in `keep`: a bone's or point's rotate, translate, scale and shear one
+/// by one, and each IK drag that is new or moved. Returns how many channels were keyed. Keys go
+/// in with [`put_key`], so a key inside a segment splits its curve.
+pub fn key_changes(
+    anim: &mut Animation,
+    time_s: f64,
+    before: &Pose,
+    pose: &Pose,
+    keep: &[String],
+) -> usize {
     let mut keyed = 0;
     let mut put = |changed: bool, f: &mut dyn FnMut()| {
         if changed {
@@ -105,47 +124,61 @@ pub fn key_changes(anim: &mut Animation, time_s: f64, before: &Pose, pose: &Pose
     };
     for (name, b) in &pose.bones {
         let old = before.bones.get(name).cloned().unwrap_or_default();
-        if *b == old {
+        let all = keep.contains(name);
+        let moved = [
+            all || changed(&[b.rotate], &[old.rotate]),
+            all || changed(&b.translate, &old.translate),
+            all || changed(&b.scale, &old.scale),
+            all || changed(&b.shear, &old.shear),
+        ];
+        if !moved.contains(&true) {
             continue;
         }
         let t = anim.bones.entry(name.clone()).or_default();
-        put(b.rotate != old.rotate, &mut || {
+        put(moved[0], &mut || {
             put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate)
         });
-        put(b.translate != old.translate, &mut || {
+        put(moved[1], &mut || {
             put_key(
                 t.translate.get_or_insert_with(Vec::new),
                 time_s,
                 b.translate,
             )
         });
-        put(b.scale != old.scale, &mut || {
+        put(moved[2], &mut || {
             put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale)
         });
-        put(b.shear != old.shear, &mut || {
+        put(moved[3], &mut || {
             put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear)
         });
     }
     for (name, p) in &pose.points {
         let old = before.points.get(name).cloned().unwrap_or_default();
-        if *p == old {
+        let all = keep.contains(name);
+        let moved = [
+            all || changed(&[p.rotate], &[old.rotate]),
+            all || changed(&p.translate, &old.translate),
+            all || changed(&p.scale, &old.scale),
+            all || changed(&p.shear, &old.shear),
+        ];
+        if !moved.contains(&true) {
             continue;
         }
         let t = anim.points.entry(name.clone()).or_default();
-        put(p.rotate != old.rotate, &mut || {
+        put(moved[0], &mut || {
             put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate)
         });
-        put(p.translate != old.translate, &mut || {
+        put(moved[1], &mut || {
             put_key(
                 t.translate.get_or_insert_with(Vec::new),
                 time_s,
                 p.translate,
             )
         });
-        put(p.scale != old.scale, &mut || {
+        put(moved[2], &mut || {
             put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale)
         });
-        put(p.shear != old.shear, &mut || {
+        put(moved[3], &mut || {
             put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear)
         });
     }
@@ -290,6 +323,8 @@ mod tests {
             animation: "walk".into(),
             time_s: 1.0,
             pose: arm_at(30.0, [0.0, 0.0]),
+            keep: vec!["arm".into()],
+            sampling: Default::default(),
         })
         .expect("keyed");
         // Taken, blank and padded names are refused, the document unchanged.
@@ -336,6 +371,8 @@ mod tests {
             animation: "wave".into(),
             time_s: 0.0,
             pose: arm_at(0.0, [0.0, 0.0]),
+            keep: vec!["arm".into()],
+            sampling: Default::default(),
         })
         .expect("keyed");
         let before = animation_named(doc.state(), "wave").sample(1.0, false);
@@ -359,6 +396,40 @@ mod tests {
             pose: before,
         });
         assert!(matches!(e, Err(DocumentError::NothingToKey(_))), "{e:?}");
+    }
+
+    #[test]
+    fn set_key_keys_what_changed_and_every_channel_of_the_kept_handles() {
+        let mut doc = Document::new();
+        let set_key = |time_s: f64, pose: Pose, keep: &[&str]| Command::SetKey {
+            animation: "wave".into(),
+            time_s,
+            pose,
+            keep: keep.iter().map(|n| n.to_string()).collect(),
+            sampling: Default::default(),
+        };
+        // The arm turned, the leg named at rest: only the arm's rotation is keyed.
+        let mut pose = arm_at(10.0, [0.0, 0.0]);
+        pose.bones.insert("leg".into(), BonePose::default());
+        doc.apply(set_key(0.0, pose.clone(), &[])).expect("keyed");
+        let anim = animation_named(doc.state(), "wave");
+        assert_eq!(anim.bones.keys().collect::<Vec<_>>(), ["arm"]);
+        let arm = &anim.bones["arm"];
+        assert_eq!(arm.rotate.as_ref().map(Vec::len), Some(1));
+        assert!(arm.translate.is_none() && arm.scale.is_none() && arm.shear.is_none());
+        // At 1 s the animation shows the same pose; the leg moved less than the tolerance:
+        // nothing to key.
+        pose.bones.get_mut("leg").expect("leg").rotate = KEY_CHANGE_TOLERANCE / 2.0;
+        let e = doc.apply(set_key(1.0, pose.clone(), &[]));
+        assert!(matches!(e, Err(DocumentError::NothingToKey(_))), "{e:?}");
+        // The leg kept (selected): all four of its channels are keyed, the arm still is not.
+        doc.apply(set_key(1.0, pose, &["leg"])).expect("keyed");
+        let anim = animation_named(doc.state(), "wave");
+        assert_eq!(anim.bones["arm"].rotate.as_ref().map(Vec::len), Some(1));
+        let leg = &anim.bones["leg"];
+        let lens = [&leg.translate, &leg.scale, &leg.shear].map(|k| k.as_ref().map(Vec::len));
+        assert_eq!(lens, [Some(1); 3]);
+        assert_eq!(leg.rotate.as_ref().map(Vec::len), Some(1));
     }
 
     #[test]

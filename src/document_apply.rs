@@ -134,11 +134,13 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
             animation,
             time_s,
             pose,
+            keep,
+            sampling,
         } => {
             check_key_time(time_s)?;
             let before = animation_named(state, &animation);
             let mut anim = before.clone();
-            key_pose(&mut anim, time_s, &pose);
+            key_pose(state, &mut anim, time_s, pose, &keep, &sampling);
             if anim == before && state.animations.contains_key(&animation) {
                 return Err(DocumentError::NothingToKey(time_s));
             }
@@ -336,7 +338,7 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
         } => {
             check_key_time(time_s)?;
             let mut anim = animation_named(state, &animation);
-            if animations::key_changes(&mut anim, time_s, &before, &pose) == 0 {
+            if animations::key_changes(&mut anim, time_s, &before, &pose, &[]) == 0 {
                 return Err(DocumentError::NothingToKey(time_s));
             }
             store_animation(&mut next, &animation, anim)?;

@@ -35,6 +35,8 @@ fn keyed() -> Document {
             animation: "wave".into(),
             time_s,
             pose,
+            keep: vec!["arm".into()],
+            sampling: Default::default(),
         })
         .expect("keyed");
     }

@@ -38,31 +38,28 @@ pub(super) fn store_animation(
     Ok(())
 }
 
-/// Keys every bone and point channel and every IK drag of `pose` at `time_s` ([`put_key`]: a key
-/// inside a segment splits its curve, so the motion around it stays as it was).
-pub(super) fn key_pose(anim: &mut Animation, time_s: f64, pose: &Pose) {
-    for (name, b) in &pose.bones {
-        let t = anim.bones.entry(name.clone()).or_default();
-        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate);
-        put_key(
-            t.translate.get_or_insert_with(Vec::new),
-            time_s,
-            b.translate,
-        );
-        put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale);
-        put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear);
+/// *Set key*'s keys of `pose` at `time_s` ([`Command::SetKey`]): the channels where `pose`
+/// differs from what `anim` shows there (sampled with `sampling`), every channel of the handles
+/// in `keep` (posed at rest when `pose` leaves them out; names that are no bone or point of
+/// `state` are skipped), and every IK drag of `pose`. Keys go in with [`put_key`], so a key
+/// inside a segment splits its curve and the motion around it stays as it was.
+pub(super) fn key_pose(
+    state: &State,
+    anim: &mut Animation,
+    time_s: f64,
+    mut pose: Pose,
+    keep: &[String],
+    sampling: &crate::anim::SampleOptions,
+) {
+    let shown = anim.sample_with(time_s, false, sampling);
+    for name in keep {
+        if state.handles.bones.iter().any(|b| &b.name == name) {
+            pose.bones.entry(name.clone()).or_default();
+        } else if state.handles.points.iter().any(|p| &p.name == name) {
+            pose.points.entry(name.clone()).or_default();
+        }
     }
-    for (name, p) in &pose.points {
-        let t = anim.points.entry(name.clone()).or_default();
-        put_key(
-            t.translate.get_or_insert_with(Vec::new),
-            time_s,
-            p.translate,
-        );
-        put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate);
-        put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale);
-        put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear);
-    }
+    animations::key_changes(anim, time_s, &shown, &pose, keep);
     for drag in &pose.ik {
         key_drag(anim, drag, time_s);
     }

@@ -317,10 +317,13 @@ fn keys_set_replace_sample_and_delete() {
         );
         pose
     };
+    // "upper" kept, as when it is the selected bone: every channel keyed at each time.
     let key = |time_s: f64, pose: Pose| Command::SetKey {
         animation: "wave".into(),
         time_s,
         pose,
+        keep: vec!["upper".into()],
+        sampling: Default::default(),
     };
     doc.apply(key(0.0, drag(Point::new(300.0, 40.0)))).unwrap();
     doc.apply(key(1.0, drag(Point::new(260.0, 0.0)))).unwrap();

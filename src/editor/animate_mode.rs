@@ -121,9 +121,10 @@ impl EditorApp {
         self.animate.playing = !self.animate.playing;
     }
 
-    /// Keys the edited pose at the playhead (*Set key*); says what it did, or why not. A key
-    /// inside a segment splits its curve, so the motion around it stays (the library's
-    /// [`crate::anim::edit::put_key`]).
+    /// Keys the edited pose at the playhead (*Set key*): the channels the edit changed and every
+    /// channel of the selected handle, as the library's [`crate::document::Command::SetKey`]
+    /// decides; says what it did, or why not. A key inside a segment splits its curve, so the
+    /// motion around it stays (the library's [`crate::anim::edit::put_key`]).
     pub fn set_key(&mut self) {
         let pose = self.edited_pose();
         let (animation, time_s) = (self.animate.animation.clone(), self.animate.time_s);
@@ -131,6 +132,8 @@ impl EditorApp {
             animation: animation.clone(),
             time_s,
             pose,
+            keep: self.selected.iter().cloned().collect(),
+            sampling: self.render_settings.sampling,
         }) {
             self.animate.shown = None;
             self.message = Some(format!("keyed '{animation}' at {time_s:.3} s"));

@@ -96,47 +96,64 @@ fn with_channels(mut pose: Pose, name: &str, bone: bool, n: [f64; 7]) -> Pose {
     pose
 }
 
+/// The seven labelled fields of `numbers`; whether one is being dragged, and whether a drag
+/// ended this frame.
+fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
+    let (mut dragging, mut released) = (false, false);
+    egui::Grid::new("numbers").show(ui, |ui| {
+        for (field, value) in FIELDS.iter().zip(numbers.iter_mut()) {
+            let label = ui.label(field.label);
+            let response = ui
+                .add(
+                    number_field(value)
+                        .speed(field.speed)
+                        .suffix(field.suffix)
+                        .max_decimals(3)
+                        // A typed number counts when entered, not at each keystroke.
+                        .update_while_editing(false),
+                )
+                .labelled_by(label.id);
+            dragging |= response.dragged();
+            released |= response.drag_stopped();
+            ui.end_row();
+        }
+    });
+    (dragging, released)
+}
+
 impl EditorApp {
-    /// The numbers of the selected bone or point.
+    /// The numbers of the selected bone or point. The panel is as tall whatever is selected
+    /// (one truncated line, then the fields, disabled at the rest values when there is nothing
+    /// to pose), so a click in the tree below it never moves the tree under the pointer.
     pub(super) fn numbers_panel(&mut self, ui: &mut egui::Ui) {
         ui.separator();
         ui.heading("Numbers");
-        let Some(name) = self.selected.clone() else {
-            ui.label("Click a bone or point to edit its numbers.");
+        let target = match self.selected.clone() {
+            None => Err("Click a bone or point to edit its numbers.".to_string()),
+            Some(name) => match kind(&self.doc.state().handles, &name) {
+                Some(bone) => Ok((name, bone)),
+                None => Err(format!(
+                    "'{name}' has no numbers to pose (a cage or region)."
+                )),
+            },
+        };
+        let line = match &target {
+            Ok((name, bone)) => format!("{} '{name}'", if *bone { "Bone" } else { "Point" }),
+            Err(why) => why.clone(),
+        };
+        ui.add(egui::Label::new(line).truncate());
+        let Ok((name, bone)) = target else {
+            let mut rest = channels(&Pose::default(), "", true);
+            ui.add_enabled_ui(false, |ui| numbers_grid(ui, &mut rest));
             return;
         };
-        let Some(bone) = kind(&self.doc.state().handles, &name) else {
-            ui.label(format!(
-                "'{name}' has no numbers to pose (a cage or region)."
-            ));
-            return;
-        };
-        ui.label(format!("{} '{name}'", if bone { "Bone" } else { "Point" }));
         let base = match &self.gesture {
             Some(Gesture::Numbers(pose)) => pose.clone(),
             _ => self.edited_pose(),
         };
         let before = channels(&base, &name, bone);
         let mut numbers = before;
-        let (mut dragging, mut released) = (false, false);
-        egui::Grid::new("numbers").show(ui, |ui| {
-            for (field, value) in FIELDS.iter().zip(&mut numbers) {
-                let label = ui.label(field.label);
-                let response = ui
-                    .add(
-                        number_field(value)
-                            .speed(field.speed)
-                            .suffix(field.suffix)
-                            .max_decimals(3)
-                            // A typed number counts when entered, not at each keystroke.
-                            .update_while_editing(false),
-                    )
-                    .labelled_by(label.id);
-                dragging |= response.dragged();
-                released |= response.drag_stopped();
-                ui.end_row();
-            }
-        });
+        let (dragging, released) = numbers_grid(ui, &mut numbers);
         if numbers != before {
             let pose = with_channels(base, &name, bone, numbers);
             if dragging && !released {

@@ -291,6 +291,8 @@ fn key_nod(app: &mut EditorApp, keys: &[(f64, f64)]) {
             animation: "nod".into(),
             time_s,
             pose: head_turned(degrees),
+            keep: vec!["head".into()],
+            sampling: Default::default(),
         }));
     }
 }

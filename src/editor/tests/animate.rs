@@ -173,3 +173,44 @@ fn auto_key_keys_each_edit_at_the_playhead_and_rows_are_named_by_handle() {
     let again = crate::document::animation_named(h.state().doc.state(), "animation");
     assert_eq!(again, anim);
 }
+
+#[test]
+fn set_key_keys_the_rotated_bone_s_rotation_and_the_selected_bone_only() {
+    let mut h = open_character("set-key-changes");
+    h.key_press(Key::Num3);
+    h.run();
+    assert!(!h.state().timeline.auto_key);
+    // Turn the head in the numbers panel (it waits for Set key), then select the lantern in
+    // the tree: K keys the head's rotation and the lantern's four channels, nothing else.
+    click(&mut h, Point::new(256.0, 150.0));
+    assert_eq!(h.state().selected.as_deref(), Some("head"));
+    set_number(&mut h, "Rotation", 15.0);
+    assert!(h.state().animate.shown.is_some());
+    h.get_by_label("lantern").scroll_to_me();
+    h.run();
+    click_label(&mut h, "lantern");
+    assert_eq!(h.state().selected.as_deref(), Some("lantern"));
+    h.key_press(Key::K);
+    h.run();
+    let anim = crate::document::animation_named(h.state().doc.state(), "animation");
+    let timelines: Vec<_> = crate::anim::edit::timelines(&anim)
+        .into_iter()
+        .map(|(t, times)| (t, times.len()))
+        .collect();
+    let bone = |bone: &str, channel| TimelineId::Bone {
+        bone: bone.into(),
+        channel,
+    };
+    let mut expected = vec![(bone("head", TransformChannel::Rotate), 1)];
+    for channel in TransformChannel::ALL {
+        expected.push((bone("lantern", channel), 1));
+    }
+    let mut got = timelines;
+    got.sort_by_key(|(t, _)| format!("{t:?}"));
+    expected.sort_by_key(|(t, _)| format!("{t:?}"));
+    assert_eq!(got, expected, "{:?}", h.state().message);
+    let lantern = &anim.bones["lantern"];
+    let head = &anim.bones["head"];
+    assert_eq!(head.rotate.as_ref().map(|k| k[0].value), Some(15.0));
+    assert_eq!(lantern.rotate.as_ref().map(|k| k[0].value), Some(0.0));
+}

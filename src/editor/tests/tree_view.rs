@@ -380,3 +380,27 @@ fn rig_mode_draws_one_attachment_per_slot_and_the_tree_picks_which() {
     h.run();
     assert!(tree_selected(&h, "bag shows nothing"));
 }
+
+#[test]
+fn selecting_in_the_tree_never_moves_the_tree_under_the_pointer() {
+    let mut h = open_character("tree-still");
+    let rows = ["hip", "chest", "head", "tail_1", "lantern"];
+    let rects = |h: &Harness<'_, EditorApp>| rows.map(|r| h.get_by_label(r).rect());
+    // Pose mode (2) and animate mode (3): from nothing selected, three bones picked one after
+    // another by a click on their rows. The rows stay where they were.
+    for mode in [Key::Num2, Key::Num3] {
+        h.key_press(mode);
+        h.run();
+        h.get_by_label("chest").scroll_to_me();
+        h.run();
+        let before = rects(&h);
+        for pick in ["chest", "head", "hip"] {
+            h.get_by_label(pick).click();
+            h.run();
+            assert_eq!(h.state().selected.as_deref(), Some(pick));
+            assert_eq!(rects(&h), before, "after picking {pick}");
+        }
+        h.key_press(Key::Escape);
+        h.run();
+    }
+}
