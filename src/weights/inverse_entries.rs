@@ -180,28 +180,12 @@ impl<'f, 'p> InverseEntries<'f, 'p> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::weights::sparse::tests::grid_laplacian;
     use crate::weights::sparse::SharedPattern;
-    use sprs::TriMat;
 
-    /// A 2D grid's Laplacian squared plus a small shift: the shape of a bi-Laplacian.
+    /// A 2D grid's Laplacian (shifted) squared: the shape of a bi-Laplacian.
     fn grid_bilaplacian(side: usize) -> sprs::CsMat<f64> {
-        let n = side * side;
-        let mut l = TriMat::new((n, n));
-        for y in 0..side {
-            for x in 0..side {
-                let i = y * side + x;
-                let mut degree = 0.0;
-                for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
-                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
-                    if (0..side as i64).contains(&nx) && (0..side as i64).contains(&ny) {
-                        l.add_triplet(i, ny as usize * side + nx as usize, -1.0);
-                        degree += 1.0;
-                    }
-                }
-                l.add_triplet(i, i, degree + 0.01);
-            }
-        }
-        let l: sprs::CsMat<f64> = l.to_csr();
+        let l = grid_laplacian(side, 0.01);
         &l * &l
     }
 

@@ -459,9 +459,31 @@ pub fn sandwich_diagonal(a: &CsMat<f64>, d: &[f64]) -> CsMat<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use sprs::TriMat;
+
+    /// The Laplacian of a `side` × `side` grid (4-neighbours) plus `shift` on the diagonal:
+    /// symmetric positive definite for a positive shift, a mesh-like sparsity pattern.
+    pub(crate) fn grid_laplacian(side: usize, shift: f64) -> CsMat<f64> {
+        let n = side * side;
+        let mut t = TriMat::new((n, n));
+        for j in 0..side {
+            for i in 0..side {
+                let v = j * side + i;
+                let mut degree = 0.0;
+                for (di, dj) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+                    let (a, b) = (i as i64 + di, j as i64 + dj);
+                    if (0..side as i64).contains(&a) && (0..side as i64).contains(&b) {
+                        t.add_triplet(v, b as usize * side + a as usize, -1.0);
+                        degree += 1.0;
+                    }
+                }
+                t.add_triplet(v, v, degree + shift);
+            }
+        }
+        t.to_csr()
+    }
 
     /// A positive semi-definite matrix that is singular: the plain factorization fails, the
     /// regularized one shifts the diagonal by a tiny relative amount and succeeds, and an
@@ -515,24 +537,8 @@ mod tests {
     fn shared_pattern_factors_and_solves_in_the_callers_order() {
         // A 9×9 grid's Laplacian plus the identity (SPD; AMD reorders it), kept without its
         // first and last vertices, with a diagonal shift as the interior point adds.
-        let side = 9;
-        let n = side * side;
-        let mut t = TriMat::new((n, n));
-        for j in 0..side {
-            for i in 0..side {
-                let v = j * side + i;
-                let mut degree = 0.0;
-                for (di, dj) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
-                    let (a, b) = (i as i64 + di, j as i64 + dj);
-                    if (0..side as i64).contains(&a) && (0..side as i64).contains(&b) {
-                        t.add_triplet(v, b as usize * side + a as usize, -1.0);
-                        degree += 1.0;
-                    }
-                }
-                t.add_triplet(v, v, degree + 1.0);
-            }
-        }
-        let a: CsMat<f64> = t.to_csr();
+        let a = grid_laplacian(9, 1.0);
+        let n = a.rows();
         let keep: Vec<usize> = (1..n - 1).collect();
         let pattern = SharedPattern::new(&a, &keep).unwrap();
         let mut values = pattern.values.clone();
