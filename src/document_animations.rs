@@ -7,7 +7,7 @@
 
 use super::{DocumentError, State};
 use crate::anim::edit::put_key;
-use crate::anim::Animation;
+use crate::anim::{Animation, Key};
 use crate::rig::Pose;
 
 /// One edit of the list of animations (see [`super::Command::Animations`]).
@@ -103,6 +103,47 @@ fn changed(a: &[f64], b: &[f64]) -> bool {
             .any(|(x, y)| (x - y).abs() > KEY_CHANGE_TOLERANCE)
 }
 
+/// A bone's or point's channels: rotate (degrees), translate (px), scale, shear (degrees).
+type Channels = (f64, [f64; 2], [f64; 2], [f64; 2]);
+
+/// A bone's or point's timelines of the same channels, in the same order.
+type ChannelTracks<'a> = (
+    &'a mut Option<Vec<Key<f64>>>,
+    &'a mut Option<Vec<Key<[f64; 2]>>>,
+    &'a mut Option<Vec<Key<[f64; 2]>>>,
+    &'a mut Option<Vec<Key<[f64; 2]>>>,
+);
+
+/// Which channels of `new` differ from `old` by more than [`KEY_CHANGE_TOLERANCE`] (every
+/// one when `all`).
+fn moved_channels(new: Channels, old: Channels, all: bool) -> [bool; 4] {
+    [
+        all || changed(&[new.0], &[old.0]),
+        all || changed(&new.1, &old.1),
+        all || changed(&new.2, &old.2),
+        all || changed(&new.3, &old.3),
+    ]
+}
+
+/// Keys at `time_s` the channels of `new` that `moved` marks, each into its track; returns
+/// how many.
+fn key_moved(tracks: ChannelTracks<'_>, time_s: f64, new: Channels, moved: [bool; 4]) -> usize {
+    let (rotate, translate, scale, shear) = tracks;
+    if moved[0] {
+        put_key(rotate.get_or_insert_with(Vec::new), time_s, new.0);
+    }
+    for (m, track, value) in [
+        (moved[1], translate, new.1),
+        (moved[2], scale, new.2),
+        (moved[3], shear, new.3),
+    ] {
+        if m {
+            put_key(track.get_or_insert_with(Vec::new), time_s, value);
+        }
+    }
+    moved.iter().filter(|&&m| m).count()
+}
+
 /// Keys at `time_s` each channel where `pose` differs from `before` (the animation's own pose
 /// there) by more than [`KEY_CHANGE_TOLERANCE`], and every channel of the bones and points
 /// `pose` names that are in `keep`: a bone's or point's rotate, translate, scale and shear one
@@ -116,71 +157,27 @@ pub fn key_changes(
     keep: &[String],
 ) -> usize {
     let mut keyed = 0;
-    let mut put = |changed: bool, f: &mut dyn FnMut()| {
-        if changed {
-            f();
-            keyed += 1;
-        }
-    };
     for (name, b) in &pose.bones {
         let old = before.bones.get(name).cloned().unwrap_or_default();
-        let all = keep.contains(name);
-        let moved = [
-            all || changed(&[b.rotate], &[old.rotate]),
-            all || changed(&b.translate, &old.translate),
-            all || changed(&b.scale, &old.scale),
-            all || changed(&b.shear, &old.shear),
-        ];
-        if !moved.contains(&true) {
-            continue;
+        let new = (b.rotate, b.translate, b.scale, b.shear);
+        let old = (old.rotate, old.translate, old.scale, old.shear);
+        let moved = moved_channels(new, old, keep.contains(name));
+        if moved.contains(&true) {
+            let t = anim.bones.entry(name.clone()).or_default();
+            let tracks = (&mut t.rotate, &mut t.translate, &mut t.scale, &mut t.shear);
+            keyed += key_moved(tracks, time_s, new, moved);
         }
-        let t = anim.bones.entry(name.clone()).or_default();
-        put(moved[0], &mut || {
-            put_key(t.rotate.get_or_insert_with(Vec::new), time_s, b.rotate)
-        });
-        put(moved[1], &mut || {
-            put_key(
-                t.translate.get_or_insert_with(Vec::new),
-                time_s,
-                b.translate,
-            )
-        });
-        put(moved[2], &mut || {
-            put_key(t.scale.get_or_insert_with(Vec::new), time_s, b.scale)
-        });
-        put(moved[3], &mut || {
-            put_key(t.shear.get_or_insert_with(Vec::new), time_s, b.shear)
-        });
     }
     for (name, p) in &pose.points {
         let old = before.points.get(name).cloned().unwrap_or_default();
-        let all = keep.contains(name);
-        let moved = [
-            all || changed(&[p.rotate], &[old.rotate]),
-            all || changed(&p.translate, &old.translate),
-            all || changed(&p.scale, &old.scale),
-            all || changed(&p.shear, &old.shear),
-        ];
-        if !moved.contains(&true) {
-            continue;
+        let new = (p.rotate, p.translate, p.scale, p.shear);
+        let old = (old.rotate, old.translate, old.scale, old.shear);
+        let moved = moved_channels(new, old, keep.contains(name));
+        if moved.contains(&true) {
+            let t = anim.points.entry(name.clone()).or_default();
+            let tracks = (&mut t.rotate, &mut t.translate, &mut t.scale, &mut t.shear);
+            keyed += key_moved(tracks, time_s, new, moved);
         }
-        let t = anim.points.entry(name.clone()).or_default();
-        put(moved[0], &mut || {
-            put_key(t.rotate.get_or_insert_with(Vec::new), time_s, p.rotate)
-        });
-        put(moved[1], &mut || {
-            put_key(
-                t.translate.get_or_insert_with(Vec::new),
-                time_s,
-                p.translate,
-            )
-        });
-        put(moved[2], &mut || {
-            put_key(t.scale.get_or_insert_with(Vec::new), time_s, p.scale)
-        });
-        put(moved[3], &mut || {
-            put_key(t.shear.get_or_insert_with(Vec::new), time_s, p.shear)
-        });
     }
     for drag in &pose.ik {
         let same = |d: &crate::rig::pose::IkDrag| d.at == drag.at && d.weight == drag.weight;
