@@ -399,41 +399,24 @@ pub struct PatternCholesky<'a> {
 impl PatternCholesky<'_> {
     /// Solves in place for one right-hand side (in the caller's order).
     pub fn solve_in_place(&self, b: &mut [f64]) {
-        self.solve_columns_in_place(b, 1);
-    }
-
-    /// Solves in place for `columns` right-hand sides stored one after another in `b` (each
-    /// of the pattern's length, in the caller's order). One solve with many columns runs the
-    /// supernodal triangular solves as matrix products: several times faster per column than
-    /// as many single solves.
-    pub fn solve_columns_in_place(&self, b: &mut [f64], columns: usize) {
         use faer::dyn_stack::{MemBuffer, MemStack};
         let n = self.pattern.len();
-        if n == 0 || columns == 0 {
+        if n == 0 {
             return;
         }
-        debug_assert_eq!(b.len(), n * columns);
         let order = &self.pattern.order;
-        let mut x = vec![0.0; n * columns];
-        for (xc, bc) in x.chunks_mut(n).zip(b.chunks(n)) {
-            for (xk, &i) in xc.iter_mut().zip(order) {
-                *xk = bc[i];
-            }
-        }
+        let mut x: Vec<f64> = order.iter().map(|&i| b[i]).collect();
         let cholesky = &self.pattern.cholesky;
-        let mut memory =
-            MemBuffer::new(cholesky.solve_in_place_scratch::<f64>(columns, faer::Par::Seq));
+        let mut memory = MemBuffer::new(cholesky.solve_in_place_scratch::<f64>(1, faer::Par::Seq));
         faer::sparse::linalg::cholesky::LltRef::new(cholesky, &self.l_values)
             .solve_in_place_with_conj(
                 faer::Conj::No,
-                MatMut::from_column_major_slice_mut(&mut x, n, columns),
+                MatMut::from_column_major_slice_mut(&mut x, n, 1),
                 faer::Par::Seq,
                 MemStack::new(&mut memory),
             );
-        for (xc, bc) in x.chunks(n).zip(b.chunks_mut(n)) {
-            for (&xk, &i) in xc.iter().zip(order) {
-                bc[i] = xk;
-            }
+        for (k, &i) in order.iter().enumerate() {
+            b[i] = x[k];
         }
     }
 }
