@@ -144,7 +144,7 @@ fn thin_closed_lines_are_exact_whatever_the_stiffness() {
         ..Default::default()
     });
     for stiffness in [LiftedStiffness::EdgeStretch, LiftedStiffness::Cotangent] {
-        for split in [RegionSplit::Depth, RegionSplit::Weights] {
+        for split in [RegionSplit::Reach, RegionSplit::Depth, RegionSplit::Weights] {
             let options = ColorizeOptions {
                 stiffness,
                 split,
@@ -342,16 +342,26 @@ fn gaps_of_two_to_six_px_form_a_boundary_instead_of_a_flood() {
 
 #[test]
 fn an_undrawn_color_boundary_splits_between_the_scribbles() {
+    // The background's two halves meet on a straight line across open paper that no neck
+    // marks. The depth flood puts the boundary near it; reach (the default) puts it at the
+    // narrowest openings between the shapes, which costs it a little here; on the emoji
+    // evaluation's undrawn boundaries it is well ahead (docs/colorize-eval.md).
     let s = scene(&SceneSpec {
         split_background: true,
         ..Default::default()
     });
-    let (ours, flood) = scores(&s, &ColorizeOptions::default());
-    println!("undrawn boundary: weights {ours:.4}, flood fill {flood:.4}");
-    assert!(
-        ours >= flood + 0.2 && ours >= 0.9,
-        "weights {ours:.4} vs flood {flood:.4}"
-    );
+    for (split, floor) in [(RegionSplit::Depth, 0.9), (RegionSplit::Reach, 0.85)] {
+        let options = ColorizeOptions {
+            split,
+            ..Default::default()
+        };
+        let (ours, flood) = scores(&s, &options);
+        println!("undrawn boundary, {split:?}: {ours:.4}, flood fill {flood:.4}");
+        assert!(
+            ours >= flood + 0.2 && ours >= floor,
+            "{split:?}: {ours:.4} vs flood {flood:.4}"
+        );
+    }
 }
 
 #[test]

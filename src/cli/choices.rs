@@ -101,6 +101,9 @@ mirror!(FillModeArg => FillMode {
 });
 
 mirror!(RegionSplitArg => RegionSplit {
+    /// Scaled geodesic reach: colors meet at necks, and each scribble reaches in
+    /// proportion to its size.
+    Reach,
     /// An ink-density flood: boundaries where ink crowds (G'MIC Smart Coloring's order).
     Density,
     /// A depth flood: boundaries where the region is narrowest; a scribble in the middle

@@ -42,14 +42,18 @@ pub struct ColorizeArgs {
     /// joined to it by a segment (0: no segments).
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().end_point_join.segment_max_px)]
     pub join_segment: f64,
-    /// How a region holding several colors is split: depth (boundaries where it is
+    /// How a region holding several colors is split: reach (colors meet at necks, each
+    /// scribble reaching in proportion to its size), depth (boundaries where it is
     /// narrowest), density (where ink crowds, G'MIC Smart Coloring's order) or weights (the
     /// content-aware weights).
-    #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "depth")]
+    #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "reach")]
     pub split: RegionSplit,
     /// With --split depth: distances to the lines beyond PX count as PX.
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_depth_px)]
     pub split_depth: f64,
+    /// With --split reach: α, a pixel d px from the lines costs d^−α to cross.
+    #[arg(long, value_name = "ALPHA", default_value_t = ColorizeOptions::default().split_depth_exponent)]
+    pub split_exponent: f64,
     /// With --split density: σ in px of the Gaussian that measures the ink around a pixel.
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_blur_px)]
     pub split_blur: f64,
@@ -64,6 +68,7 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         gap_closing_px: args.gap_closing,
         split: args.split,
         split_depth_px: args.split_depth,
+        split_depth_exponent: args.split_exponent,
         split_blur_px: args.split_blur,
         end_point_join: colorize::EndPointJoinOptions {
             spline_max_px: args.join_curve,

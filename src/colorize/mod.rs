@@ -11,8 +11,10 @@
 //!    lying on a line are dropped (a line belongs to no region).
 //! 3. [`gap_closing`]: every line casts a fading ridge of ink, so small gaps close.
 //! 4. [`ink_regions`]: the regions the closed lines enclose. A region holding scribbles of one
-//!    color takes it, exactly. A region holding several is split by [`RegionSplit`]: a depth
-//!    flood (boundaries where the region is narrowest), an ink-density flood ([`density_split`],
+//!    color takes it, exactly. A region holding several is split by [`RegionSplit`]: scaled
+//!    geodesic reach ([`reach_split`], the default: colors meet at necks, each scribble
+//!    reaching in proportion to its size), a depth flood (boundaries where the region is
+//!    narrowest), an ink-density flood ([`density_split`],
 //!    G'MIC Smart Coloring's order: where ink crowds), or the content-aware weights
 //!    (Jacobson, Baran, Popović & Sorkine 2011; Jacobson's thesis 2013 § 3.4 shows this very
 //!    application): [`image_mesh`] (an adaptive mesh, one vertex per pixel along lines and
@@ -37,6 +39,7 @@ pub mod gap_closing;
 pub mod image_mesh;
 pub mod ink_regions;
 pub mod lineart;
+pub mod reach_split;
 pub mod score;
 pub mod scribbles;
 pub mod session;
@@ -80,7 +83,7 @@ pub struct ColorizeOptions {
     pub weights: ColorWeights,
     /// Default: flat.
     pub fill: FillMode,
-    /// How a region holding several scribble colors is split. Default: depth.
+    /// How a region holding several scribble colors is split. Default: reach.
     pub split: RegionSplit,
     /// `split: density`: σ of the coarse Gaussian the paper mask is blurred with, px (the
     /// ink within about 2σ of a pixel orders the flood). Default 12 (G'MIC uses 1 % of the
@@ -94,6 +97,10 @@ pub struct ColorizeOptions {
     /// `split: depth`: distances to the lines beyond this many px count as this deep (deeper,
     /// the flood is a plain geodesic one). Default 16.
     pub split_depth_px: f64,
+    /// `split: reach`: α, crossing a pixel costs (its distance to the nearest line)^−α: the
+    /// larger, the more the narrowest opening on a path decides. Default 6 (chosen among
+    /// 0–8 on the evaluation's set 26, see docs/colorize-eval.md).
+    pub split_depth_exponent: f64,
 
     /// `soft` fill: each color's share of the (2·r + 1)² px box around a pixel, so region
     /// edges are antialiased over about that width and nothing spreads further. Default 1.
@@ -117,8 +124,9 @@ impl Default for ColorizeOptions {
             stiffness: LiftedStiffness::EdgeStretch,
             weights: ColorWeights::Harmonic,
             fill: FillMode::Flat,
-            split: RegionSplit::Depth,
+            split: RegionSplit::Reach,
             split_depth_px: 16.0,
+            split_depth_exponent: 6.0,
             split_blur_px: 12.0,
             split_fine_blur_px: 1.0,
 
@@ -273,6 +281,11 @@ pub const MAX_LIFT_SCALE_PX: f64 = 1e5;
 /// hundred px the blur costs seconds and orders nothing the depth flood would not.
 pub const MAX_SPLIT_BLUR_PX: f64 = 256.0;
 
+/// Largest `split_depth_exponent`: beyond it a pixel 0.5 px from a line costs more than
+/// 2^32 times one 1 px away, and paths are ordered by their narrowest opening alone (as
+/// with any larger α) while costs deep inside regions underflow towards 0.
+pub const MAX_SPLIT_DEPTH_EXPONENT: f64 = 32.0;
+
 /// Largest soft-fill radius, px: a wider blend is a blur, not an antialiased edge.
 pub const MAX_SOFT_RADIUS_PX: u32 = 8;
 
@@ -295,6 +308,14 @@ impl PreparedLineArt {
             return Err(ColorizeError::InvalidOptions(format!(
                 "split_depth_px must be at least 0.5, not {}",
                 options.split_depth_px
+            )));
+        }
+        if !(options.split_depth_exponent.is_finite()
+            && (0.0..=MAX_SPLIT_DEPTH_EXPONENT).contains(&options.split_depth_exponent))
+        {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "split_depth_exponent must lie in [0, {MAX_SPLIT_DEPTH_EXPONENT}], not {}",
+                options.split_depth_exponent
             )));
         }
         for (name, sigma_px) in [
@@ -401,6 +422,16 @@ impl PreparedLineArt {
                 }
                 RegionSplit::Depth => {
                     ink_regions::watershed_within(&regions.shallowness, owner, w, h, contested);
+                    return Ok(());
+                }
+                RegionSplit::Reach => {
+                    reach_split::reach_split(
+                        regions,
+                        &labels,
+                        owner,
+                        options.split_depth_exponent,
+                        contested,
+                    );
                     return Ok(());
                 }
                 RegionSplit::Weights => {}
