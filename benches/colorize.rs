@@ -4,9 +4,13 @@
 //! [`ColorizeOptions`], no layers.
 //!
 //! Timed: the whole `colorize::colorize` call on decoded images and rasterized scribbles, with
-//! the default options: gap closing, ink regions, the depth-flood split of regions holding
-//! several colours, the soft fill, lines on top (the lifted weights and their mesh only run with
-//! `split: weights`; the mesh size is printed when there is one).
+//! the default options: gap closing, ink regions, the reach split of regions holding several
+//! colors, the fill, lines on top (the lifted weights and their mesh only run with
+//! `split: weights`; the mesh size is printed when there is one). The `size/colors` cases'
+//! regions are closed, one color each; the split runs in `undrawn/size` (the background's two
+//! halves share one region, 11 colors in all) and `open/size` (the 10 scribbles on a blank
+//! page: one region holding all 10 colors, the split's worst case: one Dijkstra per color
+//! over every pixel).
 //!
 //! Targets (two-core reference machine, issue 24): 2048² under 1 s; peak memory at 2048²
 //! < 1 GiB (`cargo bench --bench colorize_memory`).
@@ -53,6 +57,39 @@ fn bench(c: &mut Criterion) {
                 })
             });
         }
+    }
+    for size in [1024u32, 2048] {
+        let s = scene(&SceneSpec {
+            size,
+            shapes: 9,
+            split_background: true,
+            ..Default::default()
+        });
+        let scribbles =
+            Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
+                .expect("the strokes rasterize");
+        let options = ColorizeOptions::default();
+        group.bench_function(format!("undrawn/{size}"), |b| {
+            b.iter(|| {
+                colorize::colorize(black_box(&s.lineart), &scribbles, &options, false)
+                    .expect("colorizes")
+            })
+        });
+        let blank = image::RgbaImage::from_pixel(size, size, image::Rgba([255, 255, 255, 255]));
+        let s = scene(&SceneSpec {
+            size,
+            shapes: 9,
+            ..Default::default()
+        });
+        let scribbles =
+            Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
+                .expect("the strokes rasterize");
+        group.bench_function(format!("open/{size}"), |b| {
+            b.iter(|| {
+                colorize::colorize(black_box(&blank), &scribbles, &options, false)
+                    .expect("colorizes")
+            })
+        });
     }
     let size = 1024;
     let s = scene(&SceneSpec {

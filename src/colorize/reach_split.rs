@@ -29,6 +29,7 @@
 //! not be connected. Ties go to the lower color: outputs are deterministic.
 
 use super::InkRegions;
+use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -40,7 +41,9 @@ pub const MIN_DEPTH_PX: f64 = 0.5;
 pub const DOT_RADIUS_PX: f64 = 1.5;
 
 /// Assigns the contested pixels (see the module doc). `contested(i)`: pixel `i` lies in a
-/// region holding several colors. `depth_exponent` α ≥ 0.
+/// region holding several colors. `depth_exponent` α ≥ 0. The colors' Dijkstras run in
+/// parallel (rayon), as many at a time as there are threads; the result does not depend on
+/// the thread count.
 pub fn reach_split(
     regions: &InkRegions,
     labels: &[u16],
@@ -49,11 +52,7 @@ pub fn reach_split(
     contested: impl Fn(usize) -> bool,
 ) {
     let (w, h) = (regions.width as usize, regions.height as usize);
-    let cost: Vec<f64> = regions
-        .depth_half_px
-        .iter()
-        .map(|&d| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent))
-        .collect();
+    let cost = crossing_costs(&regions.depth_half_px, depth_exponent);
     let (scribble, radius_px) = scribble_components(labels, w, h, &contested);
     let mut colors: Vec<u16> = (0..w * h)
         .filter(|&i| scribble[i] != u32::MAX)
@@ -61,18 +60,77 @@ pub fn reach_split(
         .collect();
     colors.sort_unstable();
     colors.dedup();
+    let field = Field {
+        width: w,
+        height: h,
+        region: &regions.region,
+        cost: &cost,
+        scribble: &scribble,
+        labels,
+        radius_px: &radius_px,
+    };
     let mut best = vec![f64::INFINITY; w * h];
-    let mut reach = vec![f64::INFINITY; w * h];
-    let mut from = vec![u32::MAX; w * h];
-    let mut settled = vec![false; w * h];
-    let mut heap = BinaryHeap::new();
-    for color in colors {
-        reach.fill(f64::INFINITY);
-        settled.fill(false);
+    for chunk in colors.chunks(rayon::current_num_threads().max(1)) {
+        let reaches: Vec<Vec<f64>> = chunk.par_iter().map(|&c| field.reach(c)).collect();
+        // In ascending color order: a pixel changes hands only to a strictly cheaper color
+        // (lower colors win ties); scribble pixels keep their own.
+        for (&color, reach) in chunk.iter().zip(&reaches) {
+            for i in 0..w * h {
+                if reach[i] < best[i] {
+                    best[i] = reach[i];
+                    if labels[i] == 0 {
+                        owner[i] = color;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Per pixel, the cost of crossing it: (depth px, at least [`MIN_DEPTH_PX`])^−α. Depths are
+/// chamfer half px, so the costs come from a table over the depths present.
+fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> Vec<f64> {
+    let of = |d: u32| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent);
+    let far = u32::MAX / 2;
+    let top = depth_half_px
+        .iter()
+        .copied()
+        .filter(|&d| d < far)
+        .max()
+        .unwrap_or(0);
+    let table: Vec<f64> = (0..=top).map(of).collect();
+    let beyond = of(far);
+    depth_half_px
+        .iter()
+        .map(|&d| table.get(d as usize).copied().unwrap_or(beyond))
+        .collect()
+}
+
+/// What one color's Dijkstra reads.
+struct Field<'a> {
+    width: usize,
+    height: usize,
+    region: &'a [u32],
+    cost: &'a [f64],
+    /// Per pixel its scribble component (u32::MAX: none).
+    scribble: &'a [u32],
+    labels: &'a [u16],
+    radius_px: &'a [f64],
+}
+
+impl Field<'_> {
+    /// Per pixel the least cost at which `color`'s scribbles reach it (∞: not at all): one
+    /// Dijkstra from all of them, a front carrying its scribble's radius, within regions.
+    fn reach(&self, color: u16) -> Vec<f64> {
+        let (w, h) = (self.width, self.height);
+        let mut reach = vec![f64::INFINITY; w * h];
+        let mut from = vec![u32::MAX; w * h];
+        let mut settled = vec![false; w * h];
+        let mut heap = BinaryHeap::new();
         for i in 0..w * h {
-            if scribble[i] != u32::MAX && labels[i] == color {
+            if self.scribble[i] != u32::MAX && self.labels[i] == color {
                 reach[i] = 0.0;
-                from[i] = scribble[i];
+                from[i] = self.scribble[i];
                 heap.push(Front {
                     cost: 0.0,
                     pixel: i as u32,
@@ -85,26 +143,20 @@ pub fn reach_split(
                 continue;
             }
             settled[i] = true;
-            // Scribble pixels keep their color; another changes hands only to a strictly
-            // cheaper color (lower colors win ties).
-            if at < best[i] {
-                best[i] = at;
-                if labels[i] == 0 {
-                    owner[i] = color;
-                }
-            }
-            let scale = 1.0 / radius_px[from[i] as usize];
+            let scale = 1.0 / self.radius_px[from[i] as usize];
             let (x, y) = (i % w, i / w);
+            // Scribbles lie in contested regions, and fronts stay in their region.
+            let region = self.region[i];
             for (dx, dy, step_px) in STEPS {
                 let (nx, ny) = (x as isize + dx, y as isize + dy);
                 if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
                     continue;
                 }
                 let j = ny as usize * w + nx as usize;
-                if settled[j] || !contested(j) || regions.region[j] != regions.region[i] {
+                if settled[j] || self.region[j] != region {
                     continue;
                 }
-                let through = at + step_px * 0.5 * (cost[i] + cost[j]) * scale;
+                let through = at + step_px * 0.5 * (self.cost[i] + self.cost[j]) * scale;
                 if through < reach[j] {
                     reach[j] = through;
                     from[j] = from[i];
@@ -115,6 +167,7 @@ pub fn reach_split(
                 }
             }
         }
+        reach
     }
 }
 
