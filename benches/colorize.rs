@@ -22,7 +22,7 @@
 //! `cargo bench --bench colorize`; one case: `cargo bench --bench colorize -- '2048/10'`.
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
-use sinew::colorize::synthetic::{scene, SceneSpec};
+use sinew::colorize::synthetic::{scene, Scene, SceneSpec};
 use sinew::colorize::{self, ColorizeOptions, PreparedLineArt, ScribbleOptions, Scribbles};
 use std::hint::black_box;
 
@@ -31,14 +31,11 @@ fn bench(c: &mut Criterion) {
     group.sampling_mode(SamplingMode::Flat).sample_size(10);
     for size in [512u32, 1024, 2048] {
         for colors in [6usize, 10] {
-            let s = scene(&SceneSpec {
+            let (s, scribbles) = scene_and_scribbles(SceneSpec {
                 size,
                 shapes: colors - 1,
                 ..Default::default()
             });
-            let scribbles =
-                Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
-                    .expect("the strokes rasterize");
             let options = ColorizeOptions::default();
             let result =
                 colorize::colorize(&s.lineart, &scribbles, &options, false).expect("colorizes");
@@ -59,15 +56,12 @@ fn bench(c: &mut Criterion) {
         }
     }
     for size in [1024u32, 2048] {
-        let s = scene(&SceneSpec {
+        let (s, scribbles) = scene_and_scribbles(SceneSpec {
             size,
             shapes: 9,
             split_background: true,
             ..Default::default()
         });
-        let scribbles =
-            Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
-                .expect("the strokes rasterize");
         let options = ColorizeOptions::default();
         group.bench_function(format!("undrawn/{size}"), |b| {
             b.iter(|| {
@@ -76,14 +70,12 @@ fn bench(c: &mut Criterion) {
             })
         });
         let blank = image::RgbaImage::from_pixel(size, size, image::Rgba([255, 255, 255, 255]));
-        let s = scene(&SceneSpec {
+        // The same shapes' scribbles on a blank page.
+        let (_, scribbles) = scene_and_scribbles(SceneSpec {
             size,
             shapes: 9,
             ..Default::default()
         });
-        let scribbles =
-            Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
-                .expect("the strokes rasterize");
         group.bench_function(format!("open/{size}"), |b| {
             b.iter(|| {
                 colorize::colorize(black_box(&blank), &scribbles, &options, false)
@@ -91,9 +83,8 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
-    let size = 1024;
-    let s = scene(&SceneSpec {
-        size,
+    let (s, scribbles) = scene_and_scribbles(SceneSpec {
+        size: 1024,
         shapes: 9,
         ..Default::default()
     });
@@ -101,10 +92,8 @@ fn bench(c: &mut Criterion) {
         PreparedLineArt::new(s.lineart.clone(), ColorizeOptions::default()).expect("prepares");
     // After a scribble is added, the re-solve colorizes the prepared line art from every
     // scribble (nothing scribble-dependent is kept between solves).
-    let scribbles = Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
-        .expect("the strokes rasterize");
     let never = std::sync::atomic::AtomicBool::new(false);
-    group.bench_function(format!("incremental/{size}"), |b| {
+    group.bench_function("incremental/1024", |b| {
         b.iter(|| {
             prepared
                 .colorize(black_box(&scribbles), false, &never)
@@ -112,6 +101,19 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.finish();
+}
+
+/// A generated scene and its scribbles rasterized.
+fn scene_and_scribbles(spec: SceneSpec) -> (Scene, Scribbles) {
+    let s = scene(&spec);
+    let scribbles = Scribbles::from_strokes(
+        &s.strokes,
+        spec.size,
+        spec.size,
+        &ScribbleOptions::default(),
+    )
+    .expect("the strokes rasterize");
+    (s, scribbles)
 }
 
 criterion_group!(benches, bench);
