@@ -33,7 +33,8 @@ use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Depths below this count as this, px: a pixel beside a line costs MIN_DEPTH_PX^−α, not ∞.
+/// Depths below this count as this, px: a guard against 0^−α = ∞ (only barrier pixels, which
+/// no front crosses, lie at depth 0; a pixel beside one lies at 1 px).
 pub const MIN_DEPTH_PX: f64 = 0.5;
 
 /// Added to a scribble's half extent, px: a one-pixel dot counts as a dab of this radius
