@@ -297,6 +297,7 @@ impl EditorApp {
         self.view_shortcuts(&ctx);
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
+        self.keep_selection();
         self.autosave(&ctx);
         self.guard_close(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
@@ -396,6 +397,21 @@ impl EditorApp {
         }
     }
 
+    /// The selection across modes and edits: kept while its handle exists (the tree shows it
+    /// in view again after a mode switch), dropped when an undo, a delete or another edit took
+    /// the handle away, so no mode shows or edits a handle that is not there.
+    fn keep_selection(&mut self) {
+        if let Some(name) = &self.selected {
+            if !self.doc.state().handles.names().any(|n| n == name) {
+                self.selected = None;
+            }
+        }
+        if self.tree.mode_shown != Some(self.mode) {
+            self.tree.mode_shown = Some(self.mode);
+            self.tree.reveal_after_switch();
+        }
+    }
+
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             self.file_menu_button(ui);
@@ -453,8 +469,10 @@ impl EditorApp {
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
-        // Rig mode's tools outgrow a short window: the panel scrolls.
-        egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
+        // Rig mode's tools outgrow a short window: the panel scrolls, each mode's panel on its
+        // own (they hold different things: one mode's scrolling does not hide another's top).
+        let scroll = egui::ScrollArea::vertical().id_salt(("side panel", self.mode as u8));
+        scroll.show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),
             Mode::Pose => {
                 self.pose_panel(ui);

@@ -31,6 +31,7 @@ mod physics;
 mod pose;
 mod rig;
 mod rows;
+mod selection;
 mod timeline;
 mod tree_view;
 mod workflow;

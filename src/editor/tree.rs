@@ -24,6 +24,9 @@ pub const AUTOSCROLL_BAND_PT: f32 = 24.0;
 /// linearly to zero at the band's inner side.
 pub const AUTOSCROLL_SPEED_PT_PER_S: f32 = 480.0;
 
+/// Frames over which a mode switch scrolls the selected row into view ([`TreeState`]).
+const REVEAL_FRAMES: u8 = 2;
+
 /// The tree's own state.
 #[derive(Default)]
 pub struct TreeState {
@@ -39,6 +42,18 @@ pub struct TreeState {
     focus: bool,
     /// The physics constraint whose fields are shown ([`super::physics_fields`]).
     pub physics: Option<String>,
+    /// The mode the tree was last shown in.
+    pub(super) mode_shown: Option<Mode>,
+    /// Frames left in which the selected handle's row is scrolled into view (after a mode
+    /// switch: each mode's panel puts the tree elsewhere).
+    pub(super) reveal_frames: u8,
+}
+
+impl TreeState {
+    /// After a mode switch: the selected row (if any) is scrolled into view.
+    pub(super) fn reveal_after_switch(&mut self) {
+        self.reveal_frames = REVEAL_FRAMES;
+    }
 }
 
 impl EditorApp {
@@ -189,6 +204,15 @@ impl EditorApp {
             }
             let selected = self.selected.as_deref() == Some(name);
             let response = ui.selectable_label(selected, name);
+            if selected && self.tree.reveal_frames > 0 {
+                self.tree.reveal_frames -= 1;
+                // At once, not animated: the panel was just laid out anew. Again over the next
+                // frames: panels sized by their content (the timeline) settle a frame later.
+                response.scroll_to_me_animation(None, egui::style::ScrollAnimation::none());
+                if self.tree.reveal_frames > 0 {
+                    ui.ctx().request_repaint();
+                }
+            }
             if response.clicked() {
                 self.select_handle(name);
             }
