@@ -303,12 +303,14 @@ impl EditorApp {
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         self.advance_playback(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.mode == Mode::Animate {
-            egui::Panel::bottom("timeline").show(ui, |ui| self.animate_panel(ui));
-        }
+        // The side panel first, from the menu bar down to the status bar: animate mode's
+        // timeline goes under the canvas only and leaves the tree its height (as in Spine).
         egui::Panel::left("side")
             .default_size(230.0)
             .show(ui, |ui| self.side_panel(ui));
+        if self.mode == Mode::Animate {
+            egui::Panel::bottom("timeline").show(ui, |ui| self.animate_panel(ui));
+        }
         egui::CentralPanel::default().show(ui, |ui| self.canvas(ui));
         if self.show_help {
             help_window(&ctx, &mut self.show_help);
@@ -471,6 +473,7 @@ impl EditorApp {
     fn side_panel(&mut self, ui: &mut egui::Ui) {
         // Rig mode's tools outgrow a short window: the panel scrolls, each mode's panel on its
         // own (they hold different things: one mode's scrolling does not hide another's top).
+        self.tree.panel_height_pt = ui.available_height();
         let scroll = egui::ScrollArea::vertical().id_salt(("side panel", self.mode as u8));
         scroll.show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),

@@ -100,8 +100,10 @@ fn with_channels(mut pose: Pose, name: &str, bone: bool, n: [f64; 7]) -> Pose {
 /// ended this frame.
 fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
     let (mut dragging, mut released) = (false, false);
+    // Rotation on its own row, then x and y side by side: four rows, not seven (the tree
+    // below gets the height).
     egui::Grid::new("numbers").show(ui, |ui| {
-        for (field, value) in FIELDS.iter().zip(numbers.iter_mut()) {
+        for (k, (field, value)) in FIELDS.iter().zip(numbers.iter_mut()).enumerate() {
             let label = ui.label(field.label);
             let response = ui
                 .add(
@@ -115,7 +117,9 @@ fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
                 .labelled_by(label.id);
             dragging |= response.dragged();
             released |= response.drag_stopped();
-            ui.end_row();
+            if k % 2 == 0 {
+                ui.end_row();
+            }
         }
     });
     (dragging, released)

@@ -33,6 +33,7 @@ mod rig;
 mod rows;
 mod selection;
 mod timeline;
+mod tree_height;
 mod tree_view;
 mod workflow;
 

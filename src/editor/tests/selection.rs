@@ -18,22 +18,18 @@ fn click_row(h: &mut Harness<'_, EditorApp>, name: &str) {
 }
 
 /// Whether the middle of the widget labelled `label` (where a click reaches it) lies in the
-/// part of the side panel the window shows: below the menu bar (the canvas area's top) and above the status bar, or in animate mode
-/// above the timeline (the canvas area's bottom).
+/// part of the side panel the window shows: below the menu bar (the canvas area's top), above
+/// the status bar and above animate mode's timeline where it spans under the side panel.
 fn in_view(h: &Harness<'_, EditorApp>, label: &str) -> bool {
     let top = h.state().placed.expect("the canvas was drawn").origin.y;
-    let bottom = match h.state().mode {
-        Mode::Animate => h
-            .state()
-            .drawing
-            .picture
-            .as_ref()
-            .expect("a picture")
-            .rect
-            .bottom(),
-        _ => h.get_by_label_contains(" layers, ").rect().top(),
-    };
     let rect = h.get_by_label(label).rect();
+    let mut bottom = h.get_by_label_contains(" layers, ").rect().top();
+    let timeline = format!("Animation '{}'", h.state().animate.animation);
+    if let Some(timeline) = h.query_by_label(&timeline).map(|t| t.rect()) {
+        if timeline.left() < rect.right() {
+            bottom = bottom.min(timeline.top());
+        }
+    }
     (top..=bottom).contains(&rect.center().y)
 }
 
