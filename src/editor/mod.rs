@@ -120,6 +120,9 @@ pub struct EditorApp {
     pub view: Option<View>,
     /// A change of the view (View menu, Home, F, Ctrl+0) for the next frame.
     pub view_request: Option<view::ViewRequest>,
+    /// The view the editor fitted last: while [`Self::view`] is still it, a change of the
+    /// canvas area's size fits it again ([`EditorApp::place_view`]).
+    pub fitted: Option<view::Fitted>,
     /// Where the canvas was drawn last frame (tests convert canvas px to screen with it).
     pub placed: Option<Placed>,
     /// The last message for the user (errors, saves).
@@ -216,6 +219,7 @@ impl EditorApp {
             selected: None,
             view: None,
             view_request: None,
+            fitted: None,
             placed: None,
             message: None,
             last_frame_ms: 0.0,
@@ -602,7 +606,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
          Esc or right click cancels); or drag its gizmo's centre / ring / square",
     ),
     ("Mouse wheel", "zoom about the pointer"),
-    ("Home", "zoom to fit the canvas"),
+    (
+        "Home",
+        "zoom to fit the canvas (kept fitted as the window or mode changes, until you zoom or pan)",
+    ),
     ("F", "frame the selected handle"),
     ("Ctrl+0", "actual size (100 %)"),
     ("Middle drag", "pan"),

@@ -24,6 +24,7 @@ mod deform;
 mod documents;
 mod events;
 mod files;
+mod fit;
 mod graph;
 mod key_menu;
 mod outputs;
