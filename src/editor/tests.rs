@@ -35,6 +35,7 @@ mod rows;
 mod selection;
 mod timeline;
 mod tree_height;
+mod tree_points;
 mod tree_view;
 mod workflow;
 
