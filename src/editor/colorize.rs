@@ -98,6 +98,8 @@ pub struct ColorizeEditor {
     pub opacity: f32,
     /// This mode's pan and zoom (the line art has its own size); `None` fits it.
     view: Option<View>,
+    /// This canvas's [`EditorApp::fitted`].
+    fitted: Option<super::view::Fitted>,
     /// The stroke being drawn, image px.
     drawing: Option<Vec<Point>>,
     solve: Option<Solve>,
@@ -126,6 +128,7 @@ impl Default for ColorizeEditor {
             view_mode: ColorizeView::Result,
             opacity: 1.0,
             view: None,
+            fitted: None,
             drawing: None,
             solve: None,
             latest: None,
@@ -640,8 +643,10 @@ impl EditorApp {
     pub(super) fn colorize_canvas(&mut self, ui: &mut egui::Ui) {
         // The shared pan/zoom code works on `self.view`: lend it this mode's view.
         std::mem::swap(&mut self.view, &mut self.colorize.view);
+        std::mem::swap(&mut self.fitted, &mut self.colorize.fitted);
         self.colorize_canvas_with_view(ui);
         std::mem::swap(&mut self.view, &mut self.colorize.view);
+        std::mem::swap(&mut self.fitted, &mut self.colorize.fitted);
     }
 
     fn colorize_canvas_with_view(&mut self, ui: &mut egui::Ui) {

@@ -208,6 +208,8 @@ impl EditorApp {
             zoom: state.zoom.clamp(0.05, 32.0),
             pan: egui::vec2(state.pan[0], state.pan[1]),
         });
+        // The user's view, as left: kept whatever size the canvas area takes.
+        self.fitted = None;
         self.mode = state.mode;
         self.selected = state
             .selected

@@ -120,6 +120,9 @@ pub struct EditorApp {
     pub view: Option<View>,
     /// A change of the view (View menu, Home, F, Ctrl+0) for the next frame.
     pub view_request: Option<view::ViewRequest>,
+    /// The view the editor fitted last: while [`Self::view`] is still it, a change of the
+    /// canvas area's size fits it again ([`EditorApp::place_view`]).
+    pub fitted: Option<view::Fitted>,
     /// Where the canvas was drawn last frame (tests convert canvas px to screen with it).
     pub placed: Option<Placed>,
     /// The last message for the user (errors, saves).
@@ -216,6 +219,7 @@ impl EditorApp {
             selected: None,
             view: None,
             view_request: None,
+            fitted: None,
             placed: None,
             message: None,
             last_frame_ms: 0.0,
@@ -297,17 +301,20 @@ impl EditorApp {
         self.view_shortcuts(&ctx);
         self.timeline_shortcuts(&ctx);
         self.shortcuts(&ctx);
+        self.keep_selection();
         self.autosave(&ctx);
         self.guard_close(&ctx);
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         self.advance_playback(&ctx);
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        if self.mode == Mode::Animate {
-            egui::Panel::bottom("timeline").show(ui, |ui| self.animate_panel(ui));
-        }
+        // The side panel first, from the menu bar down to the status bar: animate mode's
+        // timeline goes under the canvas only and leaves the tree its height (as in Spine).
         egui::Panel::left("side")
             .default_size(230.0)
             .show(ui, |ui| self.side_panel(ui));
+        if self.mode == Mode::Animate {
+            egui::Panel::bottom("timeline").show(ui, |ui| self.animate_panel(ui));
+        }
         egui::CentralPanel::default().show(ui, |ui| self.canvas(ui));
         if self.show_help {
             help_window(&ctx, &mut self.show_help);
@@ -396,6 +403,21 @@ impl EditorApp {
         }
     }
 
+    /// The selection across modes and edits: kept while its handle exists (the tree shows it
+    /// in view again after a mode switch), dropped when an undo, a delete or another edit took
+    /// the handle away, so no mode shows or edits a handle that is not there.
+    fn keep_selection(&mut self) {
+        if let Some(name) = &self.selected {
+            if !self.doc.state().handles.names().any(|n| n == name) {
+                self.selected = None;
+            }
+        }
+        if self.tree.mode_shown != Some(self.mode) {
+            self.tree.mode_shown = Some(self.mode);
+            self.tree.reveal_after_switch();
+        }
+    }
+
     fn menu_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             self.file_menu_button(ui);
@@ -453,8 +475,11 @@ impl EditorApp {
     }
 
     fn side_panel(&mut self, ui: &mut egui::Ui) {
-        // Rig mode's tools outgrow a short window: the panel scrolls.
-        egui::ScrollArea::vertical().show(ui, |ui| match self.mode {
+        // Rig mode's tools outgrow a short window: the panel scrolls, each mode's panel on its
+        // own (they hold different things: one mode's scrolling does not hide another's top).
+        self.tree.panel_height_pt = ui.available_height();
+        let scroll = egui::ScrollArea::vertical().id_salt(("side panel", self.mode as u8));
+        scroll.show(ui, |ui| match self.mode {
             Mode::Rig => self.rig_panel(ui),
             Mode::Pose => {
                 self.pose_panel(ui);
@@ -581,7 +606,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
          Esc or right click cancels); or drag its gizmo's centre / ring / square",
     ),
     ("Mouse wheel", "zoom about the pointer"),
-    ("Home", "zoom to fit the canvas"),
+    (
+        "Home",
+        "zoom to fit the canvas (kept fitted as the window or mode changes, until you zoom or pan)",
+    ),
     ("F", "frame the selected handle"),
     ("Ctrl+0", "actual size (100 %)"),
     ("Middle drag", "pan"),

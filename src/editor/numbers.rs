@@ -12,6 +12,10 @@ use super::{EditorApp, Gesture};
 use crate::rig::Pose;
 use eframe::egui;
 
+/// What the panel says with nothing selected (no fields shown: their labels would suggest
+/// values).
+pub const NOTHING_SELECTED: &str = "Nothing selected. Click a bone or point to edit its numbers.";
+
 /// One field: its label, its drag speed (per point moved) and unit suffix.
 struct Field {
     label: &'static str,
@@ -100,8 +104,10 @@ fn with_channels(mut pose: Pose, name: &str, bone: bool, n: [f64; 7]) -> Pose {
 /// ended this frame.
 fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
     let (mut dragging, mut released) = (false, false);
+    // Rotation on its own row, then x and y side by side: four rows, not seven (the tree
+    // below gets the height).
     egui::Grid::new("numbers").show(ui, |ui| {
-        for (field, value) in FIELDS.iter().zip(numbers.iter_mut()) {
+        for (k, (field, value)) in FIELDS.iter().zip(numbers.iter_mut()).enumerate() {
             let label = ui.label(field.label);
             let response = ui
                 .add(
@@ -115,7 +121,9 @@ fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
                 .labelled_by(label.id);
             dragging |= response.dragged();
             released |= response.drag_stopped();
-            ui.end_row();
+            if k % 2 == 0 {
+                ui.end_row();
+            }
         }
     });
     (dragging, released)
@@ -123,13 +131,14 @@ fn numbers_grid(ui: &mut egui::Ui, numbers: &mut [f64; 7]) -> (bool, bool) {
 
 impl EditorApp {
     /// The numbers of the selected bone or point. The panel is as tall whatever is selected
-    /// (one truncated line, then the fields, disabled at the rest values when there is nothing
-    /// to pose), so a click in the tree below it never moves the tree under the pointer.
+    /// (one truncated line, then the fields; with nothing to pose, only the line, the fields'
+    /// room kept empty), so a click in the tree below it never moves the tree under the
+    /// pointer.
     pub(super) fn numbers_panel(&mut self, ui: &mut egui::Ui) {
         ui.separator();
         ui.heading("Numbers");
         let target = match self.selected.clone() {
-            None => Err("Click a bone or point to edit its numbers.".to_string()),
+            None => Err(NOTHING_SELECTED.to_string()),
             Some(name) => match kind(&self.doc.state().handles, &name) {
                 Some(bone) => Ok((name, bone)),
                 None => Err(format!(
@@ -143,8 +152,11 @@ impl EditorApp {
         };
         ui.add(egui::Label::new(line).truncate());
         let Ok((name, bone)) = target else {
-            let mut rest = channels(&Pose::default(), "", true);
-            ui.add_enabled_ui(false, |ui| numbers_grid(ui, &mut rest));
+            // The fields' room kept empty: the tree below stays where it is.
+            let rows = FIELDS.len().div_ceil(2) as f32;
+            let spacing = ui.spacing();
+            let height = rows * spacing.interact_size.y + (rows - 1.0) * spacing.item_spacing.y;
+            ui.allocate_space(egui::vec2(ui.available_width(), height));
             return;
         };
         let base = match &self.gesture {

@@ -147,16 +147,19 @@ impl EditorApp {
             return;
         }
         ui.label("Drag any point of the drawing; shift-click pins a point.");
-        let pins = self.doc.state().pose.ik.len();
-        ui.label(format!("{pins} pins and drags"));
-        if ui.button("Clear pins").clicked() {
-            let mut pose = self.doc.state().pose.clone();
-            pose.ik.clear();
-            self.apply(Command::SetPose(pose));
-        }
-        if ui.button("Rest pose").clicked() {
-            self.apply(Command::SetPose(Pose::default()));
-        }
+        // One row: the side panel's height is the tree's below.
+        ui.horizontal_wrapped(|ui| {
+            let pins = self.doc.state().pose.ik.len();
+            ui.label(format!("{pins} pins and drags"));
+            if ui.button("Clear pins").clicked() {
+                let mut pose = self.doc.state().pose.clone();
+                pose.ik.clear();
+                self.apply(Command::SetPose(pose));
+            }
+            if ui.button("Rest pose").clicked() {
+                self.apply(Command::SetPose(Pose::default()));
+            }
+        });
     }
 
     /// The tree view under pose and animate mode's panels.
@@ -164,7 +167,7 @@ impl EditorApp {
         self.skin_picker(ui);
         ui.separator();
         ui.heading("Tree");
-        self.tree_view(ui);
+        self.tree_area(ui);
     }
 
     /// The skin the canvas draws, when the rig has skins: "(none)" shows each slot's own part.

@@ -209,10 +209,7 @@ impl EditorApp {
         }
         ui.separator();
         ui.heading("Tree");
-        egui::ScrollArea::vertical()
-            .id_salt("tree")
-            .max_height(TREE_HEIGHT_PT)
-            .show(ui, |ui| self.tree_view(ui));
+        self.tree_area(ui);
         if let Some(name) = self.selected.clone() {
             ui.separator();
             ui.label(format!("Selected: {name}"));
@@ -451,8 +448,6 @@ impl EditorApp {
 
 /// Height of the heat map legend above the canvas' bottom edge, screen points.
 const LEGEND_HEIGHT_PT: f32 = 64.0;
-/// The tree's height in rig mode's side panel at most (it scrolls beyond), points.
-pub const TREE_HEIGHT_PT: f32 = 260.0;
 /// Length of the legend's colour bar, screen points.
 const LEGEND_BAR_PT: f32 = 120.0;
 

@@ -24,6 +24,7 @@ mod deform;
 mod documents;
 mod events;
 mod files;
+mod fit;
 mod graph;
 mod key_menu;
 mod outputs;
@@ -31,7 +32,10 @@ mod physics;
 mod pose;
 mod rig;
 mod rows;
+mod selection;
 mod timeline;
+mod tree_height;
+mod tree_points;
 mod tree_view;
 mod workflow;
 

@@ -24,6 +24,17 @@ pub const AUTOSCROLL_BAND_PT: f32 = 24.0;
 /// linearly to zero at the band's inner side.
 pub const AUTOSCROLL_SPEED_PT_PER_S: f32 = 480.0;
 
+/// Frames over which a mode switch scrolls the selected row into view ([`TreeState`]).
+const REVEAL_FRAMES: u8 = 2;
+
+/// The tree's height in the side panel at least, points (a short window scrolls the panel to
+/// show it whole). About eight rows.
+pub const MIN_TREE_HEIGHT_PT: f32 = 170.0;
+/// Rig mode's tree takes this share of the side panel's height (the tools, the selection's
+/// fields and the weights share the rest); pose and animate mode's tree, last in its panel,
+/// takes the whole rest.
+pub const RIG_TREE_SHARE: f32 = 0.45;
+
 /// The tree's own state.
 #[derive(Default)]
 pub struct TreeState {
@@ -39,6 +50,20 @@ pub struct TreeState {
     focus: bool,
     /// The physics constraint whose fields are shown ([`super::physics_fields`]).
     pub physics: Option<String>,
+    /// The mode the tree was last shown in.
+    pub(super) mode_shown: Option<Mode>,
+    /// Frames left in which the selected handle's row is scrolled into view (after a mode
+    /// switch: each mode's panel puts the tree elsewhere).
+    pub(super) reveal_frames: u8,
+    /// The side panel's height this frame, points.
+    pub(super) panel_height_pt: f32,
+}
+
+impl TreeState {
+    /// After a mode switch: the selected row (if any) is scrolled into view.
+    pub(super) fn reveal_after_switch(&mut self) {
+        self.reveal_frames = REVEAL_FRAMES;
+    }
 }
 
 impl EditorApp {
@@ -48,8 +73,24 @@ impl EditorApp {
         self.rig_mode.rename_to = name.to_string();
     }
 
+    /// The tree in its own scroll area, as tall as the side panel leaves it: in rig mode
+    /// [`RIG_TREE_SHARE`] of the panel, else the rest of the panel; never less than
+    /// [`MIN_TREE_HEIGHT_PT`]. (Its height follows the panel, not the selection: a click on a
+    /// row never moves the rows.)
+    pub(super) fn tree_area(&mut self, ui: &mut egui::Ui) {
+        let most_pt = match self.mode {
+            Mode::Rig => (RIG_TREE_SHARE * self.tree.panel_height_pt).max(MIN_TREE_HEIGHT_PT),
+            _ => f32::INFINITY,
+        };
+        egui::ScrollArea::vertical()
+            .id_salt(("tree", self.mode as u8))
+            .max_height(most_pt)
+            .min_scrolled_height(MIN_TREE_HEIGHT_PT)
+            .show(ui, |ui| self.tree_view(ui));
+    }
+
     /// The tree: skeletons, points, cages, regions, parts.
-    pub(super) fn tree_view(&mut self, ui: &mut egui::Ui) {
+    fn tree_view(&mut self, ui: &mut egui::Ui) {
         let typing = ui.ctx().text_edit_focused();
         if !typing && ui.input(|i| super::file_menu::plain_key(i, Key::F2)) {
             if let Some(name) = self.selected.clone() {
@@ -189,6 +230,15 @@ impl EditorApp {
             }
             let selected = self.selected.as_deref() == Some(name);
             let response = ui.selectable_label(selected, name);
+            if selected && self.tree.reveal_frames > 0 {
+                self.tree.reveal_frames -= 1;
+                // At once, not animated: the panel was just laid out anew. Again over the next
+                // frames: panels sized by their content (the timeline) settle a frame later.
+                response.scroll_to_me_animation(None, egui::style::ScrollAnimation::none());
+                if self.tree.reveal_frames > 0 {
+                    ui.ctx().request_repaint();
+                }
+            }
             if response.clicked() {
                 self.select_handle(name);
             }

@@ -1,9 +1,12 @@
 //! The View menu and its keys: zoom to fit (Home), frame the selection (F), actual size
-//! (Ctrl+0: one canvas px per screen point).
+//! (Ctrl+0: one canvas px per screen point); and the fitted view following the canvas area.
 //!
 //! In: the keys, the menu's clicks, the selected handle (where the canvas shows it) and the
 //! canvas area's size. Out: the canvas's [`View`] (zoom and pan), set on the next frame where
-//! the canvas area is known ([`EditorApp::place_view`]).
+//! the canvas area is known ([`EditorApp::place_view`]). A view the editor fitted and the user
+//! has not zoomed or panned since is fitted again when the canvas area changes size (animate
+//! mode's timeline takes the bottom of the window, a window is resized): the whole canvas stays
+//! in view. A view the user made (wheel, pan, F, Ctrl+0, a saved view) is kept as it is.
 
 use super::canvas::{self, View};
 use super::{EditorApp, Mode};
@@ -17,6 +20,17 @@ const FIT_MARGIN_PT: f32 = 24.0;
 const MIN_FRAMED_PX: f64 = 96.0;
 /// The zoom range (screen points per canvas px), as the mouse wheel's.
 const ZOOM_RANGE: (f32, f32) = (0.05, 32.0);
+
+/// A change of the canvas area's width or height (points) above which an untouched fitted view
+/// is fitted again (below it: rounding as panels settle).
+const AREA_CHANGE_PT: f32 = 0.5;
+
+/// The view the editor fitted last, and the canvas area (points) it fitted it to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fitted {
+    pub area: Vec2,
+    pub view: View,
+}
 
 /// A view change waiting for the canvas area's size.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -58,6 +72,7 @@ impl EditorApp {
         ui.menu_button("View", |ui| {
             if ui
                 .add(egui::Button::new("Zoom to fit").shortcut_text("Home"))
+                .on_hover_text("the whole canvas in view (kept so as the window or mode changes)")
                 .clicked()
             {
                 self.view_request = Some(ViewRequest::Fit);
@@ -102,24 +117,47 @@ impl EditorApp {
         });
     }
 
+    /// Whether the view is the one the editor fitted last (the user has not zoomed or panned
+    /// since); true before the first frame too.
+    pub fn view_untouched(&self) -> bool {
+        match (self.view, self.fitted) {
+            (None, _) => true,
+            (Some(view), Some(fitted)) => view == fitted.view,
+            (Some(_), None) => false,
+        }
+    }
+
     /// The view to draw with in an area of `area` points showing a canvas of `canvas_px`:
-    /// the pending request applied, or the view as it is (fitted the first time).
+    /// the pending request applied, or the view as it is (fitted the first time, and again
+    /// when the area changed size while the view is [untouched](Self::view_untouched)).
     pub(super) fn place_view(&mut self, canvas_px: [u32; 2], area: Vec2) -> View {
+        let resized = self.fitted.is_some_and(|f| {
+            let change = (f.area - area).abs();
+            change.x > AREA_CHANGE_PT || change.y > AREA_CHANGE_PT
+        });
+        let refit = self.view.is_none() || (resized && self.view_untouched());
         let current = self.view.unwrap_or_else(|| canvas::fit(canvas_px, area));
-        let view = match self.view_request.take() {
-            None => current,
-            Some(ViewRequest::Fit) => canvas::fit(canvas_px, area),
+        let fit = || {
+            let view = canvas::fit(canvas_px, area);
+            (view, Some(Fitted { area, view }))
+        };
+        let (view, fitted) = match self.view_request.take() {
+            None if refit => fit(),
+            None => (current, self.fitted),
+            Some(ViewRequest::Fit) => fit(),
             Some(ViewRequest::ActualSize) => {
                 // The canvas point at the area's centre stays there.
                 let centre = (area / 2.0 - current.pan) / current.zoom;
-                View {
+                let view = View {
                     zoom: 1.0,
                     pan: area / 2.0 - centre,
-                }
+                };
+                (view, self.fitted)
             }
-            Some(ViewRequest::Frame(min, max)) => frame(min, max, area),
+            Some(ViewRequest::Frame(min, max)) => (frame(min, max, area), self.fitted),
         };
         self.view = Some(view);
+        self.fitted = fitted;
         view
     }
 }

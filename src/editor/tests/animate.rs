@@ -68,8 +68,13 @@ fn the_numbers_panel_poses_the_selected_bone_in_pose_mode() {
     let mut h = open_character("numbers");
     h.key_press(Key::Num2);
     h.run();
-    h.get_by_label_contains("Click a bone or point");
+    // Nothing selected: one line says so, no fields (their labels would suggest values).
+    h.get_by_label_contains("Nothing selected. Click a bone or point");
+    assert!(h.query_by_label("Rotation").is_none());
+    let tree_at = h.get_by_label("hip").rect();
     click(&mut h, Point::new(256.0, 225.0));
+    // The fields appear in the room kept for them: the tree below stays where it was.
+    assert_eq!(h.get_by_label("hip").rect(), tree_at);
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
     set_number(&mut h, "Rotation", 30.0);
     set_number(&mut h, "Translation x", 4.0);

@@ -234,9 +234,10 @@ fn a_bone_dragged_onto_another_in_the_tree_hangs_from_it_undoably_and_loops_are_
 fn a_drag_held_at_the_trees_bottom_edge_scrolls_it_to_rows_below() {
     let mut h = open_character("tree-autoscroll");
     assert_eq!(h.state().mode, Mode::Rig);
-    // The tree's visible part: from under its heading, TREE_HEIGHT_PT tall.
+    // The tree's visible part: from under its heading to above the separator before the
+    // weights' heading.
     let top = h.get_by_label("Tree").rect().bottom();
-    let bottom = top + crate::editor::rig_mode::TREE_HEIGHT_PT;
+    let bottom = h.get_by_label("Weights").rect().top() - 12.0;
     let start = h.get_by_label("head").rect().center();
     assert!(start.y > top && start.y < bottom, "the head's row shows");
     let lantern = |h: &Harness<'_, EditorApp>| h.get_by_label("lantern").rect().center();
