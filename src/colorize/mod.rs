@@ -281,9 +281,8 @@ pub const MAX_LIFT_SCALE_PX: f64 = 1e5;
 /// hundred px the blur costs seconds and orders nothing the depth flood would not.
 pub const MAX_SPLIT_BLUR_PX: f64 = 256.0;
 
-/// Largest `split_depth_exponent`: beyond it a pixel 0.5 px from a line costs more than
-/// 2^32 times one 1 px away, and paths are ordered by their narrowest opening alone (as
-/// with any larger α) while costs deep inside regions underflow towards 0.
+/// Largest `split_depth_exponent`: at 32 a pixel 1 px from a line already costs 2^32 times
+/// one 2 px away, so the narrowest opening on a path decides alone, as with any larger α.
 pub const MAX_SPLIT_DEPTH_EXPONENT: f64 = 32.0;
 
 /// Largest soft-fill radius, px: a wider blend is a blur, not an antialiased edge.

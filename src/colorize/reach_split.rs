@@ -30,7 +30,7 @@
 
 use super::InkRegions;
 use rayon::prelude::*;
-use std::cmp::Ordering;
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// Depths below this count as this, px: a guard against 0^−α = ∞ (only barrier pixels, which
@@ -126,24 +126,21 @@ impl Field<'_> {
         let (w, h) = (self.width, self.height);
         let mut reach = vec![f64::INFINITY; w * h];
         let mut from = vec![u32::MAX; w * h];
-        let mut settled = vec![false; w * h];
+        // Costs are finite and non-negative, so they order like their bit patterns; ties go to
+        // the lower pixel index.
         let mut heap = BinaryHeap::new();
         for i in 0..w * h {
             if self.scribble[i] != u32::MAX && self.labels[i] == color {
                 reach[i] = 0.0;
                 from[i] = self.scribble[i];
-                heap.push(Front {
-                    cost: 0.0,
-                    pixel: i as u32,
-                });
+                heap.push(Reverse((0f64.to_bits(), i)));
             }
         }
-        while let Some(Front { cost: at, pixel }) = heap.pop() {
-            let i = pixel as usize;
-            if settled[i] || at > reach[i] {
+        while let Some(Reverse((bits, i))) = heap.pop() {
+            let at = f64::from_bits(bits);
+            if at > reach[i] {
                 continue;
             }
-            settled[i] = true;
             let scale = 1.0 / self.radius_px[from[i] as usize];
             let (x, y) = (i % w, i / w);
             // Scribbles lie in contested regions, and fronts stay in their region.
@@ -154,17 +151,14 @@ impl Field<'_> {
                     continue;
                 }
                 let j = ny as usize * w + nx as usize;
-                if settled[j] || self.region[j] != region {
+                if self.region[j] != region {
                     continue;
                 }
                 let through = at + step_px * 0.5 * (self.cost[i] + self.cost[j]) * scale;
                 if through < reach[j] {
                     reach[j] = through;
                     from[j] = from[i];
-                    heap.push(Front {
-                        cost: through,
-                        pixel: j as u32,
-                    });
+                    heap.push(Reverse((through.to_bits(), j)));
                 }
             }
         }
@@ -223,38 +217,6 @@ fn scribble_components(
         radius_px.push(diagonal_px / 2.0 + DOT_RADIUS_PX);
     }
     (component, radius_px)
-}
-
-/// A pixel on the Dijkstra front: a min-heap entry by cost, then pixel index.
-#[derive(Clone, Copy, Debug)]
-struct Front {
-    cost: f64,
-    pixel: u32,
-}
-
-impl PartialEq for Front {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Front {}
-
-impl PartialOrd for Front {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Front {
-    /// Reversed: the cheapest (then the lowest pixel index) is the greatest, on top of the
-    /// max-heap.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then(other.pixel.cmp(&self.pixel))
-    }
 }
 
 #[cfg(test)]
