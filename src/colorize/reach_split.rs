@@ -29,9 +29,9 @@
 //! not be connected. Ties go to the lower color: outputs are deterministic.
 
 use super::InkRegions;
+use radix_heap::RadixHeapMap;
 use rayon::prelude::*;
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 
 /// Depths below this count as this, px: a guard against 0^−α = ∞ (only barrier pixels, which
 /// no front crosses, lie at depth 0; a pixel beside one lies at 1 px).
@@ -42,9 +42,15 @@ pub const MIN_DEPTH_PX: f64 = 0.5;
 pub const DOT_RADIUS_PX: f64 = 1.5;
 
 /// Assigns the contested pixels (see the module doc). `contested(i)`: pixel `i` lies in a
-/// region holding several colors. `depth_exponent` α ≥ 0. The colors' Dijkstras run in
-/// parallel (rayon), as many at a time as there are threads; the result does not depend on
-/// the thread count.
+/// region holding several colors. `depth_exponent` α ≥ 0.
+///
+/// The colors' Dijkstras run in parallel (rayon), as many at a time as there are threads,
+/// largest scribble first. A later batch's front stops where it cannot win: at a pixel that an
+/// earlier color reaches at a strictly lower cost from a scribble at least as large, every
+/// continuation is dearer too (cost a + L/r against at most b + L/r' with a > b, r ≤ r'), so
+/// the split is the one without stopping. The result does not depend on the thread count:
+/// what one batch reads was settled by the batches before it, and a pixel goes to the least
+/// cost, ties to the lower color.
 pub fn reach_split(
     regions: &InkRegions,
     labels: &[u16],
@@ -55,35 +61,56 @@ pub fn reach_split(
     let (w, h) = (regions.width as usize, regions.height as usize);
     let cost = crossing_costs(&regions.depth_half_px, depth_exponent);
     let (scribble, radius_px) = scribble_components(labels, w, h, &contested);
-    let mut colors: Vec<u16> = (0..w * h)
-        .filter(|&i| scribble[i] != u32::MAX)
-        .map(|i| labels[i])
-        .collect();
-    colors.sort_unstable();
-    colors.dedup();
+    // Each color with its largest scribble's radius, largest first (ties: lower color).
+    let mut largest_px: Vec<(u16, f64)> = Vec::new();
+    for i in 0..w * h {
+        if scribble[i] == u32::MAX {
+            continue;
+        }
+        let r = radius_px[scribble[i] as usize];
+        match largest_px.iter_mut().find(|(c, _)| *c == labels[i]) {
+            Some((_, largest)) => *largest = largest.max(r),
+            None => largest_px.push((labels[i], r)),
+        }
+    }
+    largest_px.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    let colors: Vec<u16> = largest_px.iter().map(|&(c, _)| c).collect();
+    let within = steps_within(&regions.region, w, h);
     let field = Field {
-        width: w,
-        height: h,
-        region: &regions.region,
         cost: &cost,
+        steps_within: &within,
+        offsets: STEPS.map(|(dx, dy, _)| dy * w as isize + dx),
         scribble: &scribble,
         labels,
         radius_px: &radius_px,
     };
-    let mut best = vec![f64::INFINITY; w * h];
-    for chunk in colors.chunks(rayon::current_num_threads().max(1)) {
-        let reaches: Vec<Vec<f64>> = chunk.par_iter().map(|&c| field.reach(c)).collect();
-        // In ascending color order: a pixel changes hands only to a strictly cheaper color
-        // (lower colors win ties); scribble pixels keep their own.
-        for (&color, reach) in chunk.iter().zip(&reaches) {
+    let mut won = Won {
+        cost: vec![f64::INFINITY; w * h],
+        color: vec![0; w * h],
+        radius_px: vec![0.0; w * h],
+    };
+    for (k, batch) in colors
+        .chunks(rayon::current_num_threads().max(1))
+        .enumerate()
+    {
+        // The first batch has nothing to stop at.
+        let stop = (k > 0).then_some(&won);
+        let reaches: Vec<Vec<Reach>> = batch.par_iter().map(|&c| field.reach(c, stop)).collect();
+        for (&color, reach) in batch.iter().zip(&reaches) {
             for i in 0..w * h {
-                if reach[i] < best[i] {
-                    best[i] = reach[i];
-                    if labels[i] == 0 {
-                        owner[i] = color;
-                    }
+                let (a, b) = (reach[i].cost, won.cost[i]);
+                if a < b || (a == b && a.is_finite() && color < won.color[i]) {
+                    won.cost[i] = a;
+                    won.color[i] = color;
+                    won.radius_px[i] = radius_px[reach[i].from as usize];
                 }
             }
+        }
+    }
+    // Scribble pixels keep their own color.
+    for i in 0..w * h {
+        if labels[i] == 0 && won.color[i] != 0 {
+            owner[i] = won.color[i];
         }
     }
 }
@@ -109,61 +136,101 @@ fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> Vec<f64> {
 
 /// What one color's Dijkstra reads.
 struct Field<'a> {
-    width: usize,
-    height: usize,
-    region: &'a [u32],
     cost: &'a [f64],
+    /// Per pixel, bit k set: the step `STEPS[k]` stays in the image and in the pixel's region.
+    steps_within: &'a [u8],
+    /// Per step of `STEPS`, the index offset it makes.
+    offsets: [isize; 8],
     /// Per pixel its scribble component (u32::MAX: none).
     scribble: &'a [u32],
     labels: &'a [u16],
     radius_px: &'a [f64],
 }
 
+/// Per pixel, the least cost over the colors done so far, that color (0: none) and the radius
+/// of the scribble it came from, px.
+struct Won {
+    cost: Vec<f64>,
+    color: Vec<u16>,
+    radius_px: Vec<f64>,
+}
+
+/// One color's reach at one pixel: its cost (∞: not reached, or stopped where it cannot win)
+/// and the scribble it came from (one cell, so a step reads both from one cache line).
+#[derive(Clone, Copy)]
+struct Reach {
+    cost: f64,
+    from: u32,
+}
+
 impl Field<'_> {
-    /// Per pixel the least cost at which `color`'s scribbles reach it (∞: not at all): one
-    /// Dijkstra from all of them, a front carrying its scribble's radius, within regions.
-    fn reach(&self, color: u16) -> Vec<f64> {
-        let (w, h) = (self.width, self.height);
-        let mut reach = vec![f64::INFINITY; w * h];
-        let mut from = vec![u32::MAX; w * h];
-        // Costs are finite and non-negative, so they order like their bit patterns; ties go to
-        // the lower pixel index.
-        let mut heap = BinaryHeap::new();
-        for i in 0..w * h {
-            if self.scribble[i] != u32::MAX && self.labels[i] == color {
-                reach[i] = 0.0;
-                from[i] = self.scribble[i];
-                heap.push(Reverse((0f64.to_bits(), i)));
+    /// Per pixel the least cost at which `color`'s scribbles reach it: one Dijkstra from all
+    /// of them, a front carrying its scribble's radius, within regions, stopped where `won`
+    /// (if any) already holds a strictly cheaper cost from a scribble at least as large.
+    fn reach(&self, color: u16, won: Option<&Won>) -> Vec<Reach> {
+        let unreached = Reach {
+            cost: f64::INFINITY,
+            from: u32::MAX,
+        };
+        let mut reach = vec![unreached; self.cost.len()];
+        // Costs are finite and non-negative, so they order like their bit patterns, and a
+        // Dijkstra's popped costs never decrease: a monotone (radix) heap.
+        let mut heap = RadixHeapMap::new();
+        for (i, (&s, &l)) in self.scribble.iter().zip(self.labels).enumerate() {
+            if s != u32::MAX && l == color {
+                reach[i] = Reach { cost: 0.0, from: s };
+                heap.push(Reverse(0u64), i as u32);
             }
         }
-        while let Some(Reverse((bits, i))) = heap.pop() {
+        while let Some((Reverse(bits), i)) = heap.pop() {
+            let i = i as usize;
             let at = f64::from_bits(bits);
-            if at > reach[i] {
+            let here = reach[i];
+            if at > here.cost {
                 continue;
             }
-            let scale = 1.0 / self.radius_px[from[i] as usize];
-            let (x, y) = (i % w, i / w);
-            // Scribbles lie in contested regions, and fronts stay in their region.
-            let region = self.region[i];
-            for (dx, dy, step_px) in STEPS {
-                let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+            let radius_px = self.radius_px[here.from as usize];
+            let scale = 0.5 / radius_px;
+            let within = self.steps_within[i];
+            for (k, &(_, _, step_px)) in STEPS.iter().enumerate() {
+                if within & (1 << k) == 0 {
                     continue;
                 }
-                let j = ny as usize * w + nx as usize;
-                if self.region[j] != region {
-                    continue;
-                }
-                let through = at + step_px * 0.5 * (self.cost[i] + self.cost[j]) * scale;
-                if through < reach[j] {
-                    reach[j] = through;
-                    from[j] = from[i];
-                    heap.push(Reverse((through.to_bits(), j)));
+                let j = i.wrapping_add_signed(self.offsets[k]);
+                let through = at + step_px * (self.cost[i] + self.cost[j]) * scale;
+                let lost = |won: &Won| through > won.cost[j] && radius_px <= won.radius_px[j];
+                if through < reach[j].cost && !won.is_some_and(lost) {
+                    reach[j] = Reach {
+                        cost: through,
+                        from: here.from,
+                    };
+                    heap.push(Reverse(through.to_bits()), j as u32);
                 }
             }
         }
         reach
     }
+}
+
+/// Per pixel, bit k set when the step `STEPS[k]` from it lands in the image and in the same
+/// region.
+fn steps_within(region: &[u32], w: usize, h: usize) -> Vec<u8> {
+    let mut within = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            for (k, &(dx, dy, _)) in STEPS.iter().enumerate() {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+                    continue;
+                }
+                if region[ny as usize * w + nx as usize] == region[i] {
+                    within[i] |= 1 << k;
+                }
+            }
+        }
+    }
+    within
 }
 
 /// The 8 steps (dx, dy, length px).
@@ -293,6 +360,80 @@ mod tests {
             1,
             "without depth the stroke enters the room"
         );
+    }
+
+    #[test]
+    fn the_split_does_not_depend_on_the_thread_count() {
+        // Six colors (dabs and strokes of several sizes) in one open room with a pillar: one
+        // thread runs them one by one, each stopped where an earlier one wins; three threads
+        // run them two batches of three.
+        let (w, h) = (90u32, 70u32);
+        let regions = page(w, h, |x, y| {
+            x == 0 || y == 0 || x == w - 1 || y == h - 1 || ((40..46).contains(&x) && y > 20)
+        });
+        let mut labels = vec![0u16; (w * h) as usize];
+        let strokes: [(u16, u32, u32, u32); 6] = [
+            (1, 5, 10, 30),
+            (2, 60, 60, 1),
+            (3, 70, 15, 12),
+            (4, 20, 50, 4),
+            (5, 50, 35, 1),
+            (6, 10, 65, 20),
+        ];
+        for (color, x0, y, len) in strokes {
+            for x in x0..x0 + len {
+                labels[(y * w + x) as usize] = color;
+            }
+        }
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| split(&regions, &labels, 6.0))
+        };
+        let one = on(1);
+        assert_eq!(one, on(3));
+        assert_eq!(one, on(6));
+        for color in 1..=6 {
+            assert!(one.contains(&color), "color {color} won no pixel");
+        }
+    }
+
+    #[test]
+    fn a_front_passes_through_a_smaller_scribbles_ground() {
+        // Two rooms joined by a 3-px corridor (y 19–21, x 40–49). Color 1: a long stroke at
+        // the right room's far end and a dab in the corridor; color 2: a stroke in the left
+        // room. Color 1 (the largest scribble) runs first; color 2's front must cross the
+        // dab's small disk, where color 1 is cheaper but from a smaller scribble, to claim
+        // the right room's near side. One thread (color 2 stopped where it cannot win) and
+        // two (no stopping) agree.
+        let (w, h) = (160u32, 42u32);
+        let open = |x: u32, y: u32| {
+            let left = (1..40).contains(&x) && (1..41).contains(&y);
+            let right = (50..159).contains(&x) && (1..41).contains(&y);
+            left || right || ((40..50).contains(&x) && (19..22).contains(&y))
+        };
+        let regions = page(w, h, |x, y| !open(x, y));
+        let mut labels = vec![0u16; (w * h) as usize];
+        for y in 3..39 {
+            labels[(y * w + 157) as usize] = 1;
+        }
+        labels[(20 * w + 45) as usize] = 1;
+        for x in 10..30 {
+            labels[(20 * w + x) as usize] = 2;
+        }
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a pool");
+            pool.install(|| split(&regions, &labels, 0.0))
+        };
+        let one = on(1);
+        assert_eq!(one[(20 * w + 45) as usize], 1, "the dab");
+        assert_eq!(one[(20 * w + 55) as usize], 2, "past the dab: color 2");
+        assert_eq!(one, on(2));
     }
 
     #[test]
