@@ -11,6 +11,7 @@
 
 use super::lineart::LineArt;
 use image::RgbaImage;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// How the pixels' colors are drawn.
@@ -56,62 +57,69 @@ pub fn fill_owners(
     } else {
         Vec::new()
     };
-    let fill_raw: &mut [u8] = &mut fill_only;
-    let mut layer_raws: Vec<&mut [u8]> = layers.iter_mut().map(|l| &mut **l).collect();
     let r = match mode {
         FillMode::Flat => 0,
         FillMode::Soft => soft_radius_px as usize,
     };
-    let mut counts = vec![0u32; m + 1];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            let own = owner[i] as usize;
-            let (y0, y1, x0, x1) = (
-                y.saturating_sub(r),
-                (y + r).min(h - 1),
-                x.saturating_sub(r),
-                (x + r).min(w - 1),
-            );
-            // Uniform neighborhoods (the common case) skip the counting.
-            let mut uniform = true;
-            'scan: for yy in y0..=y1 {
-                for &o in &owner[yy * w + x0..=yy * w + x1] {
-                    if o as usize != own {
-                        uniform = false;
-                        break 'scan;
-                    }
-                }
-            }
-            let total;
-            if uniform {
-                counts.fill(0);
-                counts[own] = 1;
-                total = 1;
-            } else {
-                counts.fill(0);
-                for yy in y0..=y1 {
-                    for &o in &owner[yy * w + x0..=yy * w + x1] {
-                        counts[o as usize] += 1;
-                    }
-                }
-                total = ((y1 - y0 + 1) * (x1 - x0 + 1)) as u32;
-            }
-            let mut c = [counts[0] as f64 * 255.0; 3];
-            for (k, p) in palette.iter().enumerate() {
-                for ch in 0..3 {
-                    c[ch] += counts[k + 1] as f64 * p[ch] as f64;
-                }
-            }
-            let color = c.map(|v| (v / total as f64).round().clamp(0.0, 255.0) as u8);
-            fill_raw[4 * i..4 * i + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
-            for (k, layer) in layer_raws.iter_mut().enumerate() {
-                let alpha = ((counts[k + 1] as f64 * 255.0) / total as f64).round() as u8;
-                let p = palette[k];
-                layer[4 * i..4 * i + 4].copy_from_slice(&[p[0], p[1], p[2], alpha]);
-            }
+    // Per row: its fill and its row of every mask; the rows are independent (rayon).
+    let mut layer_rows: Vec<Vec<&mut [u8]>> = (0..h).map(|_| Vec::with_capacity(m)).collect();
+    for layer in layers.iter_mut() {
+        for (row, chunk) in layer_rows.iter_mut().zip(layer.chunks_mut(4 * w)) {
+            row.push(chunk);
         }
     }
+    fill_only
+        .par_chunks_mut(4 * w)
+        .zip(layer_rows.par_iter_mut())
+        .enumerate()
+        .for_each(|(y, (fill_row, layer_row))| {
+            let mut counts = vec![0u32; m + 1];
+            for x in 0..w {
+                let own = owner[y * w + x] as usize;
+                let (y0, y1, x0, x1) = (
+                    y.saturating_sub(r),
+                    (y + r).min(h - 1),
+                    x.saturating_sub(r),
+                    (x + r).min(w - 1),
+                );
+                // Uniform neighborhoods (the common case) skip the counting.
+                let uniform = (y0..=y1).all(|yy| {
+                    owner[yy * w + x0..=yy * w + x1]
+                        .iter()
+                        .all(|&o| o as usize == own)
+                });
+                counts.fill(0);
+                let total = if uniform {
+                    counts[own] = 1;
+                    1
+                } else {
+                    for yy in y0..=y1 {
+                        for &o in &owner[yy * w + x0..=yy * w + x1] {
+                            counts[o as usize] += 1;
+                        }
+                    }
+                    ((y1 - y0 + 1) * (x1 - x0 + 1)) as u32
+                };
+                let color = if uniform {
+                    // One color's share is all of it: its color exactly (white for none).
+                    own.checked_sub(1).map_or([255; 3], |k| palette[k])
+                } else {
+                    let mut c = [counts[0] as f64 * 255.0; 3];
+                    for (k, p) in palette.iter().enumerate() {
+                        for ch in 0..3 {
+                            c[ch] += counts[k + 1] as f64 * p[ch] as f64;
+                        }
+                    }
+                    c.map(|v| (v / total as f64).round().clamp(0.0, 255.0) as u8)
+                };
+                fill_row[4 * x..4 * x + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
+                for (k, layer) in layer_row.iter_mut().enumerate() {
+                    let alpha = ((counts[k + 1] as f64 * 255.0) / total as f64).round() as u8;
+                    let p = palette[k];
+                    layer[4 * x..4 * x + 4].copy_from_slice(&[p[0], p[1], p[2], alpha]);
+                }
+            }
+        });
     let image = with_lines_on_top(&fill_only, lineart, art.opaque);
     Filled {
         image,
@@ -124,7 +132,16 @@ pub fn fill_owners(
 /// over it otherwise.
 pub fn with_lines_on_top(fill: &RgbaImage, lineart: &RgbaImage, opaque: bool) -> RgbaImage {
     let mut out = fill.clone();
-    for (o, l) in out.pixels_mut().zip(lineart.pixels()) {
+    let row_bytes = (4 * fill.width() as usize).max(1);
+    out.par_chunks_mut(row_bytes)
+        .zip(lineart.par_chunks(row_bytes))
+        .for_each(|(out_row, line_row)| with_lines_on_row(out_row, line_row, opaque));
+    out
+}
+
+/// [`with_lines_on_top`] on one row of RGBA8 pixels.
+fn with_lines_on_row(out: &mut [u8], lineart: &[u8], opaque: bool) {
+    for (o, l) in out.chunks_exact_mut(4).zip(lineart.chunks_exact(4)) {
         for k in 0..3 {
             let (f, c, a) = (o[k] as u32, l[k] as u32, l[3] as u32);
             o[k] = if opaque {
@@ -134,7 +151,6 @@ pub fn with_lines_on_top(fill: &RgbaImage, lineart: &RgbaImage, opaque: bool) ->
             };
         }
     }
-    out
 }
 
 #[cfg(test)]
