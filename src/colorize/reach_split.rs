@@ -59,7 +59,6 @@ pub fn reach_split(
     contested: impl Fn(usize) -> bool,
 ) {
     let (w, h) = (regions.width as usize, regions.height as usize);
-    let cost = crossing_costs(&regions.depth_half_px, depth_exponent);
     let (scribble, radius_px) = scribble_components(labels, w, h, &contested);
     // Each color with its largest scribble's radius, largest first (ties: lower color).
     let mut largest_px: Vec<(u16, f64)> = Vec::new();
@@ -75,10 +74,11 @@ pub fn reach_split(
     }
     largest_px.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     let colors: Vec<u16> = largest_px.iter().map(|&(c, _)| c).collect();
-    let within = steps_within(&regions.region, w, h);
+    let (cost_of_depth, depth) = crossing_costs(&regions.depth_half_px, depth_exponent);
+    let site = sites(&regions.region, &depth, w, h);
     let field = Field {
-        cost: &cost,
-        steps_within: &within,
+        site: &site,
+        cost_of_depth: &cost_of_depth,
         offsets: STEPS.map(|(dx, dy, _)| dy * w as isize + dx),
         scribble: &scribble,
         labels,
@@ -95,14 +95,14 @@ pub fn reach_split(
     {
         // The first batch has nothing to stop at.
         let stop = (k > 0).then_some(&won);
-        let reaches: Vec<Vec<Reach>> = batch.par_iter().map(|&c| field.reach(c, stop)).collect();
+        let reaches: Vec<Reach> = batch.par_iter().map(|&c| field.reach(c, stop)).collect();
         for (&color, reach) in batch.iter().zip(&reaches) {
             for i in 0..w * h {
-                let (a, b) = (reach[i].cost, won.cost[i]);
+                let (a, b) = (reach.cost[i], won.cost[i]);
                 if a < b || (a == b && a.is_finite() && color < won.color[i]) {
                     won.cost[i] = a;
                     won.color[i] = color;
-                    won.radius_px[i] = radius_px[reach[i].from as usize];
+                    won.radius_px[i] = radius_px[reach.from[i] as usize];
                 }
             }
         }
@@ -115,9 +115,10 @@ pub fn reach_split(
     }
 }
 
-/// Per pixel, the cost of crossing it: (depth px, at least [`MIN_DEPTH_PX`])^−α. Depths are
-/// chamfer half px, so the costs come from a table over the depths present.
-fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> Vec<f64> {
+/// The cost of crossing a pixel, (depth px, at least [`MIN_DEPTH_PX`])^−α, as a table over
+/// the depths present, and per pixel its index in the table (its chamfer depth in half px; the
+/// last entry stands for "no line anywhere" and for depths beyond [`MAX_DEPTH_INDEX`]).
+fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> (Vec<f64>, Vec<u32>) {
     let of = |d: u32| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent);
     let far = u32::MAX / 2;
     let top = depth_half_px
@@ -125,20 +126,52 @@ fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> Vec<f64> {
         .copied()
         .filter(|&d| d < far)
         .max()
-        .unwrap_or(0);
-    let table: Vec<f64> = (0..=top).map(of).collect();
-    let beyond = of(far);
-    depth_half_px
-        .iter()
-        .map(|&d| table.get(d as usize).copied().unwrap_or(beyond))
-        .collect()
+        .unwrap_or(0)
+        .min(MAX_DEPTH_INDEX - 1);
+    let mut table: Vec<f64> = (0..=top).map(of).collect();
+    table.push(of(far));
+    let index = depth_half_px
+        .par_iter()
+        .map(|&d| if d <= top { d } else { top + 1 })
+        .collect();
+    (table, index)
+}
+
+/// The largest depth index a pixel's site holds (24 bits beside its 8 step bits): 2²⁴ half
+/// px, 8 million px from the nearest line, far beyond any image.
+const MAX_DEPTH_INDEX: u32 = (1 << 24) - 1;
+
+/// Per pixel its site: its depth index (`depth`) above 8 bits of which steps (`STEPS`) stay in
+/// the image and in its region, bit k for step k. One 4-byte read per pixel tells a front both.
+fn sites(region: &[u32], depth: &[u32], w: usize, h: usize) -> Vec<u32> {
+    let mut site = vec![0u32; w * h];
+    site.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, s) in row.iter_mut().enumerate() {
+                let i = y * w + x;
+                let mut within = 0u32;
+                for (k, &(dx, dy, _)) in STEPS.iter().enumerate() {
+                    let (nx, ny) = (x as isize + dx, y as isize + dy);
+                    if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
+                        continue;
+                    }
+                    if region[ny as usize * w + nx as usize] == region[i] {
+                        within |= 1 << k;
+                    }
+                }
+                *s = depth[i] << 8 | within;
+            }
+        });
+    site
 }
 
 /// What one color's Dijkstra reads.
 struct Field<'a> {
-    cost: &'a [f64],
-    /// Per pixel, bit k set: the step `STEPS[k]` stays in the image and in the pixel's region.
-    steps_within: &'a [u8],
+    /// Per pixel its site ([`sites`]): depth index and the steps that stay in its region.
+    site: &'a [u32],
+    /// Per depth index, the cost of crossing a pixel ([`crossing_costs`]).
+    cost_of_depth: &'a [f64],
     /// Per step of `STEPS`, the index offset it makes.
     offsets: [isize; 8],
     /// Per pixel its scribble component (u32::MAX: none).
@@ -155,82 +188,56 @@ struct Won {
     radius_px: Vec<f64>,
 }
 
-/// One color's reach at one pixel: its cost (∞: not reached, or stopped where it cannot win)
-/// and the scribble it came from (one cell, so a step reads both from one cache line).
-#[derive(Clone, Copy)]
+/// One color's reach: per pixel its cost (∞: not reached, or stopped where it cannot win)
+/// and the scribble it came from.
 struct Reach {
-    cost: f64,
-    from: u32,
+    cost: Vec<f64>,
+    from: Vec<u32>,
 }
 
 impl Field<'_> {
     /// Per pixel the least cost at which `color`'s scribbles reach it: one Dijkstra from all
     /// of them, a front carrying its scribble's radius, within regions, stopped where `won`
     /// (if any) already holds a strictly cheaper cost from a scribble at least as large.
-    fn reach(&self, color: u16, won: Option<&Won>) -> Vec<Reach> {
-        let unreached = Reach {
-            cost: f64::INFINITY,
-            from: u32::MAX,
-        };
-        let mut reach = vec![unreached; self.cost.len()];
+    fn reach(&self, color: u16, won: Option<&Won>) -> Reach {
+        let n = self.site.len();
+        let (mut reach, mut from) = (vec![f64::INFINITY; n], vec![u32::MAX; n]);
         // Costs are finite and non-negative, so they order like their bit patterns, and a
         // Dijkstra's popped costs never decrease: a monotone (radix) heap.
         let mut heap = RadixHeapMap::new();
         for (i, (&s, &l)) in self.scribble.iter().zip(self.labels).enumerate() {
             if s != u32::MAX && l == color {
-                reach[i] = Reach { cost: 0.0, from: s };
+                (reach[i], from[i]) = (0.0, s);
                 heap.push(Reverse(0u64), i as u32);
             }
         }
+        let cost = |site: u32| self.cost_of_depth[(site >> 8) as usize];
         while let Some((Reverse(bits), i)) = heap.pop() {
             let i = i as usize;
             let at = f64::from_bits(bits);
-            let here = reach[i];
-            if at > here.cost {
+            if at > reach[i] {
                 continue;
             }
-            let radius_px = self.radius_px[here.from as usize];
+            let source = from[i];
+            let radius_px = self.radius_px[source as usize];
             let scale = 0.5 / radius_px;
-            let within = self.steps_within[i];
+            let site = self.site[i];
+            let cost_here = cost(site);
             for (k, &(_, _, step_px)) in STEPS.iter().enumerate() {
-                if within & (1 << k) == 0 {
+                if site & (1 << k) == 0 {
                     continue;
                 }
                 let j = i.wrapping_add_signed(self.offsets[k]);
-                let through = at + step_px * (self.cost[i] + self.cost[j]) * scale;
+                let through = at + step_px * (cost_here + cost(self.site[j])) * scale;
                 let lost = |won: &Won| through > won.cost[j] && radius_px <= won.radius_px[j];
-                if through < reach[j].cost && !won.is_some_and(lost) {
-                    reach[j] = Reach {
-                        cost: through,
-                        from: here.from,
-                    };
+                if through < reach[j] && !won.is_some_and(lost) {
+                    (reach[j], from[j]) = (through, source);
                     heap.push(Reverse(through.to_bits()), j as u32);
                 }
             }
         }
-        reach
+        Reach { cost: reach, from }
     }
-}
-
-/// Per pixel, bit k set when the step `STEPS[k]` from it lands in the image and in the same
-/// region.
-fn steps_within(region: &[u32], w: usize, h: usize) -> Vec<u8> {
-    let mut within = vec![0u8; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            for (k, &(dx, dy, _)) in STEPS.iter().enumerate() {
-                let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                    continue;
-                }
-                if region[ny as usize * w + nx as usize] == region[i] {
-                    within[i] |= 1 << k;
-                }
-            }
-        }
-    }
-    within
 }
 
 /// The 8 steps (dx, dy, length px).
