@@ -10,7 +10,7 @@ use crate::rig::PointHandle;
 
 use eframe::egui::Pos2;
 
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 use egui_kittest::Harness;
 
@@ -20,6 +20,7 @@ use std::sync::Arc;
 
 mod animate;
 mod colorize;
+mod colorize_split;
 mod deform;
 mod documents;
 mod events;
@@ -226,6 +227,48 @@ fn type_into(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
     h.key_press_modifiers(Modifiers::COMMAND, Key::A);
     h.run();
     h.get_by_label(label).type_text(text);
+    h.run();
+}
+
+/// Fails unless a user could see `node` to press it: its rect's center lies on the screen and
+/// inside the rect of every enclosing node that has one (the panel, window or menu around
+/// it). kittest's `click` presses at the center wherever that is, so a row scrolled out of
+/// its panel, or a widget off the screen, would otherwise be pressed unseen.
+fn assert_shown(h: &Harness<'_, EditorApp>, node: &egui_kittest::Node<'_>, what: &str) {
+    let ppp = f64::from(h.ctx.pixels_per_point());
+    let rect_of = |n: &egui_kittest::Node<'_>| {
+        n.accesskit_node().bounding_box().map(|b| {
+            egui::Rect::from_min_max(
+                Pos2::new((b.x0 / ppp) as f32, (b.y0 / ppp) as f32),
+                Pos2::new((b.x1 / ppp) as f32, (b.y1 / ppp) as f32),
+            )
+        })
+    };
+    let rect = rect_of(node).unwrap_or_else(|| panic!("{what}: no rect"));
+    let center = rect.center();
+    let screen = h.ctx.content_rect();
+    assert!(
+        screen.contains(center),
+        "{what}: at {center:?}, off the screen {screen:?}"
+    );
+    let mut parent = node.parent();
+    while let Some(p) = parent {
+        if let Some(clip) = rect_of(&p) {
+            assert!(
+                clip.contains(center),
+                "{what}: at {center:?}, outside its {:?} {clip:?}",
+                p.accesskit_node().role()
+            );
+        }
+        parent = p.parent();
+    }
+}
+
+/// Clicks the widget labelled `label` once [`assert_shown`] says a user sees it.
+fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
+    let node = h.get_by_label(label);
+    assert_shown(h, &node, label);
+    node.click();
     h.run();
 }
 
