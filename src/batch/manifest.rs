@@ -148,7 +148,7 @@ pub struct RenderJobOptions {
     #[serde(default = "default_fps")]
     pub fps: f64,
     /// Output px per canvas px. Default 1.
-    #[serde(default = "one")]
+    #[serde(default = "default_scale")]
     pub scale: f64,
     /// Output size [w, h] px. Default: the scaled canvas.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -162,11 +162,11 @@ pub struct RenderJobOptions {
 }
 
 fn default_fps() -> f64 {
-    24.0
+    crate::playback::DEFAULT_RENDER_FPS
 }
 
-fn one() -> f64 {
-    1.0
+fn default_scale() -> f64 {
+    RenderSettings::default().scale
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -224,7 +224,7 @@ impl Default for ExportJobOptions {
         let spine = SpineOptions::default();
         ExportJobOptions {
             skeleton: None,
-            spine_version: "4.2".into(),
+            spine_version: SpineVersion::default().name().into(),
             bake_fps: spine.bake_fps,
             bake: spine.bake,
             preset: SpinePreset::Full,
