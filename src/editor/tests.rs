@@ -230,45 +230,44 @@ fn type_into(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
     h.run();
 }
 
-/// Fails unless a user could see `node` to press it: its rect's center lies on the screen and
-/// inside the rect of every enclosing node that has one (the panel, window or menu around
-/// it). kittest's `click` presses at the center wherever that is, so a row scrolled out of
-/// its panel, or a widget off the screen, would otherwise be pressed unseen.
-fn assert_shown(h: &Harness<'_, EditorApp>, node: &egui_kittest::Node<'_>, what: &str) {
-    let ppp = f64::from(h.ctx.pixels_per_point());
-    let rect_of = |n: &egui_kittest::Node<'_>| {
-        n.accesskit_node().bounding_box().map(|b| {
-            egui::Rect::from_min_max(
-                Pos2::new((b.x0 / ppp) as f32, (b.y0 / ppp) as f32),
-                Pos2::new((b.x1 / ppp) as f32, (b.y1 / ppp) as f32),
-            )
-        })
-    };
-    let rect = rect_of(node).unwrap_or_else(|| panic!("{what}: no rect"));
-    let center = rect.center();
-    let screen = h.ctx.content_rect();
-    assert!(
-        screen.contains(center),
-        "{what}: at {center:?}, off the screen {screen:?}"
-    );
-    let mut parent = node.parent();
-    while let Some(p) = parent {
-        if let Some(clip) = rect_of(&p) {
-            assert!(
-                clip.contains(center),
-                "{what}: at {center:?}, outside its {:?} {clip:?}",
-                p.accesskit_node().role()
-            );
-        }
-        parent = p.parent();
-    }
+/// Where kittest's `click` presses `node`: its id and its rect's centre.
+fn press_point(node: &egui_kittest::Node<'_>) -> (egui::accesskit::NodeId, Pos2) {
+    (node.accesskit_node().locate().0, node.rect().center())
 }
 
-/// Clicks the widget labelled `label` once [`assert_shown`] says a user sees it.
+/// Fails unless a user pointing where kittest's `click` presses (`at`, the centre of the
+/// widget `id`'s rect) would be on that widget: the pointer is moved there and egui's own hit
+/// test of the next frame must find the widget under it. So a widget scrolled out of its
+/// area, clipped, off the screen or under a window or popup fails the test, where `click`
+/// would press whatever is drawn there instead.
+fn assert_shown(
+    h: &mut Harness<'_, EditorApp>,
+    (id, at): (egui::accesskit::NodeId, Pos2),
+    what: &str,
+) {
+    let screen = h.ctx.content_rect();
+    assert!(
+        screen.contains(at),
+        "{what}: at {at:?}, off the screen {screen:?}"
+    );
+    h.hover_at(at);
+    h.step();
+    let under_pointer = h.ctx.interaction_snapshot(|s| {
+        s.contains_pointer
+            .iter()
+            .any(|widget| widget.accesskit_id() == id)
+    });
+    assert!(
+        under_pointer,
+        "{what}: not under the pointer at its centre {at:?} (scrolled away, clipped or covered)"
+    );
+}
+
+/// Clicks the widget labelled `label` once [`assert_shown`] says a user would be on it.
 fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
-    let node = h.get_by_label(label);
-    assert_shown(h, &node, label);
-    node.click();
+    let at = press_point(&h.get_by_label(label));
+    assert_shown(h, at, label);
+    h.get_by_label(label).click();
     h.run();
 }
 

@@ -3,6 +3,7 @@
 use super::*;
 use crate::colorize::synthetic::{scene, SceneSpec};
 use crate::colorize::{ColorizeOptions, RegionSplit, Scribbles};
+use egui::accesskit::Role;
 
 /// Steps frames until the panel says "colorized" (the shown strokes' solve is done).
 fn wait_until_colorized(h: &mut Harness<'_, EditorApp>) {
@@ -30,8 +31,8 @@ fn file_menu_action(
     button: Option<&str>,
 ) {
     click_shown(h, "File");
-    let field = h.get_by_label(label);
-    assert_shown(h, &field, label);
+    let field = press_point(&h.get_by_label(label));
+    assert_shown(h, field, label);
     type_into(h, label, &path.display().to_string());
     if let Some(button) = button {
         click_shown(h, button);
@@ -66,12 +67,14 @@ fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
 
 /// Picks `split` in the panel's "Split" picker.
 fn pick_split(h: &mut Harness<'_, EditorApp>, split: &str) {
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split");
-    assert_shown(h, &picker, "Split");
-    picker.click();
+    let combo =
+        |h: &Harness<'_, EditorApp>| press_point(&h.get_by_role_and_label(Role::ComboBox, "Split"));
+    let at = combo(h);
+    assert_shown(h, at, "Split");
+    h.get_by_role_and_label(Role::ComboBox, "Split").click();
     h.run();
     click_shown(h, split);
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split");
+    let picker = h.get_by_role_and_label(Role::ComboBox, "Split");
     assert_eq!(picker.value().as_deref(), Some(split));
 }
 
@@ -120,7 +123,7 @@ fn the_split_picked_in_the_panel_colors_the_saved_image_as_sinew_colorize_does()
     wait_until_colorized(&mut h);
 
     // The default, reach, with its α shown.
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Split");
+    let picker = h.get_by_role_and_label(Role::ComboBox, "Split");
     assert_eq!(picker.value().as_deref(), Some("reach"));
     let reach = saved(&mut h, &out);
     assert_eq!(differing(&reach, &expected(&ColorizeOptions::default())), 0);
@@ -142,8 +145,8 @@ fn the_split_picked_in_the_panel_colors_the_saved_image_as_sinew_colorize_does()
     pick_split(&mut h, "reach");
     wait_until_colorized(&mut h);
     assert_eq!(differing(&saved(&mut h, &out), &reach), 0);
-    let field = h.get_by_label("α:");
-    assert_shown(&h, &field, "α:");
+    let field = press_point(&h.get_by_label("α:"));
+    assert_shown(&mut h, field, "α:");
     set_number(&mut h, "α:", 1.0);
     wait_until_colorized(&mut h);
     let alpha = saved(&mut h, &out);
