@@ -394,6 +394,13 @@ fn bad_manifests_are_refused_before_any_work() {
         &[split],
         "job 0 ('colorize-0'): unknown variant `deep`, expected one of `reach`, `density`, `depth`, `weights`",
     );
+    let mut alpha = colorize_job(0);
+    alpha["options"]["split_depth_exponent"] = json!(99);
+    assert_refused(
+        "alpha",
+        &[alpha],
+        "job 'colorize-0': invalid colorize option: split_depth_exponent must lie in [0, 32], not 99",
+    );
     assert_refused(
         "names",
         &[colorize_job(0), colorize_job(0)],

@@ -288,7 +288,15 @@ pub const MAX_SPLIT_DEPTH_EXPONENT: f64 = 32.0;
 /// Largest soft-fill radius, px: a wider blend is a blur, not an antialiased edge.
 pub const MAX_SOFT_RADIUS_PX: u32 = 8;
 
-/// Refuses options out of their documented ranges.
+impl ColorizeOptions {
+    /// Refuses options out of their documented ranges ([`ColorizeError::InvalidOptions`]),
+    /// as every colorization does before any work.
+    pub fn check(&self) -> Result<(), ColorizeError> {
+        check_options(self)
+    }
+}
+
+/// [`ColorizeOptions::check`].
 fn check_options(options: &ColorizeOptions) -> Result<(), ColorizeError> {
     if !(0.0..=MAX_LIFT_SCALE_PX).contains(&options.scale) {
         return Err(ColorizeError::InvalidOptions(format!(
