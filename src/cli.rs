@@ -136,14 +136,14 @@ pub struct SpineArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Spine editor line to write for: 4.2 (or 4.1, or 4.3).
-    #[arg(long, default_value = "4.2")]
+    #[arg(long, default_value = SpineVersion::default().name())]
     pub spine_version: String,
     /// Keys per second for motion Spine cannot express natively (baked).
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = SpineOptions::default().bake_fps)]
     pub fps: f64,
     /// full: every vertex and influence; game: meshes decimated to 250 vertices per part and
     /// at most 4 influences per vertex (the two options below override the preset's).
-    #[arg(long, value_parser = choices::parser::<SpinePresetArg, SpinePreset>(), default_value = "full")]
+    #[arg(long, value_parser = choices::parser::<SpinePresetArg, SpinePreset>(), default_value = choices::default_name!(SpinePresetArg, SpinePreset::default()))]
     pub preset: SpinePreset,
     /// Keep the K strongest weights per vertex, renormalized.
     #[arg(long, value_name = "K")]
@@ -152,7 +152,7 @@ pub struct SpineArgs {
     #[arg(long, value_name = "N")]
     pub max_vertices: Option<usize>,
     /// auto: bake only what native timelines cannot express; all: bake every bone.
-    #[arg(long, value_parser = choices::parser::<BakeModeArg, BakeMode>(), default_value = "auto")]
+    #[arg(long, value_parser = choices::parser::<BakeModeArg, BakeMode>(), default_value = choices::default_name!(BakeModeArg, SpineOptions::default().bake))]
     pub bake: BakeMode,
     /// Base name of the files (default: the rig file's name).
     #[arg(long)]
@@ -217,10 +217,10 @@ pub struct RenderArgs {
     #[arg(long)]
     pub anim: String,
     /// Frames per second.
-    #[arg(long, default_value_t = 24.0)]
+    #[arg(long, default_value_t = playback::DEFAULT_RENDER_FPS)]
     pub fps: f64,
     /// Output px per canvas px.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = playback::RenderSettings::default().scale)]
     pub scale: f64,
     /// Output size WxH in px (default: the scaled canvas); the canvas is centered in it.
     #[arg(long, value_parser = parse_size)]
@@ -229,18 +229,18 @@ pub struct RenderArgs {
     #[arg(long)]
     pub background: Option<String>,
     /// How handle transformations blend.
-    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = "linear")]
+    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, playback::RenderSettings::default().blend))]
     pub blend: Blend,
     /// Play curves as this runtime does instead of exactly (see README, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
-    #[arg(long, default_value = "4.2", requires = "match_runtime")]
+    #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
     pub spine_version: String,
     /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
     /// --fps`).
-    #[arg(long, default_value_t = 30.0, requires = "match_runtime")]
+    #[arg(long, default_value_t = SpineOptions::default().bake_fps, requires = "match_runtime")]
     pub bake_fps: f64,
     /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.
@@ -329,7 +329,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub max_area_fraction: Option<f64>,
     /// The weights' energy.
-    #[arg(long = "weights", value_parser = choices::parser::<WeightMethodArg, WeightMethod>(), default_value = "bbw")]
+    #[arg(long = "weights", value_parser = choices::parser::<WeightMethodArg, WeightMethod>(), default_value = choices::default_name!(WeightMethodArg, WeightOptions::default().method))]
     pub weight_method: WeightMethod,
     /// Content-aware weights: measure color changes as this many px.
     #[arg(long, value_name = "S")]
@@ -341,7 +341,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub monotone: bool,
     /// With `--weights rigid`: width of the blend band around joints, px.
-    #[arg(long = "blend", value_name = "PX", default_value_t = 0.0)]
+    #[arg(long = "blend", value_name = "PX", default_value_t = WeightOptions::default().rigid_blend_px)]
     pub rigid_blend_px: f64,
     /// Two-level weights: solve on a coarse mesh of about N vertices of the same domain, carry
     /// the weights to the fine mesh and polish them there (faster on large meshes; see
@@ -420,18 +420,18 @@ pub struct PoseArgs {
     pub time: Option<f64>,
     /// How handle transformations blend: linear (LBS), dqs (dual quaternions) or stretch
     /// (LBS with stretchable bones).
-    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = "linear")]
+    #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, Blend::default()))]
     pub blend: Blend,
     /// With --anim: sample curves as this runtime plays them instead of exactly.
     #[arg(long, value_enum, requires = "anim")]
     pub match_runtime: Option<RuntimeMatch>,
     /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
-    #[arg(long, default_value = "4.2", requires = "match_runtime")]
+    #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
     pub spine_version: String,
     /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
     /// --fps`).
-    #[arg(long, default_value_t = 30.0, requires = "match_runtime")]
+    #[arg(long, default_value_t = SpineOptions::default().bake_fps, requires = "match_runtime")]
     pub bake_fps: f64,
     /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.

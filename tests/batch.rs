@@ -244,6 +244,85 @@ fn the_character_rigs_renders_and_exports_in_one_batch() {
     assert!(std::fs::read(&gif).unwrap() == std::fs::read(dir.join("out/walk.gif")).unwrap());
 }
 
+/// Runs `sinew colorize` on `dir/in/NAME.png` and `.json` with `flags`; returns the image's
+/// bytes.
+fn colorize_command(dir: &Path, name: &str, flags: &[&str]) -> Vec<u8> {
+    let out = dir.join(format!("cli-{name}-{}.png", flags.join("")));
+    let art = dir.join(format!("in/{name}.png"));
+    let strokes = dir.join(format!("in/{name}.json"));
+    let mut args = vec![
+        "colorize",
+        s(&art),
+        "--scribbles",
+        s(&strokes),
+        "-o",
+        s(&out),
+    ];
+    args.extend_from_slice(flags);
+    let run = sinew(&args);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    std::fs::read(&out).unwrap()
+}
+
+#[test]
+fn a_colorize_job_splits_regions_as_the_command_does() {
+    // Two background colors with no line between them: the split decides where they meet.
+    let dir = scratch("split");
+    std::fs::create_dir_all(dir.join("in")).unwrap();
+    let sc = scene(&SceneSpec {
+        size: 96,
+        split_background: true,
+        ..Default::default()
+    });
+    save_png(&dir.join("in/undrawn.png"), &sc.lineart).unwrap();
+    let strokes = json!({ "strokes": sc.strokes });
+    std::fs::write(dir.join("in/undrawn.json"), strokes.to_string()).unwrap();
+    let job = |name: &str, options: Value| {
+        json!({
+            "kind": "colorize", "name": name,
+            "inputs": {"lineart": "in/undrawn.png", "scribbles": "in/undrawn.json"},
+            "options": options,
+            "outputs": {"image": format!("out/{name}.png")}
+        })
+    };
+    let jobs = [
+        job("default", json!({})),
+        job("depth", json!({"split": "depth"})),
+        job("deep", json!({"split": "depth", "split_depth_px": 4})),
+        job("density", json!({"split": "density", "split_blur_px": 3})),
+        job("alpha", json!({"split_depth_exponent": 1})),
+    ];
+    let manifest = write_manifest(&dir, &jobs);
+    let (code, report) = batch(&manifest, &[]);
+    assert_eq!(code, Some(0), "{report}");
+    let written = |name: &str| std::fs::read(dir.join(format!("out/{name}.png"))).unwrap();
+    for (name, flags) in [
+        ("default", vec![]),
+        ("depth", vec!["--split", "depth"]),
+        ("deep", vec!["--split", "depth", "--split-depth", "4"]),
+        ("density", vec!["--split", "density", "--split-blur", "3"]),
+        ("alpha", vec!["--split-exponent", "1"]),
+    ] {
+        assert!(
+            written(name) == colorize_command(&dir, "undrawn", &flags),
+            "job '{name}' differs from sinew colorize {flags:?}"
+        );
+    }
+    // The split matters on this scene: each option changed the image.
+    let default = written("default");
+    for name in ["depth", "density", "alpha"] {
+        assert!(written(name) != default, "'{name}' is the default's image");
+    }
+    assert!(
+        written("deep") != written("depth"),
+        "split_depth_px ignored"
+    );
+}
+
 /// A bad manifest: one line, exit 2, and no job ran (no output, no state).
 fn assert_refused(name: &str, jobs: &[Value], expect: &str) {
     let dir = scratch(name);
@@ -308,6 +387,20 @@ fn bad_manifests_are_refused_before_any_work() {
     let mut option = colorize_job(0);
     option["options"]["fil"] = json!("flat");
     assert_refused("option", &[option], "unknown field `fil`");
+    let mut split = colorize_job(0);
+    split["options"]["split"] = json!("deep");
+    assert_refused(
+        "split",
+        &[split],
+        "job 0 ('colorize-0'): unknown variant `deep`, expected one of `reach`, `density`, `depth`, `weights`",
+    );
+    let mut alpha = colorize_job(0);
+    alpha["options"]["split_depth_exponent"] = json!(99);
+    assert_refused(
+        "alpha",
+        &[alpha],
+        "job 'colorize-0': invalid colorize option: split_depth_exponent must lie in [0, 32], not 99",
+    );
     assert_refused(
         "names",
         &[colorize_job(0), colorize_job(0)],

@@ -5,7 +5,7 @@
 //! "Batch manifest"). Checks that need several jobs (inputs that exist or are made, outputs
 //! written once, no cycle) are [`super::plan`]'s.
 
-use crate::colorize::{ColorWeights, ColorizeOptions, FillMode};
+use crate::colorize::{ColorWeights, ColorizeOptions, FillMode, RegionSplit};
 use crate::export::spine::{BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use crate::io::BuildOptions;
 use crate::playback::RenderSettings;
@@ -148,7 +148,7 @@ pub struct RenderJobOptions {
     #[serde(default = "default_fps")]
     pub fps: f64,
     /// Output px per canvas px. Default 1.
-    #[serde(default = "one")]
+    #[serde(default = "default_scale")]
     pub scale: f64,
     /// Output size [w, h] px. Default: the scaled canvas.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -162,11 +162,11 @@ pub struct RenderJobOptions {
 }
 
 fn default_fps() -> f64 {
-    24.0
+    crate::playback::DEFAULT_RENDER_FPS
 }
 
-fn one() -> f64 {
-    1.0
+fn default_scale() -> f64 {
+    RenderSettings::default().scale
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -224,7 +224,7 @@ impl Default for ExportJobOptions {
         let spine = SpineOptions::default();
         ExportJobOptions {
             skeleton: None,
-            spine_version: "4.2".into(),
+            spine_version: SpineVersion::default().name().into(),
             bake_fps: spine.bake_fps,
             bake: spine.bake,
             preset: SpinePreset::Full,
@@ -278,7 +278,18 @@ enum ColorWeightsName {
     Bbw,
 }
 
-/// `sinew colorize`'s flags.
+/// The names of [`RegionSplit`]'s values.
+#[derive(JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+#[allow(dead_code)]
+enum RegionSplitName {
+    Reach,
+    Density,
+    Depth,
+    Weights,
+}
+
+/// `sinew colorize`'s flags. The defaults are [`ColorizeOptions::default`]'s.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct ColorizeJobOptions {
@@ -290,6 +301,19 @@ pub struct ColorizeJobOptions {
     pub weights: ColorWeights,
     /// Lift scale: a full color change counts as this many px. Default 1000.
     pub scale: f64,
+    /// How a region holding several colors is split (`--split`): reach, depth, density or
+    /// weights. Default reach.
+    #[schemars(with = "RegionSplitName")]
+    pub split: RegionSplit,
+    /// With split reach: α, a pixel d px from the lines costs d^−α to cross
+    /// (`--split-exponent`). Default 6.
+    pub split_depth_exponent: f64,
+    /// With split depth: distances to the lines beyond this many px count as this many
+    /// (`--split-depth`). Default 16.
+    pub split_depth_px: f64,
+    /// With split density: σ in px of the Gaussian that measures the ink around a pixel
+    /// (`--split-blur`). Default 12.
+    pub split_blur_px: f64,
 }
 
 impl Default for ColorizeJobOptions {
@@ -299,6 +323,10 @@ impl Default for ColorizeJobOptions {
             fill: options.fill,
             weights: options.weights,
             scale: options.scale,
+            split: options.split,
+            split_depth_exponent: options.split_depth_exponent,
+            split_depth_px: options.split_depth_px,
+            split_blur_px: options.split_blur_px,
         }
     }
 }
@@ -440,6 +468,10 @@ impl ColorizeJobOptions {
             fill: self.fill,
             weights: self.weights,
             scale: self.scale,
+            split: self.split,
+            split_depth_exponent: self.split_depth_exponent,
+            split_depth_px: self.split_depth_px,
+            split_blur_px: self.split_blur_px,
             ..Default::default()
         }
     }
@@ -509,5 +541,41 @@ mod preset_tests {
         let full = ExportJobOptions::default().spine().unwrap();
         assert_eq!(full, SpineOptions::default());
         assert!(serde_json::from_str::<ExportJobOptions>(r#"{"preset": "tiny"}"#).is_err());
+    }
+}
+
+#[cfg(test)]
+mod colorize_tests {
+    use super::*;
+
+    #[test]
+    fn a_colorize_job_defaults_as_the_library_and_passes_every_option_on() {
+        assert_eq!(
+            ColorizeJobOptions::default().colorize(),
+            ColorizeOptions::default()
+        );
+        let job: ColorizeJobOptions = serde_json::from_str(
+            r#"{"fill": "soft", "weights": "bbw", "scale": 500, "split": "density",
+                "split_depth_exponent": 3, "split_depth_px": 8, "split_blur_px": 5}"#,
+        )
+        .unwrap();
+        let options = job.colorize();
+        assert_eq!(
+            (options.fill, options.weights, options.scale, options.split),
+            (
+                FillMode::Soft,
+                ColorWeights::Bbw,
+                500.0,
+                RegionSplit::Density
+            )
+        );
+        assert_eq!(
+            (
+                options.split_depth_exponent,
+                options.split_depth_px,
+                options.split_blur_px
+            ),
+            (3.0, 8.0, 5.0)
+        );
     }
 }

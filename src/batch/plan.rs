@@ -68,6 +68,12 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
                     .spine()
                     .map_err(|e| BatchError::Job(named(job), e.to_string()))?;
             }
+            Job::Colorize(j) => {
+                j.options
+                    .colorize()
+                    .check()
+                    .map_err(|e| BatchError::Job(named(job), e.to_string()))?;
+            }
             _ => {}
         }
     }

@@ -3,7 +3,8 @@
 //! The library derives no clap trait: each mirror here derives [`clap::ValueEnum`] with the
 //! library variant's name and doc comment (which clap shows as the value's help), and converts
 //! both ways with exhaustive matches, so a variant added to the library and not here does not
-//! compile. Flags keep the library type as their value through [`parser`].
+//! compile. Flags keep the library type as their value through [`parser`], and take their
+//! default from the library through [`default_name!`], so no flag restates a default.
 
 use clap::builder::{EnumValueParser, TypedValueParser};
 use clap::ValueEnum;
@@ -23,6 +24,24 @@ where
 {
     EnumValueParser::<A>::new().map(L::from)
 }
+
+/// The flag value naming library value `$value` through its mirror `$mirror`, as a
+/// `&'static str` for clap's `default_value`: `default_value = default_name!(FillModeArg,
+/// ColorizeOptions::default().fill)` shows and parses the library's default, whatever it
+/// becomes. Worked out once per call site.
+macro_rules! default_name {
+    ($mirror:ty, $value:expr) => {{
+        static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        NAME.get_or_init(|| {
+            clap::ValueEnum::to_possible_value(&<$mirror>::from($value))
+                .expect("mirrors hide no value")
+                .get_name()
+                .to_owned()
+        })
+        .as_str()
+    }};
+}
+pub(crate) use default_name;
 
 macro_rules! mirror {
     ($mirror:ident => $library:ident { $($(#[$doc:meta])* $variant:ident,)* }) => {
@@ -175,5 +194,92 @@ mod tests {
             assert_eq!(SchemaKind::from(kind).name(), name.get_name());
             assert_eq!(SchemaKindArg::from(SchemaKind::from(kind)), kind);
         }
+    }
+
+    /// Parses `sinew ARGS`.
+    fn parse(args: &[&str]) -> crate::cli::Command {
+        use clap::Parser;
+        let argv = std::iter::once("sinew").chain(args.iter().copied());
+        crate::cli::Cli::try_parse_from(argv)
+            .unwrap_or_else(|e| panic!("{args:?}: {e}"))
+            .command
+    }
+
+    #[test]
+    fn flags_left_out_take_the_library_defaults() {
+        use crate::cli::{Command, ExportFormat};
+        use sinew::colorize::ColorizeOptions;
+        use sinew::export::spine::{SpineOptions, SpineVersion};
+        use sinew::io::BuildOptions;
+        use sinew::playback::RenderSettings;
+
+        let Command::Colorize(a) =
+            parse(&["colorize", "a.png", "--scribbles", "s.json", "-o", "o.png"])
+        else {
+            panic!("not colorize")
+        };
+        let d = ColorizeOptions::default();
+        assert_eq!((a.fill, a.weights, a.split), (d.fill, d.weights, d.split));
+        assert_eq!(
+            [
+                a.scale,
+                a.gap_closing,
+                a.split_depth,
+                a.split_exponent,
+                a.split_blur
+            ],
+            [
+                d.scale,
+                d.gap_closing_px,
+                d.split_depth_px,
+                d.split_depth_exponent,
+                d.split_blur_px
+            ]
+        );
+        assert_eq!(
+            [a.join_curve, a.join_segment],
+            [
+                d.end_point_join.spline_max_px,
+                d.end_point_join.segment_max_px
+            ]
+        );
+
+        let Command::Export(export) = parse(&["export", "spine", "rig.json", "-o", "out"]) else {
+            panic!("not export")
+        };
+        let ExportFormat::Spine(a) = export.format;
+        let d = SpineOptions::default();
+        assert_eq!(
+            (a.preset, a.bake, a.fps),
+            (SpinePreset::default(), d.bake, d.bake_fps)
+        );
+        assert_eq!(SpineVersion::parse(&a.spine_version).ok(), Some(d.version));
+
+        let Command::Render(a) = parse(&["render", "rig.json", "--anim", "walk", "-o", "o.gif"])
+        else {
+            panic!("not render")
+        };
+        let d = RenderSettings::default();
+        assert_eq!((a.blend, a.fps, a.scale), (d.blend, d.fps, d.scale));
+        assert_eq!(
+            SpineVersion::parse(&a.spine_version).ok(),
+            Some(d.export.version)
+        );
+        assert_eq!(a.bake_fps, d.export.bake_fps);
+
+        let Command::Pose(a) = parse(&["pose", "rig.json"]) else {
+            panic!("not pose")
+        };
+        assert_eq!(a.blend, Blend::default());
+        assert_eq!(
+            SpineVersion::parse(&a.spine_version).ok(),
+            Some(SpineVersion::default())
+        );
+        assert_eq!(a.bake_fps, SpineOptions::default().bake_fps);
+
+        let Command::Rig(a) = parse(&["rig", "a.png", "-o", "rig.json"]) else {
+            panic!("not rig")
+        };
+        assert_eq!(a.build.options(), BuildOptions::default());
     }
 }

@@ -19,13 +19,13 @@ pub struct ColorizeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// flat: each pixel its region's color; soft: region edges antialiased over about 3 px.
-    #[arg(long, value_parser = choices::parser::<FillModeArg, FillMode>(), default_value = "flat")]
+    #[arg(long, value_parser = choices::parser::<FillModeArg, FillMode>(), default_value = choices::default_name!(FillModeArg, ColorizeOptions::default().fill))]
     pub fill: FillMode,
     /// Also write one mask PNG per scribble color into this folder (NN-rrggbb.png).
     #[arg(long, value_name = "DIR")]
     pub layers: Option<PathBuf>,
     /// The weights' energy.
-    #[arg(long, value_parser = choices::parser::<ColorWeightsArg, ColorWeights>(), default_value = "harmonic")]
+    #[arg(long, value_parser = choices::parser::<ColorWeightsArg, ColorWeights>(), default_value = choices::default_name!(ColorWeightsArg, ColorizeOptions::default().weights))]
     pub weights: ColorWeights,
     /// Lift scale: a full color change counts as S px.
     #[arg(long, value_name = "S", default_value_t = colorize::DEFAULT_LIFT_SCALE)]
@@ -46,7 +46,7 @@ pub struct ColorizeArgs {
     /// scribble reaching in proportion to its size), depth (boundaries where it is
     /// narrowest), density (where ink crowds, G'MIC Smart Coloring's order) or weights (the
     /// content-aware weights).
-    #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = "reach")]
+    #[arg(long, value_parser = choices::parser::<RegionSplitArg, RegionSplit>(), default_value = choices::default_name!(RegionSplitArg, ColorizeOptions::default().split))]
     pub split: RegionSplit,
     /// With --split depth: distances to the lines beyond PX count as PX.
     #[arg(long, value_name = "PX", default_value_t = ColorizeOptions::default().split_depth_px)]

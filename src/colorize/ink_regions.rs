@@ -47,6 +47,26 @@ pub enum RegionSplit {
     Weights,
 }
 
+impl RegionSplit {
+    /// Every split, the default first.
+    pub const ALL: [RegionSplit; 4] = [
+        RegionSplit::Reach,
+        RegionSplit::Depth,
+        RegionSplit::Density,
+        RegionSplit::Weights,
+    ];
+
+    /// The name files and `sinew colorize --split` give it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RegionSplit::Reach => "reach",
+            RegionSplit::Density => "density",
+            RegionSplit::Depth => "depth",
+            RegionSplit::Weights => "weights",
+        }
+    }
+}
+
 /// Per pixel: the closed ink level and the region.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InkRegions {
@@ -286,6 +306,21 @@ pub fn owners<E>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_split_is_named_as_files_name_it() {
+        for split in RegionSplit::ALL {
+            assert_eq!(
+                serde_json::to_value(split).unwrap(),
+                serde_json::Value::String(split.name().into())
+            );
+        }
+        let mut names: Vec<&str> = RegionSplit::ALL.iter().map(|s| s.name()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), 4);
+        assert_eq!(RegionSplit::ALL[0], RegionSplit::default());
+    }
 
     /// A 9×5 drawing: a vertical line at x = 4, with a gap at row 2 when `gap`.
     fn split(gap: bool) -> (Vec<[u8; 3]>, u32, u32) {

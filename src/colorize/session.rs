@@ -200,6 +200,30 @@ impl ColorizeSession {
         &self.lineart.image
     }
 
+    /// The options the session colorizes with.
+    pub fn options(&self) -> &ColorizeOptions {
+        &self.lineart.options
+    }
+
+    /// Colorizes with `options` from now on (the line art prepared again only when its
+    /// preparation changes, [`PreparedLineArt::with_options`]). The strokes and their undo
+    /// history stay; every result kept, current or in the history, is dropped (it was solved
+    /// with the old options), so the next [`ColorizeSession::job`] solves again. On error (bad
+    /// options) nothing changes.
+    pub fn set_options(&mut self, options: ColorizeOptions) -> Result<(), SessionError> {
+        if options == self.lineart.options {
+            return Ok(());
+        }
+        self.lineart = Arc::new(self.lineart.with_options(options)?);
+        for state in std::iter::once(&mut self.state)
+            .chain(&mut self.undo)
+            .chain(&mut self.redo)
+        {
+            state.result = None;
+        }
+        Ok(())
+    }
+
     /// Image size, px.
     pub fn size_px(&self) -> [u32; 2] {
         [self.lineart.image.width(), self.lineart.image.height()]
@@ -525,6 +549,68 @@ mod tests {
             good += ([p[0], p[1], p[2]] == want) as usize;
         }
         good as f64 / n.max(1) as f64
+    }
+
+    #[test]
+    fn new_options_drop_every_result_and_solve_as_the_one_shot_colorize() {
+        // Two background colors and no line between them: the split decides where they meet.
+        let s = scene(&SceneSpec {
+            size: 96,
+            split_background: true,
+            ..Default::default()
+        });
+        let mut session = session(&s);
+        for (k, stroke) in s.strokes.iter().enumerate() {
+            session
+                .apply(SessionCommand::AddStroke(ScribbleStroke {
+                    color: PALETTE[k],
+                    width_px: stroke.width,
+                    points_px: stroke.points.clone(),
+                }))
+                .unwrap();
+            session.solve().unwrap();
+        }
+        let reach = session.result().unwrap().image.clone();
+        let strokes: Vec<Stroke> = session.strokes().iter().map(|s| s.to_stroke()).collect();
+        let one_shot = |options: &ColorizeOptions| {
+            let scribbles = Scribbles::from_strokes(&strokes, 96, 96, &options.scribbles).unwrap();
+            super::super::colorize(&s.lineart, &scribbles, options, false)
+                .unwrap()
+                .image
+        };
+        assert_eq!(reach, one_shot(&ColorizeOptions::default()));
+        // A new split (the preparation kept) and a new split depth (prepared anew).
+        for options in [
+            ColorizeOptions {
+                split: super::super::RegionSplit::Depth,
+                ..Default::default()
+            },
+            ColorizeOptions {
+                split: super::super::RegionSplit::Depth,
+                split_depth_px: 3.0,
+                ..Default::default()
+            },
+        ] {
+            session.set_options(options.clone()).unwrap();
+            assert_eq!(session.options(), &options);
+            assert!(session.result().is_none());
+            assert!(session.undo());
+            assert!(session.result().is_none(), "an undo step kept its result");
+            assert!(session.redo());
+            session.solve().unwrap();
+            let image = &session.result().unwrap().image;
+            assert_eq!(image, &one_shot(&options));
+            assert_ne!(image, &reach);
+        }
+        // Bad options: refused, nothing changes.
+        let kept = session.result().cloned();
+        let bad = ColorizeOptions {
+            split_depth_exponent: -1.0,
+            ..Default::default()
+        };
+        assert!(session.set_options(bad).is_err());
+        assert_eq!(session.options().split_depth_px, 3.0);
+        assert_eq!(session.result().cloned(), kept);
     }
 
     #[test]

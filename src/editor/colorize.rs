@@ -25,6 +25,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::sync::Arc;
 
+mod split_controls;
+
 /// Brush diameter a new session starts with, image px.
 pub const DEFAULT_BRUSH_PX: f32 = 6.0;
 /// The brush color a new editor starts with.
@@ -94,6 +96,9 @@ pub struct ColorizeEditor {
     /// Brush diameter, image px.
     pub width_px: f32,
     pub view_mode: ColorizeView,
+    /// What the solves use (the split picked in the panel); line art opened later takes them
+    /// too.
+    pub options: ColorizeOptions,
     /// Opacity of the result over the line art, 0..=1.
     pub opacity: f32,
     /// This mode's pan and zoom (the line art has its own size); `None` fits it.
@@ -105,6 +110,8 @@ pub struct ColorizeEditor {
     solve: Option<Solve>,
     /// The newest finished solve: its strokes and result, shown until a newer one arrives.
     latest: Option<(Arc<Vec<ScribbleStroke>>, Arc<Colorized>)>,
+    /// `latest` was solved with options changed since: shown, but solved again.
+    latest_stale: bool,
     /// Strokes whose solve failed: not tried again until they change.
     failed: Option<Vec<ScribbleStroke>>,
     lineart_texture: Option<TextureHandle>,
@@ -126,12 +133,14 @@ impl Default for ColorizeEditor {
             color_hex: String::new(),
             width_px: DEFAULT_BRUSH_PX,
             view_mode: ColorizeView::Result,
+            options: ColorizeOptions::default(),
             opacity: 1.0,
             view: None,
             fitted: None,
             drawing: None,
             solve: None,
             latest: None,
+            latest_stale: false,
             failed: None,
             lineart_texture: None,
             result_texture: None,
@@ -186,7 +195,7 @@ impl ColorizeEditor {
         let wanted = self.wanted()?;
         let known = |s: &[ScribbleStroke]| s == wanted.as_slice();
         if wanted.is_empty()
-            || self.latest.as_ref().is_some_and(|(s, _)| known(s))
+            || (!self.latest_stale && self.latest.as_ref().is_some_and(|(s, _)| known(s)))
             || self.failed.as_deref().is_some_and(known)
         {
             return None;
@@ -223,7 +232,7 @@ impl EditorApp {
     pub fn open_lineart(&mut self, path: &Path) {
         let opened = crate::io::load_png(path)
             .map_err(SessionError::from)
-            .and_then(|image| ColorizeSession::new(image, ColorizeOptions::default()));
+            .and_then(|image| ColorizeSession::new(image, self.colorize.options.clone()));
         match opened {
             Ok(session) => {
                 let c = &mut self.colorize;
@@ -240,6 +249,7 @@ impl EditorApp {
                     color: c.color,
                     width_px: c.width_px,
                     view_mode: c.view_mode,
+                    options: c.options.clone(),
                     opacity: c.opacity,
                     ..Default::default()
                 };
@@ -401,6 +411,7 @@ impl EditorApp {
                     let _ = session.set_result(&strokes, result.clone());
                 }
                 c.latest = result.map(|r| (strokes, r));
+                c.latest_stale = false;
                 c.failed = None;
             }
             Err(SessionError::Colorize(ColorizeError::Cancelled)) => {}
@@ -423,8 +434,8 @@ impl EditorApp {
                 return;
             }
         }
-        if let (None, Some(session), Some((strokes, result))) =
-            (&c.drawing, &mut c.session, &c.latest)
+        if let (None, false, Some(session), Some((strokes, result))) =
+            (&c.drawing, c.latest_stale, &mut c.session, &c.latest)
         {
             // The stroke just finished was already solved while it was drawn.
             if session.result().is_none() && session.strokes() == strokes.as_slice() {
@@ -540,6 +551,8 @@ impl EditorApp {
         });
         ui.add(slider(&mut c.opacity, 0.0..=1.0).text("result opacity"));
         ui.separator();
+        let split = c.split_controls(ui);
+        ui.separator();
         ui.label(format!("{strokes} strokes, {} colors", palette.len()));
         let mut command = None;
         for color in &palette {
@@ -585,6 +598,9 @@ impl EditorApp {
         }
         if let Some(command) = command {
             self.apply_colorize(command);
+        }
+        if let Err(message) = split {
+            self.fail(message);
         }
     }
 

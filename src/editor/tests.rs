@@ -10,7 +10,7 @@ use crate::rig::PointHandle;
 
 use eframe::egui::Pos2;
 
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 
 use egui_kittest::Harness;
 
@@ -20,6 +20,7 @@ use std::sync::Arc;
 
 mod animate;
 mod colorize;
+mod colorize_split;
 mod deform;
 mod documents;
 mod events;
@@ -226,6 +227,47 @@ fn type_into(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
     h.key_press_modifiers(Modifiers::COMMAND, Key::A);
     h.run();
     h.get_by_label(label).type_text(text);
+    h.run();
+}
+
+/// Where kittest's `click` presses `node`: its id and its rect's centre.
+fn press_point(node: &egui_kittest::Node<'_>) -> (egui::accesskit::NodeId, Pos2) {
+    (node.accesskit_node().locate().0, node.rect().center())
+}
+
+/// Fails unless a user pointing where kittest's `click` presses (`at`, the centre of the
+/// widget `id`'s rect) would be on that widget: the pointer is moved there and egui's own hit
+/// test of the next frame must find the widget under it. So a widget scrolled out of its
+/// area, clipped, off the screen or under a window or popup fails the test, where `click`
+/// would press whatever is drawn there instead.
+fn assert_shown(
+    h: &mut Harness<'_, EditorApp>,
+    (id, at): (egui::accesskit::NodeId, Pos2),
+    what: &str,
+) {
+    let screen = h.ctx.content_rect();
+    assert!(
+        screen.contains(at),
+        "{what}: at {at:?}, off the screen {screen:?}"
+    );
+    h.hover_at(at);
+    h.step();
+    let under_pointer = h.ctx.interaction_snapshot(|s| {
+        s.contains_pointer
+            .iter()
+            .any(|widget| widget.accesskit_id() == id)
+    });
+    assert!(
+        under_pointer,
+        "{what}: not under the pointer at its centre {at:?} (scrolled away, clipped or covered)"
+    );
+}
+
+/// Clicks the widget labelled `label` once [`assert_shown`] says a user would be on it.
+fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
+    let at = press_point(&h.get_by_label(label));
+    assert_shown(h, at, label);
+    h.get_by_label(label).click();
     h.run();
 }
 

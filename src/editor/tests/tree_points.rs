@@ -84,3 +84,19 @@ fn a_point_handles_row_selects_it_in_every_mode_once_in_view() {
         assert!(shows_selected(&h), "{:?}", h.state().mode);
     }
 }
+
+/// The check the newer tests click through ([`click_shown`]) refuses the row the test above
+/// first clicks on purpose, below the tree's visible part, and takes it once wheeled into view.
+#[test]
+fn click_shown_refuses_a_row_out_of_view_and_takes_it_in_view() {
+    let mut h = open_character("tree-point-shown");
+    let hidden = press_point(&h.get_by_label("antenna_tip"));
+    assert!(*tree_span(&h).end() < hidden.1.y);
+    let refused = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        assert_shown(&mut h, hidden, "antenna_tip")
+    }));
+    assert!(refused.is_err(), "a row out of view passed as shown");
+    wheel_to_row(&mut h, "antenna_tip");
+    click_shown(&mut h, "antenna_tip");
+    assert!(h.query_by_label("Selected: antenna_tip").is_some());
+}

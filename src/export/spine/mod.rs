@@ -81,6 +81,15 @@ impl SpineVersion {
         }
     }
 
+    /// The editor line as [`SpineVersion::parse`] reads it (`4.2`): its inverse.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpineVersion::V4_1 => "4.1",
+            SpineVersion::V4_2 => "4.2",
+            SpineVersion::V4_3 => "4.3",
+        }
+    }
+
     /// The `skeleton.spine` string. Runtimes check major.minor only (spine-format.md §1).
     pub fn version_string(self) -> &'static str {
         match self {
