@@ -16,6 +16,7 @@
 //!    narrowest (a cut, not a distance). An unscribbled region is flooded through its lowest
 //!    crest, the widest opening into it.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -99,7 +100,7 @@ impl InkRegions {
     ) -> Self {
         let (w, h) = (width as usize, height as usize);
         let level: Vec<u8> = closed
-            .iter()
+            .par_iter()
             .map(|c| {
                 let luminance = 0.2126 * c[0] as f32 + 0.7152 * c[1] as f32 + 0.0722 * c[2] as f32;
                 (255.0 - luminance).round().clamp(0.0, 255.0) as u8

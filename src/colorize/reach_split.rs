@@ -96,16 +96,25 @@ pub fn reach_split(
         // The first batch has nothing to stop at.
         let stop = (k > 0).then_some(&won);
         let reaches: Vec<Reach> = batch.par_iter().map(|&c| field.reach(c, stop)).collect();
-        for (&color, reach) in batch.iter().zip(&reaches) {
-            for i in 0..w * h {
-                let (a, b) = (reach.cost[i], won.cost[i]);
-                if a < b || (a == b && a.is_finite() && color < won.color[i]) {
-                    won.cost[i] = a;
-                    won.color[i] = color;
-                    won.radius_px[i] = radius_px[reach.from[i] as usize];
+        // Per pixel, independently (rayon, by rows).
+        let rows = w.max(1);
+        (won.cost.par_chunks_mut(rows))
+            .zip(won.color.par_chunks_mut(rows))
+            .zip(won.radius_px.par_chunks_mut(rows))
+            .enumerate()
+            .for_each(|(y, ((cost, won_color), won_radius_px))| {
+                for (&color, reach) in batch.iter().zip(&reaches) {
+                    for x in 0..cost.len() {
+                        let i = y * rows + x;
+                        let (a, b) = (reach.cost[i], cost[x]);
+                        if a < b || (a == b && a.is_finite() && color < won_color[x]) {
+                            cost[x] = a;
+                            won_color[x] = color;
+                            won_radius_px[x] = radius_px[reach.from[i] as usize];
+                        }
+                    }
                 }
-            }
-        }
+            });
     }
     // Scribble pixels keep their own color.
     for i in 0..w * h {
