@@ -9,8 +9,8 @@
 //! `split: weights`; the mesh size is printed when there is one). The `size/colors` cases'
 //! regions are closed, one color each; the split runs in `undrawn/size` (the background's two
 //! halves share one region, 11 colors in all) and `open/size` (the 10 scribbles on a blank
-//! page: one region holding all 10 colors, the split's worst case: one Dijkstra per color
-//! over every pixel).
+//! page: one region holding all 10 colors, the split's worst case: the largest scribble's
+//! Dijkstra over every pixel, the others stopped where they cannot win).
 //!
 //! Targets (two-core reference machine, issue 24): 2048² under 1 s; peak memory at 2048²
 //! < 1 GiB (`cargo bench --bench colorize_memory`).
