@@ -323,6 +323,16 @@ mod tests {
         owner
     }
 
+    /// [`split`] on a pool of `threads` threads: one runs the colors one by one, each stopped
+    /// where an earlier one wins; as many as there are colors runs them all unstopped.
+    fn split_on(threads: usize, regions: &InkRegions, labels: &[u16], alpha: f64) -> Vec<u16> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        pool.install(|| split(regions, labels, alpha))
+    }
+
     #[test]
     fn a_dab_claims_a_small_disk_and_a_long_stroke_the_rest() {
         // Open paper framed by ink; a 1-px dab of color 2 at (20, 20), a 31-px stroke of
@@ -401,13 +411,7 @@ mod tests {
                 labels[(y * w + x) as usize] = color;
             }
         }
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a pool");
-            pool.install(|| split(&regions, &labels, 6.0))
-        };
+        let on = |threads| split_on(threads, &regions, &labels, 6.0);
         let one = on(1);
         assert_eq!(one, on(3));
         assert_eq!(one, on(6));
@@ -439,13 +443,7 @@ mod tests {
         for x in 10..30 {
             labels[(20 * w + x) as usize] = 2;
         }
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a pool");
-            pool.install(|| split(&regions, &labels, 0.0))
-        };
+        let on = |threads| split_on(threads, &regions, &labels, 0.0);
         let one = on(1);
         assert_eq!(one[(20 * w + 45) as usize], 1, "the dab");
         assert_eq!(one[(20 * w + 55) as usize], 2, "past the dab: color 2");
