@@ -465,7 +465,7 @@ impl EditorApp {
         });
     }
 
-    /// The File menu's colorize entries.
+    /// The File menu's colorize entries; an action closes the menu, as the others do.
     pub(super) fn colorize_file_menu(&mut self, ui: &mut egui::Ui) {
         ui.separator();
         labelled_text_field(
@@ -474,21 +474,25 @@ impl EditorApp {
             &mut self.colorize.lineart_path,
         );
         if ui.button("Open line art").clicked() {
+            ui.close();
             let path = PathBuf::from(&self.colorize.lineart_path);
             self.open_lineart(&path);
         }
         labelled_text_field(ui, "Colorized PNG:", &mut self.colorize.save_path);
         if ui.button("Save colorized PNG").clicked() {
+            ui.close();
             let path = PathBuf::from(&self.colorize.save_path);
             self.message = Some(self.save_colorized(&path));
         }
         labelled_text_field(ui, "Scribbles JSON:", &mut self.colorize.scribbles_path);
         ui.horizontal(|ui| {
             if ui.button("Save scribbles").clicked() {
+                ui.close();
                 let path = PathBuf::from(&self.colorize.scribbles_path);
                 self.message = Some(self.save_scribbles(&path));
             }
             if ui.button("Load scribbles").clicked() {
+                ui.close();
                 let path = PathBuf::from(&self.colorize.scribbles_path);
                 self.load_scribbles(&path);
             }

@@ -22,8 +22,9 @@ fn wait_until_colorized(h: &mut Harness<'_, EditorApp>) {
     );
 }
 
-/// Opens the File menu, types `path` into its field `label`, presses `button` there if any,
-/// and closes the menu with Escape (the colorize entries' buttons leave it open).
+/// Opens the File menu, types `path` into its field `label`, and presses `button` there,
+/// which must close the menu as every File action does; without a button, closes the menu
+/// with Escape.
 fn file_menu_action(
     h: &mut Harness<'_, EditorApp>,
     label: &str,
@@ -36,6 +37,11 @@ fn file_menu_action(
     type_into(h, label, &path.display().to_string());
     if let Some(button) = button {
         click_shown(h, button);
+        assert!(
+            h.query_by_label(label).is_none(),
+            "\"{button}\" left the File menu open"
+        );
+        return;
     }
     // The first Escape leaves the field if it still has the focus, the next closes the menu.
     for _ in 0..2 {
