@@ -292,71 +292,67 @@ impl ColorizeOptions {
     /// Refuses options out of their documented ranges ([`ColorizeError::InvalidOptions`]),
     /// as every colorization does before any work.
     pub fn check(&self) -> Result<(), ColorizeError> {
-        check_options(self)
-    }
-}
-
-/// [`ColorizeOptions::check`].
-fn check_options(options: &ColorizeOptions) -> Result<(), ColorizeError> {
-    if !(0.0..=MAX_LIFT_SCALE_PX).contains(&options.scale) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "the lift scale must lie in [0, {MAX_LIFT_SCALE_PX}] px, not {:e}",
-            options.scale
-        )));
-    }
-    if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "line_threshold must lie in (0, 1], not {}",
-            options.line_threshold
-        )));
-    }
-    if !(options.split_depth_px.is_finite() && options.split_depth_px >= 0.5) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "split_depth_px must be at least 0.5, not {}",
-            options.split_depth_px
-        )));
-    }
-    if !(options.split_depth_exponent.is_finite()
-        && (0.0..=MAX_SPLIT_DEPTH_EXPONENT).contains(&options.split_depth_exponent))
-    {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "split_depth_exponent must lie in [0, {MAX_SPLIT_DEPTH_EXPONENT}], not {}",
-            options.split_depth_exponent
-        )));
-    }
-    for (name, sigma_px) in [
-        ("split_blur_px", options.split_blur_px),
-        ("split_fine_blur_px", options.split_fine_blur_px),
-    ] {
-        if !(sigma_px.is_finite() && (0.0..=MAX_SPLIT_BLUR_PX).contains(&sigma_px)) {
+        let options = self;
+        if !(0.0..=MAX_LIFT_SCALE_PX).contains(&options.scale) {
             return Err(ColorizeError::InvalidOptions(format!(
-                "{name} must lie in [0, {MAX_SPLIT_BLUR_PX}] px, not {sigma_px}"
+                "the lift scale must lie in [0, {MAX_LIFT_SCALE_PX}] px, not {:e}",
+                options.scale
             )));
         }
+        if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "line_threshold must lie in (0, 1], not {}",
+                options.line_threshold
+            )));
+        }
+        if !(options.split_depth_px.is_finite() && options.split_depth_px >= 0.5) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "split_depth_px must be at least 0.5, not {}",
+                options.split_depth_px
+            )));
+        }
+        if !(options.split_depth_exponent.is_finite()
+            && (0.0..=MAX_SPLIT_DEPTH_EXPONENT).contains(&options.split_depth_exponent))
+        {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "split_depth_exponent must lie in [0, {MAX_SPLIT_DEPTH_EXPONENT}], not {}",
+                options.split_depth_exponent
+            )));
+        }
+        for (name, sigma_px) in [
+            ("split_blur_px", options.split_blur_px),
+            ("split_fine_blur_px", options.split_fine_blur_px),
+        ] {
+            if !(sigma_px.is_finite() && (0.0..=MAX_SPLIT_BLUR_PX).contains(&sigma_px)) {
+                return Err(ColorizeError::InvalidOptions(format!(
+                    "{name} must lie in [0, {MAX_SPLIT_BLUR_PX}] px, not {sigma_px}"
+                )));
+            }
+        }
+        if options.soft_radius_px > MAX_SOFT_RADIUS_PX {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "soft_radius_px must be at most {MAX_SOFT_RADIUS_PX}, not {}",
+                options.soft_radius_px
+            )));
+        }
+        if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
+            return Err(ColorizeError::InvalidOptions(format!(
+                "gap_closing_px must be finite and non-negative, not {}",
+                options.gap_closing_px
+            )));
+        }
+        options
+            .end_point_join
+            .check()
+            .map_err(ColorizeError::InvalidOptions)?;
+        Ok(())
     }
-    if options.soft_radius_px > MAX_SOFT_RADIUS_PX {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "soft_radius_px must be at most {MAX_SOFT_RADIUS_PX}, not {}",
-            options.soft_radius_px
-        )));
-    }
-    if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
-        return Err(ColorizeError::InvalidOptions(format!(
-            "gap_closing_px must be finite and non-negative, not {}",
-            options.gap_closing_px
-        )));
-    }
-    options
-        .end_point_join
-        .check()
-        .map_err(ColorizeError::InvalidOptions)?;
-    Ok(())
 }
 
 impl PreparedLineArt {
     /// Checks `options` and prepares `lineart` for colorizations with them.
     pub fn new(lineart: RgbaImage, options: ColorizeOptions) -> Result<Self, ColorizeError> {
-        check_options(&options)?;
+        options.check()?;
         let art = LineArt::new(&lineart);
         // The lift and the mesh see the drawing with its gaps closed: end points joined by
         // curves of full ink, then every line's ridge.
@@ -402,7 +398,7 @@ impl PreparedLineArt {
         if !same_preparation {
             return PreparedLineArt::new(self.image.clone(), options);
         }
-        check_options(&options)?;
+        options.check()?;
         Ok(PreparedLineArt {
             options,
             ..self.clone()
