@@ -59,21 +59,25 @@ pub fn reach_split(
     contested: impl Fn(usize) -> bool,
 ) {
     let (w, h) = (regions.width as usize, regions.height as usize);
-    let (scribble, radius_px) = scribble_components(labels, w, h, &contested);
+    let (scribble, radius_px, color_of) = scribble_components(labels, w, h, &contested);
     // Each color with its largest scribble's radius, largest first (ties: lower color).
     let mut largest_px: Vec<(u16, f64)> = Vec::new();
-    for i in 0..w * h {
-        if scribble[i] == u32::MAX {
-            continue;
-        }
-        let r = radius_px[scribble[i] as usize];
-        match largest_px.iter_mut().find(|(c, _)| *c == labels[i]) {
+    for (&color, &r) in color_of.iter().zip(&radius_px) {
+        match largest_px.iter_mut().find(|(c, _)| *c == color) {
             Some((_, largest)) => *largest = largest.max(r),
-            None => largest_px.push((labels[i], r)),
+            None => largest_px.push((color, r)),
         }
     }
     largest_px.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     let colors: Vec<u16> = largest_px.iter().map(|&(c, _)| c).collect();
+    // Per color (indexed by its label), its scribbles' pixels, ascending.
+    let mut seeds: Vec<Vec<u32>> =
+        vec![Vec::new(); colors.iter().max().map_or(0, |&c| c as usize + 1)];
+    for (i, &s) in scribble.iter().enumerate() {
+        if s != u32::MAX {
+            seeds[color_of[s as usize] as usize].push(i as u32);
+        }
+    }
     let (cost_of_depth, depth) = crossing_costs(&regions.depth_half_px, depth_exponent);
     let site = sites(&regions.region, &depth, w, h);
     let field = Field {
@@ -81,7 +85,7 @@ pub fn reach_split(
         cost_of_depth: &cost_of_depth,
         offsets: STEPS.map(|(dx, dy, _)| dy * w as isize + dx),
         scribble: &scribble,
-        labels,
+        seeds: &seeds,
         radius_px: &radius_px,
     };
     let mut won = Won {
@@ -185,7 +189,8 @@ struct Field<'a> {
     offsets: [isize; 8],
     /// Per pixel its scribble component (u32::MAX: none).
     scribble: &'a [u32],
-    labels: &'a [u16],
+    /// Per color label, its scribbles' pixels.
+    seeds: &'a [Vec<u32>],
     radius_px: &'a [f64],
 }
 
@@ -214,11 +219,9 @@ impl Field<'_> {
         // Costs are finite and non-negative, so they order like their bit patterns, and a
         // Dijkstra's popped costs never decrease: a monotone (radix) heap.
         let mut heap = RadixHeapMap::new();
-        for (i, (&s, &l)) in self.scribble.iter().zip(self.labels).enumerate() {
-            if s != u32::MAX && l == color {
-                (reach[i], from[i]) = (0.0, s);
-                heap.push(Reverse(0u64), i as u32);
-            }
+        for &i in &self.seeds[color as usize] {
+            (reach[i as usize], from[i as usize]) = (0.0, self.scribble[i as usize]);
+            heap.push(Reverse(0u64), i);
         }
         let cost = |site: u32| self.cost_of_depth[(site >> 8) as usize];
         while let Some((Reverse(bits), i)) = heap.pop() {
@@ -262,15 +265,15 @@ const STEPS: [(isize, isize, f64); 8] = [
 ];
 
 /// The scribbles in contested regions: per pixel its scribble (an 8-connected component of one
-/// color's scribble pixels; u32::MAX: none) and per scribble its radius, px.
+/// color's scribble pixels; u32::MAX: none), and per scribble its radius, px, and its color.
 fn scribble_components(
     labels: &[u16],
     w: usize,
     h: usize,
     contested: &impl Fn(usize) -> bool,
-) -> (Vec<u32>, Vec<f64>) {
+) -> (Vec<u32>, Vec<f64>, Vec<u16>) {
     let mut component = vec![u32::MAX; w * h];
-    let mut radius_px = Vec::new();
+    let (mut radius_px, mut color_of) = (Vec::new(), Vec::new());
     let mut stack = Vec::new();
     for seed in 0..w * h {
         if labels[seed] == 0 || component[seed] != u32::MAX || !contested(seed) {
@@ -298,8 +301,9 @@ fn scribble_components(
         }
         let diagonal_px = ((x1 - x0) as f64).hypot((y1 - y0) as f64);
         radius_px.push(diagonal_px / 2.0 + DOT_RADIUS_PX);
+        color_of.push(color);
     }
-    (component, radius_px)
+    (component, radius_px, color_of)
 }
 
 #[cfg(test)]
