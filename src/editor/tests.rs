@@ -43,9 +43,17 @@ mod workflow;
 /// Frames a background weight build may take before a test gives up (50 ms apart).
 const BUILD_FRAMES: usize = 1200;
 
+/// Frames one `Harness::run` may take before it fails (kittest's default is 4). A save or
+/// autosave written on another thread wakes the UI when it ends (`file.rs`), at a moment that
+/// depends on the machine's load: landing inside a `run`, each wake-up adds up to two frames
+/// to the three a typed field usually takes, and a run may see the save's and the autosave's.
+/// A UI that never stops repainting still fails.
+const MAX_STEPS_PER_RUN: u64 = 8;
+
 fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
     Harness::builder()
         .with_size(egui::vec2(1200.0, 800.0))
+        .with_max_steps(MAX_STEPS_PER_RUN)
         .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
 }
 
