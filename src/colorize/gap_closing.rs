@@ -4,8 +4,9 @@
 //! In: the line art's colors over white (RGB8, row-major), the image size and the fade
 //! distance `fade_px`. Out: the "closed" colors the 5D lift and the mesh use: per channel, the
 //! darkness 255 − c becomes max over pixels q of (darkness(q) − 255·|p − q| / fade_px), a
-//! grayscale dilation by a cone, computed in two chamfer passes (Borgefors 1986 weights 1 and
-//! √2 per step; exact integer arithmetic, so results are portable).
+//! grayscale dilation by a cone, computed by chamfer propagation ([`super::chamfer`],
+//! Borgefors 1986 weights 1 and √2 per step; exact integer arithmetic, so results are
+//! portable).
 //!
 //! In the middle of a gap g px wide the ridge is still 1 − g / (2·fade_px) of the line's ink:
 //! crossing it costs, so the colors on both sides stay apart (LazyBrush and Krita's colorize
@@ -13,63 +14,38 @@
 //! `fade_px`) nothing changes. A thin antialiased line whose pixels are only 8-connected
 //! becomes a ridge several pixels wide, which the mesh resolves with well-shaped triangles.
 
+use super::chamfer;
+use rayon::prelude::*;
+
 /// The colors with every line's ridge of ink added. `fade_px` ≤ 0 returns the colors as
 /// they are.
 pub fn close_gaps(colors: &[[u8; 3]], width: u32, height: u32, fade_px: f64) -> Vec<[u8; 3]> {
     if fade_px.is_nan() || fade_px <= 0.0 || fade_px.is_infinite() {
         return colors.to_vec();
     }
-    let (w, h) = (width as usize, height as usize);
-    // Darkness lost per axial and per diagonal step, in 1/255 units.
-    let axial = (255.0 / fade_px).round().max(1.0) as i32;
-    let diagonal = (255.0 * std::f64::consts::SQRT_2 / fade_px)
-        .round()
-        .max(1.0) as i32;
-    let mut dark: Vec<[i32; 3]> = colors.iter().map(|c| c.map(|v| 255 - v as i32)).collect();
-    let relax = |dark: &mut Vec<[i32; 3]>, i: usize, j: usize, step: i32| {
-        let from = dark[j];
-        for (d, f) in dark[i].iter_mut().zip(from) {
-            *d = (*d).max(f - step);
-        }
+    debug_assert_eq!(colors.len(), width as usize * height as usize);
+    // Darkness lost per axial and per diagonal step, in 1/255 units (a loss of 255 or more
+    // leaves nothing, as does exactly 255).
+    let step = |per_px: f64| (per_px / fade_px).round().clamp(1.0, 255.0) as u8;
+    let (axial, diagonal) = (step(255.0), step(255.0 * std::f64::consts::SQRT_2));
+    // One darkness plane per channel, each dilated; a gray drawing needs only one.
+    let plane = |k: usize| -> Vec<u8> {
+        let mut dark: Vec<u8> = colors.par_iter().map(|c| 255 - c[k]).collect();
+        chamfer::propagate(
+            &mut dark,
+            width as usize,
+            axial,
+            diagonal,
+            |d, from, step| d.max(from.saturating_sub(step)),
+        );
+        dark
     };
-    // Forward: from the left and the row above.
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            if x > 0 {
-                relax(&mut dark, i, i - 1, axial);
-            }
-            if y > 0 {
-                relax(&mut dark, i, i - w, axial);
-                if x > 0 {
-                    relax(&mut dark, i, i - w - 1, diagonal);
-                }
-                if x + 1 < w {
-                    relax(&mut dark, i, i - w + 1, diagonal);
-                }
-            }
-        }
+    if colors.par_iter().all(|c| c[0] == c[1] && c[1] == c[2]) {
+        return plane(0).par_iter().map(|&d| [255 - d; 3]).collect();
     }
-    // Backward: from the right and the row below.
-    for y in (0..h).rev() {
-        for x in (0..w).rev() {
-            let i = y * w + x;
-            if x + 1 < w {
-                relax(&mut dark, i, i + 1, axial);
-            }
-            if y + 1 < h {
-                relax(&mut dark, i, i + w, axial);
-                if x + 1 < w {
-                    relax(&mut dark, i, i + w + 1, diagonal);
-                }
-                if x > 0 {
-                    relax(&mut dark, i, i + w - 1, diagonal);
-                }
-            }
-        }
-    }
-    dark.iter()
-        .map(|d| d.map(|v| (255 - v.clamp(0, 255)) as u8))
+    let (r, (g, b)) = rayon::join(|| plane(0), || rayon::join(|| plane(1), || plane(2)));
+    (r.par_iter().zip(&g).zip(&b))
+        .map(|((&r, &g), &b)| [255 - r, 255 - g, 255 - b])
         .collect()
 }
 
@@ -95,5 +71,26 @@ mod tests {
         assert_eq!(at(10, 4), 128);
         // Off means unchanged.
         assert_eq!(close_gaps(&colors, w, h, 0.0), colors);
+    }
+
+    #[test]
+    fn each_channel_of_a_colored_drawing_closes_as_that_channel_drawn_in_gray() {
+        // A red row and a blue column crossing, with a gap each, over white.
+        let (w, h) = (15u32, 11u32);
+        let mut colors = vec![[255u8; 3]; (w * h) as usize];
+        for x in (0..w).filter(|x| !(6..8).contains(x)) {
+            colors[(5 * w + x) as usize] = [220, 30, 40];
+        }
+        for y in (0..h).filter(|&y| y != 2) {
+            colors[(y * w + 10) as usize] = [20, 60, 230];
+        }
+        let closed = close_gaps(&colors, w, h, 3.0);
+        for k in 0..3 {
+            let gray: Vec<[u8; 3]> = colors.iter().map(|c| [c[k]; 3]).collect();
+            let expected: Vec<u8> = close_gaps(&gray, w, h, 3.0).iter().map(|c| c[0]).collect();
+            let got: Vec<u8> = closed.iter().map(|c| c[k]).collect();
+            assert_eq!(got, expected, "channel {k}");
+        }
+        assert_ne!(closed, colors);
     }
 }

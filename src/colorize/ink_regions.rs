@@ -16,6 +16,7 @@
 //!    narrowest (a cut, not a distance). An unscribbled region is flooded through its lowest
 //!    crest, the widest opening into it.
 
+use super::{chamfer, components};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -98,7 +99,7 @@ impl InkRegions {
         line_threshold: f32,
         depth_px: f64,
     ) -> Self {
-        let (w, h) = (width as usize, height as usize);
+        let w = width as usize;
         let level: Vec<u8> = closed
             .par_iter()
             .map(|c| {
@@ -107,30 +108,11 @@ impl InkRegions {
             })
             .collect();
         let barrier_from = (line_threshold * 255.0).ceil().clamp(1.0, 255.0) as u8;
-        let mut region = vec![0u32; w * h];
-        let mut count = 0usize;
-        let mut stack = Vec::new();
-        for seed in 0..w * h {
-            if region[seed] != 0 || level[seed] >= barrier_from {
-                continue;
-            }
-            count += 1;
-            let id = count as u32;
-            region[seed] = id;
-            stack.push(seed);
-            while let Some(i) = stack.pop() {
-                for j in neighbors4(i, w, h) {
-                    if region[j] == 0 && level[j] < barrier_from {
-                        region[j] = id;
-                        stack.push(j);
-                    }
-                }
-            }
-        }
-        let depth_half_px = chamfer_half_px(&region, w, h);
+        let (region, count) = components::label_components(&level, w, barrier_from);
+        let depth_half_px = chamfer_half_px(&region, w);
         let far_half_px = (2.0 * depth_px).round().clamp(1.0, 1e6) as u32;
         let shallowness = depth_half_px
-            .iter()
+            .par_iter()
             .map(|&v| (255 - (v.min(far_half_px) as u64 * 255 / far_half_px as u64)) as u8)
             .collect();
         InkRegions {
@@ -160,53 +142,15 @@ impl InkRegions {
 }
 
 /// The chamfer distance (2 per axial, 3 per diagonal step: half pixels) to the nearest
-/// barrier pixel (`region` 0); 0 on barriers, u32::MAX / 2 everywhere without any.
-fn chamfer_half_px(region: &[u32], w: usize, h: usize) -> Vec<u32> {
+/// barrier pixel (`region` 0) in an image `w` wide; 0 on barriers, u32::MAX / 2 everywhere
+/// without any.
+fn chamfer_half_px(region: &[u32], w: usize) -> Vec<u32> {
     const FAR: u32 = u32::MAX / 2;
     let mut d: Vec<u32> = region
-        .iter()
+        .par_iter()
         .map(|&r| if r == 0 { 0 } else { FAR })
         .collect();
-    let relax = |d: &mut Vec<u32>, i: usize, j: usize, step: u32| {
-        let v = d[j] + step;
-        if v < d[i] {
-            d[i] = v;
-        }
-    };
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            if x > 0 {
-                relax(&mut d, i, i - 1, 2);
-            }
-            if y > 0 {
-                relax(&mut d, i, i - w, 2);
-                if x > 0 {
-                    relax(&mut d, i, i - w - 1, 3);
-                }
-                if x + 1 < w {
-                    relax(&mut d, i, i - w + 1, 3);
-                }
-            }
-        }
-    }
-    for y in (0..h).rev() {
-        for x in (0..w).rev() {
-            let i = y * w + x;
-            if x + 1 < w {
-                relax(&mut d, i, i + 1, 2);
-            }
-            if y + 1 < h {
-                relax(&mut d, i, i + w, 2);
-                if x + 1 < w {
-                    relax(&mut d, i, i + w + 1, 3);
-                }
-                if x > 0 {
-                    relax(&mut d, i, i + w - 1, 3);
-                }
-            }
-        }
-    }
+    chamfer::propagate(&mut d, w, 2, 3, |d, from, step| d.min(from + step));
     d
 }
 

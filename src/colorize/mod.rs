@@ -31,6 +31,8 @@
 //! [`flood`] is the paint-bucket baseline and [`score`] the measure the tests use;
 //! [`synthetic`] draws test line art with known true colorings.
 
+pub mod chamfer;
+pub mod components;
 pub mod density_split;
 pub mod end_point_join;
 pub mod fill;
