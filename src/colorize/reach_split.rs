@@ -135,7 +135,7 @@ fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> (Vec<f64>, Vec<
     let of = |d: u32| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent);
     let far = u32::MAX / 2;
     let top = depth_half_px
-        .iter()
+        .par_iter()
         .copied()
         .filter(|&d| d < far)
         .max()
@@ -157,23 +157,25 @@ const MAX_DEPTH_INDEX: u32 = (1 << 24) - 1;
 /// Per pixel its site: its depth index (`depth`) above 8 bits of which steps (`STEPS`) stay in
 /// the image and in its region, bit k for step k. One 4-byte read per pixel tells a front both.
 fn sites(region: &[u32], depth: &[u32], w: usize, h: usize) -> Vec<u32> {
-    let mut site = vec![0u32; w * h];
+    let mut site: Vec<u32> = depth.par_iter().map(|&d| d << 8).collect();
+    let row_of = |y: usize| &region[y * w..(y + 1) * w];
     site.par_chunks_mut(w.max(1))
         .enumerate()
         .for_each(|(y, row)| {
-            for (x, s) in row.iter_mut().enumerate() {
-                let i = y * w + x;
-                let mut within = 0u32;
-                for (k, &(dx, dy, _)) in STEPS.iter().enumerate() {
-                    let (nx, ny) = (x as isize + dx, y as isize + dy);
-                    if nx < 0 || ny < 0 || nx >= w as isize || ny >= h as isize {
-                        continue;
-                    }
-                    if region[ny as usize * w + nx as usize] == region[i] {
-                        within |= 1 << k;
-                    }
+            let here = row_of(y);
+            for (k, &(dx, dy, _)) in STEPS.iter().enumerate() {
+                let Some(other) = y.checked_add_signed(dy).filter(|&ny| ny < h).map(row_of) else {
+                    continue;
+                };
+                // The pixels whose step stays in the image, beside the ones it lands on.
+                let (row, here, other) = match dx {
+                    -1 => (&mut row[1..], &here[1..], &other[..w - 1]),
+                    1 => (&mut row[..w - 1], &here[..w - 1], &other[1..]),
+                    _ => (&mut row[..], here, other),
+                };
+                for ((s, a), b) in row.iter_mut().zip(here).zip(other) {
+                    *s |= u32::from(a == b) << k;
                 }
-                *s = depth[i] << 8 | within;
             }
         });
     site
