@@ -93,32 +93,61 @@ pub fn reach_split(
         color: vec![0; w * h],
         radius_px: vec![0.0; w * h],
     };
-    for (k, batch) in colors
-        .chunks(rayon::current_num_threads().max(1))
-        .enumerate()
-    {
+    // One reach buffer per color of a batch, reused: after a batch only the pixels it reached
+    // are reset, so a late color stopped after a few pixels costs a few pixels.
+    let threads = rayon::current_num_threads().max(1);
+    let mut reaches: Vec<Reach> = Vec::new();
+    let batches = colors.chunks(threads).count();
+    for (k, batch) in colors.chunks(threads).enumerate() {
+        while reaches.len() < batch.len() {
+            reaches.push(Reach::unreached(w * h));
+        }
+        let reaches = &mut reaches[..batch.len()];
         // The first batch has nothing to stop at.
         let stop = (k > 0).then_some(&won);
-        let reaches: Vec<Reach> = batch.par_iter().map(|&c| field.reach(c, stop)).collect();
-        // Per pixel, independently (rayon, by rows).
-        let rows = w.max(1);
-        (won.cost.par_chunks_mut(rows))
-            .zip(won.color.par_chunks_mut(rows))
-            .zip(won.radius_px.par_chunks_mut(rows))
-            .enumerate()
-            .for_each(|(y, ((cost, won_color), won_radius_px))| {
-                for (&color, reach) in batch.iter().zip(&reaches) {
-                    for x in 0..cost.len() {
-                        let i = y * rows + x;
-                        let (a, b) = (reach.cost[i], cost[x]);
-                        if a < b || (a == b && a.is_finite() && color < won_color[x]) {
-                            cost[x] = a;
-                            won_color[x] = color;
-                            won_radius_px[x] = radius_px[reach.from[i] as usize];
-                        }
-                    }
+        (reaches.par_iter_mut().zip(batch)).for_each(|(reach, &c)| field.reach(c, stop, reach));
+        let offer = |won_cost: &mut f64, won_color: &mut u16, won_radius_px: &mut f64, i: usize| {
+            for (&color, reach) in batch.iter().zip(reaches.iter()) {
+                let (offered, taken) = (reach.cost[i], *won_cost);
+                if offered < taken
+                    || (offered == taken && offered.is_finite() && color < *won_color)
+                {
+                    *won_cost = offered;
+                    *won_color = color;
+                    *won_radius_px = radius_px[reach.from[i] as usize];
                 }
-            });
+            }
+        };
+        let reached: usize = reaches.iter().map(|r| r.reached.len()).sum();
+        if reached < w * h / SPARSE_MERGE_SHARE {
+            // Few pixels reached: offer only those, in one thread.
+            for reach in reaches.iter() {
+                for &i in &reach.reached {
+                    let i = i as usize;
+                    offer(
+                        &mut won.cost[i],
+                        &mut won.color[i],
+                        &mut won.radius_px[i],
+                        i,
+                    );
+                }
+            }
+        } else {
+            // Per pixel, independently (rayon, by rows).
+            let rows = w.max(1);
+            (won.cost.par_chunks_mut(rows))
+                .zip(won.color.par_chunks_mut(rows))
+                .zip(won.radius_px.par_chunks_mut(rows))
+                .enumerate()
+                .for_each(|(y, ((cost, color), radius_px))| {
+                    for x in 0..cost.len() {
+                        offer(&mut cost[x], &mut color[x], &mut radius_px[x], y * rows + x);
+                    }
+                });
+        }
+        if k + 1 < batches {
+            reaches.par_iter_mut().for_each(Reach::reset);
+        }
     }
     // Scribble pixels keep their own color.
     for i in 0..w * h {
@@ -149,6 +178,10 @@ fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> (Vec<f64>, Vec<
         .collect();
     (table, index)
 }
+
+/// A batch whose colors reached fewer than 1/this of the pixels is merged (and its buffers
+/// reset) pixel by pixel over the ones reached; otherwise over every pixel in order.
+const SPARSE_MERGE_SHARE: usize = 8;
 
 /// The largest depth index a pixel's site holds (24 bits beside its 8 step bits): 2²⁴ half
 /// px, 8 million px from the nearest line, far beyond any image.
@@ -205,34 +238,68 @@ struct Won {
 }
 
 /// One color's reach: per pixel its cost (∞: not reached, or stopped where it cannot win)
-/// and the scribble it came from.
+/// and the scribble it came from, and the pixels it reached.
 struct Reach {
     cost: Vec<f64>,
     from: Vec<u32>,
+    /// The pixels whose cost is finite, each once.
+    reached: Vec<u32>,
+}
+
+impl Reach {
+    /// No pixel reached, over `n` pixels.
+    fn unreached(n: usize) -> Self {
+        Reach {
+            cost: vec![f64::INFINITY; n],
+            from: vec![u32::MAX; n],
+            reached: Vec::new(),
+        }
+    }
+
+    /// Sets pixel `i`'s cost and scribble.
+    fn set(&mut self, i: usize, cost: f64, from: u32) {
+        if self.cost[i] == f64::INFINITY {
+            self.reached.push(i as u32);
+        }
+        (self.cost[i], self.from[i]) = (cost, from);
+    }
+
+    /// Back to no pixel reached, touching only the pixels that were (or every pixel, in
+    /// order, when they were many).
+    fn reset(&mut self) {
+        if self.reached.len() < self.cost.len() / SPARSE_MERGE_SHARE {
+            for &i in &self.reached {
+                (self.cost[i as usize], self.from[i as usize]) = (f64::INFINITY, u32::MAX);
+            }
+        } else {
+            self.cost.fill(f64::INFINITY);
+            self.from.fill(u32::MAX);
+        }
+        self.reached.clear();
+    }
 }
 
 impl Field<'_> {
     /// Per pixel the least cost at which `color`'s scribbles reach it: one Dijkstra from all
     /// of them, a front carrying its scribble's radius, within regions, stopped where `won`
     /// (if any) already holds a strictly cheaper cost from a scribble at least as large.
-    fn reach(&self, color: u16, won: Option<&Won>) -> Reach {
-        let n = self.site.len();
-        let (mut reach, mut from) = (vec![f64::INFINITY; n], vec![u32::MAX; n]);
+    /// `into` starts unreached ([`Reach::unreached`] or [`Reach::reset`]).
+    fn reach(&self, color: u16, won: Option<&Won>, into: &mut Reach) {
         // Costs are finite and non-negative, so they order like their bit patterns, and a
         // Dijkstra's popped costs never decrease: a monotone (radix) heap.
         let mut heap = RadixHeapMap::new();
         for &i in &self.seeds[color as usize] {
-            (reach[i as usize], from[i as usize]) = (0.0, self.scribble[i as usize]);
+            into.set(i as usize, 0.0, self.scribble[i as usize]);
             heap.push(Reverse(0u64), i);
         }
         let cost = |site: u32| self.cost_of_depth[(site >> 8) as usize];
         while let Some((Reverse(bits), i)) = heap.pop() {
             let i = i as usize;
             let at = f64::from_bits(bits);
-            if at > reach[i] {
+            if at > into.cost[i] {
                 continue;
             }
-            let source = from[i];
+            let source = into.from[i];
             let radius_px = self.radius_px[source as usize];
             let scale = 0.5 / radius_px;
             let site = self.site[i];
@@ -244,13 +311,12 @@ impl Field<'_> {
                 let j = i.wrapping_add_signed(self.offsets[k]);
                 let through = at + step_px * (cost_here + cost(self.site[j])) * scale;
                 let lost = |won: &Won| through > won.cost[j] && radius_px <= won.radius_px[j];
-                if through < reach[j] && !won.is_some_and(lost) {
-                    (reach[j], from[j]) = (through, source);
+                if through < into.cost[j] && !won.is_some_and(lost) {
+                    into.set(j, through, source);
                     heap.push(Reverse(through.to_bits()), j as u32);
                 }
             }
         }
-        Reach { cost: reach, from }
     }
 }
 
