@@ -333,15 +333,91 @@ fn assert_refused(name: &str, jobs: &[Value], expect: &str) {
     assert!(!dir.join("batch.state.json").exists());
 }
 
+/// `job` with the field at `path` (keys from the job's top) set to `value`.
+fn with_field(mut job: Value, path: &[&str], value: Value) -> Value {
+    let mut field = &mut job;
+    for key in path {
+        field = &mut field[*key];
+    }
+    *field = value;
+    job
+}
+
 #[test]
 fn bad_manifests_are_refused_before_any_work() {
-    let mut missing = colorize_job(1);
-    missing["inputs"]["lineart"] = json!("in/nothing.png");
-    assert_refused(
-        "missing",
-        &[colorize_job(0), missing],
-        "in/nothing.png: the input does not exist and no job writes it",
-    );
+    // (case, k, field, value, message): colorize_job(k) with one field set, after the jobs
+    // before it (colorize-0 .. colorize-k-1) as they are.
+    let cases = [
+        (
+            "missing",
+            1,
+            &["inputs", "lineart"][..],
+            json!("in/nothing.png"),
+            "in/nothing.png: the input does not exist and no job writes it",
+        ),
+        (
+            "twice",
+            1,
+            &["outputs", "image"],
+            json!("out/art0.png"),
+            "jobs 'colorize-0' and 'colorize-1' both write it",
+        ),
+        // An output folder holding another job's output is one output written twice too.
+        (
+            "inside",
+            1,
+            &["outputs", "layers"],
+            json!("out"),
+            "both write it",
+        ),
+        (
+            "unknown",
+            1,
+            &["kind"],
+            json!("bake"),
+            "job 1 ('colorize-1'): unknown kind 'bake' (known: rig, autorig, render, export, colorize)",
+        ),
+        (
+            "own",
+            0,
+            &["outputs", "image"],
+            json!("in/art0.png"),
+            "the output would overwrite an input",
+        ),
+        (
+            "manifest",
+            0,
+            &["outputs", "image"],
+            json!("batch.json"),
+            "the output would overwrite the manifest or its state",
+        ),
+        (
+            "option",
+            0,
+            &["options", "fil"],
+            json!("flat"),
+            "unknown field `fil`",
+        ),
+        (
+            "split",
+            0,
+            &["options", "split"],
+            json!("deep"),
+            "job 0 ('colorize-0'): unknown variant `deep`, expected one of `reach`, `density`, `depth`, `weights`",
+        ),
+        (
+            "alpha",
+            0,
+            &["options", "split_depth_exponent"],
+            json!(99),
+            "job 'colorize-0': invalid colorize option: split_depth_exponent must lie in [0, 32], not 99",
+        ),
+    ];
+    for (name, k, field, value, expect) in cases {
+        let mut jobs: Vec<Value> = (0..k).map(colorize_job).collect();
+        jobs.push(with_field(colorize_job(k), field, value));
+        assert_refused(name, &jobs, expect);
+    }
 
     // a writes what b reads, b writes what a reads.
     let mut a = colorize_job(0);
@@ -351,56 +427,6 @@ fn bad_manifests_are_refused_before_any_work() {
     b["inputs"]["lineart"] = json!("out/a.png");
     b["outputs"]["image"] = json!("out/b.png");
     assert_refused("cycle", &[a, b], "form a cycle");
-
-    let mut twice = colorize_job(1);
-    twice["outputs"]["image"] = json!("out/art0.png");
-    assert_refused(
-        "twice",
-        &[colorize_job(0), twice],
-        "jobs 'colorize-0' and 'colorize-1' both write it",
-    );
-    // An output folder holding another job's output is one output written twice too.
-    let mut inside = colorize_job(1);
-    inside["outputs"]["layers"] = json!("out");
-    assert_refused("inside", &[colorize_job(0), inside], "both write it");
-
-    let mut unknown = colorize_job(1);
-    unknown["kind"] = json!("bake");
-    assert_refused(
-        "unknown",
-        &[colorize_job(0), unknown],
-        "job 1 ('colorize-1'): unknown kind 'bake' (known: rig, autorig, render, export, colorize)",
-    );
-
-    let mut own = colorize_job(0);
-    own["outputs"]["image"] = json!("in/art0.png");
-    assert_refused("own", &[own], "the output would overwrite an input");
-
-    let mut manifest = colorize_job(0);
-    manifest["outputs"]["image"] = json!("batch.json");
-    assert_refused(
-        "manifest",
-        &[manifest],
-        "the output would overwrite the manifest or its state",
-    );
-
-    let mut option = colorize_job(0);
-    option["options"]["fil"] = json!("flat");
-    assert_refused("option", &[option], "unknown field `fil`");
-    let mut split = colorize_job(0);
-    split["options"]["split"] = json!("deep");
-    assert_refused(
-        "split",
-        &[split],
-        "job 0 ('colorize-0'): unknown variant `deep`, expected one of `reach`, `density`, `depth`, `weights`",
-    );
-    let mut alpha = colorize_job(0);
-    alpha["options"]["split_depth_exponent"] = json!(99);
-    assert_refused(
-        "alpha",
-        &[alpha],
-        "job 'colorize-0': invalid colorize option: split_depth_exponent must lie in [0, 32], not 99",
-    );
     assert_refused(
         "names",
         &[colorize_job(0), colorize_job(0)],

@@ -1,5 +1,7 @@
 //! The editor driven through egui_kittest: real frames, simulated pointer and keys, checked
-//! against the document.
+//! against the document. Widgets are clicked through [`click_shown`] and [`click_shown_by`]
+//! (or [`press_shown_by`] where frames are stepped), which fail where a user could not click
+//! them; clippy.toml disallows kittest's own clicks, so an exception says so at its place.
 
 use super::rig_mode::distance;
 use crate::geom::Point;
@@ -10,7 +12,7 @@ use crate::rig::PointHandle;
 
 use eframe::egui::Pos2;
 
-use egui_kittest::kittest::{NodeT, Queryable};
+use egui_kittest::kittest::{By, NodeT, Queryable};
 
 use egui_kittest::Harness;
 
@@ -230,8 +232,7 @@ fn bar_png(dir: &Path) -> PathBuf {
 /// Clicks the text field labelled `label`, selects what it holds (Ctrl+A) and types `text`
 /// over it.
 fn type_into(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
-    h.get_by_label(label).click();
-    h.run();
+    click_shown(h, label);
     h.key_press_modifiers(Modifiers::COMMAND, Key::A);
     h.run();
     h.get_by_label(label).type_text(text);
@@ -247,7 +248,9 @@ fn press_point(node: &egui_kittest::Node<'_>) -> (egui::accesskit::NodeId, Pos2)
 /// widget `id`'s rect) would be on that widget: the pointer is moved there and egui's own hit
 /// test of the next frame must find the widget under it. So a widget scrolled out of its
 /// area, clipped, off the screen or under a window or popup fails the test, where `click`
-/// would press whatever is drawn there instead.
+/// would press whatever is drawn there instead. So does input still queued when the widget was
+/// located (a key press whose frames have not run): the place was read from a frame that input
+/// had yet to change, where a user sees the key's effect before pointing.
 fn assert_shown(
     h: &mut Harness<'_, EditorApp>,
     (id, at): (egui::accesskit::NodeId, Pos2),
@@ -258,8 +261,15 @@ fn assert_shown(
         screen.contains(at),
         "{what}: at {at:?}, off the screen {screen:?}"
     );
+    let frame = h.ctx.cumulative_frame_nr();
     h.hover_at(at);
+    // One frame per queued event: more than the pointer's one means input was still queued.
     h.step();
+    assert_eq!(
+        h.ctx.cumulative_frame_nr(),
+        frame + 1,
+        "{what}: located while input was still queued (run a key's frames before clicking)"
+    );
     let under_pointer = h.ctx.interaction_snapshot(|s| {
         s.contains_pointer
             .iter()
@@ -271,12 +281,43 @@ fn assert_shown(
     );
 }
 
-/// Clicks the widget labelled `label` once [`assert_shown`] says a user would be on it.
-fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
-    let at = press_point(&h.get_by_label(label));
-    assert_shown(h, at, label);
-    h.get_by_label(label).click();
+/// How the editor tests click a widget: the one widget `by` finds, once [`assert_shown`] says
+/// a user would be on it (kittest's own `click` presses a widget even where it is hidden). The
+/// caller runs the frames: `step` while the editor keeps repainting (playing, computing),
+/// [`click_shown_by`] otherwise.
+fn press_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
+    let what = format!("{by:?}");
+    let at = press_point(&h.get(by.clone()));
+    assert_shown(h, at, &what);
+    // The one place the editor tests call kittest's click (clippy.toml disallows it elsewhere).
+    #[allow(clippy::disallowed_methods)]
+    h.get(by).click();
+}
+
+/// [`press_shown_by`], then the frames run to rest.
+fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
+    press_shown_by(h, by);
     h.run();
+}
+
+/// [`click_shown_by`] the widget labelled `label`.
+fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
+    click_shown_by(h, By::new().label(label));
+}
+
+/// [`press_shown_by`] the widget labelled `label`; the caller steps the frames.
+fn press_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
+    press_shown_by(h, By::new().label(label));
+}
+
+/// The combo box labelled `label`, for [`click_shown_by`] and lookups.
+fn combo_box(label: &str) -> By<'_> {
+    By::new().role(egui::accesskit::Role::ComboBox).label(label)
+}
+
+/// The button labelled `label` (not a window's title of the same text).
+fn button(label: &str) -> By<'_> {
+    By::new().role(egui::accesskit::Role::Button).label(label)
 }
 
 /// An editor on a document of one 96×48 bar layer (saved as `DIR/bar.png`), never rigged.
@@ -293,8 +334,7 @@ fn never_rigged_bar(dir: &Path) -> Harness<'static, EditorApp> {
 
 /// Opens the File menu, types `text` into its field `label` and closes the menu again.
 fn type_in_file_menu(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
-    h.get_by_label("File").click();
-    h.run();
+    click_shown(h, "File");
     type_into(h, label, text);
     assert_eq!(h.get_by_label(label).value().as_deref(), Some(text));
     // The first Escape leaves the field, the second closes the menu.
@@ -367,23 +407,19 @@ fn head_turned(degrees: f64) -> Pose {
 /// In animate mode, through the animation list and the numbers panel: a new animation renamed
 /// "nod", the head (a click on the bone selects it) keyed at 0° at 0 s and at 20° at 0.5 s.
 fn key_a_nod_from_the_numbers_panel(h: &mut Harness<'_, EditorApp>) {
-    h.get_by_label("New animation").click();
-    h.run();
+    click_shown(h, "New animation");
     type_into(h, "Rename to:", "nod");
-    h.get_by_label("Rename animation").click();
-    h.run();
+    click_shown(h, "Rename animation");
     click(h, Point::new(256.0, 150.0));
     assert_eq!(h.state().selected.as_deref(), Some("head"));
     for (frames, degrees) in [(0, 0.0), (12, 20.0)] {
         for _ in 0..frames {
-            h.get_by_label("Next frame").click();
-            h.run();
+            click_shown(h, "Next frame");
         }
         // 0° is the rest pose's: another number first, so the pose names the head.
         set_number(h, "Rotation", degrees + 5.0);
         set_number(h, "Rotation", degrees);
-        h.get_by_label("Set key").click();
-        h.run();
+        click_shown(h, "Set key");
     }
 }
 
@@ -596,8 +632,7 @@ fn new_animation_on_skinned_character(name: &str) -> (Harness<'static, EditorApp
     h.run();
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("New animation").click();
-    h.run();
+    click_shown(&mut h, "New animation");
     let animation = h.state().animate.animation.clone();
     (h, animation)
 }

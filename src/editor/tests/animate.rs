@@ -8,11 +8,6 @@ fn names(h: &Harness<'_, EditorApp>) -> Vec<String> {
     h.state().doc.state().animations.keys().cloned().collect()
 }
 
-fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
-    h.get_by_label(label).click();
-    h.run();
-}
-
 #[test]
 fn animations_are_created_renamed_duplicated_picked_and_deleted_from_the_list() {
     let mut h = open_character("animation-list");
@@ -22,10 +17,10 @@ fn animations_are_created_renamed_duplicated_picked_and_deleted_from_the_list() 
     h.get_by_label("animation (no keys yet)");
     assert!(names(&h).is_empty());
 
-    click_label(&mut h, "New animation");
+    click_shown(&mut h, "New animation");
     assert_eq!(names(&h), ["animation"]);
     type_into(&mut h, "Rename to:", "walk");
-    click_label(&mut h, "Rename animation");
+    click_shown(&mut h, "Rename animation");
     assert_eq!(names(&h), ["walk"]);
     assert_eq!(h.state().animate.animation, "walk");
 
@@ -37,7 +32,7 @@ fn animations_are_created_renamed_duplicated_picked_and_deleted_from_the_list() 
     h.run();
     let walk = crate::document::animation_named(h.state().doc.state(), "walk");
     assert_eq!(walk.ik.len(), 1, "{:?}", h.state().message);
-    click_label(&mut h, "Duplicate animation");
+    click_shown(&mut h, "Duplicate animation");
     assert_eq!(names(&h), ["walk", "walk 2"]);
     assert_eq!(h.state().animate.animation, "walk 2");
     assert_eq!(
@@ -47,15 +42,15 @@ fn animations_are_created_renamed_duplicated_picked_and_deleted_from_the_list() 
 
     // Renaming onto a name taken is refused with a message; nothing changes.
     type_into(&mut h, "Rename to:", "walk");
-    click_label(&mut h, "Rename animation");
+    click_shown(&mut h, "Rename animation");
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("already exists"), "{message}");
     assert_eq!(names(&h), ["walk", "walk 2"]);
 
     // Pick "walk" from the list, delete it: "walk 2" is edited; Ctrl+Z brings "walk" back.
-    click_label(&mut h, "walk");
+    click_shown(&mut h, "walk");
     assert_eq!(h.state().animate.animation, "walk");
-    click_label(&mut h, "Delete animation");
+    click_shown(&mut h, "Delete animation");
     assert_eq!(names(&h), ["walk 2"]);
     assert_eq!(h.state().animate.animation, "walk 2");
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
@@ -95,7 +90,9 @@ fn the_numbers_panel_poses_the_selected_bone_in_pose_mode() {
     assert_eq!(h.state().doc.state().pose.bones["chest"].scale, [1.0, 1.0]);
 
     // Dragging a field shows the pose live and commits once, on release.
-    let field = h.get_by_label("Rotation").rect().center();
+    let field = press_point(&h.get_by_label("Rotation"));
+    assert_shown(&mut h, field, "Rotation");
+    let field = field.1;
     let before_drag = h.state().doc.state().pose.clone();
     h.drag_at(field);
     h.step();
@@ -123,7 +120,7 @@ fn auto_key_keys_each_edit_at_the_playhead_and_rows_are_named_by_handle() {
     let mut h = open_character("auto-key");
     h.key_press(Key::Num3);
     h.run();
-    click_label(&mut h, "Auto-key");
+    click_shown(&mut h, "Auto-key");
     assert!(h.state().timeline.auto_key);
 
     // Turning the head in the numbers panel keys its rotation only, at once.
@@ -138,7 +135,7 @@ fn auto_key_keys_each_edit_at_the_playhead_and_rows_are_named_by_handle() {
     // At 0.5 s, a drag of the torso is keyed as it is released, and its row in the dopesheet
     // is named after the handle nearest the point grabbed, not `ik[0]`.
     for _ in 0..12 {
-        click_label(&mut h, "Next frame");
+        click_shown(&mut h, "Next frame");
     }
     let grip = torso_point(&h);
     drag(&mut h, grip, [grip[0] + 12.0, grip[1]]);
@@ -172,7 +169,7 @@ fn auto_key_keys_each_edit_at_the_playhead_and_rows_are_named_by_handle() {
     assert_eq!(sheet.names[head_row.expect("head rotate")], "head rotate");
 
     // Off again: an edit waits for Set key.
-    click_label(&mut h, "Auto-key");
+    click_shown(&mut h, "Auto-key");
     set_number(&mut h, "Rotation", 40.0);
     assert!(h.state().animate.shown.is_some());
     let again = crate::document::animation_named(h.state().doc.state(), "animation");
@@ -193,7 +190,7 @@ fn set_key_keys_the_rotated_bone_s_rotation_and_the_selected_bone_only() {
     assert!(h.state().animate.shown.is_some());
     h.get_by_label("lantern").scroll_to_me();
     h.run();
-    click_label(&mut h, "lantern");
+    click_shown(&mut h, "lantern");
     assert_eq!(h.state().selected.as_deref(), Some("lantern"));
     h.key_press(Key::K);
     h.run();

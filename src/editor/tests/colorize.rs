@@ -185,8 +185,7 @@ fn colorize_scribbles_save_load_and_autosave() {
     h.run();
 
     // The panel's button writes the scribble file `sinew colorize --scribbles` reads.
-    h.get_by_label("Save scribbles").click();
-    h.run();
+    click_shown(&mut h, "Save scribbles");
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("saved 2 strokes"), "{message}");
     let text = std::fs::read_to_string(&saved).expect("saved");
@@ -227,10 +226,8 @@ fn colorize_scribbles_save_load_and_autosave() {
     assert_eq!(stroke_count(&h), Some(1));
 
     // Cleared strokes are autosaved as none, whatever the path field holds.
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Scribbles JSON:").click();
-    h.run();
+    click_shown(&mut h, "File");
+    click_shown(&mut h, "Scribbles JSON:");
     h.key_press_modifiers(Modifiers::COMMAND, Key::A);
     h.key_press(Key::Backspace);
     h.run();

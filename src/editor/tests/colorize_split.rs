@@ -3,7 +3,6 @@
 use super::*;
 use crate::colorize::synthetic::{scene, SceneSpec};
 use crate::colorize::{ColorizeOptions, RegionSplit, Scribbles};
-use egui::accesskit::Role;
 
 /// Steps frames until the panel says "colorized" (the shown strokes' solve is done).
 fn wait_until_colorized(h: &mut Harness<'_, EditorApp>) {
@@ -73,15 +72,9 @@ fn differing(a: &image::RgbaImage, b: &image::RgbaImage) -> usize {
 
 /// Picks `split` in the panel's "Split" picker.
 fn pick_split(h: &mut Harness<'_, EditorApp>, split: &str) {
-    let combo =
-        |h: &Harness<'_, EditorApp>| press_point(&h.get_by_role_and_label(Role::ComboBox, "Split"));
-    let at = combo(h);
-    assert_shown(h, at, "Split");
-    h.get_by_role_and_label(Role::ComboBox, "Split").click();
-    h.run();
+    click_shown_by(h, combo_box("Split"));
     click_shown(h, split);
-    let picker = h.get_by_role_and_label(Role::ComboBox, "Split");
-    assert_eq!(picker.value().as_deref(), Some(split));
+    assert_eq!(h.get(combo_box("Split")).value().as_deref(), Some(split));
 }
 
 #[test]
@@ -129,8 +122,7 @@ fn the_split_picked_in_the_panel_colors_the_saved_image_as_sinew_colorize_does()
     wait_until_colorized(&mut h);
 
     // The default, reach, with its α shown.
-    let picker = h.get_by_role_and_label(Role::ComboBox, "Split");
-    assert_eq!(picker.value().as_deref(), Some("reach"));
+    assert_eq!(h.get(combo_box("Split")).value().as_deref(), Some("reach"));
     let reach = saved(&mut h, &out);
     assert_eq!(differing(&reach, &expected(&ColorizeOptions::default())), 0);
 

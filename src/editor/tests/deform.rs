@@ -10,10 +10,8 @@ fn the_deform_tool_keys_soft_offsets_at_the_playhead() {
     let mut h = open_character("deform-tool");
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("New animation").click();
-    h.run();
-    h.get_by_label("Deform tool").click();
-    h.run();
+    click_shown(&mut h, "New animation");
+    click_shown(&mut h, "Deform tool");
     set_number(&mut h, "Deform radius", 20.0);
     assert_eq!(h.state().deform.radius_px, 20.0);
     let grip = torso_point(&h);
@@ -80,8 +78,7 @@ fn the_deform_tool_keys_soft_offsets_at_the_playhead() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("within the deform radius"), "{message}");
     assert_eq!(offsets(&h).map(|o| o.1), Some(keyed.clone()));
-    h.get_by_label("Deform tool").click();
-    h.run();
+    click_shown(&mut h, "Deform tool");
     assert!(!h.state().deform.enabled);
 
     // Saved with Ctrl+S and read back: the deform key, of the mesh's vertex count.

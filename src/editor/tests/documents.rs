@@ -83,8 +83,7 @@ fn closing_with_unsaved_changes_asks_first() {
     h.get_by_label(
         "Save the changes before closing? (Type a .json file name in the File menu first.)",
     );
-    h.get_by_label("Save").click();
-    h.run();
+    click_shown(&mut h, "Save");
     assert_eq!(h.state().closing(), Closing::Open);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains(".json file name"), "{message}");
@@ -123,8 +122,7 @@ fn closing_with_unsaved_changes_asks_first() {
         "Save the changes to {} before closing?",
         path.display()
     ));
-    h.get_by_label("Save").click();
-    h.run();
+    click_shown(&mut h, "Save");
     // (A small save may already be done by the end of the frames run.)
     assert!(
         h.state().saving() || h.state().closing() == Closing::Allowed,
@@ -145,8 +143,7 @@ fn closing_with_unsaved_changes_asks_first() {
     let mut h = never_rigged_bar(&dir);
     h.state_mut().request_close();
     h.run();
-    h.get_by_label("Don't save").click();
-    h.run();
+    click_shown(&mut h, "Don't save");
     assert_eq!(h.state().closing(), Closing::Allowed);
     let mut clean = harness(EditorApp::new(Document::new()));
     assert!(!press_close_button(&mut clean));

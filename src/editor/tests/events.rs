@@ -26,12 +26,10 @@ fn event_on_sheet(h: &Harness<'_, EditorApp>, time_s: f64) -> Pos2 {
 
 /// Through the *Define event* window: event `name` with default int `int`.
 fn define_event(h: &mut Harness<'_, EditorApp>, name: &str, int: i32) {
-    h.get_by_label("Define event…").click();
-    h.run();
+    click_shown(h, "Define event…");
     type_into(h, "New event name:", name);
     set_number(h, "Default int", f64::from(int));
-    h.get_by_label("Define").click();
-    h.run();
+    click_shown(h, "Define");
 }
 
 #[test]
@@ -39,8 +37,7 @@ fn an_event_key_is_defined_added_edited_moved_and_saved() {
     let mut h = open_character("events");
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("New animation").click();
-    h.run();
+    click_shown(&mut h, "New animation");
     define_event(&mut h, "footstep", 1);
     let defs = h.state().doc.state().events.clone();
     assert_eq!(
@@ -58,10 +55,17 @@ fn an_event_key_is_defined_added_edited_moved_and_saved() {
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("already defined"), "{message}");
     assert_eq!(h.state().doc.state().events["footstep"].int, 1);
-    h.get_by_label("Define").click();
-    h.run();
-    h.key_press(Key::Escape);
-    h.run();
+    // The window stays open with the refused name; its close button closes it, and *Define
+    // event…* (no longer under it) opens it again.
+    assert_eq!(
+        h.get_by_label("New event name:").value().as_deref(),
+        Some("footstep")
+    );
+    click_shown(&mut h, "Close window");
+    assert!(
+        h.query_by_label("New event name:").is_none(),
+        "the close button left the window open"
+    );
     define_event(&mut h, "cue", 0);
     if h.query_by_label("New event name:").is_some() {
         panic!("{:?}", h.state().message);
@@ -69,16 +73,11 @@ fn an_event_key_is_defined_added_edited_moved_and_saved() {
 
     // Twelve frames on (0.5 s at 24 fps), the event picked is added at the playhead.
     for _ in 0..12 {
-        h.get_by_label("Next frame").click();
-        h.run();
+        click_shown(&mut h, "Next frame");
     }
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Event to add");
-    picker.click();
-    h.run();
-    h.get_by_label("footstep").click();
-    h.run();
-    h.get_by_label("Add event").click();
-    h.run();
+    click_shown_by(&mut h, combo_box("Event to add"));
+    click_shown(&mut h, "footstep");
+    click_shown(&mut h, "Add event");
     assert_eq!(
         events(&h),
         [(0.5, "footstep".to_string(), None, None)],
@@ -136,11 +135,8 @@ fn an_event_key_is_defined_added_edited_moved_and_saved() {
     assert_eq!(anim.events[0].float, None);
 
     // Another name picked from the definitions, then undone (one step each).
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Event name");
-    picker.click();
-    h.run();
-    h.get_by_label("cue").click();
-    h.run();
+    click_shown_by(&mut h, combo_box("Event name"));
+    click_shown(&mut h, "cue");
     assert_eq!(events(&h)[0].1, "cue", "{:?}", h.state().message);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run();

@@ -104,9 +104,7 @@ fn an_untouched_view_refits_as_the_mode_changes_the_canvas_area_and_a_users_view
     middle_drag(&mut h, egui::vec2(-80.0, 30.0));
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label_contains("Zoom to fit").click();
-    h.run();
+    click_shown(&mut h, "View");
+    click_shown_by(&mut h, By::new().label_contains("Zoom to fit"));
     assert_character_in_view(&h, "animate mode after View → Zoom to fit");
 }

@@ -41,13 +41,11 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     // The rotate key at 0 s made a Bézier in the one-segment curve editor.
     let at = key_on_sheet(&h, Rotate, 0.0);
     click_screen(&mut h, at);
-    h.get_by_label("Bézier").click();
-    h.run();
+    click_shown(&mut h, "Bézier");
     let numbers = rotate_numbers(&h);
 
     // The graph view: seven curves, each named in the legend.
-    h.get_by_label("Graph view").click();
-    h.run();
+    click_shown(&mut h, "Graph view");
     let names = HEAD_CURVES;
     for name in names {
         h.get_by_label(name);
@@ -70,8 +68,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     );
 
     // The legend hides a curve and shows it again.
-    h.get_by_label("head translate x").click();
-    h.run();
+    click_shown(&mut h, "head translate x");
     let shown = |h: &Harness<'_, EditorApp>| {
         let layout = graph(h);
         layout
@@ -82,8 +79,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
     };
     assert!(!shown(&h).iter().any(|n| n == "head translate x"));
     assert_eq!(shown(&h).len(), 6);
-    h.get_by_label("head translate x").click();
-    h.run();
+    click_shown(&mut h, "head translate x");
     assert_eq!(shown(&h).len(), 7);
 
     // The rotate curve's first handle dragged right and down: a later, lower handle.
@@ -107,8 +103,7 @@ fn the_graph_view_draws_every_channel_of_the_handle_resizes_and_drags_handles() 
 #[test]
 fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request() {
     let mut h = nodding_head("graph-axes");
-    h.get_by_label("Graph view").click();
-    h.run();
+    click_shown(&mut h, "Graph view");
 
     // Seven curves, each over its own range: the time axis is labelled, the value axis not
     // (its numbers would mean seven things).
@@ -131,8 +126,7 @@ fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request(
 
     // Same scale: one range for every curve, and value ticks that mean it. The rotate key's
     // 20° sits on the tick labelled 20.
-    h.get_by_label("Same scale").click();
-    h.run();
+    click_shown(&mut h, "Same scale");
     let shared = graph(&h);
     let (low, high) = (shared.curves[0].low, shared.curves[0].high);
     assert!(shared.curves.iter().all(|c| (c.low, c.high) == (low, high)));
@@ -152,11 +146,9 @@ fn the_graph_view_labels_its_axes_and_draws_every_curve_on_one_scale_on_request(
 
     // Back to a range per curve, every curve but the rotation hidden: the axis is labelled
     // in the rotation's own range.
-    h.get_by_label("Same scale").click();
-    h.run();
+    click_shown(&mut h, "Same scale");
     for name in &HEAD_CURVES[1..] {
-        h.get_by_label(name).click();
-        h.run();
+        click_shown(&mut h, name);
     }
     let rotate = graph(&h);
     assert_eq!(rotate.curves.len(), 1);

@@ -53,8 +53,7 @@ fn a_right_click_on_keys_opens_a_menu_that_sets_curves_copies_pastes_and_deletes
         4,
         "one key per channel at 0 s"
     );
-    h.get_by_label("Stepped").click();
-    h.run();
+    click_shown(&mut h, "Stepped");
     for channel in channels {
         assert_eq!(
             curve_at(&h, channel, 0.0),
@@ -85,8 +84,7 @@ fn a_right_click_on_keys_opens_a_menu_that_sets_curves_copies_pastes_and_deletes
     let at = key_on_sheet(&h, Rotate, 0.0);
     right_click_screen(&mut h, at);
     assert_eq!(h.state().timeline.selection.len(), 1);
-    h.get_by_label("Bézier ease in and out").click();
-    h.run();
+    click_shown(&mut h, "Bézier ease in and out");
     let numbers: Vec<f64> =
         serde_json::from_value(curve_at(&h, "rotate", 0.0)).expect("four Bézier numbers");
     let expected = [0.5 / 3.0, 0.0, 1.0 / 3.0, 20.0];
@@ -102,16 +100,13 @@ fn a_right_click_on_keys_opens_a_menu_that_sets_curves_copies_pastes_and_deletes
     // Copied from the menu, pasted from it at the playhead (frame 6, 0.25 s), deleted from it.
     let at = key_on_sheet(&h, Rotate, 0.5);
     right_click_screen(&mut h, at);
-    h.get_by_label("Copy").click();
-    h.run();
+    click_shown(&mut h, "Copy");
     for _ in 0..6 {
-        h.get_by_label("Next frame").click();
-        h.run();
+        click_shown(&mut h, "Next frame");
     }
     let at = key_on_sheet(&h, Rotate, 0.0);
     right_click_screen(&mut h, at);
-    h.get_by_label("Paste at the playhead").click();
-    h.run();
+    click_shown(&mut h, "Paste at the playhead");
     let rotate_times = |h: &Harness<'_, EditorApp>| -> Vec<f64> {
         head_rotate_keys(h).iter().map(|k| k.0).collect()
     };
@@ -119,7 +114,6 @@ fn a_right_click_on_keys_opens_a_menu_that_sets_curves_copies_pastes_and_deletes
     assert_eq!(head_rotate_keys(&h)[1].1, 20.0, "the copied key's value");
     let at = key_on_sheet(&h, Rotate, 0.25);
     right_click_screen(&mut h, at);
-    h.get_by_label("Delete").click();
-    h.run();
+    click_shown(&mut h, "Delete");
     assert_eq!(rotate_times(&h), [0.0, 0.5]);
 }

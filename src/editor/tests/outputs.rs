@@ -40,12 +40,9 @@ fn renders_the_current_animation_in_the_background() {
     h.run();
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("nod").click();
-    h.run();
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Render…").click();
-    h.run();
+    click_shown(&mut h, "nod");
+    click_shown(&mut h, "File");
+    click_shown(&mut h, "Render…");
     type_into(
         &mut h,
         "Render the current animation to (.gif, .png sheet or a folder):",
@@ -60,8 +57,7 @@ fn renders_the_current_animation_in_the_background() {
         h.run();
     }
     // The button, not the window's title.
-    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
-        .click();
+    press_shown_by(&mut h, button("Render"));
     wait_for_render(&mut h, 50);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("rendered"), "{message}");
@@ -73,8 +69,7 @@ fn renders_the_current_animation_in_the_background() {
     assert_eq!(u32::from(width), canvas_width.div_ceil(2));
     // Deleted from the list, "nod" is gone; the animation edited then has no keys yet, and
     // rendering it says so and writes no file.
-    h.get_by_label("Delete animation").click();
-    h.run();
+    click_shown(&mut h, "Delete animation");
     assert!(h.state().doc.state().animations.is_empty());
     h.get_by_label("animation (no keys yet)");
     type_into(
@@ -83,8 +78,7 @@ fn renders_the_current_animation_in_the_background() {
         &path.with_file_name("nope.gif").display().to_string(),
     );
     // The button, not the window's title.
-    h.get_by_role_and_label(egui::accesskit::Role::Button, "Render")
-        .click();
+    press_shown_by(&mut h, button("Render"));
     wait_for_render(&mut h, 20);
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("no animation of that name"), "{message}");
@@ -106,20 +100,14 @@ fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
 fn the_render_dialog_names_the_spine_export_its_runtime_curves_reproduce() {
     let path = character_rig("render-spine");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Render…").click();
-    h.run();
+    click_shown(&mut h, "File");
+    click_shown(&mut h, "Render…");
     assert!(h.query_by_label("Spine version").is_none());
-    h.get_by_label("Curves as Spine's runtimes play them")
-        .click();
-    h.run();
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Spine version");
-    assert_eq!(picker.value().as_deref(), Some("4.2"));
-    picker.click();
-    h.run();
-    h.get_by_label("4.1").click();
-    h.run();
+    click_shown(&mut h, "Curves as Spine's runtimes play them");
+    let picker = combo_box("Spine version");
+    assert_eq!(h.get(picker.clone()).value().as_deref(), Some("4.2"));
+    click_shown_by(&mut h, picker);
+    click_shown(&mut h, "4.1");
     type_into(&mut h, "Bake keys per second", "20");
     h.key_press(Key::Enter);
     h.run();

@@ -30,8 +30,7 @@ fn a_physics_constraints_fields_in_the_tree_edit_it_and_refuse_bad_numbers() {
     assert!(h.query_by_label("Physics mass").is_none());
     h.get_by_label("physics tail_sway").scroll_to_me();
     h.run();
-    h.get_by_label("physics tail_sway").click();
-    h.run();
+    click_shown(&mut h, "physics tail_sway");
     let before = tail_sway(&h);
     assert_eq!(before.bone, "tail_4");
     let mass = h.get_by_label("Physics mass").value().unwrap_or_default();

@@ -119,10 +119,8 @@ fn pins_leave_the_drawing_where_it_is() {
     );
 
     // Clear pins, rest pose, one pin: the same as one pin on a fresh document.
-    h.get_by_label("Clear pins").click();
-    h.run();
-    h.get_by_label("Rest pose").click();
-    h.run();
+    click_shown(&mut h, "Clear pins");
+    click_shown(&mut h, "Rest pose");
     assert_eq!(h.state().doc.state().pose, Pose::default());
     shift_click(&mut h, torso);
     let mut fresh = open_character("pins-fresh");
@@ -162,14 +160,9 @@ fn the_canvas_draws_the_poses_draw_order_tint_and_visibility() {
     doc.save(&path).expect("saved");
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
-    h.get_by_label("File").click();
-    h.run();
-    let field = h.get_by_label("Rig or PNG path:");
-    field.focus();
-    field.type_text(&path.display().to_string());
-    h.run();
-    h.get_by_label("Open rig").click();
-    h.run();
+    click_shown(&mut h, "File");
+    type_into(&mut h, "Rig or PNG path:", &path.display().to_string());
+    click_shown(&mut h, "Open rig");
     assert_eq!(
         h.state().doc.path.as_deref(),
         Some(path.as_path()),
@@ -331,12 +324,10 @@ fn the_skin_picker_draws_the_chosen_skin_and_undo_takes_it_back() {
     };
     assert!(drawn(&h).contains(&"bag".to_string()));
     // The picker shows "(none)"; open it and choose the pail skin.
-    let picker = h.get_by_role_and_label(egui::accesskit::Role::ComboBox, "Skin");
-    assert_eq!(picker.value().as_deref(), Some("(none)"));
-    picker.click();
-    h.run();
-    h.get_by_label("pail").click();
-    h.run();
+    let picker = combo_box("Skin");
+    assert_eq!(h.get(picker.clone()).value().as_deref(), Some("(none)"));
+    click_shown_by(&mut h, picker);
+    click_shown(&mut h, "pail");
     let scene = h.state().doc.posable().expect("posable").clone();
     assert_eq!(scene.skins(), ["pail".to_string()]);
     let names = drawn(&h);

@@ -12,8 +12,7 @@ fn rig_weigh_pose_undo_through_the_ui() {
     let tail = [inside[0] + 12.0, inside[1] + 8.0];
 
     // Rig mode: draw a bone inside the torso with the bone tool.
-    h.get_by_label("Bone").click();
-    h.run();
+    click_shown(&mut h, "Bone");
     drag(&mut h, inside, tail);
     let handles = &h.state().doc.state().handles;
     assert_eq!(
@@ -34,7 +33,7 @@ fn rig_weigh_pose_undo_through_the_ui() {
     h.get_by_label("Weights need computing");
 
     // Computing runs in the background; the UI keeps drawing frames meanwhile.
-    h.get_by_label("Compute weights").click();
+    press_shown(&mut h, "Compute weights");
     h.step();
     assert!(h.state().computing());
     h.step();
@@ -92,8 +91,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     let before = h.state().doc.state().handles.clone();
 
     // A cage: four clicks, then a click on the first vertex closes it.
-    h.get_by_label("Cage").click();
-    h.run();
+    click_shown(&mut h, "Cage");
     let square = [
         [150.0, 150.0],
         [360.0, 150.0],
@@ -113,8 +111,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     assert_eq!(h.state().selected.as_deref(), Some(cage.as_str()));
 
     // A region: three clicks and Enter.
-    h.get_by_label("Region").click();
-    h.run();
+    click_shown(&mut h, "Region");
     for p in [[240.0, 250.0], [270.0, 250.0], [255.0, 280.0]] {
         click(&mut h, p);
     }
@@ -123,8 +120,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     assert_eq!(h.state().doc.state().handles.regions.len(), 1);
 
     // The select tool drags the cage by its outline.
-    h.get_by_label("Select").click();
-    h.run();
+    click_shown(&mut h, "Select");
     drag(&mut h, [255.0, 150.0], [265.0, 140.0]);
     let moved = &h.state().doc.state().handles.cages[0].polygon;
     assert!(
@@ -135,7 +131,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     // The traced mesh, rebuilt live when a meshing option changes.
     h.get_by_label("Show the traced mesh").scroll_to_me();
     h.run();
-    h.get_by_label("Show the traced mesh").click();
+    press_shown(&mut h, "Show the traced mesh");
     wait_until(&mut h, "the mesh preview", |app| {
         !app.previewing() && app.preview_vertex_count().is_some()
     });
@@ -156,7 +152,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     let hand_made = h.state().doc.state().handles.clone();
     h.get_by_label("Propose handles").scroll_to_me();
     h.run();
-    h.get_by_label("Propose handles").click();
+    press_shown(&mut h, "Propose handles");
     wait_until(&mut h, "the automatic rig", |app| {
         !app.rig_tools.proposing()
     });
@@ -194,18 +190,15 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     };
 
     // Lock the head from its box in the handle list, select the chest, take the brush.
-    h.get_by_label("lock head").click();
-    h.run();
+    click_shown(&mut h, "lock head");
     assert!(
         h.state().doc.state().locked.contains("head"),
         "{:?}",
         h.state().message
     );
-    h.get_by_label("chest").click();
-    h.run();
+    click_shown(&mut h, "chest");
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
-    h.get_by_label("Paint").click();
-    h.run();
+    click_shown(&mut h, "Paint");
     h.get_by_label("Subtract");
     assert_eq!(h.state().paint.mode, crate::weights::BrushMode::Add);
     set_number(&mut h, "Brush radius px:", 24.0);
@@ -269,9 +262,8 @@ fn paint_weights_with_a_locked_handle_through_the_ui() {
     // Redo the stroke, lock the chest too and recompute: the painted chest stays.
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     h.run();
-    h.get_by_label("lock chest").click();
-    h.run();
-    h.get_by_label("Compute weights").click();
+    click_shown(&mut h, "lock chest");
+    press_shown(&mut h, "Compute weights");
     wait_for_weights(&mut h);
     let (scene, index) = torso(h.state());
     let recomputed = scene.doc.parts[index].weights.clone().expect("weights");
@@ -289,17 +281,14 @@ fn the_heat_map_has_a_legend_naming_the_handle_whose_weights_it_shows() {
     h.get_by_label("Weights are up to date");
     assert!(h.query_by_label_contains("weights of").is_none());
     // Selecting a bone in the tree shows its weights and the legend says whose they are.
-    h.get_by_label("chest").click();
-    h.run();
+    click_shown(&mut h, "chest");
     assert_eq!(h.state().selected.as_deref(), Some("chest"));
     h.get_by_label("weights of chest");
-    h.get_by_label("head").click();
-    h.run();
+    click_shown(&mut h, "head");
     h.get_by_label("weights of head");
     assert!(h.query_by_label("weights of chest").is_none());
     // Stale weights draw no heat map, so no legend either.
-    h.get_by_label("Bone").click();
-    h.run();
+    click_shown(&mut h, "Bone");
     let inside = torso_point(&h);
     drag(&mut h, inside, [inside[0] + 12.0, inside[1] + 8.0]);
     h.get_by_label("Weights need computing");

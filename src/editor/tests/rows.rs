@@ -20,8 +20,7 @@ fn attachment_keys_move_copy_paste_and_delete_in_their_row() {
     let keys = |h: &Harness<'_, EditorApp>| bag_attachment_keys(h, &animation);
     h.get_by_label("bag shows bag_pail").scroll_to_me();
     h.run();
-    h.get_by_label("bag shows bag_pail").click();
-    h.run();
+    click_shown(&mut h, "bag shows bag_pail");
     assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
     let row = TimelineId::Attachment { slot: "bag".into() };
     let sheet = h.state().timeline.sheet.clone().expect("sheet");
@@ -112,8 +111,7 @@ fn deform_keys_have_a_row_with_curves_and_move_copy_and_paste() {
     // Its first key eases into the second: one 0..1 Bézier for all the offsets.
     let at = key_at(&h, &row, 0.0);
     click_screen(&mut h, at);
-    h.get_by_label("Bézier").click();
-    h.run();
+    click_shown(&mut h, "Bézier");
     let eased = deform(&h);
     assert_eq!(
         eased[0].curve,
@@ -160,8 +158,7 @@ fn delete_key_removes_every_kind_of_key_at_the_playhead() {
     // An attachment swap at 0 s, through the tree.
     h.get_by_label("bag shows bag_pail").scroll_to_me();
     h.run();
-    h.get_by_label("bag shows bag_pail").click();
-    h.run();
+    click_shown(&mut h, "bag shows bag_pail");
     assert_eq!(
         bag_attachment_keys(&h, &animation),
         [(0.0, Some("bag_pail".into()))]
@@ -172,8 +169,7 @@ fn delete_key_removes_every_kind_of_key_at_the_playhead() {
     };
     assert_eq!(keyed(&h), 1, "{:?}", h.state().message);
     // *Delete key* takes every key at the playhead, the swap included, as one undo step.
-    h.get_by_label("Delete key").click();
-    h.run();
+    click_shown(&mut h, "Delete key");
     assert!(bag_attachment_keys(&h, &animation).is_empty());
     assert_eq!(keyed(&h), 0);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);

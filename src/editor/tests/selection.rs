@@ -13,8 +13,7 @@ fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
 fn click_row(h: &mut Harness<'_, EditorApp>, name: &str) {
     h.get_by_label(name).scroll_to_me();
     h.run();
-    h.get_by_label(name).click();
-    h.run();
+    click_shown(h, name);
 }
 
 /// Whether the middle of the widget labelled `label` (where a click reaches it) lies in the
@@ -80,8 +79,7 @@ fn the_selection_stays_across_mode_switches_while_its_handle_exists() {
     }
     // The mode buttons of the menu bar too.
     for label in ["Animate mode", "Rig mode", "Pose mode"] {
-        h.get_by_label(label).click();
-        h.run();
+        click_shown(&mut h, label);
         assert_eq!(shown_selection(&h, "lantern"), Some(true), "after {label}");
     }
 
@@ -89,8 +87,7 @@ fn the_selection_stays_across_mode_switches_while_its_handle_exists() {
     // pose mode, it is gone, and so is the selection: no mode shows a handle that does not exist.
     h.key_press(Key::Num1);
     h.run();
-    h.get_by_label("Point").click();
-    h.run();
+    click_shown(&mut h, "Point");
     click(&mut h, Point::new(40.0, 40.0));
     let added = h
         .state()

@@ -18,11 +18,9 @@ fn set_two_keys_and_scrub_the_timeline() {
         "{:?}",
         h.state().message
     );
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     for _ in 0..24 {
-        h.get_by_label("Next frame").click();
-        h.run();
+        click_shown(&mut h, "Next frame");
     }
     assert!(
         (h.state().animate.time_s - 1.0).abs() < 1e-9,
@@ -32,13 +30,11 @@ fn set_two_keys_and_scrub_the_timeline() {
     // Grab the pin where the first key left it and move it to the other side.
     let second = [grip[0] - 20.0, grip[1] - 10.0];
     drag(&mut h, first, second);
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     let anim = crate::document::animation_named(h.state().doc.state(), "animation");
     assert_eq!(crate::document::key_times(&anim), vec![0.0, 1.0]);
     for _ in 0..12 {
-        h.get_by_label("Previous frame").click();
-        h.run();
+        click_shown(&mut h, "Previous frame");
     }
     let halfway = h.state().edited_pose();
     assert_eq!(halfway.ik.len(), 1);
@@ -105,8 +101,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     assert!((h.state().timeline.selection[0].time_s - 0.75).abs() < 1e-9);
 
     // Copy it, put the playhead at 1 s on the ruler, paste: a 20° key at 1 s.
-    h.get_by_label("Copy keys").click();
-    h.run();
+    click_shown(&mut h, "Copy keys");
     let ruler_y = sheet.ruler.center().y;
     click_screen(&mut h, Pos2::new(sheet.x_of(1.0), ruler_y));
     assert!(
@@ -114,8 +109,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
         "{}",
         h.state().animate.time_s
     );
-    h.get_by_label("Paste keys").click();
-    h.run();
+    click_shown(&mut h, "Paste keys");
     let rotate = head_rotate_keys(&h);
     assert_eq!(rotate.len(), 3, "{:?}", h.state().message);
     assert!(
@@ -127,8 +121,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
     let at = key_on_sheet(&h, Rotate, 0.0);
     click_screen(&mut h, at);
     assert_eq!(h.state().timeline.selection.len(), 1);
-    h.get_by_label("Bézier").click();
-    h.run();
+    click_shown(&mut h, "Bézier");
     let curve = head_rotate_keys(&h)[0].2.clone();
     let numbers: Vec<f64> = serde_json::from_value(curve.clone()).expect("a Bézier: {curve}");
     let expected = [0.25, 20.0 / 3.0, 0.5, 40.0 / 3.0];
@@ -199,13 +192,12 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     h.run();
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("nod").click();
-    h.run();
+    click_shown(&mut h, "nod");
     assert_eq!(h.state().animate.animation, "nod");
     let fps = h.state().render_settings.fps;
     let on_frame = |t: f64| ((t * fps) - (t * fps).round()).abs() < 1e-6;
     // Play (a click; the playing editor asks for frame after frame, so frames are stepped).
-    h.get_by_label("Play").click();
+    press_shown(&mut h, "Play");
     h.step();
     let mut wrapped = false;
     let mut last = 0.0;
@@ -218,13 +210,12 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
     }
     assert!(wrapped, "playback never looped");
     // Without looping it stops on the last key.
-    h.get_by_label("Pause").click();
+    press_shown(&mut h, "Pause");
     h.step();
     h.run();
-    h.get_by_label("Loop").click();
-    h.run();
+    click_shown(&mut h, "Loop");
     assert!(!h.state().timeline.looping);
-    h.get_by_label("Play").click();
+    press_shown(&mut h, "Play");
     h.step();
     for _ in 0..240 {
         h.step();
@@ -260,18 +251,15 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
         "Previous frame"
     };
     for _ in 0..steps.abs() {
-        h.get_by_label(button).click();
-        h.run();
+        click_shown(&mut h, button);
     }
     assert!((h.state().animate.time_s - 0.5).abs() < 1e-9);
-    h.get_by_label("Onion skin").click();
-    h.run();
+    click_shown(&mut h, "Onion skin");
     let scene = h.state().doc.posable().expect("posable").clone();
     let placed = h.state().placed.expect("placed");
     let at_end = h.state_mut().onion_shapes(&scene, &placed);
     for _ in 0..frames_to(&h, 0.25).abs() {
-        h.get_by_label("Previous frame").click();
-        h.run();
+        click_shown(&mut h, "Previous frame");
     }
     assert!((h.state().animate.time_s - 0.25).abs() < 1e-9);
     let middle = h.state_mut().onion_shapes(&scene, &placed);
@@ -281,8 +269,7 @@ fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
         2 * at_end.len(),
         "two frames each side vs two before"
     );
-    h.get_by_label("Onion skin").click();
-    h.run();
+    click_shown(&mut h, "Onion skin");
     assert!(h.state_mut().onion_shapes(&scene, &placed).is_empty());
 }
 
@@ -293,8 +280,7 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 30.0)]);
     h.key_press(Key::Num3);
     h.run();
-    h.get_by_label("nod").click();
-    h.run();
+    click_shown(&mut h, "nod");
     // Click one key, shift-click another: both selected; shift-click again: deselected.
     let at = key_on_sheet(&h, Rotate, 0.5);
     click_screen(&mut h, at);

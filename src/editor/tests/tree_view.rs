@@ -7,8 +7,7 @@ use egui_kittest::kittest::NodeT;
 fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
     h.get_by_label(label).scroll_to_me();
     h.run();
-    h.get_by_label(label).click();
-    h.run();
+    click_shown(h, label);
 }
 
 /// The same view, up to a fraction of a point (the side panel's width settles over the first
@@ -144,10 +143,8 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
     );
 
     // The View menu does the same, its entries showing their keys.
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label_contains("Zoom to fit").click();
-    h.run();
+    click_shown(&mut h, "View");
+    click_shown_by(&mut h, By::new().label_contains("Zoom to fit"));
     assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
 }
 
@@ -156,7 +153,9 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
 fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
     h.get_by_label(from).scroll_to_me();
     h.run();
-    let start = h.get_by_label(from).rect().center();
+    let start = press_point(&h.get_by_label(from));
+    assert_shown(h, start, from);
+    let start = start.1;
     h.drag_at(start);
     h.step();
     // Past egui's drag threshold, so the drop row for "no parent" shows.
@@ -238,8 +237,13 @@ fn a_drag_held_at_the_trees_bottom_edge_scrolls_it_to_rows_below() {
     // weights' heading.
     let top = h.get_by_label("Tree").rect().bottom();
     let bottom = h.get_by_label("Weights").rect().top() - 12.0;
-    let start = h.get_by_label("head").rect().center();
-    assert!(start.y > top && start.y < bottom, "the head's row shows");
+    let start = press_point(&h.get_by_label("head"));
+    assert!(
+        start.1.y > top && start.1.y < bottom,
+        "the head's row shows"
+    );
+    assert_shown(&mut h, start, "head");
+    let start = start.1;
     let lantern = |h: &Harness<'_, EditorApp>| h.get_by_label("lantern").rect().center();
     assert!(
         lantern(&h).y > bottom + 20.0,
@@ -328,8 +332,7 @@ fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
 
     // Twelve frames on (0.5 s at 24 fps), "nothing" keys the slot hidden.
     for _ in 0..12 {
-        h.get_by_label("Next frame").click();
-        h.run();
+        click_shown(&mut h, "Next frame");
     }
     click_label(&mut h, "bag shows nothing");
     assert_eq!(keys(&h), [(0.0, Some("bag_pail".into())), (0.5, None)]);
@@ -396,8 +399,7 @@ fn selecting_in_the_tree_never_moves_the_tree_under_the_pointer() {
         h.run();
         let before = rects(&h);
         for pick in ["chest", "head", "hip"] {
-            h.get_by_label(pick).click();
-            h.run();
+            click_shown(&mut h, pick);
             assert_eq!(h.state().selected.as_deref(), Some(pick));
             assert_eq!(rects(&h), before, "after picking {pick}");
         }

@@ -16,8 +16,7 @@ fn drag_keys(h: &Harness<'_, EditorApp>) -> Vec<(f64, Point)> {
 
 fn press_times(h: &mut Harness<'_, EditorApp>, label: &str, times: usize) {
     for _ in 0..times {
-        h.get_by_label(label).click();
-        h.run();
+        click_shown(h, label);
     }
 }
 
@@ -30,11 +29,9 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     h.run();
 
     // File menu: type the PNG's path into its field and import it.
-    h.get_by_label("File").click();
-    h.run();
+    click_shown(&mut h, "File");
     type_into(&mut h, "Rig or PNG path:", &png.display().to_string());
-    h.get_by_label("Import layer").click();
-    h.run();
+    click_shown(&mut h, "Import layer");
     assert_eq!(
         h.state().doc.state().layers.len(),
         1,
@@ -43,16 +40,14 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     );
 
     // Two bones along the bar, the second continuing the first's skeleton.
-    h.get_by_label("Bone").click();
-    h.run();
+    click_shown(&mut h, "Bone");
     drag(&mut h, [16.0, 24.0], [48.0, 24.0]);
     drag(&mut h, [48.0, 24.0], [80.0, 24.0]);
     let bones = h.state().doc.state().handles.bones.clone();
     assert_eq!(bones.len(), 2, "{:?}", h.state().message);
     assert_eq!(bones[1].parent.as_deref(), Some(bones[0].name.as_str()));
 
-    h.get_by_label("Compute weights").click();
-    h.run();
+    click_shown(&mut h, "Compute weights");
     wait_for_weights(&mut h);
     assert!(h.state().doc.posable().is_some(), "{:?}", h.state().message);
 
@@ -62,19 +57,16 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     // (Gripped below the bones' line: a drag that starts on a bone turns the bone.)
     let (up, down) = ([80.0, 22.0], [80.0, 42.0]);
     drag(&mut h, [80.0, 32.0], up);
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     press_times(&mut h, "Next frame", 24);
     drag(&mut h, up, down);
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     let keys = drag_keys(&h);
     assert_eq!(keys.len(), 2, "{:?}", h.state().message);
     assert!((keys[1].0 - 1.0).abs() < 1e-9);
 
     // Set key with nothing changed says so and adds no undo step.
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.contains("nothing to key"), "{message}");
 
@@ -86,8 +78,7 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
         .expect("a row for the drag");
     click_screen(&mut h, at);
     assert_eq!(h.state().timeline.selection.len(), 1);
-    h.get_by_label("Bézier").click();
-    h.run();
+    click_shown(&mut h, "Bézier");
     let layout = h.state().timeline.curve.clone().expect("the curve editor");
     let [first, _] = layout.handles.expect("Bézier handles");
     drag_screen(&mut h, first, first + egui::vec2(40.0, 0.0));
@@ -108,8 +99,7 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     let at = |anim: &crate::anim::Animation, k: usize| {
         anim.sample_with(k as f64 / 20.0, false, &options).ik[0].to
     };
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     assert_eq!(drag_keys(&h).len(), 3, "{:?}", h.state().message);
     let split = crate::document::animation_named(h.state().doc.state(), "animation");
     for k in 0..=20 {
@@ -125,15 +115,14 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     press_times(&mut h, "Next frame", 6);
     let grip = h.state().edited_pose().ik[0].to;
     drag(&mut h, grip, [grip[0] - 6.0, grip[1]]);
-    h.get_by_label("Set key").click();
-    h.run();
+    click_shown(&mut h, "Set key");
     let keys = drag_keys(&h);
     assert_eq!(keys.len(), 4, "{:?}", h.state().message);
     assert!((keys[2].0 - 0.75).abs() < 1e-9 && (keys[2].1[0] - (grip[0] - 6.0)).abs() < 0.5);
 
     // Play: the playhead moves on its own; pause stops it.
     // (A playing editor asks for frame after frame: frames are stepped, not run to rest.)
-    h.get_by_label("Play").click();
+    press_shown(&mut h, "Play");
     h.step();
     let mut shown = Vec::new();
     for _ in 0..20 {
@@ -143,7 +132,7 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     shown.sort_by(f64::total_cmp);
     shown.dedup();
     assert!(shown.len() > 2, "playback showed only {shown:?}");
-    h.get_by_label("Pause").click();
+    press_shown(&mut h, "Pause");
     h.step();
     h.run();
     let stopped = h.state().animate.time_s;
@@ -167,13 +156,10 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
     h.key_press_modifiers(Modifiers::COMMAND, Key::N);
     h.run();
     assert!(h.state().doc.path.is_none());
-    h.get_by_label("File").click();
-    h.run();
+    click_shown(&mut h, "File");
     // A submenu's button reads "Open recent ⏵".
-    h.get_by_label_contains("Open recent").click();
-    h.run();
-    h.get_by_label(&json.display().to_string()).click();
-    h.run();
+    click_shown_by(&mut h, By::new().label_contains("Open recent"));
+    click_shown(&mut h, &json.display().to_string());
     assert_eq!(h.state().doc.path.as_deref(), Some(json.as_path()));
     assert!(h.state().doc.posable().is_some());
     assert_eq!(
