@@ -1,5 +1,8 @@
 //! Peak heap memory of one colorization at 2048² with 10 scribble colors (target < 1 GiB),
-//! and at 512² and 1024² for the trend. A counting global allocator records the high-water
+//! and at 512² and 1024² for the trend, on the scenes of `benches/colorize.rs`: `closed` (every
+//! region closed, one color each), `undrawn` (the background's two halves in one region: the
+//! reach split runs over it) and `open` (the 10 scribbles on a blank page: one region holding
+//! every color, the split's worst case). A counting global allocator records the high-water
 //! mark of live heap bytes during the `colorize::colorize` call (the line art and scribbles,
 //! allocated before, are not counted; they are printed). `cargo bench --bench colorize_memory`
 
@@ -34,29 +37,38 @@ static ALLOCATOR: Counting = Counting;
 fn main() {
     // `cargo bench` passes --bench; nothing to parse.
     for size in [512u32, 1024, 2048] {
-        let s = scene(&SceneSpec {
-            size,
-            shapes: 9,
-            ..Default::default()
-        });
-        let scribbles =
-            Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
-                .expect("the strokes rasterize");
-        let inputs = s.lineart.as_raw().len() + scribbles.labels.len() * 2;
-        for layers in [false, true] {
-            let before = LIVE.load(Ordering::Relaxed);
-            PEAK.store(before, Ordering::Relaxed);
-            let result =
-                colorize::colorize(&s.lineart, &scribbles, &ColorizeOptions::default(), layers)
-                    .expect("colorizes");
-            let extra = PEAK.load(Ordering::Relaxed) - before;
-            println!(
-                "{size}², 10 colors{}: peak heap during colorize {:.1} MB (inputs {:.1} MB; {} mesh vertices)",
-                if layers { ", with layers" } else { "" },
-                extra as f64 / 1e6,
-                inputs as f64 / 1e6,
-                result.stats.vertices
-            );
+        for scene_name in ["closed", "undrawn", "open"] {
+            let s = scene(&SceneSpec {
+                size,
+                shapes: 9,
+                split_background: scene_name == "undrawn",
+                ..Default::default()
+            });
+            let lineart = if scene_name == "open" {
+                image::RgbaImage::from_pixel(size, size, image::Rgba([255; 4]))
+            } else {
+                s.lineart
+            };
+            let scribbles =
+                Scribbles::from_strokes(&s.strokes, size, size, &ScribbleOptions::default())
+                    .expect("the strokes rasterize");
+            let inputs = lineart.as_raw().len() + scribbles.labels.len() * 2;
+            for layers in [false, true] {
+                let before = LIVE.load(Ordering::Relaxed);
+                PEAK.store(before, Ordering::Relaxed);
+                let result =
+                    colorize::colorize(&lineart, &scribbles, &ColorizeOptions::default(), layers)
+                        .expect("colorizes");
+                let extra = PEAK.load(Ordering::Relaxed) - before;
+                println!(
+                    "{scene_name} {size}², {} colors{}: peak heap during colorize {:.1} MB (inputs {:.1} MB; {} mesh vertices)",
+                    scribbles.colors.len(),
+                    if layers { ", with layers" } else { "" },
+                    extra as f64 / 1e6,
+                    inputs as f64 / 1e6,
+                    result.stats.vertices
+                );
+            }
         }
     }
 }

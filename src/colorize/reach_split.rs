@@ -79,7 +79,7 @@ pub fn reach_split(
         }
     }
     let (cost_of_depth, depth) = crossing_costs(&regions.depth_half_px, depth_exponent);
-    let site = sites(&regions.region, &depth, w, h);
+    let site = sites(&regions.region, depth, w, h);
     let field = Field {
         site: &site,
         cost_of_depth: &cost_of_depth,
@@ -189,8 +189,10 @@ const MAX_DEPTH_INDEX: u32 = (1 << 24) - 1;
 
 /// Per pixel its site: its depth index (`depth`) above 8 bits of which steps (`STEPS`) stay in
 /// the image and in its region, bit k for step k. One 4-byte read per pixel tells a front both.
-fn sites(region: &[u32], depth: &[u32], w: usize, h: usize) -> Vec<u32> {
-    let mut site: Vec<u32> = depth.par_iter().map(|&d| d << 8).collect();
+fn sites(region: &[u32], depth: Vec<u32>, w: usize, h: usize) -> Vec<u32> {
+    // In place: the depth indices are not needed after.
+    let mut site = depth;
+    site.par_iter_mut().for_each(|d| *d <<= 8);
     let row_of = |y: usize| &region[y * w..(y + 1) * w];
     site.par_chunks_mut(w.max(1))
         .enumerate()
