@@ -96,52 +96,58 @@ pub fn reach_split(
     // One reach buffer per color of a batch, reused: after a batch only the pixels it reached
     // are reset, so a late color stopped after a few pixels costs a few pixels.
     let threads = rayon::current_num_threads().max(1);
-    let mut reaches: Vec<Reach> = Vec::new();
+    let mut reaches: Vec<Reach> = (0..threads.min(colors.len()))
+        .into_par_iter()
+        .map(|_| Reach::unreached(w * h))
+        .collect();
     let batches = colors.chunks(threads).count();
     for (k, batch) in colors.chunks(threads).enumerate() {
-        while reaches.len() < batch.len() {
-            reaches.push(Reach::unreached(w * h));
-        }
         let reaches = &mut reaches[..batch.len()];
         // The first batch has nothing to stop at.
         let stop = (k > 0).then_some(&won);
         (reaches.par_iter_mut().zip(batch)).for_each(|(reach, &c)| field.reach(c, stop, reach));
-        let offer = |won_cost: &mut f64, won_color: &mut u16, won_radius_px: &mut f64, i: usize| {
-            for (&color, reach) in batch.iter().zip(reaches.iter()) {
-                let (offered, taken) = (reach.cost[i], *won_cost);
-                if offered < taken
-                    || (offered == taken && offered.is_finite() && color < *won_color)
-                {
-                    *won_cost = offered;
-                    *won_color = color;
-                    *won_radius_px = radius_px[reach.from[i] as usize];
-                }
+        // A color's offer of its cost at pixel i, taken when cheaper (ties: the lower color).
+        let offer = |won_cost: &mut f64,
+                     won_color: &mut u16,
+                     won_radius_px: &mut f64,
+                     (color, reach): (u16, &Reach),
+                     i: usize| {
+            let (offered, taken) = (reach.cost[i], *won_cost);
+            if offered < taken || (offered == taken && offered.is_finite() && color < *won_color) {
+                *won_cost = offered;
+                *won_color = color;
+                *won_radius_px = radius_px[reach.from[i] as usize];
             }
         };
+        let offers = || batch.iter().copied().zip(reaches.iter());
         let reached: usize = reaches.iter().map(|r| r.reached.len()).sum();
         if reached < w * h / SPARSE_MERGE_SHARE {
-            // Few pixels reached: offer only those, in one thread.
-            for reach in reaches.iter() {
+            // Few pixels reached: only those, in one thread.
+            for (color, reach) in offers() {
                 for &i in &reach.reached {
                     let i = i as usize;
-                    offer(
-                        &mut won.cost[i],
-                        &mut won.color[i],
-                        &mut won.radius_px[i],
-                        i,
-                    );
+                    let won_at = (&mut won.cost[i], &mut won.color[i]);
+                    offer(won_at.0, won_at.1, &mut won.radius_px[i], (color, reach), i);
                 }
             }
         } else {
-            // Per pixel, independently (rayon, by rows).
+            // Every pixel, by rows in parallel.
             let rows = w.max(1);
             (won.cost.par_chunks_mut(rows))
                 .zip(won.color.par_chunks_mut(rows))
                 .zip(won.radius_px.par_chunks_mut(rows))
                 .enumerate()
                 .for_each(|(y, ((cost, color), radius_px))| {
-                    for x in 0..cost.len() {
-                        offer(&mut cost[x], &mut color[x], &mut radius_px[x], y * rows + x);
+                    for by in offers() {
+                        for x in 0..cost.len() {
+                            offer(
+                                &mut cost[x],
+                                &mut color[x],
+                                &mut radius_px[x],
+                                by,
+                                y * rows + x,
+                            );
+                        }
                     }
                 });
         }
@@ -258,14 +264,6 @@ impl Reach {
         }
     }
 
-    /// Sets pixel `i`'s cost and scribble.
-    fn set(&mut self, i: usize, cost: f64, from: u32) {
-        if self.cost[i] == f64::INFINITY {
-            self.reached.push(i as u32);
-        }
-        (self.cost[i], self.from[i]) = (cost, from);
-    }
-
     /// Back to no pixel reached, touching only the pixels that were (or every pixel, in
     /// order, when they were many).
     fn reset(&mut self) {
@@ -287,21 +285,28 @@ impl Field<'_> {
     /// (if any) already holds a strictly cheaper cost from a scribble at least as large.
     /// `into` starts unreached ([`Reach::unreached`] or [`Reach::reset`]).
     fn reach(&self, color: u16, won: Option<&Won>, into: &mut Reach) {
+        // Slices and a local list, so the hot loop keeps their addresses in registers.
+        let (reach, from) = (&mut into.cost[..], &mut into.from[..]);
+        let mut reached = std::mem::take(&mut into.reached);
         // Costs are finite and non-negative, so they order like their bit patterns, and a
         // Dijkstra's popped costs never decrease: a monotone (radix) heap.
         let mut heap = RadixHeapMap::new();
         for &i in &self.seeds[color as usize] {
-            into.set(i as usize, 0.0, self.scribble[i as usize]);
-            heap.push(Reverse(0u64), i);
+            let i = i as usize;
+            if reach[i] == f64::INFINITY {
+                reached.push(i as u32);
+            }
+            (reach[i], from[i]) = (0.0, self.scribble[i]);
+            heap.push(Reverse(0u64), i as u32);
         }
         let cost = |site: u32| self.cost_of_depth[(site >> 8) as usize];
         while let Some((Reverse(bits), i)) = heap.pop() {
             let i = i as usize;
             let at = f64::from_bits(bits);
-            if at > into.cost[i] {
+            if at > reach[i] {
                 continue;
             }
-            let source = into.from[i];
+            let source = from[i];
             let radius_px = self.radius_px[source as usize];
             let scale = 0.5 / radius_px;
             let site = self.site[i];
@@ -313,12 +318,16 @@ impl Field<'_> {
                 let j = i.wrapping_add_signed(self.offsets[k]);
                 let through = at + step_px * (cost_here + cost(self.site[j])) * scale;
                 let lost = |won: &Won| through > won.cost[j] && radius_px <= won.radius_px[j];
-                if through < into.cost[j] && !won.is_some_and(lost) {
-                    into.set(j, through, source);
+                if through < reach[j] && !won.is_some_and(lost) {
+                    if reach[j] == f64::INFINITY {
+                        reached.push(j as u32);
+                    }
+                    (reach[j], from[j]) = (through, source);
                     heap.push(Reverse(through.to_bits()), j as u32);
                 }
             }
         }
+        into.reached = reached;
     }
 }
 
