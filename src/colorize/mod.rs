@@ -351,18 +351,38 @@ impl ColorizeOptions {
     }
 }
 
-impl PreparedLineArt {
-    /// Checks `options` and prepares `lineart` for colorizations with them.
-    pub fn new(lineart: RgbaImage, options: ColorizeOptions) -> Result<Self, ColorizeError> {
-        options.check()?;
-        let art = LineArt::new(&lineart);
+/// What preparing line art reads of [`ColorizeOptions`], and nothing else: the preparation
+/// runs on this alone, so two option sets with equal preparations share its work
+/// ([`PreparedLineArt::with_options`]).
+#[derive(Clone, Debug, PartialEq)]
+struct Preparation {
+    line_threshold: f32,
+    end_point_join: EndPointJoinOptions,
+    gap_closing_px: f64,
+    split_depth_px: f64,
+}
+
+impl Preparation {
+    fn of(options: &ColorizeOptions) -> Self {
+        Preparation {
+            line_threshold: options.line_threshold,
+            end_point_join: options.end_point_join.clone(),
+            gap_closing_px: options.gap_closing_px,
+            split_depth_px: options.split_depth_px,
+        }
+    }
+
+    /// Steps 1 and 3 on `lineart`: the drawing over white, its colors with gaps closed, and
+    /// the regions those enclose.
+    fn run(&self, lineart: &RgbaImage) -> (LineArt, Vec<[u8; 3]>, InkRegions) {
+        let art = LineArt::new(lineart);
         // The lift and the mesh see the drawing with its gaps closed: end points joined by
         // curves of full ink, then every line's ridge.
         let joins = end_point_join::join_end_points(
-            &art.line_mask(options.line_threshold),
+            &art.line_mask(self.line_threshold),
             art.width,
             art.height,
-            &options.end_point_join,
+            &self.end_point_join,
         );
         let mut joined = art.over_white.clone();
         for (c, &j) in joined.iter_mut().zip(&joins.mask) {
@@ -370,15 +390,23 @@ impl PreparedLineArt {
                 *c = [0; 3];
             }
         }
-        let closed =
-            gap_closing::close_gaps(&joined, art.width, art.height, options.gap_closing_px);
+        let closed = gap_closing::close_gaps(&joined, art.width, art.height, self.gap_closing_px);
         let regions = InkRegions::new(
             &closed,
             art.width,
             art.height,
-            options.line_threshold,
-            options.split_depth_px,
+            self.line_threshold,
+            self.split_depth_px,
         );
+        (art, closed, regions)
+    }
+}
+
+impl PreparedLineArt {
+    /// Checks `options` and prepares `lineart` for colorizations with them.
+    pub fn new(lineart: RgbaImage, options: ColorizeOptions) -> Result<Self, ColorizeError> {
+        options.check()?;
+        let (art, closed, regions) = Preparation::of(&options).run(&lineart);
         Ok(PreparedLineArt {
             image: lineart,
             art,
@@ -389,14 +417,11 @@ impl PreparedLineArt {
     }
 
     /// This line art prepared for `options`. When what the preparation reads is unchanged
-    /// (line threshold, end-point joins, gap closing, split depth), its work is kept and only
-    /// the options change (a new split or α costs a copy); otherwise it is prepared anew.
+    /// (`Preparation`: line threshold, end-point joins, gap closing, split depth), its work
+    /// is kept and only the options change (a new split or α costs a copy); otherwise it is
+    /// prepared anew.
     pub fn with_options(&self, options: ColorizeOptions) -> Result<Self, ColorizeError> {
-        let o = &self.options;
-        let same_preparation = o.line_threshold == options.line_threshold
-            && o.end_point_join == options.end_point_join
-            && o.gap_closing_px == options.gap_closing_px
-            && o.split_depth_px == options.split_depth_px;
+        let same_preparation = Preparation::of(&self.options) == Preparation::of(&options);
         if !same_preparation {
             return PreparedLineArt::new(self.image.clone(), options);
         }
