@@ -123,11 +123,15 @@ pub fn reach_split(
         let reached: usize = reaches.iter().map(|r| r.reached.len()).sum();
         if reached < w * h / SPARSE_MERGE_SHARE {
             // Few pixels reached: only those, in one thread.
-            for (color, reach) in offers() {
-                for &i in &reach.reached {
+            let Won {
+                cost,
+                color,
+                radius_px,
+            } = &mut won;
+            for by in offers() {
+                for &i in &by.1.reached {
                     let i = i as usize;
-                    let won_at = (&mut won.cost[i], &mut won.color[i]);
-                    offer(won_at.0, won_at.1, &mut won.radius_px[i], (color, reach), i);
+                    offer(&mut cost[i], &mut color[i], &mut radius_px[i], by, i);
                 }
             }
         } else {
