@@ -100,7 +100,7 @@ pub fn reach_split(
         .into_par_iter()
         .map(|_| Reach::unreached(w * h))
         .collect();
-    let batches = colors.chunks(threads).count();
+    let batches = colors.len().div_ceil(threads);
     for (k, batch) in colors.chunks(threads).enumerate() {
         let reaches = &mut reaches[..batch.len()];
         // The first batch has nothing to stop at.
