@@ -34,6 +34,9 @@ TOLERANCE = 16
 GMIC_SMART_ARGS = "1,95,0,0,1,24,200,0,75,2,60,20,90,1,10,1,0"
 GMIC_PROPAGATION_ARGS = "0,2,0,0.05"
 SUBSETS = ["closed", "gaps", "undrawn"]
+# The issue's set: "a third of the cases have color boundaries that the line art does not draw,
+# or gaps"; ours has a third of each subset.
+ISSUE_MIX = {"closed": 2 / 3, "gaps": 1 / 6, "undrawn": 1 / 6}
 ALL_METHODS = ["sinew-flat", "sinew-soft", "gmic-smart", "gmic-propagation", "flood"]
 
 
@@ -139,23 +142,33 @@ def main():
 def print_table(results, size, count):
     print(f"{count} cases at {size}²; score = share of non-line pixels within {TOLERANCE}/255 of the truth")
     print()
-    print("| method | all | closed | gaps | undrawn | hard (gaps + undrawn) | worst case | median s |")
-    print("|---|---|---|---|---|---|---|---|")
-    for m, rows in results.items():
+    print("| method | all | closed | gaps | undrawn | hard (gaps + undrawn) | issue's mix | worst case | median s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    rows_of = dict(results)
+    if len(results) > 1:
+        # The best method per case: a bound on what choosing among these methods could score.
+        rows_of["best per case"] = [
+            max((rows[k] for rows in results.values()), key=lambda r: r["score"]) | {"seconds": None}
+            for k in range(len(next(iter(results.values()))))
+        ]
+    for m, rows in rows_of.items():
         def mean(pred):
             v = [r["score"] for r in rows if pred(r)]
             return statistics.fmean(v) if v else float("nan")
 
         secs = [r["seconds"] for r in rows if r["seconds"] is not None]
+        by_subset = {s: mean(lambda r, s=s: r["subset"] == s) for s in SUBSETS}
         cells = [
             mean(lambda r: True),
-            *(mean(lambda r, s=s: r["subset"] == s) for s in SUBSETS),
+            *by_subset.values(),
             mean(lambda r: r["subset"] != "closed"),
+            # Weighted as the issue's own set: a third of the cases hard (half gaps, half
+            # undrawn), two thirds closed.
+            sum(ISSUE_MIX[s] * v for s, v in by_subset.items()),
             min(r["score"] for r in rows),
         ]
         median = f"{statistics.median(secs):.3f}" if secs else "—"
         print(f"| {m} | " + " | ".join(f"{c:.4f}" for c in cells) + f" | {median} |")
-
 
 if __name__ == "__main__":
     main()
