@@ -17,7 +17,9 @@
 //!
 //! `incremental/1024`: the line art prepared once ([`PreparedLineArt`]: gap closing, ink
 //! regions), then the colorization after one more scribble, as the editor's colorize mode
-//! re-solves while the artist scribbles (issue 24's target: under 100 ms at 1024²).
+//! re-solves while the artist scribbles (issue 24's target: under 100 ms at 1024²);
+//! `incremental-undrawn/1024` the same on the `undrawn` scene, where each re-solve splits the
+//! contested background.
 //!
 //! `cargo bench --bench colorize`; one case: `cargo bench --bench colorize -- '2048/10'`.
 
@@ -94,6 +96,22 @@ fn bench(c: &mut Criterion) {
     // scribble (nothing scribble-dependent is kept between solves).
     let never = std::sync::atomic::AtomicBool::new(false);
     group.bench_function("incremental/1024", |b| {
+        b.iter(|| {
+            prepared
+                .colorize(black_box(&scribbles), false, &never)
+                .expect("colorizes")
+        })
+    });
+    // The same on the undrawn scene: the re-solve splits the contested background by reach.
+    let (s, scribbles) = scene_and_scribbles(SceneSpec {
+        size: 1024,
+        shapes: 9,
+        split_background: true,
+        ..Default::default()
+    });
+    let prepared =
+        PreparedLineArt::new(s.lineart.clone(), ColorizeOptions::default()).expect("prepares");
+    group.bench_function("incremental-undrawn/1024", |b| {
         b.iter(|| {
             prepared
                 .colorize(black_box(&scribbles), false, &never)

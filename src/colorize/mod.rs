@@ -59,7 +59,9 @@ pub use weights::{ColorWeights, LiftedStiffness};
 use crate::weights::BbwOptions;
 use image::RgbaImage;
 use serde::{Deserialize, Serialize};
+use reach_split::ReachSites;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
 
 /// How to colorize. Every field has a documented default.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -271,6 +273,9 @@ pub struct PreparedLineArt {
     pub closed: Vec<[u8; 3]>,
     /// The regions the closed lines enclose, and the ink levels the watershed follows.
     pub regions: InkRegions,
+    /// What the reach split reads of the regions, made by the first solve that splits by
+    /// reach and kept for the next ones.
+    reach_sites: OnceLock<ReachSites>,
     pub options: ColorizeOptions,
 }
 
@@ -412,6 +417,7 @@ impl PreparedLineArt {
             art,
             closed,
             regions,
+            reach_sites: OnceLock::new(),
             options,
         })
     }
@@ -480,8 +486,10 @@ impl PreparedLineArt {
                     return Ok(());
                 }
                 RegionSplit::Reach => {
+                    let sites = self.reach_sites.get_or_init(|| ReachSites::new(regions));
                     reach_split::reach_split(
                         regions,
+                        sites,
                         &labels,
                         owner,
                         options.split_depth_exponent,

@@ -51,8 +51,12 @@ pub const DOT_RADIUS_PX: f64 = 1.5;
 /// the split is the one without stopping. The result does not depend on the thread count:
 /// what one batch reads was settled by the batches before it, and a pixel goes to the least
 /// cost, ties to the lower color.
+///
+/// `sites`: [`ReachSites::new`] of `regions` (they depend on the line art alone, so a session
+/// keeps them across solves).
 pub fn reach_split(
     regions: &InkRegions,
+    sites: &ReachSites,
     labels: &[u16],
     owner: &mut [u16],
     depth_exponent: f64,
@@ -78,10 +82,10 @@ pub fn reach_split(
             seeds[color_of[s as usize] as usize].push(i as u32);
         }
     }
-    let (cost_of_depth, depth) = crossing_costs(&regions.depth_half_px, depth_exponent);
-    let site = sites(&regions.region, depth, w, h);
+    assert_eq!(sites.site.len(), w * h, "the sites of other regions");
+    let cost_of_depth = crossing_costs(sites.top_depth_index, depth_exponent);
     let field = Field {
-        site: &site,
+        site: &sites.site,
         cost_of_depth: &cost_of_depth,
         offsets: STEPS.map(|(dx, dy, _)| dy * w as isize + dx),
         scribble: &scribble,
@@ -167,11 +171,32 @@ pub fn reach_split(
     }
 }
 
-/// The cost of crossing a pixel, (depth px, at least [`MIN_DEPTH_PX`])^−α, as a table over
-/// the depths present, and per pixel its index in the table (its chamfer depth in half px; the
-/// last entry stands for "no line anywhere" and for depths beyond [`MAX_DEPTH_INDEX`]).
-fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> (Vec<f64>, Vec<u32>) {
-    let of = |d: u32| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent);
+/// What the reach split reads of the line art alone: per pixel its site ([`sites`]: depth
+/// index and the steps that stay in its region), computed once per [`InkRegions`] and kept
+/// across solves ([`super::PreparedLineArt`] holds one).
+#[derive(Clone, Debug)]
+pub struct ReachSites {
+    site: Vec<u32>,
+    /// The largest depth index below "far" ([`depth_indices`]).
+    top_depth_index: u32,
+}
+
+impl ReachSites {
+    /// The sites of `regions` (4 bytes per pixel).
+    pub fn new(regions: &InkRegions) -> Self {
+        let (w, h) = (regions.width as usize, regions.height as usize);
+        let (top_depth_index, depth) = depth_indices(&regions.depth_half_px);
+        ReachSites {
+            site: sites(&regions.region, depth, w, h),
+            top_depth_index,
+        }
+    }
+}
+
+/// Per pixel its depth index: its chamfer depth in half px, clamped to the deepest depth
+/// present `top` (at most [`MAX_DEPTH_INDEX`] − 1) plus one, which stands for "no line
+/// anywhere" and for depths beyond [`MAX_DEPTH_INDEX`]. Returns (`top`, indices).
+fn depth_indices(depth_half_px: &[u32]) -> (u32, Vec<u32>) {
     let far = u32::MAX / 2;
     let top = depth_half_px
         .par_iter()
@@ -180,13 +205,20 @@ fn crossing_costs(depth_half_px: &[u32], depth_exponent: f64) -> (Vec<f64>, Vec<
         .max()
         .unwrap_or(0)
         .min(MAX_DEPTH_INDEX - 1);
-    let mut table: Vec<f64> = (0..=top).map(of).collect();
-    table.push(of(far));
     let index = depth_half_px
         .par_iter()
         .map(|&d| if d <= top { d } else { top + 1 })
         .collect();
-    (table, index)
+    (top, index)
+}
+
+/// The cost of crossing a pixel, (depth px, at least [`MIN_DEPTH_PX`])^−α, per depth index
+/// `0..=top` ([`depth_indices`]), then for "far".
+fn crossing_costs(top: u32, depth_exponent: f64) -> Vec<f64> {
+    let of = |d: u32| (d as f64 / 2.0).max(MIN_DEPTH_PX).powf(-depth_exponent);
+    let mut table: Vec<f64> = (0..=top).map(of).collect();
+    table.push(of(u32::MAX / 2));
+    table
 }
 
 /// A batch whose colors reached fewer than 1/this of the pixels is merged (and its buffers
@@ -404,7 +436,8 @@ mod tests {
 
     fn split(regions: &InkRegions, labels: &[u16], alpha: f64) -> Vec<u16> {
         let mut owner = labels.to_vec();
-        reach_split(regions, labels, &mut owner, alpha, |i| {
+        let sites = ReachSites::new(regions);
+        reach_split(regions, &sites, labels, &mut owner, alpha, |i| {
             regions.region[i] > 0
         });
         owner
