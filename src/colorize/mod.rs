@@ -58,8 +58,8 @@ pub use weights::{ColorWeights, LiftedStiffness};
 
 use crate::weights::BbwOptions;
 use image::RgbaImage;
-use serde::{Deserialize, Serialize};
 use reach_split::ReachSites;
+use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 

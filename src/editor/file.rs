@@ -26,6 +26,11 @@ pub struct ViewState {
     pub zoom: f32,
     /// Canvas origin offset, points.
     pub pan: [f32; 2],
+    /// The view was the editor's fit, untouched by the user: reopening fits the canvas to the
+    /// window it opens in (its size may differ) instead of restoring `zoom` and `pan`
+    /// (default false: files written before this was kept restore them).
+    #[serde(default)]
+    pub fitted: bool,
     pub mode: Mode,
     pub selected: Option<String>,
     pub animation: String,
@@ -192,6 +197,7 @@ impl EditorApp {
         ViewState {
             zoom: view.zoom,
             pan: [view.pan.x, view.pan.y],
+            fitted: self.view_untouched(),
             mode: self.mode,
             selected: self.selected.clone(),
             animation: self.animate.animation.clone(),
@@ -204,11 +210,12 @@ impl EditorApp {
 
     /// Puts the view back as `state` describes it (a handle that no longer exists is dropped).
     pub fn restore_view(&mut self, state: ViewState) {
-        self.view = Some(View {
+        // A fitted view is fitted again on the first frame, to the area it opens in; the
+        // user's view is put back as left, and kept whatever size the canvas area takes.
+        self.view = (!state.fitted).then(|| View {
             zoom: state.zoom.clamp(0.05, 32.0),
             pan: egui::vec2(state.pan[0], state.pan[1]),
         });
-        // The user's view, as left: kept whatever size the canvas area takes.
         self.fitted = None;
         self.mode = state.mode;
         self.selected = state

@@ -108,3 +108,64 @@ fn an_untouched_view_refits_as_the_mode_changes_the_canvas_area_and_a_users_view
     click_shown_by(&mut h, By::new().label_contains("Zoom to fit"));
     assert_character_in_view(&h, "animate mode after View → Zoom to fit");
 }
+
+/// An editor on a new document in a window of `size` points, after its first frames.
+fn empty_editor_sized(size: egui::Vec2) -> Harness<'static, EditorApp> {
+    let mut h = Harness::builder()
+        .with_size(size)
+        .with_max_steps(MAX_STEPS_PER_RUN)
+        .build_ui_state(
+            |ui, app: &mut EditorApp| app.frame(ui),
+            EditorApp::new(Document::new()),
+        );
+    h.run();
+    h
+}
+
+/// Ctrl+O, the path typed, Enter.
+fn open_by_keys(h: &mut Harness<'_, EditorApp>, path: &std::path::Path) {
+    h.key_press_modifiers(Modifiers::COMMAND, Key::O);
+    h.run();
+    type_into(h, "Path:", &path.display().to_string());
+    h.key_press(Key::Enter);
+    h.run();
+    assert_eq!(h.state().doc.path.as_deref(), Some(path));
+    // The frames that draw the opened document.
+    wait_for(h, |app| app.drawing.picture.is_some());
+}
+
+#[test]
+fn a_fitted_view_reopens_fitted_to_the_new_window_and_a_users_view_as_left() {
+    let mut h = open_character("fit-reopen");
+    let path = h.state().doc.path.clone().expect("a saved document");
+    // Pose mode, where the canvas shows the posed picture.
+    h.key_press(Key::Num2);
+    h.run();
+    let saved_zoom = h.state().view.expect("a view").zoom;
+    // Ctrl+S with the editor's fit untouched.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    wait_for(&mut h, |app| !app.saving());
+
+    // Reopened in a smaller window, the canvas is fitted to it: the whole character shows,
+    // at a smaller zoom than it was saved with.
+    let mut small = empty_editor_sized(egui::vec2(900.0, 600.0));
+    open_by_keys(&mut small, &path);
+    assert_character_in_view(&small, "reopened in a smaller window");
+    let zoom = small.state().view.expect("a view").zoom;
+    assert!(zoom < saved_zoom * 0.9, "zoom {zoom} vs saved {saved_zoom}");
+    // And it stays the editor's fit: it follows the canvas area as the mode changes.
+    small.key_press(Key::Num3);
+    small.run();
+    assert_character_in_view(&small, "animate mode after reopening");
+
+    // The user's own view (a pan) is saved as it is and reopened as it was, in any window.
+    middle_drag(&mut h, egui::vec2(60.0, -40.0));
+    let panned = h.state().view.expect("a view");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run();
+    wait_for(&mut h, |app| !app.saving());
+    let mut other = empty_editor_sized(egui::vec2(900.0, 600.0));
+    open_by_keys(&mut other, &path);
+    assert_eq!(other.state().view, Some(panned));
+}
