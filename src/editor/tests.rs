@@ -321,6 +321,19 @@ fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
     h.run();
 }
 
+/// Scrolls the side panel to the widget labelled `label` (a tree row, say), then
+/// [`click_shown`]s it.
+fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
+    h.get_by_label(label).scroll_to_me();
+    h.run();
+    click_shown(h, label);
+}
+
+/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
+fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
+    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
+}
+
 /// [`click_shown_by`] the widget labelled `label`.
 fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
     click_shown_by(h, By::new().label(label));

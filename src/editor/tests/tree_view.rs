@@ -1,24 +1,11 @@
 //! The tree view and the View menu's keys, driven by input events only.
 
 use super::*;
-use egui_kittest::kittest::NodeT;
-
-/// Scrolls the side panel to the widget labelled `label`, then clicks it.
-fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
-    h.get_by_label(label).scroll_to_me();
-    h.run();
-    click_shown(h, label);
-}
 
 /// The same view, up to a fraction of a point (the side panel's width settles over the first
 /// frames, and the fit with it).
 fn same_view(a: Option<View>, b: View) -> bool {
     a.is_some_and(|a| (a.zoom - b.zoom).abs() < 1e-3 && (a.pan - b.pan).length() < 1.0)
-}
-
-/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
-fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
-    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
 }
 
 #[test]
