@@ -28,9 +28,12 @@ fn main() {
     for part in &mut doc.parts {
         part.image = assets.join(&part.image).to_string_lossy().into_owned();
     }
-    let dir = std::env::temp_dir().join(format!("sinew-bench-editor-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    let path = dir.join("character.json");
+    // Removed when dropped at the end of main, or while a panic unwinds.
+    let dir = tempfile::Builder::new()
+        .prefix("sinew-bench-editor-")
+        .tempdir()
+        .expect("scratch dir");
+    let path = dir.path().join("character.json");
     doc.save(&path).expect("saved");
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     app.mode = Mode::Pose;
@@ -97,5 +100,4 @@ fn main() {
         "the drag did not reach the document: {:?}",
         h.state().message
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -29,3 +29,8 @@ pub mod schema;
 pub mod skin;
 pub mod trace;
 pub mod weights;
+
+/// Scratch folders for the tests, removed when a test ends (also included by the integration
+/// tests' `tests/command`).
+#[cfg(test)]
+pub(crate) mod test_scratch;

@@ -666,7 +666,8 @@ mod tests {
 
     #[test]
     fn relative_paths() {
-        let dir = std::env::temp_dir().join(format!("sinew-rel-{}", std::process::id()));
+        let tmp = crate::test_scratch::scratch("rel");
+        let dir = tmp.path();
         std::fs::create_dir_all(dir.join("a/b")).unwrap();
         std::fs::create_dir_all(dir.join("c")).unwrap();
         std::fs::write(dir.join("c/x.png"), b"").unwrap();
@@ -688,6 +689,5 @@ mod tests {
                 "rig.parts/x.png"
             );
         }
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -525,7 +525,8 @@ fn ok(out: &std::process::Output, what: &str) {
 #[cfg(feature = "cli")]
 #[test]
 fn autorig_then_rig_then_pose_works_with_no_manual_step() {
-    let dir = scratch("e2e");
+    let tmp = scratch("e2e");
+    let dir = tmp.path();
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let flat = s(&assets().join("flat.png"));
     let handles = dir.join("handles.json");
@@ -620,7 +621,8 @@ fn autorig_then_rig_then_pose_works_with_no_manual_step() {
 #[cfg(feature = "cli")]
 #[test]
 fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
-    let dir = scratch("layers");
+    let tmp = scratch("layers");
+    let dir = tmp.path();
     let list: Vec<String> = character_layers().into_iter().map(|l| l.0).collect();
     let paths: Vec<String> = list
         .iter()
@@ -674,7 +676,8 @@ fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
 #[cfg(feature = "cli")]
 #[test]
 fn autorig_bad_input_is_one_line_and_exit_2() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
     let bad = dir.join("bad.png");
     std::fs::write(&bad, b"not a png").unwrap();
     let out_path = dir.join("h.json");
@@ -873,7 +876,8 @@ fn proposed_rigs_over_two_evaluation_characters_match_golden() {
 #[cfg(feature = "cli")]
 #[test]
 fn rig_binds_pieces_no_handle_reaches_with_a_one_line_warning() {
-    let dir = scratch("autorig-unreached");
+    let tmp = scratch("autorig-unreached");
+    let dir = tmp.path();
     let sprite = root().join("tests/fixtures/autorig-eval/detached_head.png");
     let handles = dir.join("handles.json");
     std::fs::write(

@@ -69,8 +69,9 @@ fn statuses(report: &Value) -> Vec<(String, String)> {
 
 #[test]
 fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
-    let dir = scratch("incremental");
-    line_art(&dir, 3);
+    let tmp = scratch("incremental");
+    let dir = tmp.path();
+    line_art(dir, 3);
     let character: Vec<String> = ["torso", "head", "tail"]
         .iter()
         .map(|n| format!("{CHARACTER}/{n}.png"))
@@ -82,7 +83,7 @@ fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
         "options": {"build": {"mesh": {"min_angle_deg": 25.0}}},
         "outputs": {"rig": "out/rig/parts.json", "preview": "out/rig/mesh.png"}
     }));
-    let manifest = write_manifest(&dir, &jobs);
+    let manifest = write_manifest(dir, &jobs);
     let (code, report) = batch(&manifest, &["--jobs", "2"]);
     assert_eq!(code, Some(0), "{report}");
     assert!(statuses(&report).iter().all(|(_, st)| st == "done"));
@@ -135,7 +136,7 @@ fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
     std::fs::copy(dir.join("in/art2.json"), dir.join("in/art0.json")).unwrap();
     jobs[1]["options"]["scale"] = json!(500.0);
     std::fs::remove_file(dir.join("out/rig/mesh.png")).unwrap();
-    let manifest = write_manifest(&dir, &jobs);
+    let manifest = write_manifest(dir, &jobs);
     let (code, report) = batch(&manifest, &[]);
     assert_eq!(code, Some(0));
     let ran: Vec<String> = statuses(&report)
@@ -149,8 +150,9 @@ fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
 
 #[test]
 fn a_failing_job_fails_its_readers_but_not_the_others() {
-    let dir = scratch("failing");
-    line_art(&dir, 2);
+    let tmp = scratch("failing");
+    let dir = tmp.path();
+    line_art(dir, 2);
     // Scribbles that are not a scribble file: that job fails when it runs.
     std::fs::write(dir.join("in/art1.json"), "{\"strokes\": 3}").unwrap();
     let mut jobs = vec![colorize_job(0), colorize_job(1)];
@@ -160,7 +162,7 @@ fn a_failing_job_fails_its_readers_but_not_the_others() {
         "inputs": {"images": ["out/art1.png"]},
         "outputs": {"rig": "out/reader.json"}
     }));
-    let manifest = write_manifest(&dir, &jobs);
+    let manifest = write_manifest(dir, &jobs);
     let (code, report) = batch(&manifest, &[]);
     assert_eq!(code, Some(2), "{report}");
     assert_eq!(
@@ -183,7 +185,7 @@ fn a_failing_job_fails_its_readers_but_not_the_others() {
     assert!(dir.join("out/art0.png").is_file());
     assert!(!dir.join("out/art1.png").exists());
     // Fixed, the rerun does only what is left.
-    line_art(&dir, 2);
+    line_art(dir, 2);
     let (code, report) = batch(&manifest, &[]);
     assert_eq!(code, Some(0), "{report}");
     assert_eq!(
@@ -198,7 +200,8 @@ fn a_failing_job_fails_its_readers_but_not_the_others() {
 
 #[test]
 fn the_character_rigs_renders_and_exports_in_one_batch() {
-    let dir = scratch("character");
+    let tmp = scratch("character");
+    let dir = tmp.path();
     let list: Value =
         serde_json::from_str(&std::fs::read_to_string(format!("{CHARACTER}/layers.json")).unwrap())
             .unwrap();
@@ -222,7 +225,7 @@ fn the_character_rigs_renders_and_exports_in_one_batch() {
                "options": {"animation": "walk", "fps": 6, "scale": 0.25},
                "outputs": {"output": "out/walk.gif"}}),
     ];
-    let manifest = write_manifest(&dir, &jobs);
+    let manifest = write_manifest(dir, &jobs);
     let (code, report) = batch(&manifest, &[]);
     assert_eq!(code, Some(0), "{report}");
     assert!(dir.join("out/spine/rig.json").is_file());
@@ -271,7 +274,8 @@ fn colorize_command(dir: &Path, name: &str, flags: &[&str]) -> Vec<u8> {
 #[test]
 fn a_colorize_job_splits_regions_as_the_command_does() {
     // Two background colors with no line between them: the split decides where they meet.
-    let dir = scratch("split");
+    let tmp = scratch("split");
+    let dir = tmp.path();
     std::fs::create_dir_all(dir.join("in")).unwrap();
     let sc = scene(&SceneSpec {
         size: 96,
@@ -296,7 +300,7 @@ fn a_colorize_job_splits_regions_as_the_command_does() {
         job("density", json!({"split": "density", "split_blur_px": 3})),
         job("alpha", json!({"split_depth_exponent": 1})),
     ];
-    let manifest = write_manifest(&dir, &jobs);
+    let manifest = write_manifest(dir, &jobs);
     let (code, report) = batch(&manifest, &[]);
     assert_eq!(code, Some(0), "{report}");
     let written = |name: &str| std::fs::read(dir.join(format!("out/{name}.png"))).unwrap();
@@ -308,7 +312,7 @@ fn a_colorize_job_splits_regions_as_the_command_does() {
         ("alpha", vec!["--split-exponent", "1"]),
     ] {
         assert!(
-            written(name) == colorize_command(&dir, "undrawn", &flags),
+            written(name) == colorize_command(dir, "undrawn", &flags),
             "job '{name}' differs from sinew colorize {flags:?}"
         );
     }
@@ -325,9 +329,10 @@ fn a_colorize_job_splits_regions_as_the_command_does() {
 
 /// A bad manifest: one line, exit 2, and no job ran (no output, no state).
 fn assert_refused(name: &str, jobs: &[Value], expect: &str) {
-    let dir = scratch(name);
-    line_art(&dir, 2);
-    let manifest = write_manifest(&dir, jobs);
+    let tmp = scratch(name);
+    let dir = tmp.path();
+    line_art(dir, 2);
+    let manifest = write_manifest(dir, jobs);
     assert_bad_input(&["batch", s(&manifest)], expect);
     assert!(!dir.join("out").exists(), "{name}: a job ran");
     assert!(!dir.join("batch.state.json").exists());

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 #[test]
 fn rig_then_pose_writes_rig_preview_image_and_vertices() {
-    let dir = scratch("ok");
+    let tmp = scratch("ok");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(128).save(&sprite).unwrap();
     let (rig, preview, posed, vertices) = (
@@ -55,7 +56,8 @@ fn rig_then_pose_writes_rig_preview_image_and_vertices() {
 
 #[test]
 fn bad_images_fail_cleanly_without_output() {
-    let dir = scratch("bad-images");
+    let tmp = scratch("bad-images");
+    let dir = tmp.path();
     let good = dir.join("good.png");
     common::critter(64).save(&good).unwrap();
     let not_png = dir.join("not.png");
@@ -99,7 +101,7 @@ fn bad_images_fail_cleanly_without_output() {
     std::fs::write(&out, b"previous").unwrap();
     assert_bad_input(&["rig", s(&empty), "-o", s(&out)], "no pixel with alpha");
     assert_eq!(std::fs::read(&out).unwrap(), b"previous");
-    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+    let leftovers: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .filter_map(|e| e.ok())
         .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
@@ -109,7 +111,8 @@ fn bad_images_fail_cleanly_without_output() {
 
 #[test]
 fn bad_rig_documents_fail_cleanly_without_output() {
-    let dir = scratch("bad-rigs");
+    let tmp = scratch("bad-rigs");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let rig = dir.join("rig.json");
@@ -172,7 +175,8 @@ fn one_bone_rig(
 
 #[test]
 fn absurd_sizes_and_durations_fail_cleanly_without_output() {
-    let dir = scratch("absurd");
+    let tmp = scratch("absurd");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let rig = dir.join("rig.json");
@@ -189,7 +193,7 @@ fn absurd_sizes_and_durations_fail_cleanly_without_output() {
     );
     assert!(!rig.exists());
 
-    let mut doc = one_bone_rig(&dir, &sprite, &rig);
+    let mut doc = one_bone_rig(dir, &sprite, &rig);
     // One key at a typo'd time: 1e6 s of animation.
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 1e6, "value": 30}
@@ -264,7 +268,8 @@ fn argument_errors_are_one_line() {
 
 #[test]
 fn a_failed_demo_leaves_no_empty_folder() {
-    let dir = scratch("demo-fail");
+    let tmp = scratch("demo-fail");
+    let dir = tmp.path();
     let assets = dir.join("assets");
     std::fs::create_dir_all(&assets).unwrap();
     common::critter(64).save(assets.join("body.png")).unwrap();
@@ -281,12 +286,13 @@ fn a_failed_demo_leaves_no_empty_folder() {
 
 #[test]
 fn outputs_never_write_over_inputs_and_output_folders_are_made() {
-    let dir = scratch("overwrite");
+    let tmp = scratch("overwrite");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let sprite_bytes = std::fs::read(&sprite).unwrap();
     let rig = dir.join("critter.json");
-    let mut doc = one_bone_rig(&dir, &sprite, &rig);
+    let mut doc = one_bone_rig(dir, &sprite, &rig);
     let handles = dir.join("handles.json");
     doc["animations"] = serde_json::json!({"go": {"bones": {"a": {"rotate": [
         {"time": 0, "value": 0}, {"time": 0.25, "value": 30}
@@ -295,7 +301,7 @@ fn outputs_never_write_over_inputs_and_output_folders_are_made() {
     let rig_bytes = std::fs::read(&rig).unwrap();
     // Exporting beside the rig would write critter.json over it and critter.png over the sprite.
     assert_bad_input(
-        &["export", "spine", s(&rig), "-o", s(&dir)],
+        &["export", "spine", s(&rig), "-o", s(dir)],
         "would overwrite an input",
     );
     // A sprite sheet writes its JSON beside it: critter.png -> critter.json, the rig.
@@ -320,7 +326,8 @@ fn outputs_never_write_over_inputs_and_output_folders_are_made() {
 
 #[test]
 fn bad_handles_fail_cleanly_without_output() {
-    let dir = scratch("bad-handles");
+    let tmp = scratch("bad-handles");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let out = dir.join("rig.json");
@@ -409,8 +416,9 @@ fn bad_handles_fail_cleanly_without_output() {
 
 #[test]
 fn demo_writes_rig_animations_gifs_and_sheets_and_render_and_pose_play_them() {
-    let dir = scratch("demo");
-    let out = sinew(&["demo", "-o", s(&dir)]);
+    let tmp = scratch("demo");
+    let dir = tmp.path();
+    let out = sinew(&["demo", "-o", s(dir)]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),

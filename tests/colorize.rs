@@ -543,7 +543,8 @@ fn scribble_layer(sc: &Scribbles) -> RgbaImage {
 #[cfg(feature = "cli")]
 #[test]
 fn the_command_colors_from_a_layer_or_json_and_writes_layers() {
-    let dir = scratch("ok");
+    let tmp = scratch("ok");
+    let dir = tmp.path();
     let sc = scene(&SceneSpec {
         size: 128,
         ..Default::default()
@@ -609,7 +610,8 @@ fn assert_bad_input(args: &[&str], output: &Path, expect_in_message: &str) {
 #[cfg(feature = "cli")]
 #[test]
 fn the_command_rejects_bad_input() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
     let sc = scene(&SceneSpec {
         size: 64,
         shapes: 1,

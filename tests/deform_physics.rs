@@ -39,8 +39,9 @@ fn vertex_count(doc: &Value) -> usize {
 
 #[test]
 fn deform_offsets_of_the_wrong_length_are_refused() {
-    let dir = scratch("deform-length");
-    let (mut doc, rig) = rig(&dir);
+    let tmp = scratch("deform-length");
+    let dir = tmp.path();
+    let (mut doc, rig) = rig(dir);
     let n = vertex_count(&doc);
     let part = doc["parts"][0]["name"].as_str().unwrap().to_string();
     doc["animations"] = json!({"squash": {"deform": {part.clone(): [
@@ -81,8 +82,9 @@ fn deform_offsets_of_the_wrong_length_are_refused() {
 
 #[test]
 fn bad_physics_parameters_are_refused() {
-    let dir = scratch("physics-bad");
-    let (doc, rig) = rig(&dir);
+    let tmp = scratch("physics-bad");
+    let dir = tmp.path();
+    let (doc, rig) = rig(dir);
     let png = dir.join("out.png");
     for (constraint, message) in [
         (
@@ -118,8 +120,9 @@ fn bad_physics_parameters_are_refused() {
 
 #[test]
 fn physics_frames_depend_on_the_time_alone() {
-    let dir = scratch("physics-time");
-    let (mut doc, rig) = rig(&dir);
+    let tmp = scratch("physics-time");
+    let dir = tmp.path();
+    let (mut doc, rig) = rig(dir);
     doc["handles"]["physics"] = json!([{"name": "p", "bone": "b", "rotate": 1, "x": 1,
         "inertia": 0.8, "strength": 40, "damping": 0.9, "gravity": 30}]);
     doc["animations"] = json!({"swing": {"bones": {"a": {

@@ -198,7 +198,8 @@ fn posing_needs_current_weights_and_a_valid_pose() {
 
 #[test]
 fn saves_atomically_and_reopens_ready_to_pose() {
-    let dir = command::scratch("document-save");
+    let tmp = command::scratch("document-save");
+    let dir = tmp.path();
     // The image must live where the saved file can refer to it.
     let mut layer = bar_layer("bar", &std::env::temp_dir(), false);
     layer.path = dir.join("bar.png");
@@ -236,7 +237,8 @@ fn saves_atomically_and_reopens_ready_to_pose() {
 
 #[test]
 fn the_bundled_character_opens_and_poses() {
-    let dir = command::scratch("document-character");
+    let tmp = command::scratch("document-character");
+    let dir = tmp.path();
     let mut scene_doc = common::character_scene().doc;
     let assets = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
     for part in &mut scene_doc.parts {

@@ -14,6 +14,8 @@
 // that show them have run.
 #![allow(clippy::disallowed_methods)]
 
+mod command;
+
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
 use sinew::document::Document;
@@ -192,10 +194,10 @@ fn bar_png(dir: &Path) -> PathBuf {
 
 #[test]
 fn dialogs_are_native_where_a_portal_answers_and_typed_where_none_does() {
-    let dir = std::env::temp_dir().join(format!("sinew-portal-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    let png = bar_png(&dir);
+    // Dropped last: after the editor, its save threads and the portal's answers.
+    let tmp = command::scratch("portal");
+    let dir = tmp.path();
+    let png = bar_png(dir);
     let json = dir.join("bar.json");
     let bus = Bus::start();
     // This binary's one test: no other thread reads the environment meanwhile.
@@ -305,5 +307,4 @@ fn dialogs_are_native_where_a_portal_answers_and_typed_where_none_does() {
     );
     drop(h);
     std::env::remove_var("DBUS_SESSION_BUS_ADDRESS");
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -29,9 +29,10 @@ fn rig_with(dir: &Path, events: serde_json::Value, animation: serde_json::Value)
 
 #[test]
 fn render_prints_and_the_sheet_lists_each_frames_events() {
-    let dir = scratch("render");
+    let tmp = scratch("render");
+    let dir = tmp.path();
     rig_with(
-        &dir,
+        dir,
         serde_json::json!({
             "step": {"int": 1, "audio": "sfx/step.wav", "volume": 0.8},
             "land": {"float": 2.5, "string": "thud"}
@@ -152,12 +153,12 @@ fn render_prints_and_the_sheet_lists_each_frames_events() {
             .len(),
         4
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bad_events_are_refused_in_one_line() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
     let anim = |name: &str| {
         serde_json::json!({"bones": {"a": {"rotate": [{"time": 0, "value": 0}]}},
                            "events": [{"time": 0.5, "name": name}]})
@@ -191,7 +192,7 @@ fn bad_events_are_refused_in_one_line() {
     ];
     let rig = dir.join("rig.json");
     for (events, animation, message) in cases {
-        rig_with(&dir, events, animation);
+        rig_with(dir, events, animation);
         let gif = dir.join("out.gif");
         assert_bad_input(&["render", s(&rig), "--anim", "go", "-o", s(&gif)], message);
         assert!(!gif.exists());
@@ -199,5 +200,4 @@ fn bad_events_are_refused_in_one_line() {
         assert_bad_input(&["export", "spine", s(&rig), "-o", s(&export)], message);
         assert!(!export.exists());
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }

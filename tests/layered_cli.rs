@@ -47,7 +47,8 @@ fn psnr(a: &RgbaImage, b: &RgbaImage) -> f64 {
 
 /// Autorig, rig with the proposed handles, draw the rest pose: it is the tool's flattening.
 fn rest_pose_matches(file: &str, reference: &RgbaImage, name: &str) {
-    let dir = scratch(name);
+    let tmp = scratch(name);
+    let dir = tmp.path();
     let (handles, rig, rest) = (
         dir.join("handles.json"),
         dir.join("rig.json"),
@@ -74,7 +75,7 @@ fn rest_pose_matches(file: &str, reference: &RgbaImage, name: &str) {
         ["torso", "arm_l/upper", "arm_l/hand", "head", "leaf"]
     );
     assert!(dir.join("rig.parts/arm_l/hand.png").is_file());
-    parts_keep_their_layers_bounds(&art, &dir, &doc);
+    parts_keep_their_layers_bounds(&art, dir, &doc);
     let rest = image::open(&rest).unwrap().into_rgba8();
     let db = psnr(&rest, reference);
     println!("{file}: rest pose vs the tool's flattened image: PSNR {db:.1} dB");
@@ -148,7 +149,8 @@ fn krita_ora_rig_rest_pose_renders_kritas_merged_image() {
 /// part there; the next part of the group joins it where they overlap, as without pivots.
 #[test]
 fn a_groups_pivot_layer_is_where_its_first_bone_starts() {
-    let dir = scratch("pivots");
+    let tmp = scratch("pivots");
+    let dir = tmp.path();
     let handles = dir.join("handles.json");
     ok(&["autorig", s(&fixture("pivots.psd")), "-o", s(&handles)]);
     let proposal: serde_json::Value =
@@ -180,7 +182,8 @@ fn a_groups_pivot_layer_is_where_its_first_bone_starts() {
 
 #[test]
 fn bad_layered_files_are_refused_and_nothing_is_written() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
     let rig = dir.join("rig.json");
     let cut = dir.join("cut.psd");
     let bytes = std::fs::read(fixture("character.psd")).unwrap();
@@ -191,7 +194,7 @@ fn bad_layered_files_are_refused_and_nothing_is_written() {
     let no_stack = dir.join("empty.ora");
     std::fs::write(&no_stack, b"PK\x05\x06\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0\0").unwrap();
     assert_bad_input(&["autorig", s(&no_stack), "-o", s(&rig)], "stack.xml");
-    let entries: Vec<_> = std::fs::read_dir(&dir)
+    let entries: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .flatten()
         .map(|e| e.file_name())

@@ -57,8 +57,9 @@ fn listing(dir: &Path) -> BTreeMap<String, Vec<u8>> {
 #[cfg(unix)]
 #[test]
 fn outputs_are_written_through_symbolic_links() {
-    let dir = scratch("links");
-    let rig = rig(&dir, 64, 0.25);
+    let tmp = scratch("links");
+    let dir = tmp.path();
+    let rig = rig(dir, 64, 0.25);
     let real = dir.join("real.png");
     std::fs::write(&real, b"stale").unwrap();
     let link = dir.join("link.png");
@@ -106,8 +107,9 @@ fn mkfifo(path: &Path) {
 #[test]
 fn pipes_devices_and_the_wrong_kind_of_entry_are_refused_and_kept() {
     use std::os::unix::fs::FileTypeExt;
-    let dir = scratch("special");
-    let rig = rig(&dir, 64, 0.25);
+    let tmp = scratch("special");
+    let dir = tmp.path();
+    let rig = rig(dir, 64, 0.25);
     let fifo = dir.join("pipe.png");
     mkfifo(&fifo);
     assert_bad_input(&["pose", s(&rig), "-o", s(&fifo)], "it is a named pipe");
@@ -176,8 +178,9 @@ fn pipes_devices_and_the_wrong_kind_of_entry_are_refused_and_kept() {
 
 #[test]
 fn a_render_replaces_the_whole_previous_render_and_keeps_other_files() {
-    let dir = scratch("replace");
-    let rig = rig(&dir, 64, 1.0);
+    let tmp = scratch("replace");
+    let dir = tmp.path();
+    let rig = rig(dir, 64, 1.0);
     let frames = dir.join("frames");
     ok(&[
         "render",
@@ -212,14 +215,15 @@ fn a_render_replaces_the_whole_previous_render_and_keeps_other_files() {
         b"mine too"
     );
     // Nothing hidden is left beside the folder.
-    assert_nothing_hidden_in(&dir);
+    assert_nothing_hidden_in(dir);
 }
 
 #[test]
 fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
-    let dir = scratch("kill");
+    let tmp = scratch("kill");
+    let dir = tmp.path();
     // Big frames, so that writing them takes a good part of the run.
-    let rig = rig(&dir, 256, 2.0);
+    let rig = rig(dir, 256, 2.0);
     let render = |fps: &str, out: &Path| {
         vec![
             "render".to_string(),
@@ -306,7 +310,7 @@ fn a_render_killed_by_a_signal_leaves_the_previous_or_the_new_render() {
         .map(String::as_str)
         .collect::<Vec<_>>());
     assert_eq!(listing(&target), new);
-    assert_nothing_hidden_in(&dir);
+    assert_nothing_hidden_in(dir);
 }
 
 /// No hidden entry (a temporary or a half-swapped folder) is left in `dir`.
@@ -320,8 +324,9 @@ fn assert_nothing_hidden_in(dir: &Path) {
 
 #[test]
 fn temporaries_left_by_a_killed_run_are_removed_by_the_next() {
-    let dir = scratch("stale");
-    let rig = rig(&dir, 64, 0.25);
+    let tmp = scratch("stale");
+    let dir = tmp.path();
+    let rig = rig(dir, 64, 0.25);
     let export = dir.join("export");
     ok(&["export", "spine", s(&rig), "-o", s(&export)]);
     // A pid above the kernel's largest never runs: these are a killed run's.
@@ -379,7 +384,8 @@ fn a_set_of_files_killed_between_its_renames_is_whole_after_the_next_run() {
         eprintln!("skipped: no strace here to stop the run at its renames (apt install strace)");
         return;
     }
-    let dir = scratch("set-kill");
+    let tmp = scratch("set-kill");
+    let dir = tmp.path();
     let small = dir.join("small");
     let big = dir.join("big");
     std::fs::create_dir_all(&small).unwrap();

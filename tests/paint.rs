@@ -1,19 +1,14 @@
 //! Weight painting and locked handles through the document: commands, undo, recomputes that
 //! keep locked weights (same mesh and re-traced), saving and reopening the locks.
 
+mod command;
 mod common;
 
+use command::scratch;
 use common::document::{bar_layer, bone, compute};
 use sinew::document::{Command, Document, DocumentError};
 use sinew::geom::Point;
 use sinew::weights::{BrushMode, BrushOptions, Falloff};
-
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-paint-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch folder");
-    dir
-}
 
 /// A bar with three bones along it, weights computed.
 fn arm(dir: &std::path::Path) -> Document {
@@ -123,8 +118,9 @@ fn stroke(handle: &str, mode: BrushMode) -> Command {
 
 #[test]
 fn painting_keeps_locked_handles_and_undoes_in_one_step() {
-    let dir = scratch("undo");
-    let mut doc = arm(&dir);
+    let tmp = scratch("undo");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     let before = rows(&doc);
     // Columns: a = 0, b = 1, c = 2.
     doc.apply(Command::SetLocked {
@@ -209,8 +205,9 @@ fn painting_keeps_locked_handles_and_undoes_in_one_step() {
 
 #[test]
 fn recomputing_with_a_lock_keeps_the_influence_limit() {
-    let dir = scratch("limit");
-    let mut doc = arm(&dir);
+    let tmp = scratch("limit");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     doc.apply(fill_b(
         vec![Point::new(230.0, 40.0), Point::new(280.0, 40.0)],
         30.0,
@@ -244,8 +241,9 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
 
 #[test]
 fn painting_keeps_the_influence_limit() {
-    let dir = scratch("paint-limit");
-    let mut doc = arm(&dir);
+    let tmp = scratch("paint-limit");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     // c painted over a's end of the bar, where a and b already weigh every vertex.
     let paint_c = |strength: f64| Command::PaintWeights {
         part: "bar".into(),
@@ -285,8 +283,9 @@ fn painting_keeps_the_influence_limit() {
 
 #[test]
 fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
-    let dir = scratch("recompute");
-    let mut doc = arm(&dir);
+    let tmp = scratch("recompute");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     let fresh = rows(&doc);
     // Paint b far into c's side, lock b, then edit a bone so the weights must be recomputed.
     doc.apply(fill_b(
@@ -389,8 +388,9 @@ fn recomputing_keeps_locked_weights_on_the_same_and_a_new_mesh() {
 
 #[test]
 fn locks_are_saved_and_reopened() {
-    let dir = scratch("save");
-    let mut doc = arm(&dir);
+    let tmp = scratch("save");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     let path = dir.join("arm.json");
     doc.save(&path).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
@@ -442,8 +442,9 @@ fn locks_are_saved_and_reopened() {
 
 #[test]
 fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
-    let dir = scratch("stale");
-    let mut doc = arm(&dir);
+    let tmp = scratch("stale");
+    let dir = tmp.path();
+    let mut doc = arm(dir);
     doc.apply(fill_b(vec![Point::new(250.0, 40.0)], 20.0))
         .unwrap();
     let v = vertices(&doc);

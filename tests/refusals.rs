@@ -33,8 +33,9 @@ fn write(dir: &Path, name: &str, value: &Value) -> PathBuf {
 
 #[test]
 fn export_names_that_make_hidden_files_are_refused() {
-    let dir = scratch("name");
-    let (_, rig) = rig(&dir);
+    let tmp = scratch("name");
+    let dir = tmp.path();
+    let (_, rig) = rig(dir);
     let out = dir.join("export");
     for name in [".", "..", ".hidden"] {
         assert_bad_input(
@@ -47,14 +48,15 @@ fn export_names_that_make_hidden_files_are_refused() {
 
 #[test]
 fn ik_drag_targets_have_one_limit_in_pose_render_and_export() {
-    let dir = scratch("drag");
-    let (mut doc, _) = rig(&dir);
+    let tmp = scratch("drag");
+    let dir = tmp.path();
+    let (mut doc, _) = rig(dir);
     let pose = write(
-        &dir,
+        dir,
         "far.json",
         &json!({"ik": [{"at": [32, 30], "to": [1e7, 0]}]}),
     );
-    let rig_path = write(&dir, "r.json", &doc);
+    let rig_path = write(dir, "r.json", &doc);
     let png = dir.join("out.png");
     assert_bad_input(
         &["pose", s(&rig_path), "--pose", s(&pose), "-o", s(&png)],
@@ -65,7 +67,7 @@ fn ik_drag_targets_have_one_limit_in_pose_render_and_export() {
     doc["animations"]["far"] = json!({"ik": [{"at": [32, 30], "to": [
         {"time": 0, "value": [32, 30]}, {"time": 0.5, "value": [1e7, 0]}
     ]}]});
-    let rig_path = write(&dir, "far-rig.json", &doc);
+    let rig_path = write(dir, "far-rig.json", &doc);
     let gif = dir.join("out.gif");
     for args in [
         vec!["render", s(&rig_path), "--anim", "far", "-o", s(&gif)],
@@ -79,10 +81,11 @@ fn ik_drag_targets_have_one_limit_in_pose_render_and_export() {
 
 #[test]
 fn a_rig_without_parts_is_refused_on_load() {
-    let dir = scratch("parts");
-    let (mut doc, _) = rig(&dir);
+    let tmp = scratch("parts");
+    let dir = tmp.path();
+    let (mut doc, _) = rig(dir);
     doc["parts"] = json!([]);
-    let rig_path = write(&dir, "empty.json", &doc);
+    let rig_path = write(dir, "empty.json", &doc);
     assert_bad_input(
         &["pose", s(&rig_path), "-o", s(&dir.join("p.png"))],
         "the rig has no parts",
@@ -91,8 +94,9 @@ fn a_rig_without_parts_is_refused_on_load() {
 
 #[test]
 fn a_scale_that_rounds_the_frame_to_nothing_is_refused() {
-    let dir = scratch("scale");
-    let (_, rig_path) = rig(&dir);
+    let tmp = scratch("scale");
+    let dir = tmp.path();
+    let (_, rig_path) = rig(dir);
     let gif = dir.join("tiny.gif");
     assert_bad_input(
         &[
@@ -112,12 +116,13 @@ fn a_scale_that_rounds_the_frame_to_nothing_is_refused() {
 
 #[test]
 fn absurd_magnitudes_are_refused_with_their_limit() {
-    let dir = scratch("magnitudes");
-    let (doc, rig_path) = rig(&dir);
+    let tmp = scratch("magnitudes");
+    let dir = tmp.path();
+    let (doc, rig_path) = rig(dir);
     let png = dir.join("p.png");
     // A rotation of 1e300 degrees in a pose, and in an animation's key.
     let pose = write(
-        &dir,
+        dir,
         "spin.json",
         &json!({"bones": {"a": {"rotate": 1e300}}}),
     );
@@ -127,7 +132,7 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
     );
     let mut spin = doc.clone();
     spin["animations"]["go"]["bones"]["a"]["rotate"][1]["value"] = json!(1e300);
-    let spin_rig = write(&dir, "spin-rig.json", &spin);
+    let spin_rig = write(dir, "spin-rig.json", &spin);
     assert_bad_input(
         &["pose", s(&spin_rig), "-o", s(&png)],
         "key 1 has a value beyond ±1000000",
@@ -136,7 +141,7 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
     let mut curve = doc.clone();
     curve["animations"]["go"]["bones"]["a"]["rotate"][0]["curve"] =
         json!([0.1, 1e300, 0.2, -1e300]);
-    let curve_rig = write(&dir, "curve-rig.json", &curve);
+    let curve_rig = write(dir, "curve-rig.json", &curve);
     assert_bad_input(
         &[
             "render",
@@ -152,7 +157,7 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
     let sprite = dir.join("critter.png");
     for tail in [1e200, 1.7e308] {
         let handles = write(
-            &dir,
+            dir,
             "far-bone.json",
             &json!({"bones": [{"name": "a", "head": [32, 45], "tail": [32, tail]}]}),
         );
@@ -169,7 +174,7 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
         );
         let mut far = doc.clone();
         far["handles"]["bones"][0]["tail"] = json!([32, tail]);
-        let far_rig = write(&dir, "far-rig.json", &far);
+        let far_rig = write(dir, "far-rig.json", &far);
         assert_bad_input(
             &["export", "spine", s(&far_rig), "-o", s(&dir.join("e"))],
             "beyond ±1000000 px",
@@ -180,14 +185,15 @@ fn absurd_magnitudes_are_refused_with_their_limit() {
 
 #[test]
 fn self_intersecting_cages_and_regions_name_the_handle_and_the_edges() {
-    let dir = scratch("bowtie");
+    let tmp = scratch("bowtie");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let out = dir.join("r.json");
     let bow_tie = json!([[10, 10], [50, 50], [50, 10], [10, 50]]);
     for kind in ["regions", "cages"] {
         let handles = write(
-            &dir,
+            dir,
             "h.json",
             &json!({"bones": [{"name": "a", "head": [32, 45], "tail": [32, 20]}],
                     kind: [{"name": "tie", "polygon": bow_tie}]}),
@@ -199,7 +205,7 @@ fn self_intersecting_cages_and_regions_name_the_handle_and_the_edges() {
         assert!(!message.contains("IMAGE"), "{message}");
     }
     let collinear = write(
-        &dir,
+        dir,
         "h.json",
         &json!({"cages": [{"name": "line", "polygon": [[10, 10], [20, 20], [30, 30], [40, 40]]}]}),
     );
@@ -212,7 +218,8 @@ fn self_intersecting_cages_and_regions_name_the_handle_and_the_edges() {
 
 #[test]
 fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
-    let dir = scratch("columns");
+    let tmp = scratch("columns");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let out = dir.join("r.json");
@@ -228,7 +235,7 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
             bone
         })
         .collect();
-    let chain = write(&dir, "chain.json", &json!({ "bones": bones }));
+    let chain = write(dir, "chain.json", &json!({ "bones": bones }));
     let t = std::time::Instant::now();
     assert_bad_input(
         &["rig", s(&sprite), "--handles", s(&chain), "-o", s(&out)],
@@ -241,7 +248,7 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
         })
         .collect();
     let cage = write(
-        &dir,
+        dir,
         "cage.json",
         &json!({"cages": [{"name": "c", "polygon": polygon}]}),
     );
@@ -269,13 +276,14 @@ fn handles_that_make_too_many_weight_columns_are_refused_before_any_work() {
 /// the union of the shape and the cage's inside. Cages that cross each other are refused, named.
 #[test]
 fn a_cage_crossing_the_outline_is_rigged_and_crossing_cages_are_named() {
-    let dir = scratch("cage-outline");
+    let tmp = scratch("cage-outline");
+    let dir = tmp.path();
     let sprite = dir.join("critter.png");
     common::critter(64).save(&sprite).unwrap();
     let out = dir.join("r.json");
     // Half inside the drawing, half outside the canvas.
     let handles = write(
-        &dir,
+        dir,
         "h.json",
         &json!({"cages": [{"name": "belly", "polygon": [[30, 28], [120, 28], [120, 36], [30, 36]]}]}),
     );
@@ -328,7 +336,7 @@ fn a_cage_crossing_the_outline_is_rigged_and_crossing_cages_are_named() {
         assert!((w0 + w1 - 1.0).abs() < 1e-6 && by_name.values().all(|&w| w < 1e-9));
     }
     let two = write(
-        &dir,
+        dir,
         "two.json",
         &json!({"cages": [
             {"name": "a", "polygon": [[-10, -10], [80, -10], [80, 80], [-10, 80]]},
@@ -345,8 +353,9 @@ fn a_cage_crossing_the_outline_is_rigged_and_crossing_cages_are_named() {
 
 #[test]
 fn the_export_that_match_runtime_reproduces_must_be_one_sinew_writes() {
-    let dir = scratch("match");
-    let (_, rig) = rig(&dir);
+    let tmp = scratch("match");
+    let dir = tmp.path();
+    let (_, rig) = rig(dir);
     let png = dir.join("out.png");
     let pose = |extra: &[&str]| {
         let mut args = vec!["pose", s(&rig), "--anim", "go", "--time", "0.1"];

@@ -3,7 +3,7 @@
 //! `docs/formats.md` validate, and each of those examples also loads with sinew's own reader;
 //! wrong files are rejected by the schema and by the reader alike.
 
-#[cfg(feature = "cli")]
+// Scratch folders always; the `sinew` runs with the binary (feature `cli`).
 mod command;
 mod common;
 
@@ -97,8 +97,8 @@ fn the_bundled_files_validate() {
 /// an animation and a locked handle.
 #[test]
 fn a_written_rig_validates() {
-    let dir = std::env::temp_dir().join(format!("sinew-schema-rig-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = command::scratch("rig");
+    let dir = tmp.path();
     let path = dir.join("critter.png");
     let image = common::critter(96);
     image.save(&path).unwrap();
@@ -117,7 +117,7 @@ fn a_written_rig_validates() {
         ..Handles::default()
     };
     let (mut doc, _) =
-        pipeline::build_rig(&[layer], &dir, &BuildOptions::default(), &handles).expect("rigs");
+        pipeline::build_rig(&[layer], dir, &BuildOptions::default(), &handles).expect("rigs");
     doc.animations.insert(
         "nod".into(),
         anim::Animation::from_json(
@@ -136,7 +136,6 @@ fn a_written_rig_validates() {
     assert!(written["parts"][0]["weights"]["rows"].is_array());
     assert!(written["options"]["ik"].is_object());
     assert_valid(SchemaKind::Rig, &written, "a rig the library wrote");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -375,7 +374,8 @@ fn the_command_prints_each_schema() {
 #[test]
 fn the_rig_the_command_writes_for_the_character_validates() {
     let assets = root().join("assets/character");
-    let dir = command::scratch("character");
+    let tmp = command::scratch("character");
+    let dir = tmp.path();
     let layers = read_json(&assets.join("layers.json"));
     // The layers, then the other attachments of their slots.
     let attachments = layers["attachments"].as_object().expect("attachments");

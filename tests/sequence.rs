@@ -9,12 +9,9 @@ use sinew::io::sequence::{
 };
 use std::path::{Path, PathBuf};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("sinew-seq-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod command;
+
+use command::scratch;
 
 /// A decoded GIF: every frame composed onto the logical screen as a browser shows it.
 struct DecodedGif {
@@ -286,12 +283,13 @@ fn check_sheet(
 
 #[test]
 fn sheet_json_reproduces_every_frame() {
-    let dir = temp_dir("sheet");
+    let tmp = scratch("sheet");
+    let dir = tmp.path();
     let mut frames = synthetic_animation(72, 10);
     // A held pose (stored once) and an empty frame.
     frames.push(frames[3].clone());
     frames.push(RgbaImage::new(72, 72));
-    let json = check_sheet(&frames, &dir, "walk", &SheetOptions::default());
+    let json = check_sheet(&frames, dir, "walk", &SheetOptions::default());
     let table = json["frames"].as_object().unwrap();
     assert!(table.contains_key("walk_0000.png") && table.contains_key("walk_0011.png"));
     assert_eq!(
@@ -310,7 +308,7 @@ fn sheet_json_reproduces_every_frame() {
         naming: FrameNaming::Index,
         ..SheetOptions::default()
     };
-    let json = check_sheet(&frames, &dir, "plain", &plain);
+    let json = check_sheet(&frames, dir, "plain", &plain);
     assert_eq!(json["frames"]["0"]["trimmed"], false);
     assert_ne!(json["frames"]["3"]["frame"], json["frames"]["10"]["frame"]);
 
@@ -327,12 +325,12 @@ fn sheet_json_reproduces_every_frame() {
     .unwrap();
     assert_eq!(std::fs::read(dir.join("walk.json")).unwrap(), first);
     assert_eq!(std::fs::read(dir.join("walk.png")).unwrap(), first_png);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn folder_holds_numbered_frames() {
-    let dir = temp_dir("folder");
+    let tmp = scratch("folder");
+    let dir = tmp.path();
     let frames = synthetic_animation(32, 5);
     let out = dir.join("frames");
     // A frame of a longer earlier render goes with it; the user's files and folders stay.
@@ -366,12 +364,12 @@ fn folder_holds_numbered_frames() {
     let fresh = dir.join("new_frames");
     write_folder(&frames[..1], 12.0, &fresh).unwrap();
     assert!(fresh.join("frame_0000.png").is_file());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bad_input_gives_one_line_errors_and_no_files() {
-    let dir = temp_dir("errors");
+    let tmp = scratch("errors");
+    let dir = tmp.path();
     let frames = synthetic_animation(16, 2);
     let options = SequenceOptions::default();
     let one_line = |e: SequenceError| {
@@ -421,9 +419,8 @@ fn bad_input_gives_one_line_errors_and_no_files() {
         SequenceError::SheetTooLarge { max_side_px: 8, .. }
     ));
 
-    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    let left: Vec<_> = std::fs::read_dir(dir).unwrap().collect();
     assert_eq!(left.len(), 1, "only the blocker file remains");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// PSNR (dB) of the visible colours of `frames` after Wu + k-means and after NeuQuant, both
@@ -538,7 +535,8 @@ impl sinew::io::sequence::FrameSource for OnDemand {
 fn frames_drawn_on_demand_are_written_a_chunk_at_a_time_with_the_same_bytes() {
     use sinew::io::sequence::STREAM_CHUNK_FRAMES;
     use std::sync::atomic::Ordering::Relaxed;
-    let dir = temp_dir("stream");
+    let tmp = scratch("stream");
+    let dir = tmp.path();
     let frames = synthetic_animation(48, 2 * STREAM_CHUNK_FRAMES + 5);
     let count = frames.len();
     let source = OnDemand {
@@ -596,5 +594,4 @@ fn frames_drawn_on_demand_are_written_a_chunk_at_a_time_with_the_same_bytes() {
         encode_gif(&frames, 24.0, &GifOptions::default()).unwrap()
     );
     assert_eq!(source.drawn.load(Relaxed), 2 * count);
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -51,8 +51,9 @@ fn belly(png: &Path) -> [u8; 4] {
 
 #[test]
 fn skins_and_attachment_keys_choose_what_the_slot_draws() {
-    let dir = scratch("skins");
-    let (_, rig) = rig(&dir);
+    let tmp = scratch("skins");
+    let dir = tmp.path();
+    let (_, rig) = rig(dir);
     let png = dir.join("p.png");
     let pose = |extra: &[&str]| {
         let mut args = vec!["pose", s(&rig), "-o", s(&png)];
@@ -80,7 +81,7 @@ fn skins_and_attachment_keys_choose_what_the_slot_draws() {
     assert_eq!(pose(&["--anim", "swap", "--time", "0.8"])[3], 0);
     // A pose file may name the attachment too.
     let file = write(
-        &dir,
+        dir,
         "pose.json",
         &json!({"parts": {"critter": {"attachment": "critter_blue"}}}),
     );
@@ -109,20 +110,20 @@ fn skins_and_attachment_keys_choose_what_the_slot_draws() {
         [orange, orange, swapped, [0, 0, 0, 0]],
         "{names:?}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn missing_attachments_slots_and_skins_are_refused_in_one_line() {
-    let dir = scratch("skins-bad");
-    let (doc, _) = rig(&dir);
+    let tmp = scratch("skins-bad");
+    let dir = tmp.path();
+    let (doc, _) = rig(dir);
     let png = dir.join("out.png");
     let gif = dir.join("out.gif");
     let export = dir.join("export");
 
     let mut bad = doc.clone();
     bad["animations"]["swap"]["parts"]["critter"]["attachment"][1]["value"] = json!("ghost");
-    let rig = write(&dir, "ghost.json", &bad);
+    let rig = write(dir, "ghost.json", &bad);
     for args in [
         vec!["render", s(&rig), "--anim", "swap", "-o", s(&gif)],
         vec!["pose", s(&rig), "--anim", "swap", "-o", s(&png)],
@@ -137,13 +138,13 @@ fn missing_attachments_slots_and_skins_are_refused_in_one_line() {
 
     let mut bad = doc.clone();
     bad["skins"]["blue"]["tail"] = json!("critter_blue");
-    let rig = write(&dir, "tail.json", &bad);
+    let rig = write(dir, "tail.json", &bad);
     assert_bad_input(
         &["pose", s(&rig), "-o", s(&png)],
         "skin 'blue' names slot 'tail', which the rig does not have",
     );
 
-    let rig = write(&dir, "good.json", &doc);
+    let rig = write(dir, "good.json", &doc);
     assert_bad_input(
         &["pose", s(&rig), "--skin", "red", "-o", s(&png)],
         "the rig has no skin 'red' (its skins: blue)",
@@ -162,7 +163,7 @@ fn missing_attachments_slots_and_skins_are_refused_in_one_line() {
         "the rig has no skin 'red'",
     );
     let file = write(
-        &dir,
+        dir,
         "pose.json",
         &json!({"parts": {"critter": {"attachment": "ghost"}}}),
     );
@@ -196,5 +197,4 @@ fn missing_attachments_slots_and_skins_are_refused_in_one_line() {
         );
     }
     assert!(!png.exists() && !gif.exists() && !export.exists() && !out_rig.exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }

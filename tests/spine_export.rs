@@ -57,14 +57,15 @@ fn assert_refused(args: &[&str], out: &Path, expect_in_message: &str) {
 
 #[test]
 fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
-    let dir = scratch("rigs");
+    let tmp = scratch("rigs");
+    let dir = tmp.path();
     let out = dir.join("out");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("keep.txt"), "an earlier file").unwrap();
 
     // No weights: rigged without handles.
     let plain = dir.join("plain.json");
-    let body = layer(&dir, "body");
+    let body = layer(dir, "body");
     assert!(sinew(&["rig", s(&body), "-o", s(&plain)]).status.success());
     assert_refused(
         &["export", "spine", s(&plain), "-o", s(&out)],
@@ -73,9 +74,10 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
     );
 
     // A part name the atlas format cannot hold.
-    let named = scratch("names");
-    let colon = layer(&named, "arm:left");
-    let rig_colon = rig(&named, &[colon], serde_json::json!({}));
+    let named_tmp = scratch("names");
+    let named = named_tmp.path();
+    let colon = layer(named, "arm:left");
+    let rig_colon = rig(named, &[colon], serde_json::json!({}));
     assert_refused(
         &["export", "spine", s(&rig_colon), "-o", s(&out)],
         &out,
@@ -83,10 +85,11 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
     );
 
     // A handle named like the export's root bone.
-    let rooted = scratch("root");
-    let body_r = layer(&rooted, "body");
+    let rooted_tmp = scratch("root");
+    let rooted = rooted_tmp.path();
+    let body_r = layer(rooted, "body");
     let rig_root = rig(
-        &rooted,
+        rooted,
         &[body_r],
         serde_json::json!({"points": [{"name": "root", "at": [30, 30]}]}),
     );
@@ -97,9 +100,10 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
     );
 
     // A part whose image is missing.
-    let good = scratch("good");
-    let arm = layer(&good, "arm");
-    let rig_good = rig(&good, std::slice::from_ref(&arm), serde_json::json!({}));
+    let good_tmp = scratch("good");
+    let good = good_tmp.path();
+    let arm = layer(good, "arm");
+    let rig_good = rig(good, std::slice::from_ref(&arm), serde_json::json!({}));
     std::fs::rename(&arm, good.join("moved.png")).unwrap();
     assert_refused(
         &["export", "spine", s(&rig_good), "-o", s(&out)],
@@ -172,7 +176,4 @@ fn bad_rigs_and_flags_are_refused_without_touching_the_output_folder() {
         .collect();
     names.sort();
     assert_eq!(names, ["keep.txt", "rig.atlas", "rig.json", "rig.png"]);
-    for d in [dir, named, rooted, good] {
-        std::fs::remove_dir_all(d).unwrap();
-    }
 }

@@ -517,8 +517,9 @@ fn check_rig_in_skins(
 
 #[test]
 fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
-    let dir = scratch("demo");
-    sinew(&["demo", "-o", s(&dir)]);
+    let tmp = scratch("demo");
+    let dir = tmp.path();
+    sinew(&["demo", "-o", s(dir)]);
     // The demo's own export loads too.
     let oracle = run_oracle(&dir.join("spine"), "character", &BTreeMap::new());
     assert!(oracle.warnings.is_empty(), "{:#?}", oracle.warnings);
@@ -582,13 +583,13 @@ fn the_demo_character_plays_in_spine_core_where_sinew_draws_it() {
         exact > ANIMATION_TOLERANCE_PX,
         "exact-mode deviation only {exact} px"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
-    let dir = scratch("generated");
-    let rig = generated_rig(&dir);
+    let tmp = scratch("generated");
+    let dir = tmp.path();
+    let rig = generated_rig(dir);
     let defaults = SpineOptions::default();
     check_rig(
         &rig,
@@ -647,13 +648,13 @@ fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
         &few,
         Compare::ReportOnly,
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
-    let dir = scratch("ik");
-    let rig = ik_rig(&dir);
+    let tmp = scratch("ik");
+    let dir = tmp.path();
+    let rig = ik_rig(dir);
     let defaults = SpineOptions::default();
     check_rig(
         &rig,
@@ -736,7 +737,6 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
             assert!(apart <= 1e-3, "sinew bake of {name} at {t} s: {apart} px");
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Physics over time: the demo's tail (a Spine 4.2 physics constraint on `tail_4`) while it
@@ -748,8 +748,9 @@ fn bone_ik_constraints_are_solved_by_spine_core_as_sinew_solves_them() {
 fn physics_and_deform_keys_play_in_spine_core_as_sinew_simulates_them() {
     const PHYSICS_HZ: f64 = 60.0;
     const PHYSICS_SECONDS: f64 = 2.0;
-    let dir = scratch("physics");
-    sinew(&["demo", "-o", s(&dir)]);
+    let tmp = scratch("physics");
+    let dir = tmp.path();
+    sinew(&["demo", "-o", s(dir)]);
     let rig = dir.join("character.json");
     let out = dir.join("export");
     sinew(&["export", "spine", s(&rig), "-o", s(&out), "--name", "rig"]);
@@ -807,5 +808,4 @@ fn physics_and_deform_keys_play_in_spine_core_as_sinew_simulates_them() {
         deform_px > 5.0,
         "the squash moved the torso only {deform_px} px"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -520,12 +520,9 @@ mod tests {
         (s, background, inside)
     }
 
-    /// An empty scratch folder of this process.
-    fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("sinew-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    /// An empty folder of its own for one test, removed when the result drops.
+    fn scratch(name: &str) -> tempfile::TempDir {
+        crate::test_scratch::scratch(name)
     }
 
     fn session(s: &crate::colorize::synthetic::Scene) -> ColorizeSession {
@@ -793,7 +790,8 @@ mod tests {
     fn strokes_save_and_load_as_a_scribble_file_with_one_undo_step() {
         let (s, background, inside) = circle();
         let mut session = session(&s);
-        let dir = scratch("strokes");
+        let tmp = scratch("strokes");
+        let dir = tmp.path();
         let path = dir.join("lineart.scribbles.json");
         assert!(matches!(
             session.save_strokes(&path),
@@ -840,14 +838,14 @@ mod tests {
         .unwrap();
         assert!(other.load_strokes(&off_image).is_err());
         assert_eq!(other.strokes(), &[inside]);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn saves_the_result_atomically_and_only_once_solved() {
         let (s, background, _) = circle();
         let mut session = session(&s);
-        let dir = scratch("session");
+        let tmp = scratch("session");
+        let dir = tmp.path();
         let path = dir.join("colored.png");
         session
             .apply(SessionCommand::AddStroke(background))
@@ -863,6 +861,5 @@ mod tests {
             crate::io::load_png(&path).unwrap(),
             session.result().unwrap().image
         );
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -18,6 +18,8 @@ use egui_kittest::Harness;
 
 use std::path::Path;
 
+use tempfile::TempDir;
+
 use std::sync::Arc;
 
 mod animate;
@@ -60,14 +62,14 @@ fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
 }
 
 /// The bundled character rigged with default options, saved (with absolute image paths) in a
-/// fresh folder.
-fn character_rig(name: &str) -> PathBuf {
+/// fresh scratch folder: the folder (removed when it drops) and the rig's path.
+fn character_rig(name: &str) -> (TempDir, PathBuf) {
     character_rig_with(name, false)
 }
 
 /// [`character_rig`] with, when `skins`, the other attachments of its slots and its skins, as
 /// `sinew demo` rigs them (`layers.json`'s `attachments` and `skins`).
-fn character_rig_with(name: &str, skins: bool) -> PathBuf {
+fn character_rig_with(name: &str, skins: bool) -> (TempDir, PathBuf) {
     let assets = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets/character");
     let list: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(assets.join("layers.json")).expect("layers.json"),
@@ -90,9 +92,7 @@ fn character_rig_with(name: &str, skins: bool) -> PathBuf {
         &std::fs::read_to_string(assets.join("handles.json")).expect("handles.json"),
     )
     .expect("handles parse");
-    let dir = std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let dir = crate::test_scratch::scratch(&format!("editor-{name}"));
     let (mut doc, _) = crate::pipeline::build_rig(&layers, &assets, &Default::default(), &handles)
         .expect("the character rigs");
     if skins {
@@ -102,17 +102,38 @@ fn character_rig_with(name: &str, skins: bool) -> PathBuf {
     for part in &mut doc.parts {
         part.image = assets.join(&part.image).to_string_lossy().into_owned();
     }
-    let path = dir.join("character.json");
+    let path = dir.path().join("character.json");
     doc.save(&path).expect("saved");
-    path
+    (dir, path)
+}
+
+/// A harness with the scratch folder of the document it opened. The harness drops first
+/// (fields drop in order), then the folder: the editor's saves and autosaves, which write
+/// beside the document, never find it gone while the test runs.
+struct InFolder {
+    h: Harness<'static, EditorApp>,
+    _dir: TempDir,
+}
+
+impl std::ops::Deref for InFolder {
+    type Target = Harness<'static, EditorApp>;
+    fn deref(&self) -> &Self::Target {
+        &self.h
+    }
+}
+
+impl std::ops::DerefMut for InFolder {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.h
+    }
 }
 
 /// The editor on [`character_rig`]`(name)`, after its first frames.
-fn open_character(name: &str) -> Harness<'static, EditorApp> {
-    let path = character_rig(name);
+fn open_character(name: &str) -> InFolder {
+    let (dir, path) = character_rig(name);
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
-    h
+    InFolder { h, _dir: dir }
 }
 
 fn screen(h: &Harness<'_, EditorApp>, canvas_px: impl Into<Point>) -> Pos2 {
@@ -298,6 +319,19 @@ fn press_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
 fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
     press_shown_by(h, by);
     h.run();
+}
+
+/// Scrolls the side panel to the widget labelled `label` (a tree row, say), then
+/// [`click_shown`]s it.
+fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
+    h.get_by_label(label).scroll_to_me();
+    h.run();
+    click_shown(h, label);
+}
+
+/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
+fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
+    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
 }
 
 /// [`click_shown_by`] the widget labelled `label`.
@@ -536,14 +570,14 @@ fn key_on_sheet(
 }
 
 /// The character with animation "nod" (the head turned 0° at 0 s, 30° at 0.5 s) in its file.
-fn character_with_nod(name: &str) -> PathBuf {
-    let path = character_rig(name);
+fn character_with_nod(name: &str) -> (TempDir, PathBuf) {
+    let (dir, path) = character_rig(name);
     let mut doc = crate::io::RigDocument::load(&path).expect("loads");
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     key_nod(&mut app, &[(0.0, 0.0), (0.5, 30.0)]);
     doc.animations = app.doc.state().animations.clone();
     doc.save(&path).expect("saved");
-    path
+    (dir, path)
 }
 
 /// Shift-click at `at` (canvas px) without moving: one frame per event, as a window sends them.
@@ -626,15 +660,15 @@ fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
 
 /// The character with its skins, in animate mode on a new empty animation (made with the *New
 /// animation* button); its harness and the animation's name.
-fn new_animation_on_skinned_character(name: &str) -> (Harness<'static, EditorApp>, String) {
-    let path = character_rig_with(name, true);
+fn new_animation_on_skinned_character(name: &str) -> (InFolder, String) {
+    let (dir, path) = character_rig_with(name, true);
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
     h.key_press(Key::Num3);
     h.run();
     click_shown(&mut h, "New animation");
     let animation = h.state().animate.animation.clone();
-    (h, animation)
+    (InFolder { h, _dir: dir }, animation)
 }
 
 /// The bag slot's attachment keys in `animation`: (time, attachment shown).

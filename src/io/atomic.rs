@@ -222,29 +222,28 @@ pub fn remove_stale_temporaries(target: &Path) {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("sinew-atomic-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        dir
+    /// An empty folder of its own for one test, removed when the result drops.
+    fn scratch(name: &str) -> tempfile::TempDir {
+        crate::test_scratch::scratch(&format!("atomic-{name}"))
     }
 
     #[test]
     fn replaces_content_and_leaves_no_temporary() {
-        let dir = scratch("replace");
+        let tmp = scratch("replace");
+        let dir = tmp.path();
         let target = dir.join("a.json");
         write_atomic(&target, b"old").unwrap();
         write_atomic(&target, b"new").unwrap();
         assert_eq!(fs::read(&target).unwrap(), b"new");
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
+        assert_eq!(fs::read_dir(dir).unwrap().count(), 1);
         // A write into a missing folder fails and leaves the target untouched.
         assert!(write_atomic(&dir.join("missing/b.json"), b"x").is_err());
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn writes_of_one_target_from_two_threads_do_not_mix() {
-        let dir = scratch("two");
+        let tmp = scratch("two");
+        let dir = tmp.path();
         let target = dir.join("a.json");
         let contents = [vec![b'a'; 1 << 20], vec![b'b'; 1 << 20]];
         std::thread::scope(|scope| {
@@ -259,14 +258,14 @@ mod tests {
         });
         let written = fs::read(&target).unwrap();
         assert!(contents.contains(&written), "the target mixes two writes");
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 1);
-        fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(fs::read_dir(dir).unwrap().count(), 1);
     }
 
     #[cfg(unix)]
     #[test]
     fn writes_go_through_symbolic_links_and_folders_are_refused() {
-        let dir = scratch("links");
+        let tmp = scratch("links");
+        let dir = tmp.path();
         let real = dir.join("real.png");
         fs::write(&real, b"old").unwrap();
         let link = dir.join("link.png");
@@ -289,17 +288,17 @@ mod tests {
         let err = write_atomic(&a, b"x").unwrap_err();
         assert!(err.to_string().contains("symbolic links"), "{err}");
         // A folder where a file is expected, and a file where a folder is.
-        let err = write_atomic(&dir, b"x").unwrap_err();
+        let err = write_atomic(dir, b"x").unwrap_err();
         assert!(err.to_string().contains("it is a folder"), "{err}");
         let err = resolve_output(&real, OutputKind::Folder).unwrap_err();
         assert!(err.to_string().contains("not a folder"), "{err}");
         assert_eq!(resolve_output(&link, OutputKind::File).unwrap(), real);
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn stale_temporaries_of_dead_processes_are_removed_and_live_ones_kept() {
-        let dir = scratch("stale");
+        let tmp = scratch("stale");
+        let dir = tmp.path();
         let target = dir.join("walk.json");
         fs::write(&target, b"previous").unwrap();
         // A pid above the kernel's largest (4194304) never runs.
@@ -324,7 +323,6 @@ mod tests {
         for p in [&live, &other, &unlike] {
             assert!(p.exists(), "{}", p.display());
         }
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -74,8 +74,8 @@ mod tests {
 
     #[test]
     fn round_trip_and_bad_files() {
-        let dir = std::env::temp_dir().join(format!("sinew-image-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = crate::test_scratch::scratch("image");
+        let dir = tmp.path();
         let img = RgbaImage::from_fn(3, 2, |x, y| {
             image::Rgba([x as u8 * 80, y as u8 * 100, 7, 200])
         });
@@ -98,6 +98,5 @@ mod tests {
             load_png(&dir.join("missing.png")),
             Err(ImageError::Read { .. })
         ));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -110,8 +110,8 @@ mod tests {
 
     #[test]
     fn an_output_naming_an_input_or_another_output_is_refused() {
-        let dir = std::env::temp_dir().join(format!("sinew-outputs-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = crate::test_scratch::scratch("outputs");
+        let dir = tmp.path();
         let input = dir.join("in.png");
         std::fs::write(&input, b"x").unwrap();
         let other = dir.join("out.json");
@@ -137,6 +137,5 @@ mod tests {
             check_outputs([input.as_path()], [Some(other.as_path()), None]),
             Ok(())
         );
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

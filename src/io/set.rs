@@ -325,11 +325,9 @@ mod tests {
     use super::*;
     use crate::io::atomic::write_atomic;
 
-    fn scratch(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("sinew-set-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&dir);
-        fs::create_dir_all(&dir).unwrap();
-        dir
+    /// An empty folder of its own for one test, removed when the result drops.
+    fn scratch(name: &str) -> tempfile::TempDir {
+        crate::test_scratch::scratch(&format!("set-{name}"))
     }
 
     /// Every entry of `dir`, name → bytes.
@@ -351,7 +349,8 @@ mod tests {
 
     #[test]
     fn a_set_is_written_whole_or_not_at_all() {
-        let dir = scratch("whole");
+        let tmp = scratch("whole");
+        let dir = tmp.path();
         let (png, json) = (dir.join("sheet.png"), dir.join("sheet.json"));
         write_set(&[
             (png.clone(), b"old png".to_vec()),
@@ -369,7 +368,7 @@ mod tests {
             assert_eq!(failed.map_err(|(path, _)| path), Err(bad));
             assert_eq!(fs::read(&png).unwrap(), b"old png");
         }
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 3);
+        assert_eq!(fs::read_dir(dir).unwrap().count(), 3);
         write_set(&[
             (png.clone(), b"new png".to_vec()),
             (json.clone(), b"new".to_vec()),
@@ -378,8 +377,7 @@ mod tests {
         assert_eq!(fs::read(&png).unwrap(), b"new png");
         assert_eq!(fs::read(&json).unwrap(), b"new");
         // No journal stays after a set is written.
-        assert_eq!(fs::read_dir(&dir).unwrap().count(), 3);
-        fs::remove_dir_all(&dir).unwrap();
+        assert_eq!(fs::read_dir(dir).unwrap().count(), 3);
     }
 
     /// The folder a run killed after its commit leaves, at each point of its renames: old
@@ -408,8 +406,9 @@ mod tests {
     #[test]
     fn a_set_killed_between_its_renames_is_completed_by_the_next_write_into_its_folder() {
         for renamed in 0..=3 {
-            let dir = scratch(&format!("killed-{renamed}"));
-            let journal = killed_after_commit(&dir, DEAD, renamed, 0);
+            let tmp = scratch(&format!("killed-{renamed}"));
+            let dir = tmp.path();
+            let journal = killed_after_commit(dir, DEAD, renamed, 0);
             if !Path::new("/proc/self").exists() {
                 eprintln!("no /proc: whether a process runs cannot be told; journals are kept");
                 return;
@@ -428,15 +427,15 @@ mod tests {
                     (n.to_string(), bytes)
                 })
                 .collect();
-            assert_eq!(listing(&dir), expected, "{renamed} renamed before the kill");
-            fs::remove_dir_all(&dir).unwrap();
+            assert_eq!(listing(dir), expected, "{renamed} renamed before the kill");
         }
     }
 
     #[test]
     fn a_journal_cut_short_rolls_the_set_back() {
-        let dir = scratch("cut");
-        let journal = killed_after_commit(&dir, DEAD, 0, 0);
+        let tmp = scratch("cut");
+        let dir = tmp.path();
+        let journal = killed_after_commit(dir, DEAD, 0, 0);
         let whole = fs::read(&journal).unwrap();
         // Cut inside the last field: no end line.
         fs::write(&journal, &whole[..whole.len() - 7]).unwrap();
@@ -454,29 +453,28 @@ mod tests {
             .map(|n| (dir.join(n), n.as_bytes().to_vec()))
             .collect();
         write_set(&set).unwrap();
-        let names: Vec<String> = listing(&dir).into_iter().map(|(n, _)| n).collect();
+        let names: Vec<String> = listing(dir).into_iter().map(|(n, _)| n).collect();
         assert_eq!(names, ["a.atlas", "a.json", "a.png"]);
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn journals_of_running_processes_and_foreign_files_are_left_alone() {
-        let dir = scratch("live");
+        let tmp = scratch("live");
+        let dir = tmp.path();
         // This process's own journal, in flight as if another thread were renaming.
-        let journal = killed_after_commit(&dir, std::process::id(), 1, u64::MAX);
+        let journal = killed_after_commit(dir, std::process::id(), 1, u64::MAX);
         in_flight().push(absolute(&journal));
         let foreign = dir.join(format!("{JOURNAL_PREFIX}{DEAD}.1{JOURNAL_SUFFIX}"));
         fs::write(&foreign, b"sinew-set 2\nwhatever").unwrap();
-        let before = listing(&dir);
-        complete_interrupted_sets(&dir);
-        assert_eq!(listing(&dir), before);
+        let before = listing(dir);
+        complete_interrupted_sets(dir);
+        assert_eq!(listing(dir), before);
         // Once no thread has it in flight (a rename failed), it is completed.
         in_flight().retain(|j| j != &absolute(&journal));
-        complete_interrupted_sets(&dir);
+        complete_interrupted_sets(dir);
         assert!(!journal.exists());
         assert!(foreign.exists());
         assert_eq!(fs::read(dir.join("a.json")).unwrap(), b"new a.json");
-        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

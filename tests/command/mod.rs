@@ -6,7 +6,9 @@
 //! without it only the scratch folders are here.
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+#[cfg(feature = "cli")]
+use std::path::PathBuf;
 #[cfg(feature = "cli")]
 use std::process::{Command, Output};
 
@@ -22,16 +24,15 @@ pub fn sinew(args: &[&str]) -> Output {
         .expect("run sinew")
 }
 
-/// An empty folder of its own for one test (named after the test file and `name`).
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "sinew-{}-{name}-{}",
-        module_path!().replace("::", "-"),
-        std::process::id()
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// Scratch folders removed when a test ends, shared with the library's unit tests (the
+/// module's doc tells how to keep them: `SINEW_KEEP_TEST_DIRS=1`).
+#[path = "../../src/test_scratch.rs"]
+pub mod test_scratch;
+
+/// An empty folder of its own for one test (named after the test file and `name`), removed
+/// when the result drops: keep it alive while the `sinew` it runs may still write there.
+pub fn scratch(name: &str) -> tempfile::TempDir {
+    test_scratch::scratch(&format!("{}-{name}", module_path!().replace("::", "-")))
 }
 
 /// A path as a command-line argument.

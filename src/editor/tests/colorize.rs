@@ -34,21 +34,20 @@ fn colorize_result(h: &Harness<'_, EditorApp>) -> Arc<crate::colorize::Colorized
 }
 
 /// A generated one-circle colorize scene of `size` px, its line art written as `file` in a
-/// fresh scratch folder `sinew-editor-NAME-PID`: the scene, the folder and the line art's path.
+/// fresh scratch folder `sinew-editor-NAME-XXXXXX`: the scene, the folder (removed when it
+/// drops) and the line art's path.
 fn one_circle_lineart(
     name: &str,
     size: u32,
     file: &str,
-) -> (crate::colorize::synthetic::Scene, PathBuf, PathBuf) {
+) -> (crate::colorize::synthetic::Scene, TempDir, PathBuf) {
     let s = crate::colorize::synthetic::scene(&crate::colorize::synthetic::SceneSpec {
         size,
         shapes: 1,
         ..Default::default()
     });
-    let dir = std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    let lineart = dir.join(file);
+    let dir = crate::test_scratch::scratch(&format!("editor-{name}"));
+    let lineart = dir.path().join(file);
     crate::io::save_png(&lineart, &s.lineart).expect("written");
     (s, dir, lineart)
 }
@@ -56,7 +55,8 @@ fn one_circle_lineart(
 #[test]
 fn colorize_two_scribbles_then_undo_one() {
     use crate::colorize::synthetic::PALETTE;
-    let (s, dir, lineart) = one_circle_lineart("colorize", 128, "lineart.png");
+    let (s, tmp, lineart) = one_circle_lineart("colorize", 128, "lineart.png");
+    let dir = tmp.path();
     let corrupt = dir.join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG\r\n\x1a\nnot really").expect("written");
     // Share of the non-line pixels of true color `region` that `image` colors `want`.
@@ -151,14 +151,14 @@ fn colorize_two_scribbles_then_undo_one() {
     h.run();
     let result = h.state().colorize.shown_result().cloned().expect("shown");
     assert!(Arc::ptr_eq(&result, &one));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn colorize_scribbles_save_load_and_autosave() {
     use crate::colorize::session::{ScribbleStroke, SessionCommand};
     use crate::colorize::synthetic::PALETTE;
-    let (s, dir, lineart) = one_circle_lineart("scribbles", 96, "cat.png");
+    let (s, tmp, lineart) = one_circle_lineart("scribbles", 96, "cat.png");
+    let dir = tmp.path();
     let strokes: Vec<ScribbleStroke> = [PALETTE[10], PALETTE[0]]
         .iter()
         .zip(&s.strokes)
@@ -252,5 +252,4 @@ fn colorize_scribbles_save_load_and_autosave() {
         crate::colorize::session::strokes_from_json(&text).expect("a scribble file"),
         strokes[..1]
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -85,9 +85,8 @@ fn the_split_picked_in_the_panel_colors_the_saved_image_as_sinew_colorize_does()
         split_background: true,
         ..Default::default()
     });
-    let dir = std::env::temp_dir().join(format!("sinew-editor-split-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
+    let tmp = crate::test_scratch::scratch("editor-split");
+    let dir = tmp.path();
     let (lineart, scribbles) = (dir.join("undrawn.png"), dir.join("undrawn.json"));
     crate::io::save_png(&lineart, &s.lineart).expect("written");
     let file = serde_json::json!({ "strokes": s.strokes });
@@ -156,5 +155,4 @@ fn the_split_picked_in_the_panel_colors_the_saved_image_as_sinew_colorize_does()
     let alpha_changed = differing(&alpha, &reach);
     assert!(alpha_changed > 0, "α changed nothing");
     println!("depth changed {changed} px of reach's, α 1 {alpha_changed} px");
-    let _ = std::fs::remove_dir_all(&dir);
 }

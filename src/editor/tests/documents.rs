@@ -5,7 +5,7 @@ use super::*;
 
 #[test]
 fn bad_files_show_a_message_and_keep_the_document() {
-    let path = character_rig("bad");
+    let (_dir, path) = character_rig("bad");
     let dir = path.parent().expect("a folder").to_path_buf();
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     let layers = app.doc.state().layers.len();
@@ -36,8 +36,9 @@ fn bad_files_show_a_message_and_keep_the_document() {
 
 #[test]
 fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
-    let dir = std::env::temp_dir().join(format!("sinew-editor-save-{}", std::process::id()));
-    let mut h = never_rigged_bar(&dir);
+    let tmp = crate::test_scratch::scratch("editor-save");
+    let dir = tmp.path();
+    let mut h = never_rigged_bar(dir);
     let path = dir.join("bar.json");
     let message = h.state_mut().save_to(&path);
     assert!(message.starts_with("saving"), "{message}");
@@ -65,14 +66,14 @@ fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
     }));
     wait_for(&mut h, |app| !app.saving());
     assert!(h.state().doc.dirty());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn closing_with_unsaved_changes_asks_first() {
     use closing::Closing;
-    let dir = std::env::temp_dir().join(format!("sinew-editor-close-{}", std::process::id()));
-    let mut h = never_rigged_bar(&dir);
+    let tmp = crate::test_scratch::scratch("editor-close");
+    let dir = tmp.path();
+    let mut h = never_rigged_bar(dir);
     assert!(h.state().doc.dirty());
     let png = dir.join("bar.png");
     let png_bytes = std::fs::read(&png).expect("bar.png");
@@ -140,7 +141,7 @@ fn closing_with_unsaved_changes_asks_first() {
     assert!(!press_close_button(&mut h));
 
     // Discarding closes at once; a clean document closes without asking.
-    let mut h = never_rigged_bar(&dir);
+    let mut h = never_rigged_bar(dir);
     h.state_mut().request_close();
     h.run();
     click_shown(&mut h, "Don't save");
@@ -148,16 +149,16 @@ fn closing_with_unsaved_changes_asks_first() {
     let mut clean = harness(EditorApp::new(Document::new()));
     assert!(!press_close_button(&mut clean));
     assert_eq!(clean.state().closing(), Closing::Allowed);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn a_save_still_running_is_reported_after_reopening_and_finished_at_exit() {
-    let dir = std::env::temp_dir().join(format!("sinew-editor-reopen-{}", std::process::id()));
-    let mut h = never_rigged_bar(&dir);
+    let tmp = crate::test_scratch::scratch("editor-reopen");
+    let dir = tmp.path();
+    let mut h = never_rigged_bar(dir);
     let path = dir.join("bar.json");
     h.state_mut().save_to(&path);
-    let other = character_rig("reopen-save");
+    let (_other_dir, other) = character_rig("reopen-save");
     h.state_mut().open(&other);
     assert!(h.state().saving());
     wait_for(&mut h, |app| !app.saving());
@@ -168,7 +169,7 @@ fn a_save_still_running_is_reported_after_reopening_and_finished_at_exit() {
     assert!(!view_path(&path).exists());
 
     // At exit the editor waits for writes still under way.
-    let mut h = never_rigged_bar(&dir);
+    let mut h = never_rigged_bar(dir);
     let path = dir.join("exit.json");
     h.state_mut().save_to(&path);
     let ctx = h.ctx.clone();
@@ -177,13 +178,13 @@ fn a_save_still_running_is_reported_after_reopening_and_finished_at_exit() {
     assert!(path.is_file());
     assert!(crate::document::autosave_path(&path).is_file());
     assert!(!h.state().saving() && !h.state().autosaving());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
-    let dir = std::env::temp_dir().join(format!("sinew-editor-autosave-{}", std::process::id()));
-    let mut h = never_rigged_bar(&dir);
+    let tmp = crate::test_scratch::scratch("editor-autosave");
+    let dir = tmp.path();
+    let mut h = never_rigged_bar(dir);
     let path = dir.join("bar.json");
     let ctx = h.ctx.clone();
     h.state_mut().start_autosave(&path, &ctx);
@@ -201,12 +202,11 @@ fn autosave_writes_a_never_rigged_document_off_the_ui_thread() {
     wait_for(&mut h, |app| !app.autosaving());
     let message = h.state().message.clone().unwrap_or_default();
     assert!(message.starts_with("autosave failed"), "{message}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn reopening_restores_the_view() {
-    let path = character_rig("view");
+    let (_dir, path) = character_rig("view");
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     app.mode = Mode::Animate;
     app.view = Some(View {

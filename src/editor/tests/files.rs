@@ -3,14 +3,16 @@
 
 use super::*;
 
-fn scratch(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("sinew-editor-{name}-{}", std::process::id()))
+/// An empty folder of its own for one test, removed when the result drops.
+fn scratch(name: &str) -> TempDir {
+    crate::test_scratch::scratch(&format!("editor-{name}"))
 }
 
 #[test]
 fn the_file_menus_field_takes_a_click_and_typing_and_imports_a_png() {
-    let dir = scratch("menu-field");
-    let png = bar_png(&dir);
+    let tmp = scratch("menu-field");
+    let dir = tmp.path();
+    let png = bar_png(dir);
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
     click_shown(&mut h, "File");
@@ -32,13 +34,13 @@ fn the_file_menus_field_takes_a_click_and_typing_and_imports_a_png() {
     assert!(h.query_by_label("Import layer").is_none());
     // The modified document shows so; typing S in a field never reaches a shortcut.
     h.get_by_label_contains("modified");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_layers() {
-    let dir = scratch("shortcuts");
-    let png = bar_png(&dir);
+    let tmp = scratch("shortcuts");
+    let dir = tmp.path();
+    let png = bar_png(dir);
     let json = dir.join("bar.json");
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
@@ -140,7 +142,6 @@ fn ctrl_s_saves_as_ctrl_n_starts_over_ctrl_o_opens_and_nothing_is_saved_without_
     h.run();
     assert!(!h.state().doc.dirty());
     assert!(h.query_by_label_contains("modified").is_none());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -219,8 +220,9 @@ impl egui::DroppedFile for Dropped {
 
 #[test]
 fn an_empty_canvas_asks_for_images_and_takes_a_dropped_png() {
-    let dir = scratch("drop");
-    let png = bar_png(&dir);
+    let tmp = scratch("drop");
+    let dir = tmp.path();
+    let png = bar_png(dir);
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
     h.get_by_label(drawing::DROP_HINT);
@@ -235,13 +237,13 @@ fn an_empty_canvas_asks_for_images_and_takes_a_dropped_png() {
         h.state().message
     );
     assert!(h.query_by_label(drawing::DROP_HINT).is_none());
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn a_dropped_psd_becomes_its_visible_layers() {
-    let dir = scratch("drop-psd");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("drop-psd");
+    let dir = tmp.path();
+    std::fs::create_dir_all(dir).unwrap();
     let psd = dir.join("character.psd");
     let fixture =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/layered/character.psd");
@@ -284,7 +286,6 @@ fn a_dropped_psd_becomes_its_visible_layers() {
         "{:?}",
         hand.offset_px
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

@@ -18,7 +18,7 @@ const HEAD_CURVES: [&str; 7] = [
 
 /// The bundled character in animate mode with the head keyed at 0° at 0 s and 20° at 0.5 s
 /// from the numbers panel (every transform channel gets keys).
-fn nodding_head(name: &str) -> Harness<'static, EditorApp> {
+fn nodding_head(name: &str) -> InFolder {
     let mut h = open_character(name);
     h.key_press(Key::Num3);
     h.run();

@@ -4,7 +4,7 @@ use super::*;
 
 #[test]
 fn exports_for_spine_from_the_file_menu_function() {
-    let path = character_rig("export");
+    let (_dir, path) = character_rig("export");
     let mut app = EditorApp::new(Document::open(&path).expect("opens"));
     let dir = path.parent().expect("a folder").join("spine");
     // The menu's options reach the exporter: Spine 4.3, at most 2 influences per vertex.
@@ -33,7 +33,7 @@ fn exports_for_spine_from_the_file_menu_function() {
 
 #[test]
 fn renders_the_current_animation_in_the_background() {
-    let path = character_rig("render");
+    let (_dir, path) = character_rig("render");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     let gif = path.parent().expect("a folder").join("nod.gif");
     key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 20.0)]);
@@ -98,7 +98,7 @@ fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
 
 #[test]
 fn the_render_dialog_names_the_spine_export_its_runtime_curves_reproduce() {
-    let path = character_rig("render-spine");
+    let (_dir, path) = character_rig("render-spine");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     click_shown(&mut h, "File");
     click_shown(&mut h, "Render…");

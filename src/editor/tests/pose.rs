@@ -138,7 +138,7 @@ fn pins_leave_the_drawing_where_it_is() {
 fn the_canvas_draws_the_poses_draw_order_tint_and_visibility() {
     // A document whose animation hides the head, tints the bag and brings the torso to the
     // front, opened through File → Open.
-    let path = character_rig("draw-list");
+    let (_dir, path) = character_rig("draw-list");
     let mut doc = crate::io::RigDocument::load(&path).expect("loads");
     let mut order: Vec<String> = doc.parts.iter().map(|p| p.name.clone()).collect();
     order.retain(|n| n != "torso");
@@ -313,7 +313,7 @@ fn a_drag_on_a_bone_turns_it_and_a_first_drag_of_the_drawing_holds_the_skeletons
 
 #[test]
 fn the_skin_picker_draws_the_chosen_skin_and_undo_takes_it_back() {
-    let path = character_rig_with("skins", true);
+    let (_dir, path) = character_rig_with("skins", true);
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
     h.key_press(Key::Num2);

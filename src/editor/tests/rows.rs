@@ -71,8 +71,8 @@ fn attachment_keys_move_copy_paste_and_delete_in_their_row() {
 }
 
 /// The character with animation "squash": the torso's mesh deformed, keys at 0 and 0.5 s.
-fn character_with_squash(name: &str) -> (PathBuf, usize) {
-    let path = character_rig(name);
+fn character_with_squash(name: &str) -> (TempDir, PathBuf, usize) {
+    let (dir, path) = character_rig(name);
     let mut doc = crate::io::RigDocument::load(&path).expect("loads");
     let vertices = doc
         .parts
@@ -88,12 +88,12 @@ fn character_with_squash(name: &str) -> (PathBuf, usize) {
         {"time": 0.5, "value": squash}]}}});
     doc.animations = crate::anim::animations_from_json(&json).expect("an animation");
     doc.save(&path).expect("saved");
-    (path, vertices)
+    (dir, path, vertices)
 }
 
 #[test]
 fn deform_keys_have_a_row_with_curves_and_move_copy_and_paste() {
-    let (path, vertices) = character_with_squash("deform-row");
+    let (_dir, path, vertices) = character_with_squash("deform-row");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
     h.key_press(Key::Num3);

@@ -2,19 +2,6 @@
 //! and the canvas, the mode keys, Ctrl+Z.
 
 use super::*;
-use egui_kittest::kittest::NodeT;
-
-/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
-fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
-    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
-}
-
-/// Scrolls the side panel to the tree's row `name` and clicks it.
-fn click_row(h: &mut Harness<'_, EditorApp>, name: &str) {
-    h.get_by_label(name).scroll_to_me();
-    h.run();
-    click_shown(h, name);
-}
 
 /// Whether the middle of the widget labelled `label` (where a click reaches it) lies in the
 /// part of the side panel the window shows: below the menu bar (the canvas area's top), above
@@ -52,7 +39,7 @@ fn the_selection_stays_across_mode_switches_while_its_handle_exists() {
     // Pose mode: the lantern picked in the tree is highlighted there, its numbers shown.
     h.key_press(Key::Num2);
     h.run();
-    click_row(&mut h, "lantern");
+    click_label(&mut h, "lantern");
     assert_eq!(shown_selection(&h, "lantern"), Some(true));
 
     // Every mode and back again, by key: the lantern stays selected wherever a tree shows.

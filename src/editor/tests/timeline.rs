@@ -187,7 +187,7 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
 
 #[test]
 fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
-    let path = character_with_nod("playback");
+    let (_dir, path) = character_with_nod("playback");
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
     h.key_press(Key::Num3);

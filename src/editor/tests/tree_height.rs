@@ -37,8 +37,8 @@ fn rows_in_view(h: &Harness<'_, EditorApp>) -> usize {
 }
 
 /// The editor on the character in a window `height` points tall.
-fn character_in_window(name: &str, height: f32) -> Harness<'static, EditorApp> {
-    let path = character_rig(name);
+fn character_in_window(name: &str, height: f32) -> InFolder {
+    let (dir, path) = character_rig(name);
     let mut h = Harness::builder()
         .with_size(egui::vec2(1200.0, height))
         .build_ui_state(
@@ -46,7 +46,7 @@ fn character_in_window(name: &str, height: f32) -> Harness<'static, EditorApp> {
             EditorApp::new(Document::open(&path).expect("opens")),
         );
     h.run();
-    h
+    InFolder { h, _dir: dir }
 }
 
 #[test]

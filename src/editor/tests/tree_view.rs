@@ -1,24 +1,11 @@
 //! The tree view and the View menu's keys, driven by input events only.
 
 use super::*;
-use egui_kittest::kittest::NodeT;
-
-/// Scrolls the side panel to the widget labelled `label`, then clicks it.
-fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
-    h.get_by_label(label).scroll_to_me();
-    h.run();
-    click_shown(h, label);
-}
 
 /// The same view, up to a fraction of a point (the side panel's width settles over the first
 /// frames, and the fit with it).
 fn same_view(a: Option<View>, b: View) -> bool {
     a.is_some_and(|a| (a.zoom - b.zoom).abs() < 1e-3 && (a.pan - b.pan).length() < 1.0)
-}
-
-/// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
-fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
-    h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
 }
 
 #[test]
@@ -349,7 +336,7 @@ fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
 
 #[test]
 fn rig_mode_draws_one_attachment_per_slot_and_the_tree_picks_which() {
-    let path = character_rig_with("rig-attachments", true);
+    let (_dir, path) = character_rig_with("rig-attachments", true);
     let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
     h.run();
     assert_eq!(h.state().mode, Mode::Rig);

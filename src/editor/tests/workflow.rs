@@ -22,8 +22,9 @@ fn press_times(h: &mut Harness<'_, EditorApp>, label: &str, times: usize) {
 
 #[test]
 fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
-    let dir = std::env::temp_dir().join(format!("sinew-editor-loop-{}", std::process::id()));
-    let png = bar_png(&dir);
+    let tmp = crate::test_scratch::scratch("editor-loop");
+    let dir = tmp.path();
+    let png = bar_png(dir);
     let json = dir.join("bar.json");
     let mut h = harness(EditorApp::new(Document::new()));
     h.run();
@@ -166,5 +167,4 @@ fn import_rig_pose_key_ease_key_inside_play_save_and_reopen() {
         crate::document::animation_named(h.state().doc.state(), "animation"),
         saved
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
