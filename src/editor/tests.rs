@@ -2,7 +2,7 @@
 //! against the document. Widgets are clicked through [`click_shown`] and [`click_shown_by`]
 //! (or [`press_shown_by`] where frames are stepped), which fail where a user could not click
 //! them, and brought into view with the mouse wheel ([`wheel_into_view`]); clippy.toml
-//! disallows kittest's own clicks, so an exception says so at its place.
+//! disallows kittest's own clicks and scrolls, so an exception says so at its place.
 
 use super::rig_mode::distance;
 use crate::geom::Point;
