@@ -1,7 +1,8 @@
 //! The editor driven through egui_kittest: real frames, simulated pointer and keys, checked
 //! against the document. Widgets are clicked through [`click_shown`] and [`click_shown_by`]
 //! (or [`press_shown_by`] where frames are stepped), which fail where a user could not click
-//! them; clippy.toml disallows kittest's own clicks, so an exception says so at its place.
+//! them, and brought into view with the mouse wheel ([`wheel_into_view`]); clippy.toml
+//! disallows kittest's own clicks and scrolls, so an exception says so at its place.
 
 use super::rig_mode::distance;
 use crate::geom::Point;
@@ -283,23 +284,151 @@ fn assert_shown(
         "{what}: at {at:?}, off the screen {screen:?}"
     );
     let frame = h.ctx.cumulative_frame_nr();
-    h.hover_at(at);
+    let on_it = under_pointer(h, at, id);
     // One frame per queued event: more than the pointer's one means input was still queued.
-    h.step();
     assert_eq!(
         h.ctx.cumulative_frame_nr(),
         frame + 1,
         "{what}: located while input was still queued (run a key's frames before clicking)"
     );
-    let under_pointer = h.ctx.interaction_snapshot(|s| {
+    assert!(
+        on_it,
+        "{what}: not under the pointer at its centre {at:?} (scrolled away, clipped or covered)"
+    );
+}
+
+/// Moves the pointer to `at` and steps one frame: whether egui's hit test then finds the
+/// widget (or Ui) `id` under it.
+fn under_pointer(h: &mut Harness<'_, EditorApp>, at: Pos2, id: egui::accesskit::NodeId) -> bool {
+    h.hover_at(at);
+    h.step();
+    h.ctx.interaction_snapshot(|s| {
         s.contains_pointer
             .iter()
             .any(|widget| widget.accesskit_id() == id)
-    });
+    })
+}
+
+/// Lines (egui's `line_scroll_speed`, 40 pt) one turn of [`wheel_into_view`]'s wheel scrolls
+/// at most; fewer when the widget is nearer its area's edge.
+const WHEEL_LINES: f32 = 3.0;
+
+/// Turns of the wheel [`wheel_into_view`] makes before it fails.
+const WHEEL_TURNS: usize = 30;
+
+/// How far inside its area [`wheel_into_view`] holds the pointer, pt.
+const WHEEL_MARGIN_PT: f32 = 4.0;
+
+/// Widgets [`holding_area`] points at, looking for one a user sees, before it fails.
+const AREA_PROBES: usize = 40;
+
+/// Brings the widget `by` finds into view as a user does: the pointer over the area holding it
+/// (where [`holding_area`] finds it shown, nearest the widget), the mouse wheel turned towards
+/// the widget a few lines at a time (one `run` each), until a user pointing at its centre
+/// would be on it ([`assert_shown`]'s hit test). Fails after [`WHEEL_TURNS`] turns, or when the
+/// widget lies in its area's view and still is not under the pointer (covered).
+fn wheel_into_view(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
+    let what = format!("{by:?}");
+    let line_pt = h.ctx.options(|o| o.input_options.line_scroll_speed);
+    for _ in 0..WHEEL_TURNS {
+        let (id, at) = press_point(&h.get(by.clone()));
+        let screen = h.ctx.content_rect();
+        if screen.contains(at) && under_pointer(h, at, id) {
+            return;
+        }
+        let area = holding_area(h, &by, &what);
+        let inside = area.shrink(WHEEL_MARGIN_PT.min(area.height() / 4.0));
+        // Down (the content moves up: a negative wheel delta) when the widget is below.
+        let beyond_pt = if at.y > inside.bottom() {
+            inside.bottom() - at.y
+        } else if at.y < inside.top() {
+            inside.top() - at.y
+        } else {
+            panic!("{what}: at {at:?}, in its area's view {area:?}, not under the pointer");
+        };
+        let lines = (beyond_pt.abs() / line_pt).ceil().clamp(1.0, WHEEL_LINES);
+        h.hover_at(inside.clamp(at));
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, lines.copysign(beyond_pt)),
+            phase: egui::TouchPhase::Move,
+            modifiers: Modifiers::NONE,
+        });
+        h.run();
+    }
+    let (id, at) = press_point(&h.get(by));
     assert!(
-        under_pointer,
-        "{what}: not under the pointer at its centre {at:?} (scrolled away, clipped or covered)"
+        under_pointer(h, at, id),
+        "{what}: not in view after {WHEEL_TURNS} turns of the wheel"
     );
+}
+
+/// Where a user sees the area holding the widget `by`: the visible part (egui's rect clipped by
+/// its parents', as its hit test uses it) of the innermost Ui around the widget that shows any
+/// of what it holds. Found by pointing at the widgets drawn nearest the widget in each Ui
+/// around it, innermost first, until one is under the pointer; fails after [`AREA_PROBES`].
+fn holding_area(h: &mut Harness<'_, EditorApp>, by: &By<'_>, what: &str) -> egui::Rect {
+    let screen = h.ctx.content_rect();
+    let (around, centre, levels) = {
+        let node = h.get(by.clone());
+        let centre = node.rect().center();
+        let mut around = Vec::new();
+        let mut levels: Vec<Vec<(egui::accesskit::NodeId, Pos2)>> = Vec::new();
+        let mut seen = std::collections::HashSet::from([node.accesskit_node().locate().0]);
+        let mut ui = node.accesskit_node().parent();
+        while let Some(parent) = ui {
+            around.push(parent.locate().0);
+            let mut drawn: Vec<_> = node
+                .new_related(parent)
+                .children_recursive()
+                .filter_map(|n| {
+                    let id = n.accesskit_node().locate().0;
+                    let at = n
+                        .accesskit_node()
+                        .bounding_box()
+                        .map(|_| n.rect().center())?;
+                    (seen.insert(id) && screen.contains(at)).then_some((id, at))
+                })
+                .collect();
+            drawn.sort_by(|a, b| a.1.distance(centre).total_cmp(&b.1.distance(centre)));
+            levels.push(drawn);
+            ui = parent.parent();
+        }
+        (around, centre, levels)
+    };
+    let mut probes = 0;
+    for (id, at) in levels.into_iter().flatten() {
+        probes += 1;
+        assert!(
+            probes <= AREA_PROBES,
+            "{what}: none of the {AREA_PROBES} widgets nearest its centre {centre:?} is in view"
+        );
+        if !under_pointer(h, at, id) {
+            continue;
+        }
+        // egui's hit test takes a widget within its search radius of the pointer: the Uis
+        // around it are read at the middle of its visible part.
+        let shown = h.ctx.interaction_snapshot(|s| {
+            s.contains_pointer
+                .iter()
+                .find(|w| w.accesskit_id() == id)
+                .copied()
+        });
+        if let Some(visible) = shown.and_then(|w| h.ctx.read_response(w)) {
+            let middle = visible.interact_rect.center();
+            if !visible.interact_rect.contains(at) && !under_pointer(h, middle, id) {
+                continue;
+            }
+        }
+        let under = h.ctx.interaction_snapshot(|s| s.contains_pointer.clone());
+        let innermost = around
+            .iter()
+            .find_map(|ui| under.iter().find(|w| w.accesskit_id() == *ui).copied());
+        if let Some(ui) = innermost.and_then(|ui| h.ctx.read_response(ui)) {
+            return ui.interact_rect;
+        }
+    }
+    panic!("{what}: nothing around it is in view");
 }
 
 /// How the editor tests click a widget: the one widget `by` finds, once [`assert_shown`] says
@@ -321,11 +450,10 @@ fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
     h.run();
 }
 
-/// Scrolls the side panel to the widget labelled `label` (a tree row, say), then
+/// Wheels the widget labelled `label` (a tree row, say) into view ([`wheel_into_view`]), then
 /// [`click_shown`]s it.
 fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
-    h.get_by_label(label).scroll_to_me();
-    h.run();
+    wheel_into_view(h, By::new().label(label));
     click_shown(h, label);
 }
 

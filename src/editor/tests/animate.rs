@@ -188,9 +188,7 @@ fn set_key_keys_the_rotated_bone_s_rotation_and_the_selected_bone_only() {
     assert_eq!(h.state().selected.as_deref(), Some("head"));
     set_number(&mut h, "Rotation", 15.0);
     assert!(h.state().animate.shown.is_some());
-    h.get_by_label("lantern").scroll_to_me();
-    h.run();
-    click_shown(&mut h, "lantern");
+    click_label(&mut h, "lantern");
     assert_eq!(h.state().selected.as_deref(), Some("lantern"));
     h.key_press(Key::K);
     h.run();

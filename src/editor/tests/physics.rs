@@ -13,10 +13,9 @@ fn tail_sway(h: &Harness<'_, EditorApp>) -> crate::rig::PhysicsConstraint {
         .clone()
 }
 
-/// Scrolls the side panel to `label` and types `text` into it, then Enter.
+/// Wheels the side panel to `label` and types `text` into it, then Enter.
 fn enter(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
-    h.get_by_label(label).scroll_to_me();
-    h.run();
+    wheel_into_view(h, By::new().label(label));
     type_into(h, label, text);
     h.key_press(Key::Enter);
     h.run();
@@ -28,9 +27,7 @@ fn a_physics_constraints_fields_in_the_tree_edit_it_and_refuse_bad_numbers() {
     h.key_press(Key::Num2);
     h.run();
     assert!(h.query_by_label("Physics mass").is_none());
-    h.get_by_label("physics tail_sway").scroll_to_me();
-    h.run();
-    click_shown(&mut h, "physics tail_sway");
+    click_label(&mut h, "physics tail_sway");
     let before = tail_sway(&h);
     assert_eq!(before.bone, "tail_4");
     let mass = h.get_by_label("Physics mass").value().unwrap_or_default();

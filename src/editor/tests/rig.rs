@@ -129,8 +129,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
     );
 
     // The traced mesh, rebuilt live when a meshing option changes.
-    h.get_by_label("Show the traced mesh").scroll_to_me();
-    h.run();
+    wheel_into_view(&mut h, By::new().label("Show the traced mesh"));
     press_shown(&mut h, "Show the traced mesh");
     wait_until(&mut h, "the mesh preview", |app| {
         !app.previewing() && app.preview_vertex_count().is_some()
@@ -150,8 +149,7 @@ fn cages_regions_mesh_preview_and_automatic_rig_in_rig_mode() {
 
     // The automatic rig replaces the handles; undo brings the hand-made ones back.
     let hand_made = h.state().doc.state().handles.clone();
-    h.get_by_label("Propose handles").scroll_to_me();
-    h.run();
+    wheel_into_view(&mut h, By::new().label("Propose handles"));
     press_shown(&mut h, "Propose handles");
     wait_until(&mut h, "the automatic rig", |app| {
         !app.rig_tools.proposing()

@@ -18,9 +18,7 @@ fn key_at(h: &Harness<'_, EditorApp>, timeline: &TimelineId, time_s: f64) -> Pos
 fn attachment_keys_move_copy_paste_and_delete_in_their_row() {
     let (mut h, animation) = new_animation_on_skinned_character("attachment-row");
     let keys = |h: &Harness<'_, EditorApp>| bag_attachment_keys(h, &animation);
-    h.get_by_label("bag shows bag_pail").scroll_to_me();
-    h.run();
-    click_shown(&mut h, "bag shows bag_pail");
+    click_label(&mut h, "bag shows bag_pail");
     assert_eq!(keys(&h), [(0.0, Some("bag_pail".into()))]);
     let row = TimelineId::Attachment { slot: "bag".into() };
     let sheet = h.state().timeline.sheet.clone().expect("sheet");
@@ -156,9 +154,7 @@ fn deform_keys_have_a_row_with_curves_and_move_copy_and_paste() {
 fn delete_key_removes_every_kind_of_key_at_the_playhead() {
     let (mut h, animation) = new_animation_on_skinned_character("delete-key");
     // An attachment swap at 0 s, through the tree.
-    h.get_by_label("bag shows bag_pail").scroll_to_me();
-    h.run();
-    click_shown(&mut h, "bag shows bag_pail");
+    click_label(&mut h, "bag shows bag_pail");
     assert_eq!(
         bag_attachment_keys(&h, &animation),
         [(0.0, Some("bag_pail".into()))]

@@ -138,8 +138,7 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
 /// Drags the tree row labelled `from` (pressed at its middle) and releases it on the row
 /// labelled `onto`, in pointer steps.
 fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
-    h.get_by_label(from).scroll_to_me();
-    h.run();
+    wheel_into_view(h, By::new().label(from));
     let start = press_point(&h.get_by_label(from));
     assert_shown(h, start, from);
     let start = start.1;
@@ -382,8 +381,7 @@ fn selecting_in_the_tree_never_moves_the_tree_under_the_pointer() {
     for mode in [Key::Num2, Key::Num3] {
         h.key_press(mode);
         h.run();
-        h.get_by_label("chest").scroll_to_me();
-        h.run();
+        wheel_into_view(&mut h, By::new().label("chest"));
         let before = rects(&h);
         for pick in ["chest", "head", "hip"] {
             click_shown(&mut h, pick);
