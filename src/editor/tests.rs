@@ -56,8 +56,13 @@ const BUILD_FRAMES: usize = 1200;
 const MAX_STEPS_PER_RUN: u64 = 8;
 
 fn harness(app: EditorApp) -> Harness<'static, EditorApp> {
+    harness_sized(app, egui::vec2(1200.0, 800.0))
+}
+
+/// [`harness`] in a window of `size` points.
+fn harness_sized(app: EditorApp, size: egui::Vec2) -> Harness<'static, EditorApp> {
     Harness::builder()
-        .with_size(egui::vec2(1200.0, 800.0))
+        .with_size(size)
         .with_max_steps(MAX_STEPS_PER_RUN)
         .build_ui_state(|ui, app: &mut EditorApp| app.frame(ui), app)
 }

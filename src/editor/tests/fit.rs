@@ -111,13 +111,7 @@ fn an_untouched_view_refits_as_the_mode_changes_the_canvas_area_and_a_users_view
 
 /// An editor on a new document in a window of `size` points, after its first frames.
 fn empty_editor_sized(size: egui::Vec2) -> Harness<'static, EditorApp> {
-    let mut h = Harness::builder()
-        .with_size(size)
-        .with_max_steps(MAX_STEPS_PER_RUN)
-        .build_ui_state(
-            |ui, app: &mut EditorApp| app.frame(ui),
-            EditorApp::new(Document::new()),
-        );
+    let mut h = harness_sized(EditorApp::new(Document::new()), size);
     h.run();
     h
 }

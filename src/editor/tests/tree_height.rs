@@ -39,12 +39,10 @@ fn rows_in_view(h: &Harness<'_, EditorApp>) -> usize {
 /// The editor on the character in a window `height` points tall.
 fn character_in_window(name: &str, height: f32) -> InFolder {
     let (dir, path) = character_rig(name);
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1200.0, height))
-        .build_ui_state(
-            |ui, app: &mut EditorApp| app.frame(ui),
-            EditorApp::new(Document::open(&path).expect("opens")),
-        );
+    let mut h = harness_sized(
+        EditorApp::new(Document::open(&path).expect("opens")),
+        egui::vec2(1200.0, height),
+    );
     h.run();
     InFolder { h, _dir: dir }
 }
