@@ -113,12 +113,25 @@ fn character_rig_with(name: &str, skins: bool) -> (TempDir, PathBuf) {
     (dir, path)
 }
 
-/// A harness with the scratch folder of the document it opened. The harness drops first
-/// (fields drop in order), then the folder: the editor's saves and autosaves, which write
-/// beside the document, never find it gone while the test runs.
+/// A harness with the scratch folder of the document it opened. When it drops, it first waits
+/// for the editor's saves and autosaves still being written on other threads (as the editor
+/// does at exit), then the harness drops, then the folder: no write lands in the folder as it
+/// is removed (one that did left the folder behind, holding an autosave).
 struct InFolder {
     h: Harness<'static, EditorApp>,
     _dir: TempDir,
+}
+
+impl Drop for InFolder {
+    fn drop(&mut self) {
+        self.h.state_mut().finish_writes();
+    }
+}
+
+/// The editor on the document at `path` in `dir` (no frame run yet).
+fn opened_in(dir: TempDir, path: &Path) -> InFolder {
+    let h = harness(EditorApp::new(Document::open(path).expect("opens")));
+    InFolder { h, _dir: dir }
 }
 
 impl std::ops::Deref for InFolder {
@@ -137,9 +150,9 @@ impl std::ops::DerefMut for InFolder {
 /// The editor on [`character_rig`]`(name)`, after its first frames.
 fn open_character(name: &str) -> InFolder {
     let (dir, path) = character_rig(name);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let mut h = opened_in(dir, &path);
     h.run();
-    InFolder { h, _dir: dir }
+    h
 }
 
 fn screen(h: &Harness<'_, EditorApp>, canvas_px: impl Into<Point>) -> Pos2 {
@@ -795,13 +808,13 @@ fn shown_part_point(h: &Harness<'_, EditorApp>, name: &str) -> Point {
 /// animation* button); its harness and the animation's name.
 fn new_animation_on_skinned_character(name: &str) -> (InFolder, String) {
     let (dir, path) = character_rig_with(name, true);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let mut h = opened_in(dir, &path);
     h.run();
     h.key_press(Key::Num3);
     h.run();
     click_shown(&mut h, "New animation");
     let animation = h.state().animate.animation.clone();
-    (InFolder { h, _dir: dir }, animation)
+    (h, animation)
 }
 
 /// The bag slot's attachment keys in `animation`: (time, attachment shown).

@@ -33,8 +33,8 @@ fn exports_for_spine_from_the_file_menu_function() {
 
 #[test]
 fn renders_the_current_animation_in_the_background() {
-    let (_dir, path) = character_rig("render");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path) = character_rig("render");
+    let mut h = opened_in(dir, &path);
     let gif = path.parent().expect("a folder").join("nod.gif");
     key_nod(h.state_mut(), &[(0.0, 0.0), (0.5, 20.0)]);
     h.run();
@@ -98,8 +98,8 @@ fn wait_for_render(h: &mut Harness<'_, EditorApp>, pause_ms: u64) {
 
 #[test]
 fn the_render_dialog_names_the_spine_export_its_runtime_curves_reproduce() {
-    let (_dir, path) = character_rig("render-spine");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path) = character_rig("render-spine");
+    let mut h = opened_in(dir, &path);
     click_shown(&mut h, "File");
     click_shown(&mut h, "Render…");
     assert!(h.query_by_label("Spine version").is_none());

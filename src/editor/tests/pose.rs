@@ -313,8 +313,8 @@ fn a_drag_on_a_bone_turns_it_and_a_first_drag_of_the_drawing_holds_the_skeletons
 
 #[test]
 fn the_skin_picker_draws_the_chosen_skin_and_undo_takes_it_back() {
-    let (_dir, path) = character_rig_with("skins", true);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path) = character_rig_with("skins", true);
+    let mut h = opened_in(dir, &path);
     h.run();
     h.key_press(Key::Num2);
     h.run();

@@ -91,8 +91,8 @@ fn character_with_squash(name: &str) -> (TempDir, PathBuf, usize) {
 
 #[test]
 fn deform_keys_have_a_row_with_curves_and_move_copy_and_paste() {
-    let (_dir, path, vertices) = character_with_squash("deform-row");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path, vertices) = character_with_squash("deform-row");
+    let mut h = opened_in(dir, &path);
     h.run();
     h.key_press(Key::Num3);
     h.run();

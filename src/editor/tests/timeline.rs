@@ -187,8 +187,8 @@ fn dopesheet_select_move_copy_paste_curve_and_undo() {
 
 #[test]
 fn playback_steps_frames_loops_or_stops_and_onion_skins_show_neighbours() {
-    let (_dir, path) = character_with_nod("playback");
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path) = character_with_nod("playback");
+    let mut h = opened_in(dir, &path);
     h.run();
     h.key_press(Key::Num3);
     h.run();

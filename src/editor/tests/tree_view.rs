@@ -335,8 +335,8 @@ fn a_slots_attachment_list_in_the_tree_keys_attachment_swaps_at_the_playhead() {
 
 #[test]
 fn rig_mode_draws_one_attachment_per_slot_and_the_tree_picks_which() {
-    let (_dir, path) = character_rig_with("rig-attachments", true);
-    let mut h = harness(EditorApp::new(Document::open(&path).expect("opens")));
+    let (dir, path) = character_rig_with("rig-attachments", true);
+    let mut h = opened_in(dir, &path);
     h.run();
     assert_eq!(h.state().mode, Mode::Rig);
     let drawn = |h: &Harness<'_, EditorApp>| -> Vec<String> {
