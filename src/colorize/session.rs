@@ -520,11 +520,6 @@ mod tests {
         (s, background, inside)
     }
 
-    /// An empty folder of its own for one test, removed when the result drops.
-    fn scratch(name: &str) -> tempfile::TempDir {
-        crate::test_scratch::scratch(name)
-    }
-
     fn session(s: &crate::colorize::synthetic::Scene) -> ColorizeSession {
         ColorizeSession::new(s.lineart.clone(), ColorizeOptions::default()).unwrap()
     }
@@ -790,7 +785,7 @@ mod tests {
     fn strokes_save_and_load_as_a_scribble_file_with_one_undo_step() {
         let (s, background, inside) = circle();
         let mut session = session(&s);
-        let tmp = scratch("strokes");
+        let tmp = crate::test_scratch::scratch("strokes");
         let dir = tmp.path();
         let path = dir.join("lineart.scribbles.json");
         assert!(matches!(
@@ -844,7 +839,7 @@ mod tests {
     fn saves_the_result_atomically_and_only_once_solved() {
         let (s, background, _) = circle();
         let mut session = session(&s);
-        let tmp = scratch("session");
+        let tmp = crate::test_scratch::scratch("session");
         let dir = tmp.path();
         let path = dir.join("colored.png");
         session

@@ -170,5 +170,6 @@ def print_table(results, size, count):
         median = f"{statistics.median(secs):.3f}" if secs else "—"
         print(f"| {m} | " + " | ".join(f"{c:.4f}" for c in cells) + f" | {median} |")
 
+
 if __name__ == "__main__":
     main()
