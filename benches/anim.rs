@@ -72,6 +72,7 @@ fn synthetic() -> (Animation, Handles) {
             .map(|i| PointHandle {
                 name: format!("point_{i}"),
                 at: Point::new(5.0 * i as f64, 40.0),
+                parent: None,
             })
             .collect(),
         ..Default::default()

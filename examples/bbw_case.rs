@@ -62,6 +62,7 @@ fn point(name: &str, at: [f64; 2]) -> PointHandle {
     PointHandle {
         name: name.into(),
         at: at.into(),
+        parent: None,
     }
 }
 

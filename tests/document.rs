@@ -46,6 +46,7 @@ fn edits_undo_and_redo_in_order() {
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
         at: Point::new(290.0, 50.0),
+        parent: None,
     }))
     .unwrap();
     // Handles changed: the rig is stale until weights are computed again.
@@ -145,6 +146,7 @@ fn a_rig_built_for_older_inputs_is_refused() {
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
         at: Point::new(290.0, 50.0),
+        parent: None,
     }))
     .unwrap();
     let scene = compute_rig(
@@ -188,6 +190,7 @@ fn posing_needs_current_weights_and_a_valid_pose() {
     doc.apply(Command::AddPoint(PointHandle {
         name: "tip".into(),
         at: Point::new(290.0, 50.0),
+        parent: None,
     }))
     .unwrap();
     assert!(matches!(

@@ -222,6 +222,7 @@ fn recomputing_with_a_lock_keeps_the_influence_limit() {
     doc.apply(Command::AddPoint(sinew::rig::PointHandle {
         name: "p".into(),
         at: Point::new(250.0, 40.0),
+        parent: None,
     }))
     .unwrap();
     limit_and_compute(&mut doc, 2);
@@ -461,6 +462,7 @@ fn locked_weights_survive_saving_a_stale_rig_and_reopening() {
     doc.apply(Command::AddPoint(sinew::rig::PointHandle {
         name: "tip".into(),
         at: Point::new(40.0, 40.0),
+        parent: None,
     }))
     .unwrap();
     let path = dir.join("stale.json");

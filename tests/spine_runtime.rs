@@ -6,7 +6,8 @@
 //! nothing it would ignore. The deviation from sinew's exact playback is printed.
 //!
 //! Rigs: the bundled character as `sinew demo` writes it (bones, a point; Bézier keys), a
-//! generated rig with two skeletons, a point, a cage, a region, colour, visibility and
+//! generated rig with two skeletons, three points (two carried by bones, one of them baked),
+//! a cage, a region, colour, visibility and
 //! draw-order keys, stepped keys and timelines that start after 0 s, and a generated rig with
 //! bone IK constraints: a two-bone arm (bend negative, mix < 1, softness, its root keyed to a
 //! non-uniform scale) and a one-bone pole

@@ -34,6 +34,7 @@ fn critter(max_area_fraction: f64) -> (Vec<Layer>, Handles, BuildOptions) {
     let point = |name: &str, at: [f64; 2]| PointHandle {
         name: name.into(),
         at: Point::new(at[0] * s, at[1] * s),
+        parent: None,
     };
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),

@@ -112,6 +112,7 @@ fn a_bone_chain_on_the_critter_converges_on_every_handle() {
     let point = |name: &str, at: [f64; 2]| PointHandle {
         name: name.into(),
         at: at.into(),
+        parent: None,
     };
     let bone = |name: &str, parent: Option<&str>, head: [f64; 2], tail: [f64; 2]| Bone {
         name: name.into(),
@@ -273,10 +274,12 @@ fn content_aware_weights_change_fastest_across_a_color_edge() {
             PointHandle {
                 name: "left".into(),
                 at: Point::new(40.0, 40.0),
+                parent: None,
             },
             PointHandle {
                 name: "right".into(),
                 at: Point::new(280.0, 40.0),
+                parent: None,
             },
         ],
         ..Default::default()

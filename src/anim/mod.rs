@@ -268,6 +268,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "tip".into(),
                 at: Point::new(0.0, 0.0),
+                parent: None,
             }],
             cages: vec![Cage {
                 name: "belly".into(),

@@ -234,6 +234,7 @@ pub fn autorig(
         .map(|(k, p)| PointHandle {
             name: format!("point_{}", k + 1),
             at: p,
+            parent: None,
         })
         .collect();
     let cages = match options.cage_vertices {

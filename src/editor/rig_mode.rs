@@ -422,6 +422,7 @@ impl EditorApp {
                         if self.apply(Command::AddPoint(PointHandle {
                             name: name.clone(),
                             at: c,
+                            parent: None,
                         })) {
                             self.selected = Some(name);
                         }

@@ -5,7 +5,8 @@
 //!
 //! Which handles the solver may move: a bone or point or cage the pose names is *keyed* and
 //! keeps what the pose gives it — relative to its nearest unkeyed ancestor bone if it has one
-//! (a keyed forearm under a free upper arm turns with it), absolutely otherwise. Every other
+//! (a keyed forearm under a free upper arm turns with it, and so does a keyed point it
+//! carries), absolutely otherwise. Every other
 //! handle is free: bones rigid (rotation and translation, [`IkOptions::bones`]), regions
 //! near-rigid,
 //! points and cage vertices as
@@ -220,6 +221,27 @@ impl RigIk {
         let bone_index = |name: &str| handles.bones.iter().position(|b| b.name == name);
         // A bone is decided (by the pose or by forward kinematics) unless it may move.
         let keyed = |i: usize| pose.bones.contains_key(&handles.bones[i].name) || !movable(i);
+        // A decided column `j` under bone `parent`: it follows the nearest unkeyed ancestor,
+        // if any (validated parents are acyclic), or stays where forward kinematics puts it.
+        let decided = |j: usize, parent: Option<usize>| -> Result<ColumnDofs, IkError> {
+            let mut ancestor = parent;
+            while let Some(a) = ancestor {
+                if !keyed(a) {
+                    break;
+                }
+                ancestor = handles.bones[a].parent.as_deref().and_then(bone_index);
+            }
+            Ok(match ancestor {
+                Some(a) => {
+                    let world_from_ancestor = fk[a].inverse().ok_or(IkError::Singular)?;
+                    ColumnDofs::Follows {
+                        parent: a,
+                        local: world_from_ancestor.then_after(&fk[j]),
+                    }
+                }
+                None => ColumnDofs::Fixed(fk[j]),
+            })
+        };
         for (i, bone) in handles.bones.iter().enumerate() {
             let parent = bone.parent.as_deref().and_then(bone_index);
             if !keyed(i) {
@@ -242,24 +264,7 @@ impl RigIk {
                 }
                 continue;
             }
-            // The nearest unkeyed ancestor, if any; validated parents are acyclic.
-            let mut ancestor = parent;
-            while let Some(a) = ancestor {
-                if !keyed(a) {
-                    break;
-                }
-                ancestor = handles.bones[a].parent.as_deref().and_then(bone_index);
-            }
-            columns.push(match ancestor {
-                Some(a) => {
-                    let world_from_ancestor = fk[a].inverse().ok_or(IkError::Singular)?;
-                    ColumnDofs::Follows {
-                        parent: a,
-                        local: world_from_ancestor.then_after(&fk[i]),
-                    }
-                }
-                None => ColumnDofs::Fixed(fk[i]),
-            });
+            columns.push(decided(i, parent)?);
         }
         let free = |dofs: HandleDofs| match dofs {
             HandleDofs::Affine => ColumnDofs::Affine { rigidity: 0.0 },
@@ -270,10 +275,10 @@ impl RigIk {
                 linear: Matrix2::identity(),
             },
         };
-        for point in &handles.points {
+        for (i, point) in handles.points.iter().enumerate() {
             let j = columns.len();
             columns.push(if pose.points.contains_key(&point.name) || !movable(j) {
-                ColumnDofs::Fixed(fk[j])
+                decided(j, handles.point_parent(i))?
             } else {
                 free(options.points)
             });

@@ -600,6 +600,7 @@ mod tests {
         locked.handles.points.push(crate::rig::PointHandle {
             name: "nose".into(),
             at: Point::new(1.0, 1.0),
+            parent: None,
         });
         locked.locked = vec!["nose".into()];
         let text = serde_json::to_string(&locked).unwrap();

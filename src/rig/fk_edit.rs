@@ -168,12 +168,25 @@ pub fn apply(
         out.bones.insert(name.to_string(), local);
     } else {
         let mut local = as_shown.points.get(name).cloned().unwrap_or_default();
+        // A carried point's pose applies before its parent's motion: screen offsets and
+        // angles are measured through that motion's linear part.
+        let point = target.column - handles.bones.len();
+        let world_from_parent = handles
+            .point_parent(point)
+            .map_or_else(Affine::identity, |b| shown[b]);
         match edit {
             FkEdit::Grab { delta_px } => {
-                local.translate[0] += delta_px[0];
-                local.translate[1] += delta_px[1];
+                let inverse = world_from_parent
+                    .inverse()
+                    .ok_or_else(|| PoseError::Singular(name.to_string()))?;
+                let d = inverse.linear * delta_px;
+                local.translate[0] += d.x;
+                local.translate[1] += d.y;
             }
-            FkEdit::Rotate { angle_deg } => local.rotate += angle_deg,
+            FkEdit::Rotate { angle_deg } => {
+                let sign = world_from_parent.linear.determinant().signum();
+                local.rotate += sign * angle_deg;
+            }
             FkEdit::Scale { factor } => {
                 local.scale[0] *= factor;
                 local.scale[1] *= factor;
@@ -213,6 +226,7 @@ mod tests {
         h.points.push(PointHandle {
             name: "p".into(),
             at: Point::new(5.0, 5.0),
+            parent: None,
         });
         h
     }
@@ -322,6 +336,42 @@ mod tests {
         assert!(close(shown_point(&t, 2, Point::new(5.0, 5.0)), [6.0, 7.0]));
         let target = target(&h, &t, "p").unwrap();
         assert!((turn_deg(Vec2::new(1.0, 0.0), target.direction) - 30.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_point_on_a_turned_bone_moves_and_turns_as_shown_on_screen() {
+        let mut h = arm();
+        h.points[0].parent = Some("fore".into());
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "upper".into(),
+            crate::rig::pose::BonePose {
+                rotate: 90.0,
+                ..Default::default()
+            },
+        );
+        let shown = handle_transforms(&h, &pose).unwrap();
+        let at = Point::new(5.0, 5.0);
+        let before = shown_point(&shown, 2, at);
+        let moved = apply(
+            &h,
+            &pose,
+            &shown,
+            "p",
+            FkEdit::Grab {
+                delta_px: Vec2::new(1.0, 2.0),
+            },
+        )
+        .unwrap();
+        let t = handle_transforms(&h, &moved).unwrap();
+        let after = shown_point(&t, 2, at);
+        assert!(close(after, [before.x + 1.0, before.y + 2.0]), "{after:?}");
+        let turned = apply(&h, &moved, &t, "p", FkEdit::Rotate { angle_deg: 30.0 }).unwrap();
+        let t = handle_transforms(&h, &turned).unwrap();
+        assert!(close(shown_point(&t, 2, at), [after.x, after.y]));
+        // The bone turned the point's axis to 90°; the edit adds 30° on screen.
+        let target = target(&h, &t, "p").unwrap();
+        assert!((turn_deg(Vec2::new(1.0, 0.0), target.direction) - 120.0).abs() < 1e-9);
     }
 
     #[test]

@@ -99,7 +99,8 @@ impl Default for BonePose {
     }
 }
 
-/// A point handle's pose: about its rest position, in canvas axes.
+/// A point handle's pose: about its rest position, in canvas axes. A point carried by a bone
+/// ([`super::PointHandle::parent`]) takes this pose at rest, then moves as its parent does.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PointPose {

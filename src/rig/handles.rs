@@ -24,13 +24,18 @@ pub struct Bone {
     pub tail: Point,
 }
 
-/// A loose point handle at `at` (canvas px).
+/// A point handle at `at` (canvas px): loose, or carried by a bone.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PointHandle {
     pub name: String,
     #[schemars(with = "[f64; 2]")]
     pub at: Point,
+    /// The bone that carries the point: posed, the point moves as that bone does, then by its
+    /// own pose (as a Spine point attachment or a child bone would). `None`: a loose point,
+    /// posed on its own in canvas axes. Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parent: Option<String>,
 }
 
 /// A cage: a closed polygon (canvas px) whose vertices are handles.
@@ -124,6 +129,8 @@ pub enum HandleError {
     EmptyName,
     #[error("bone '{bone}' has unknown parent '{parent}'")]
     UnknownParent { bone: String, parent: String },
+    #[error("point '{point}' has unknown parent bone '{parent}'")]
+    UnknownPointParent { point: String, parent: String },
     #[error("bone '{0}' is its own ancestor (cyclic parents)")]
     CyclicParents(String),
     #[error("bone '{0}' has zero length (head = tail)")]
@@ -228,6 +235,13 @@ fn check_reach<'a>(
 pub const MIN_BONE_LENGTH_PX: f64 = 1e-6;
 
 impl Handles {
+    /// The index in `bones` of the bone carrying point `points[i]`, if it has one (a parent
+    /// named but missing, as in [`Handles::for_part`]'s subsets, counts as none).
+    pub fn point_parent(&self, i: usize) -> Option<usize> {
+        let parent = self.points.get(i)?.parent.as_deref()?;
+        self.bones.iter().position(|b| b.name == parent)
+    }
+
     /// The root of bone `name`'s skeleton: the ancestor with no parent (the bone itself when
     /// it has none). `None` when no bone has that name or the parents loop (an invalid rig).
     pub fn root_bone(&self, name: &str) -> Option<&Bone> {
@@ -262,7 +276,12 @@ impl Handles {
                 fix(parent);
             }
         }
-        self.points.iter_mut().for_each(|p| fix(&mut p.name));
+        for p in &mut self.points {
+            fix(&mut p.name);
+            if let Some(parent) = &mut p.parent {
+                fix(parent);
+            }
+        }
         self.cages.iter_mut().for_each(|c| fix(&mut c.name));
         self.regions.iter_mut().for_each(|r| fix(&mut r.name));
         if let Some(parts) = self.bind.remove(from) {
@@ -275,14 +294,19 @@ impl Handles {
         self.physics.iter_mut().for_each(|c| fix(&mut c.bone));
     }
 
-    /// Removes handle `name`. A removed bone's children move up to its parent, and the bone IK
-    /// constraints that name it go with it.
+    /// Removes handle `name`. A removed bone's children (bones and points) move up to its
+    /// parent, and the bone IK constraints that name it go with it.
     pub fn delete(&mut self, name: &str) {
         if let Some(index) = self.bones.iter().position(|b| b.name == name) {
             let removed = self.bones.remove(index);
             for b in &mut self.bones {
                 if b.parent.as_deref() == Some(name) {
                     b.parent = removed.parent.clone();
+                }
+            }
+            for p in &mut self.points {
+                if p.parent.as_deref() == Some(name) {
+                    p.parent = removed.parent.clone();
                 }
             }
         }
@@ -581,6 +605,18 @@ impl Handles {
                 }
             }
         }
+        for p in &self.points {
+            if let Some(parent) = p
+                .parent
+                .as_ref()
+                .filter(|n| !index.contains_key(n.as_str()))
+            {
+                return Err(HandleError::UnknownPointParent {
+                    point: p.name.clone(),
+                    parent: parent.clone(),
+                });
+            }
+        }
         for start in 0..self.bones.len() {
             // A chain longer than the bone count must revisit a bone.
             let (mut at, mut steps) = (parent[start], 0);
@@ -656,6 +692,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "a".into(),
                 at: Point::new(1.0, 1.0),
+                parent: None,
             }],
             ..Default::default()
         };
@@ -690,6 +727,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "p".into(),
                 at: Point::new(f64::NAN, 0.0),
+                parent: None,
             }],
             ..Default::default()
         };
@@ -712,11 +750,44 @@ mod tests {
     }
 
     #[test]
+    fn a_points_parent_is_a_bone_kept_through_renames_and_deletes() {
+        let point = |parent: &str| PointHandle {
+            name: "p".into(),
+            at: Point::new(1.0, 1.0),
+            parent: Some(parent.into()),
+        };
+        let mut h = Handles {
+            bones: vec![bone("a", None), bone("b", Some("a"))],
+            points: vec![point("zz")],
+            ..Default::default()
+        };
+        assert_eq!(
+            h.validate(),
+            Err(HandleError::UnknownPointParent {
+                point: "p".into(),
+                parent: "zz".into()
+            })
+        );
+        h.points[0] = point("b");
+        assert_eq!(h.validate(), Ok(()));
+        assert_eq!(h.point_parent(0), Some(1));
+        h.rename("b", "fore");
+        assert_eq!(h.points[0].parent.as_deref(), Some("fore"));
+        // The deleted bone's point moves up to its parent, as its child bones do.
+        h.delete("fore");
+        assert_eq!(h.points[0].parent.as_deref(), Some("a"));
+        h.delete("a");
+        assert_eq!(h.points[0].parent, None);
+        assert_eq!(h.validate(), Ok(()));
+    }
+
+    #[test]
     fn bind_names_known_handles_and_expands_to_columns() {
         let mut h = Handles {
             points: vec![PointHandle {
                 name: "p".into(),
                 at: Point::new(0.0, 0.0),
+                parent: None,
             }],
             cages: vec![Cage {
                 name: "c".into(),

@@ -147,7 +147,7 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         pose.points.keys(),
         handles.points.iter().map(|p| &p.name),
     )?;
-    for point in &handles.points {
+    for (i, point) in handles.points.iter().enumerate() {
         let p = pose.points.get(&point.name).cloned().unwrap_or_default();
         if !finite(&[
             p.translate[0],
@@ -160,12 +160,23 @@ pub fn handle_transforms(handles: &Handles, pose: &Pose) -> Result<Vec<Affine>, 
         ]) {
             return Err(PoseError::NonFinite(point.name.clone()));
         }
+        // A point carried by a bone moves as it does: a default local pose is its parent's
+        // transformation exactly (as a bone's is).
+        let world_from_parent = handles.point_parent(i).map(|b| out[b]);
+        if p == PointPose::default() {
+            out.push(world_from_parent.unwrap_or_else(Affine::identity));
+            continue;
+        }
         // About the rest position: move there, turn and scale, move back, then translate.
         let at = point.at.coords;
         let linear = local_linear(p.rotate, p.scale, p.shear);
-        out.push(Affine {
+        let local = Affine {
             linear,
             translation: at - linear * at + Vec2::new(p.translate[0], p.translate[1]),
+        };
+        out.push(match world_from_parent {
+            Some(parent) => parent.then_after(&local),
+            None => local,
         });
     }
     check_names(
@@ -250,8 +261,19 @@ pub fn pose_from_transforms(handles: &Handles, transforms: &[Affine]) -> Result<
         );
     }
     let mut j = handles.bones.len();
-    for point in &handles.points {
-        let t = &transforms[j];
+    for (i, point) in handles.points.iter().enumerate() {
+        // A carried point's pose is about its parent's motion: local = parent⁻¹ · transform.
+        let carried;
+        let t = match handles.point_parent(i) {
+            Some(b) => {
+                carried = transforms[b]
+                    .inverse()
+                    .ok_or_else(|| PoseError::Singular(handles.bones[b].name.clone()))?
+                    .then_after(&transforms[j]);
+                &carried
+            }
+            None => &transforms[j],
+        };
         let (rotate, scale, shear) =
             decompose_linear(&t.linear).ok_or_else(|| PoseError::Singular(point.name.clone()))?;
         let at = point.at.coords;
@@ -342,6 +364,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "p".into(),
                 at: Point::new(5.0, 5.0),
+                parent: None,
             }],
             ..Default::default()
         }
@@ -407,6 +430,44 @@ mod tests {
         let t = handle_transforms(&handles, &pose).unwrap();
         assert!(close(t[0].apply(Point::new(0.0, 10.0)), [3.0, 20.0]));
         assert!(close(t[0].apply(Point::new(1.0, 0.0)), [4.0, 0.0]));
+    }
+
+    #[test]
+    fn a_carried_point_moves_as_its_bone_then_by_its_own_pose() {
+        let mut handles = arm();
+        handles.points[0].parent = Some("lower".into());
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "upper".into(),
+            BonePose {
+                rotate: 90.0,
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&handles, &pose).unwrap();
+        // Unposed, it is its parent's transformation, bit for bit.
+        assert_eq!(t[2], t[1]);
+        assert!(close(t[2].apply(Point::new(5.0, 5.0)), [5.0, -5.0]));
+        // Its own pose applies at rest, before the bone's motion: +x at rest is up on screen.
+        pose.points.insert(
+            "p".into(),
+            PointPose {
+                translate: [2.0, 0.0],
+                rotate: 30.0,
+                ..Default::default()
+            },
+        );
+        let t = handle_transforms(&handles, &pose).unwrap();
+        assert!(close(t[2].apply(Point::new(5.0, 5.0)), [5.0, -7.0]));
+        // Back from the transformations, about the parent: the same pose.
+        let back = pose_from_transforms(&handles, &t).unwrap();
+        let p = &back.points["p"];
+        assert!((p.translate[0] - 2.0).abs() < 1e-9 && p.translate[1].abs() < 1e-9);
+        assert!((p.rotate - 30.0).abs() < 1e-9);
+        // Loose, the same pose ignores the bones.
+        handles.points[0].parent = None;
+        let t = handle_transforms(&handles, &pose).unwrap();
+        assert!(close(t[2].apply(Point::new(5.0, 5.0)), [7.0, 5.0]));
     }
 
     #[test]

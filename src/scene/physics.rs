@@ -28,7 +28,8 @@ pub fn update_step_s() -> f64 {
     1.0 / UPDATE_HZ
 }
 
-/// A constrained bone: its index, rest frame and length, and its descendants' indices.
+/// A constrained bone: its index, rest frame and length, and the columns it carries (itself,
+/// its descendant bones and the points they carry).
 #[derive(Clone, Debug)]
 struct Constrained {
     bone: usize,
@@ -78,6 +79,14 @@ impl PhysicsRun {
                         break;
                     }
                 }
+                // And the points those bones carry (columns after the bones').
+                let points = (0..handles.points.len()).filter(|&i| {
+                    handles
+                        .point_parent(i)
+                        .is_some_and(|p| carried.contains(&p))
+                });
+                let points: Vec<usize> = points.map(|i| handles.bones.len() + i).collect();
+                carried.extend(points);
                 Some(Constrained {
                     bone,
                     rest: bone_rest_frame(b.head, b.tail),

@@ -189,6 +189,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "p".into(),
                 at: Point::new(5.0, 5.0),
+                parent: None,
             }],
             bind: Default::default(),
             ik: Vec::new(),

@@ -57,8 +57,8 @@ fn rect(x: f32, y: f32, w: f32, h: f32) -> impl Fn(&mut tiny_skia::PathBuilder) 
     }
 }
 
-/// Two skeletons, a point, a cage and a region over three layers, and animations that use
-/// every kind of timeline the export writes.
+/// Two skeletons, three points (two carried by bones), a cage and a region over three
+/// layers, and animations that use every kind of timeline the export writes.
 pub fn generated_rig(dir: &Path) -> PathBuf {
     layer(
         &dir.join("body.png"),
@@ -77,11 +77,13 @@ pub fn generated_rig(dir: &Path) -> PathBuf {
     );
     let handles = serde_json::json!({
         "bones": [
-            {"name": "arm_b", "parent": "spine_b", "head": [100, 57], "tail": [145, 57]},
+            {"name": "arm_b", "parent": "spine_b", "head": [100, 57], "tail": [145, 50]},
             {"name": "spine_b", "head": [60, 88], "tail": [60, 32]},
             {"name": "blob_b", "head": [122, 98], "tail": [138, 98]}
         ],
-        "points": [{"name": "nose", "at": [35, 40]}],
+        "points": [{"name": "nose", "at": [35, 40]},
+                   {"name": "knuckle", "at": [135, 58], "parent": "arm_b"},
+                   {"name": "tip", "at": [60, 45], "parent": "spine_b"}],
         "cages": [{"name": "belly", "polygon": [[45, 62], [78, 62], [78, 84], [45, 84]]}],
         "regions": [{"name": "patch", "polygon": [[82, 30], [94, 30], [94, 42], [82, 42]]}],
         "bind": {"blob_b": ["blob"], "arm_b": ["arm", "body"]}
@@ -105,7 +107,16 @@ pub fn generated_rig(dir: &Path) -> PathBuf {
                 "translate": [{"time": 0, "value": [0, 0], "curve": [0.2, 4, 0.3, 6, 0.2, 0, 0.3, -3]},
                               {"time": 0.6, "value": [6, -5]}],
                 "rotate": [{"time": 0, "value": 0}, {"time": 0.6, "value": 30}],
-                "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.3, 0.7]}]}},
+                "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.3, 0.7]}]},
+                // Carried by a turned bone: offsets turned into its axes, Bézier handles too.
+                "knuckle": {
+                "translate": [{"time": 0, "value": [0, 0], "curve": [0.25, 3, 0.5, 5, 0.25, -2, 0.5, -6]},
+                              {"time": 0.7, "value": [5, -7]}],
+                "rotate": [{"time": 0.1, "value": 0}, {"time": 0.8, "value": -40}]},
+                // Its channels' time handles differ: no turned Bézier says that, so it is baked.
+                "tip": {
+                "translate": [{"time": 0, "value": [0, 0], "curve": [0.1, 2, 0.6, 4, 0.4, 0, 0.5, 3]},
+                              {"time": 0.9, "value": [4, 6]}]}},
             "cages": {"belly": [
                 {"time": 0, "value": [[45, 62], [78, 62], [78, 84], [45, 84]], "curve": [0.2, 0, 0.3, 1]},
                 {"time": 0.7, "value": [[43, 60], [82, 63], [80, 88], [44, 86]]}]},

@@ -63,6 +63,7 @@ fn saving_a_never_rigged_document_runs_off_the_ui_thread() {
     h.state_mut().apply(Command::AddPoint(PointHandle {
         name: "late".into(),
         at: Point::new(40.0, 24.0),
+        parent: None,
     }));
     wait_for(&mut h, |app| !app.saving());
     assert!(h.state().doc.dirty());

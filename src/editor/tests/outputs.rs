@@ -24,6 +24,7 @@ fn exports_for_spine_from_the_file_menu_function() {
     app.apply(Command::AddPoint(PointHandle {
         name: "extra".into(),
         at: Point::new(10.0, 10.0),
+        parent: None,
     }));
     let empty = path.parent().expect("a folder").join("none");
     let message = app.export_spine(&empty);

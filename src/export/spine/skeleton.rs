@@ -9,8 +9,9 @@
 //! Layout: one root bone at Spine's origin; under it every bone forest of the rig (disjoint
 //! skeletons stay disjoint below the root), each sinew bone with its head as origin and its x axis
 //! along head → tail (sinew's bone frames already follow Spine's conventions); then one
-//! zero-length bone per point handle (at the point), per cage vertex (named `cage.k`, as its
-//! weight column) and per region (at its first polygon vertex), all children of the root.
+//! zero-length bone per point handle (at the point, with the world's axes at rest; a child of
+//! the bone that carries it, or of the root), per cage vertex (named `cage.k`, as its weight
+//! column) and per region (at its first polygon vertex), both children of the root.
 
 use super::frame::{BoneLocal, SpineFrame};
 use super::SpineError;
@@ -154,27 +155,54 @@ pub fn build_skeleton(
         }
     }
 
-    let mut point_bone = |name: String, at: Point, source: BoneSource| {
+    // A point's bone: world axes at rest, origin at the point, under the Spine bone of sinew
+    // bone `carrier` (placed above: bones come before points), or the root.
+    let mut point_bone = |name: String,
+                          at: Point,
+                          source: BoneSource,
+                          carrier: Option<usize>|
+     -> Result<(), SpineError> {
+        let parent = carrier
+            .map(|b| column_bone[b])
+            .filter(|&k| k < bones.len())
+            .unwrap_or(0);
         let p = frame.spine_from_canvas(at);
-        let setup = BoneLocal {
+        let world = BoneLocal {
             x: p[0],
             y: p[1],
+            ..Default::default()
+        }
+        .matrix();
+        let parent_world = bones[parent].setup_world;
+        let local = parent_world
+            .inverse()
+            .ok_or_else(|| SpineError::Singular(bones[parent].name.clone()))?
+            .then_after(&world);
+        // The parent frames are rotations and translations: so is the local one.
+        let setup = BoneLocal {
+            x: local.translation.x,
+            y: local.translation.y,
+            rotation_deg: local.linear[(1, 0)]
+                .atan2(local.linear[(0, 0)])
+                .to_degrees(),
             ..Default::default()
         };
         let column = column_index[name.as_str()];
         column_bone[column] = bones.len();
         bones.push(SpineBone {
             name,
-            parent: Some(0),
+            parent: Some(parent),
             length: 0.0,
-            setup_world: setup.matrix(),
+            setup_world: parent_world.then_after(&setup.matrix()),
             setup,
             source,
             column: Some(column),
         });
+        Ok(())
     };
     for (i, point) in handles.points.iter().enumerate() {
-        point_bone(point.name.clone(), point.at, BoneSource::Point(i));
+        let carrier = handles.point_parent(i);
+        point_bone(point.name.clone(), point.at, BoneSource::Point(i), carrier)?;
     }
     for (c, cage) in handles.cages.iter().enumerate() {
         for (k, at) in cage.polygon.iter().enumerate() {
@@ -182,7 +210,8 @@ pub fn build_skeleton(
                 format!("{}.{k}", cage.name),
                 *at,
                 BoneSource::CageVertex { cage: c, vertex: k },
-            );
+                None,
+            )?;
         }
     }
     for (i, region) in handles.regions.iter().enumerate() {
@@ -191,7 +220,7 @@ pub fn build_skeleton(
             .first()
             .copied()
             .unwrap_or_else(Point::origin);
-        point_bone(region.name.clone(), at, BoneSource::Region(i));
+        point_bone(region.name.clone(), at, BoneSource::Region(i), None)?;
     }
     if let Some(j) = column_bone.iter().position(|&b| b == usize::MAX) {
         // Only a bone whose parent chain never reaches a root is left out; validation
@@ -234,6 +263,7 @@ mod tests {
             points: vec![PointHandle {
                 name: "p".into(),
                 at: Point::new(5.0, 6.0),
+                parent: None,
             }],
             cages: vec![Cage {
                 name: "c".into(),

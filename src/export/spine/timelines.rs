@@ -11,7 +11,9 @@
 //!   multiply scale into a setup scale of 1); `translate` flips y, and so do the y channel's
 //!   Bézier `cy` values (a Bézier is affine-invariant in its values);
 //! - point handles: `translate` (y flipped), `rotate`, `scale` on their zero-length bone (a
-//!   point's pose turns and scales about its rest position, which is its bone's origin);
+//!   point's pose turns and scales about its rest position, which is its bone's origin); a
+//!   point carried by a bone has its `translate` turned into that bone's setup axes, Bézier
+//!   handles too (a point whose channels' time handles differ is baked instead);
 //! - cage keys: one `translate` timeline per cage-vertex bone (posed − rest, y flipped); the
 //!   cage's single 0..1 Bézier becomes per-channel absolute handles `v0 + (v1 − v0)·cy`;
 //! - part colour → slot `rgba` (Bézier `cy` are channel values, as in sinew); visibility →
@@ -27,6 +29,7 @@ use super::skeleton::Skeleton;
 use crate::anim::{Animation, Curve, Key, StepKey};
 use crate::geom::Point;
 use crate::rig::Handles;
+use nalgebra::Matrix2;
 use serde_json::{json, Map, Value};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -147,6 +150,63 @@ pub fn timeline2(keys: &[Key<[f64; 2]>], flip_y: bool) -> Value {
     )
 }
 
+/// For a point carried by a bone, the linear map from Spine's world axes to its parent bone's
+/// setup axes (in which its bone's offsets are written); `None` for a loose point.
+pub fn carrier_from_world(
+    handles: &Handles,
+    skeleton: &Skeleton,
+    point: &str,
+) -> Option<Matrix2<f64>> {
+    let i = handles.points.iter().position(|p| p.name == point)?;
+    handles.point_parent(i)?;
+    let bone = skeleton.column_bone.get(handles.bones.len() + i)?;
+    let parent = skeleton.bones.get(*bone)?.parent?;
+    skeleton.bones[parent].setup_world.linear.try_inverse()
+}
+
+/// Whether every Bézier among `keys` has the same time handles (`cx1`, `cx2`) in both
+/// channels: then a linear mix of the channels is again such a curve.
+pub fn channels_share_time_handles(keys: &[Key<[f64; 2]>]) -> bool {
+    keys.iter().all(|k| match &k.curve {
+        Curve::Bezier(h) => h.len() < 8 || (h[0] == h[4] && h[2] == h[6]),
+        _ => true,
+    })
+}
+
+/// A carried point's `translate` timeline: its canvas offsets with y flipped (Spine's world),
+/// turned into its parent's setup axes by `carrier_from_world`; each Bézier's value handles
+/// turned the same way (exact: both channels share their time handles). `None` when they do
+/// not ([`channels_share_time_handles`]): the point is then baked.
+pub fn carried_translate_timeline(
+    keys: &[Key<[f64; 2]>],
+    carrier_from_world: &Matrix2<f64>,
+) -> Option<Value> {
+    if !channels_share_time_handles(keys) {
+        return None;
+    }
+    let m = carrier_from_world;
+    let turn = |x: f64, y: f64| m * nalgebra::Vector2::new(x, -y);
+    Some(Value::Array(
+        with_start(keys)
+            .iter()
+            .map(|k| {
+                let v = turn(k.value[0], k.value[1]);
+                let curve = match &k.curve {
+                    Curve::Bezier(h) if h.len() >= 8 => {
+                        let (a, b) = (turn(h[1], h[5]), turn(h[3], h[7]));
+                        curve_json(
+                            &Curve::Bezier(vec![h[0], a.x, h[2], b.x, h[4], a.y, h[6], b.y]),
+                            &|_, y| y,
+                        )
+                    }
+                    other => curve_json(other, &|_, y| y),
+                };
+                key_object(k.time, vec![("x", num(v.x)), ("y", num(v.y))], curve)
+            })
+            .collect(),
+    ))
+}
+
 /// One cage vertex's `translate` timeline: posed − rest (y flipped); the cage's 0..1 curve in
 /// each channel's own units.
 fn cage_vertex_timeline(
@@ -231,7 +291,15 @@ pub fn native_timelines(
     }
     for (name, t) in &animation.points {
         if let Some(k) = &t.translate {
-            put(name, "translate", timeline2(k, true));
+            match carrier_from_world(handles, skeleton, name) {
+                // Baked instead when not expressible (see `plan_bake`).
+                Some(m) => {
+                    if let Some(timeline) = carried_translate_timeline(k, &m) {
+                        put(name, "translate", timeline);
+                    }
+                }
+                None => put(name, "translate", timeline2(k, true)),
+            }
         }
         if let Some(k) = &t.rotate {
             put(name, "rotate", timeline1(k));
