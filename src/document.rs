@@ -254,9 +254,10 @@ pub enum Command {
         from: String,
         to: String,
     },
-    /// Gives a bone another parent (`None`: it becomes a skeleton's root).
+    /// Gives a bone another parent (`None`: it becomes a skeleton's root), or a point handle
+    /// another bone to carry it (`None`: it becomes loose).
     Reparent {
-        bone: String,
+        handle: String,
         parent: Option<String>,
     },
     /// Deletes a handle; a deleted bone's children move up to its parent.

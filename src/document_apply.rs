@@ -79,37 +79,19 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
                     .map(|scene| Arc::new(scene.with_columns_renamed(&columns)));
             }
         }
-        Command::Reparent { bone, parent } => {
+        Command::Reparent { handle, parent } => {
+            let point = next.handles.points.iter().position(|p| p.name == handle);
             if let Some(parent) = &parent {
                 if !next.handles.bones.iter().any(|b| b.name == *parent) {
                     return Err(DocumentError::UnknownHandle(parent.clone()));
                 }
-                // Walk up from the new parent: meeting `bone` would close a loop.
-                let mut up = Some(parent.clone());
-                let mut steps = 0;
-                while let Some(name) = up {
-                    if name == bone || steps > next.handles.bones.len() {
-                        return Err(DocumentError::ReparentCycle {
-                            bone,
-                            parent: parent.clone(),
-                        });
-                    }
-                    steps += 1;
-                    up = next
-                        .handles
-                        .bones
-                        .iter()
-                        .find(|b| b.name == name)
-                        .and_then(|b| b.parent.clone());
-                }
             }
-            let b = next
-                .handles
-                .bones
-                .iter_mut()
-                .find(|b| b.name == bone)
-                .ok_or(DocumentError::UnknownHandle(bone))?;
-            b.parent = parent;
+            if let Some(i) = point {
+                // A point hangs from a bone; no bone hangs from a point, so no loop.
+                next.handles.points[i].parent = parent;
+            } else {
+                reparent_bone(&mut next.handles, handle, parent)?;
+            }
         }
         Command::Delete { name } => {
             if !next.handles.names().any(|n| n == name) {
@@ -373,4 +355,38 @@ fn rename_in_pose(pose: &mut Pose, from: &str, to: &str) {
     if let Some(v) = pose.cages.remove(from) {
         pose.cages.insert(to.to_string(), v);
     }
+}
+
+/// Hangs bone `bone` from `parent` (a known bone, or none), refusing a loop.
+fn reparent_bone(
+    handles: &mut Handles,
+    bone: String,
+    parent: Option<String>,
+) -> Result<(), DocumentError> {
+    if let Some(parent) = &parent {
+        // Walk up from the new parent: meeting `bone` would close a loop.
+        let mut up = Some(parent.clone());
+        let mut steps = 0;
+        while let Some(name) = up {
+            if name == bone || steps > handles.bones.len() {
+                return Err(DocumentError::ReparentCycle {
+                    bone,
+                    parent: parent.clone(),
+                });
+            }
+            steps += 1;
+            up = handles
+                .bones
+                .iter()
+                .find(|b| b.name == name)
+                .and_then(|b| b.parent.clone());
+        }
+    }
+    let b = handles
+        .bones
+        .iter_mut()
+        .find(|b| b.name == bone)
+        .ok_or(DocumentError::UnknownHandle(bone))?;
+    b.parent = parent;
+    Ok(())
 }

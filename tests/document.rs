@@ -77,7 +77,7 @@ fn a_failing_command_changes_nothing() {
     // A cycle, an unknown name, a duplicate name, a clash on rename.
     let bad = [
         Command::Reparent {
-            bone: "upper".into(),
+            handle: "upper".into(),
             parent: Some("lower".into()),
         },
         Command::Delete {

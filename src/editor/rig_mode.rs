@@ -23,7 +23,8 @@ pub enum Tool {
     Select,
     /// Press at the head, release at the tail. Starting on a bone's tail makes it the parent.
     Bone,
-    /// Click to place a point handle.
+    /// Click to place a point handle: carried by the selected bone (or by the selected point's
+    /// bone), loose when none is selected.
     Point,
     /// Click vertices of a cage; click the first one again (or press Enter) to close it.
     Cage,
@@ -233,16 +234,19 @@ impl EditorApp {
                 .iter()
                 .map(|b| b.name.clone())
                 .collect();
-            if let Some(bone) = self
-                .doc
-                .state()
-                .handles
+            // A bone's parent, or the bone that carries a point.
+            let handles = &self.doc.state().handles;
+            let now = handles
                 .bones
                 .iter()
                 .find(|b| b.name == name)
-            {
-                let mut parent = bone.parent.clone();
-                let before = parent.clone();
+                .map(|b| b.parent.clone())
+                .or_else(|| {
+                    let point = handles.points.iter().find(|p| p.name == name);
+                    point.map(|p| p.parent.clone())
+                });
+            if let Some(before) = now {
+                let mut parent = before.clone();
                 egui::ComboBox::from_label("Parent")
                     .selected_text(parent.clone().unwrap_or_else(|| "(none)".into()))
                     .show_ui(ui, |ui| {
@@ -253,7 +257,7 @@ impl EditorApp {
                     });
                 if parent != before {
                     self.apply(Command::Reparent {
-                        bone: name.clone(),
+                        handle: name.clone(),
                         parent,
                     });
                 }
@@ -419,10 +423,11 @@ impl EditorApp {
                     Tool::Region => self.polygon_click(rig_tools::PolygonKind::Region, c, &placed),
                     Tool::Point => {
                         let name = self.unique_name("point");
+                        let parent = self.new_point_parent();
                         if self.apply(Command::AddPoint(PointHandle {
                             name: name.clone(),
                             at: c,
-                            parent: None,
+                            parent,
                         })) {
                             self.selected = Some(name);
                         }
@@ -436,6 +441,18 @@ impl EditorApp {
                 }
             }
         }
+    }
+
+    /// The bone a new point is carried by: the selected bone, or the one carrying the
+    /// selected point (so points placed one after another share it); none otherwise.
+    fn new_point_parent(&self) -> Option<String> {
+        let handles = &self.doc.state().handles;
+        let selected = self.selected.as_deref()?;
+        if handles.bones.iter().any(|b| b.name == selected) {
+            return Some(selected.to_string());
+        }
+        let point = handles.points.iter().find(|p| p.name == selected)?;
+        point.parent.clone()
     }
 
     pub(super) fn unique_name(&self, stem: &str) -> String {

@@ -24,6 +24,7 @@ use tempfile::TempDir;
 use std::sync::Arc;
 
 mod animate;
+mod carried_points;
 mod colorize;
 mod colorize_split;
 mod deform;
@@ -473,6 +474,40 @@ fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
 fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
     wheel_into_view(h, By::new().label(label));
     click_shown(h, label);
+}
+
+/// Drags the tree row labelled `from` (pressed at its middle) and releases it on the row
+/// labelled `onto` (a handle's row, or the "no parent" row), in pointer steps. Rows are found
+/// as buttons: the weights readout beside the canvas may show the same names as text.
+fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
+    let target = |h: &Harness<'_, EditorApp>| {
+        let row = h
+            .query(button(onto))
+            .unwrap_or_else(|| h.get_by_label(onto));
+        row.rect().center()
+    };
+    wheel_into_view(h, button(from));
+    let start = press_point(&h.get(button(from)));
+    assert_shown(h, start, from);
+    let start = start.1;
+    h.drag_at(start);
+    h.step();
+    // Past egui's drag threshold, so the drop row for "no parent" shows.
+    h.hover_at(start + egui::vec2(0.0, 12.0));
+    h.step();
+    h.step();
+    // The target row is found again at every step, as an eye follows it: a drag near the
+    // tree's edge scrolls it.
+    let mut end = target(h);
+    for k in 1..=4 {
+        end = target(h);
+        assert!(end.y > 0.0, "the row {onto} is scrolled out of view");
+        h.hover_at(start + (end - start) * (k as f32 / 4.0));
+        h.step();
+    }
+    h.drop_at(end);
+    h.step();
+    h.run();
 }
 
 /// Whether the tree shows `name` selected (egui reports a selectable label as toggled).

@@ -1,9 +1,10 @@
 //! The tree view (rig, pose and animate modes' side panel): skeletons with their bones nested
-//! under their parents (and each bone's physics constraints, [`super::physics_fields`]), the
-//! points, cages and regions, and the parts (slots) front to back.
+//! under their parents (and each bone's physics constraints, [`super::physics_fields`], and
+//! the points it carries), the loose points, cages and regions, and the parts (slots) front to
+//! back.
 //!
 //! In: the document's handles and layers, clicks, F2 or a double click (rename in place),
-//! rig mode's drags of a bone onto another bone (or onto the skeletons' "no parent" row; a
+//! rig mode's drags of a bone or point onto a bone (or onto the skeletons' "no parent" row; a
 //! drag held near the tree's top or bottom edge scrolls it, so any row can be reached), the
 //! parts' eye boxes. Out: the selection (the canvas's: one and the same), `Rename` and
 //! `Reparent` commands (undoable; a loop is refused with a message), and which parts the canvas hides (a view setting, not part of the document: the
@@ -14,10 +15,10 @@ use crate::document::Command;
 use eframe::egui::{self, Key};
 use std::collections::{BTreeMap, BTreeSet};
 
-/// A bone being dragged in the tree (egui's drag-and-drop payload).
-struct DraggedBone(String);
+/// A bone or point being dragged in the tree (egui's drag-and-drop payload).
+struct DraggedHandle(String);
 
-/// While a bone is dragged, a pointer within this distance of the tree's visible top or
+/// While a handle is dragged, a pointer within this distance of the tree's visible top or
 /// bottom edge (inside or out) scrolls the tree that way, points.
 pub const AUTOSCROLL_BAND_PT: f32 = 24.0;
 /// The scrolling speed with the pointer at the edge or beyond, points per second; it falls
@@ -114,20 +115,26 @@ impl EditorApp {
                 for root in roots {
                     self.bone_subtree(ui, &handles, &root, 0);
                 }
-                // While a bone is dragged: a row to drop it on to make it a skeleton's root.
-                if egui::DragAndDrop::has_payload_of_type::<DraggedBone>(ui.ctx()) {
+                // While a handle is dragged: a row to drop it on to make it a skeleton's root
+                // (a bone) or loose (a point).
+                if egui::DragAndDrop::has_payload_of_type::<DraggedHandle>(ui.ctx()) {
                     let row = ui.add(
                         egui::Label::new("(drop here: no parent)").sense(egui::Sense::hover()),
                     );
-                    if let Some(bone) = row.dnd_release_payload::<DraggedBone>() {
-                        self.reparent_bone(&bone.0, None);
+                    if let Some(handle) = row.dnd_release_payload::<DraggedHandle>() {
+                        self.reparent(&handle.0, None);
                     }
                 }
             });
         let groups = [
             (
                 "Points",
-                handles.points.iter().map(|p| p.name.clone()).collect(),
+                handles
+                    .points
+                    .iter()
+                    .filter(|p| p.parent.is_none())
+                    .map(|p| p.name.clone())
+                    .collect(),
             ),
             (
                 "Cages",
@@ -147,7 +154,10 @@ impl EditorApp {
                 .default_open(true)
                 .show(ui, |ui| {
                     for name in names {
-                        let _ = self.handle_row(ui, &name);
+                        let row = self.handle_row(ui, &name);
+                        if title == "Points" {
+                            self.drag_source(row, &name);
+                        }
                     }
                 });
         }
@@ -171,26 +181,38 @@ impl EditorApp {
                 self.handle_row(ui, name)
             })
             .inner;
-        // Rig mode (the setup pose, where the hierarchy is edited): drag a bone's row onto
-        // another bone's row to hang it there.
-        if let (Some(row), Mode::Rig) = (row, self.mode) {
-            let row = row.interact(egui::Sense::drag());
-            row.dnd_set_drag_payload(DraggedBone(name.to_string()));
+        // Rig mode (the setup pose, where the hierarchy is edited): drag a bone's or point's
+        // row onto a bone's row to hang it there.
+        if let (Some(row), Mode::Rig) = (self.drag_source(row, name), self.mode) {
             if row
-                .dnd_hover_payload::<DraggedBone>()
+                .dnd_hover_payload::<DraggedHandle>()
                 .is_some_and(|b| b.0 != name)
             {
                 let stroke = ui.visuals().selection.stroke;
                 ui.painter()
                     .rect_stroke(row.rect, 2.0, stroke, egui::StrokeKind::Outside);
             }
-            if let Some(bone) = row.dnd_release_payload::<DraggedBone>() {
-                if bone.0 != name {
-                    self.reparent_bone(&bone.0, Some(name));
+            if let Some(handle) = row.dnd_release_payload::<DraggedHandle>() {
+                if handle.0 != name {
+                    self.reparent(&handle.0, Some(name));
                 }
             }
         }
         self.physics_rows(ui, name, depth);
+        // The points the bone carries, one level in.
+        for point in handles
+            .points
+            .iter()
+            .filter(|p| p.parent.as_deref() == Some(name))
+        {
+            let row = ui
+                .horizontal(|ui| {
+                    ui.add_space(12.0 * (depth + 1) as f32);
+                    self.handle_row(ui, &point.name)
+                })
+                .inner;
+            self.drag_source(row, &point.name);
+        }
         let children: Vec<String> = handles
             .bones
             .iter()
@@ -250,28 +272,38 @@ impl EditorApp {
         .inner
     }
 
-    /// Hangs `bone` from `parent` (none: a skeleton's root) through the document's undoable
-    /// `Reparent`; the rest geometry is in canvas px, so the bone stays where it is drawn. A
-    /// parent that would close a loop is refused with the document's message.
-    pub fn reparent_bone(&mut self, bone: &str, parent: Option<&str>) {
-        let now = self
-            .doc
-            .state()
-            .handles
-            .bones
-            .iter()
-            .find(|b| b.name == bone)
-            .map(|b| b.parent.clone());
+    /// In rig mode, makes a handle's row draggable (its payload: the handle's name); returns
+    /// the row's response with the drag sensed.
+    fn drag_source(&self, row: Option<egui::Response>, name: &str) -> Option<egui::Response> {
+        let row = row.filter(|_| self.mode == Mode::Rig)?;
+        let row = row.interact(egui::Sense::drag());
+        row.dnd_set_drag_payload(DraggedHandle(name.to_string()));
+        Some(row)
+    }
+
+    /// Hangs bone or point `handle` from bone `parent` (none: a skeleton's root, or a loose
+    /// point) through the document's undoable `Reparent`; the rest geometry is in canvas px, so
+    /// the handle stays where it is drawn. A parent that would close a loop is refused with the
+    /// document's message.
+    pub fn reparent(&mut self, handle: &str, parent: Option<&str>) {
+        let handles = &self.doc.state().handles;
+        let bone = handles.bones.iter().find(|b| b.name == handle);
+        let is_bone = bone.is_some();
+        let now = bone.map(|b| b.parent.clone()).or_else(|| {
+            let point = handles.points.iter().find(|p| p.name == handle);
+            point.map(|p| p.parent.clone())
+        });
         if now.as_ref().map(|p| p.as_deref()) == Some(parent) {
             return;
         }
         if self.apply(Command::Reparent {
-            bone: bone.to_string(),
+            handle: handle.to_string(),
             parent: parent.map(str::to_string),
         }) {
-            self.message = Some(match parent {
-                Some(p) => format!("'{bone}' now hangs from '{p}'"),
-                None => format!("'{bone}' is now a skeleton's root"),
+            self.message = Some(match (parent, is_bone) {
+                (Some(p), _) => format!("'{handle}' now hangs from '{p}'"),
+                (None, true) => format!("'{handle}' is now a skeleton's root"),
+                (None, false) => format!("'{handle}' is now a loose point"),
             });
         }
     }
@@ -455,10 +487,10 @@ impl EditorApp {
     }
 }
 
-/// Scrolls the tree (the scroll area `ui` is in) while a bone is dragged with the pointer near
+/// Scrolls the tree (the scroll area `ui` is in) while a handle is dragged with the pointer near
 /// its visible top or bottom edge: [`AUTOSCROLL_BAND_PT`], [`AUTOSCROLL_SPEED_PT_PER_S`].
 fn scroll_while_dragging(ui: &egui::Ui) {
-    if !egui::DragAndDrop::has_payload_of_type::<DraggedBone>(ui.ctx()) {
+    if !egui::DragAndDrop::has_payload_of_type::<DraggedHandle>(ui.ctx()) {
         return;
     }
     let Some(at) = ui.ctx().pointer_latest_pos() else {

@@ -135,33 +135,6 @@ fn home_fits_f_frames_the_selection_and_ctrl_0_shows_actual_size() {
     assert!(same_view(h.state().view, fitted), "{:?}", h.state().view);
 }
 
-/// Drags the tree row labelled `from` (pressed at its middle) and releases it on the row
-/// labelled `onto`, in pointer steps.
-fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
-    wheel_into_view(h, By::new().label(from));
-    let start = press_point(&h.get_by_label(from));
-    assert_shown(h, start, from);
-    let start = start.1;
-    h.drag_at(start);
-    h.step();
-    // Past egui's drag threshold, so the drop row for "no parent" shows.
-    h.hover_at(start + egui::vec2(0.0, 12.0));
-    h.step();
-    h.step();
-    // The target row is found again at every step, as an eye follows it: a drag near the
-    // tree's edge scrolls it.
-    let mut end = h.get_by_label(onto).rect().center();
-    for k in 1..=4 {
-        end = h.get_by_label(onto).rect().center();
-        assert!(end.y > 0.0, "the row {onto} is scrolled out of view");
-        h.hover_at(start + (end - start) * (k as f32 / 4.0));
-        h.step();
-    }
-    h.drop_at(end);
-    h.step();
-    h.run();
-}
-
 fn parent_of(h: &Harness<'_, EditorApp>, bone: &str) -> Option<String> {
     let handles = &h.state().doc.state().handles;
     let bone = handles.bones.iter().find(|b| b.name == bone).expect("bone");
