@@ -6,15 +6,15 @@
 //! stand-in serving `org.freedesktop.portal.FileChooser` as xdg-desktop-portal does: a
 //! request object path per call and a `Response` signal on it carrying the picked URIs (or
 //! code 1, cancelled). The editor's side is the real one: rfd's portal backend through the
-//! system's libdbus, driven by key presses and clicks on widgets found by their labels.
+//! system's libdbus, driven by key presses and clicks on widgets found by their labels. The
+//! clicks are the editor's unit tests' (`shown`, the same file): each fails where a user
+//! pointing at the widget's centre would not be on it (egui's own hit test).
 #![cfg(feature = "editor")]
-// Its six clicks are kittest's own, not yet checked as the editor's unit tests check theirs
-// (`click_shown` in src/editor/tests.rs, which this binary cannot reach): the labels clicked
-// here (Cancel, File, Import layer…, Export Spine…, Browse…) are each located after the frames
-// that show them have run.
-#![allow(clippy::disallowed_methods)]
 
 mod command;
+/// The checked clicks of the editor's unit tests, the same file.
+#[path = "../src/editor/tests/shown.rs"]
+mod shown;
 
 use egui_kittest::kittest::Queryable;
 use egui_kittest::Harness;
@@ -27,6 +27,7 @@ use std::sync::{Arc, Mutex};
 use zbus::zvariant::{OwnedObjectPath, OwnedValue, Value};
 
 use eframe::egui::{self, Key, Modifiers};
+use shown::{click_shown, press_shown};
 
 const PORTAL_NAME: &str = "org.freedesktop.portal.Desktop";
 const PORTAL_PATH: &str = "/org/freedesktop/portal/desktop";
@@ -209,8 +210,7 @@ fn dialogs_are_native_where_a_portal_answers_and_typed_where_none_does() {
     h.key_press_modifiers(Modifiers::COMMAND, Key::O);
     h.run();
     h.get_by_label("Path:");
-    h.get_by_label("Cancel").click();
-    h.run();
+    click_shown(&mut h, "Cancel");
     assert!(h.query_by_label("Path:").is_none());
     drop(h);
 
@@ -236,9 +236,8 @@ fn dialogs_are_native_where_a_portal_answers_and_typed_where_none_does() {
 
     // File → Import layer…: the portal's OpenFile picks the PNG; no typed window.
     answer(Some(&png));
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Import layer…").click();
+    click_shown(&mut h, "File");
+    press_shown(&mut h, "Import layer…");
     h.run_steps(2);
     assert!(h.query_by_label("Path:").is_none());
     wait_for(&mut h, "the import", |app| {
@@ -283,11 +282,9 @@ fn dialogs_are_native_where_a_portal_answers_and_typed_where_none_does() {
     let out = dir.join("spine-out");
     std::fs::create_dir_all(&out).expect("folder");
     answer(Some(&out));
-    h.get_by_label("File").click();
-    h.run();
-    h.get_by_label("Export Spine…").click();
-    h.run();
-    h.get_by_label("Browse…").click();
+    click_shown(&mut h, "File");
+    click_shown(&mut h, "Export Spine…");
+    press_shown(&mut h, "Browse…");
     h.run_steps(2);
     wait_for(&mut h, "the export folder", |app| !app.dialogs.open());
     assert_eq!(

@@ -346,6 +346,69 @@ fn wrong_files_are_rejected_by_the_schema_and_the_reader() {
     }
 }
 
+/// The names the batch schema allows for a colorize job's `fill`, `weights` and `split` are
+/// exactly those serde writes for the library's values (the schema is derived from the same
+/// enums), and a job naming each one validates and loads.
+#[test]
+fn the_colorize_jobs_value_names_are_the_enums_serde_names() {
+    use sinew::colorize::{ColorWeights, FillMode, RegionSplit};
+    let batch = serde_json::to_value(schema(SchemaKind::Batch)).unwrap();
+    let names_in_schema = |option: &str| -> Vec<String> {
+        let reference = batch["$defs"]["ColorizeJobOptions"]["properties"][option]["$ref"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{option}: no $ref"));
+        let values = &batch["$defs"][reference.trim_start_matches("#/$defs/")];
+        let mut names: Vec<String> = match values.get("oneOf") {
+            Some(one_of) => one_of
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v["const"].clone())
+                .collect(),
+            None => values["enum"].as_array().expect("oneOf or enum").clone(),
+        }
+        .into_iter()
+        .map(|name| name.as_str().expect("a name").to_string())
+        .collect();
+        names.sort();
+        names
+    };
+    /// The names serde writes for `values`, sorted.
+    fn serde_names<T: serde::Serialize>(values: &[T]) -> Vec<String> {
+        let mut names: Vec<String> = values
+            .iter()
+            .map(|v| {
+                serde_json::to_value(v)
+                    .unwrap()
+                    .as_str()
+                    .expect("a name")
+                    .to_string()
+            })
+            .collect();
+        names.sort();
+        names
+    }
+    let options = [
+        ("fill", serde_names(&[FillMode::Flat, FillMode::Soft])),
+        (
+            "weights",
+            serde_names(&[ColorWeights::Harmonic, ColorWeights::Bbw]),
+        ),
+        ("split", serde_names(&RegionSplit::ALL)),
+    ];
+    for (option, names) in options {
+        assert_eq!(names_in_schema(option), names, "{option}");
+        for value in names {
+            let manifest = json!({"jobs": [{"kind": "colorize", "name": "a",
+                "inputs": {"lineart": "a.png", "scribbles": "a.json"},
+                "options": {option: value}, "outputs": {"image": "b.png"}}]});
+            assert_valid(SchemaKind::Batch, &manifest, &format!("{option} {value}"));
+            load(SchemaKind::Batch, &manifest.to_string())
+                .unwrap_or_else(|e| panic!("{option} {value}: {e}"));
+        }
+    }
+}
+
 /// `sinew schema KIND` prints the library's schema; an unknown kind is one line, exit 2.
 #[cfg(feature = "cli")]
 #[test]

@@ -260,50 +260,18 @@ pub struct ColorizeInputs {
     pub scribbles: PathBuf,
 }
 
-/// The names of [`FillMode`]'s values.
-#[derive(JsonSchema)]
-#[serde(rename_all = "lowercase")]
-#[allow(dead_code)]
-enum FillModeName {
-    Flat,
-    Soft,
-}
-
-/// The names of [`ColorWeights`]' values.
-#[derive(JsonSchema)]
-#[serde(rename_all = "lowercase")]
-#[allow(dead_code)]
-enum ColorWeightsName {
-    Harmonic,
-    Bbw,
-}
-
-/// The names of [`RegionSplit`]'s values.
-#[derive(JsonSchema)]
-#[serde(rename_all = "kebab-case")]
-#[allow(dead_code)]
-enum RegionSplitName {
-    Reach,
-    Density,
-    Depth,
-    Weights,
-}
-
 /// `sinew colorize`'s flags. The defaults are [`ColorizeOptions::default`]'s.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct ColorizeJobOptions {
     /// Default flat.
-    #[schemars(with = "FillModeName")]
     pub fill: FillMode,
     /// Default harmonic.
-    #[schemars(with = "ColorWeightsName")]
     pub weights: ColorWeights,
     /// Lift scale: a full color change counts as this many px. Default 1000.
     pub scale: f64,
     /// How a region holding several colors is split (`--split`): reach, depth, density or
     /// weights. Default reach.
-    #[schemars(with = "RegionSplitName")]
     pub split: RegionSplit,
     /// With split reach: α, a pixel d px from the lines costs d^−α to cross
     /// (`--split-exponent`). Default 6.

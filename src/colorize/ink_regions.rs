@@ -23,7 +23,9 @@ use std::collections::VecDeque;
 
 /// How a region holding scribbles of several colors (no line drawn between them, or a gap
 /// too wide to close) is split among them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum RegionSplit {
     /// Scaled geodesic reach ([`super::reach_split`]): each pixel takes the color whose

@@ -299,61 +299,81 @@ impl ColorizeOptions {
     /// Refuses options out of their documented ranges ([`ColorizeError::InvalidOptions`]),
     /// as every colorization does before any work.
     pub fn check(&self) -> Result<(), ColorizeError> {
-        let options = self;
-        if !(0.0..=MAX_LIFT_SCALE_PX).contains(&options.scale) {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "the lift scale must lie in [0, {MAX_LIFT_SCALE_PX}] px, not {:e}",
-                options.scale
-            )));
-        }
-        if !(options.line_threshold > 0.0 && options.line_threshold <= 1.0) {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "line_threshold must lie in (0, 1], not {}",
-                options.line_threshold
-            )));
-        }
-        if !(options.split_depth_px.is_finite() && options.split_depth_px >= 0.5) {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "split_depth_px must be at least 0.5, not {}",
-                options.split_depth_px
-            )));
-        }
-        if !(options.split_depth_exponent.is_finite()
-            && (0.0..=MAX_SPLIT_DEPTH_EXPONENT).contains(&options.split_depth_exponent))
-        {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "split_depth_exponent must lie in [0, {MAX_SPLIT_DEPTH_EXPONENT}], not {}",
-                options.split_depth_exponent
-            )));
-        }
+        use std::ops::Bound::{Excluded, Included};
+        check_range(
+            "scale (the lift scale)",
+            self.scale,
+            0.0..=MAX_LIFT_SCALE_PX,
+            " px",
+        )?;
+        check_range(
+            "line_threshold",
+            self.line_threshold,
+            (Excluded(0.0), Included(1.0)),
+            "",
+        )?;
+        check_range("split_depth_px", self.split_depth_px, 0.5.., "")?;
+        check_range(
+            "split_depth_exponent",
+            self.split_depth_exponent,
+            0.0..=MAX_SPLIT_DEPTH_EXPONENT,
+            "",
+        )?;
         for (name, sigma_px) in [
-            ("split_blur_px", options.split_blur_px),
-            ("split_fine_blur_px", options.split_fine_blur_px),
+            ("split_blur_px", self.split_blur_px),
+            ("split_fine_blur_px", self.split_fine_blur_px),
         ] {
-            if !(sigma_px.is_finite() && (0.0..=MAX_SPLIT_BLUR_PX).contains(&sigma_px)) {
-                return Err(ColorizeError::InvalidOptions(format!(
-                    "{name} must lie in [0, {MAX_SPLIT_BLUR_PX}] px, not {sigma_px}"
-                )));
-            }
+            check_range(name, sigma_px, 0.0..=MAX_SPLIT_BLUR_PX, " px")?;
         }
-        if options.soft_radius_px > MAX_SOFT_RADIUS_PX {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "soft_radius_px must be at most {MAX_SOFT_RADIUS_PX}, not {}",
-                options.soft_radius_px
-            )));
-        }
-        if !(options.gap_closing_px.is_finite() && options.gap_closing_px >= 0.0) {
-            return Err(ColorizeError::InvalidOptions(format!(
-                "gap_closing_px must be finite and non-negative, not {}",
-                options.gap_closing_px
-            )));
-        }
-        options
-            .end_point_join
+        check_range(
+            "soft_radius_px",
+            self.soft_radius_px,
+            0.0..=f64::from(MAX_SOFT_RADIUS_PX),
+            "",
+        )?;
+        check_range("gap_closing_px", self.gap_closing_px, 0.0.., "")?;
+        self.end_point_join
             .check()
-            .map_err(ColorizeError::InvalidOptions)?;
-        Ok(())
+            .map_err(ColorizeError::InvalidOptions)
     }
+}
+
+/// Refuses the option `name` unless its `value` is finite and within `range` (`unit` is
+/// written after the range's limits; an open end is `inf`, which is refused as NaN is): the
+/// one place [`ColorizeOptions::check`]'s range messages are worded. A magnitude of 10⁶ or
+/// more, or below 10⁻³, is written as `1e300`.
+fn check_range<T>(
+    name: &str,
+    value: T,
+    range: impl std::ops::RangeBounds<f64>,
+    unit: &str,
+) -> Result<(), ColorizeError>
+where
+    T: Copy + Into<f64> + std::fmt::Display + std::fmt::LowerExp,
+{
+    use std::ops::Bound::{Excluded, Included, Unbounded};
+    let x: f64 = value.into();
+    if x.is_finite() && range.contains(&x) {
+        return Ok(());
+    }
+    let shown = if x.is_finite() && x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{value:e}")
+    } else {
+        value.to_string()
+    };
+    let low = match range.start_bound() {
+        Included(lo) => format!("[{lo}"),
+        Excluded(lo) => format!("({lo}"),
+        Unbounded => "(-inf".to_string(),
+    };
+    let high = match range.end_bound() {
+        Included(hi) => format!("{hi}]"),
+        Excluded(hi) => format!("{hi})"),
+        Unbounded => "inf)".to_string(),
+    };
+    Err(ColorizeError::InvalidOptions(format!(
+        "{name} must lie in {low}, {high}{unit}, not {shown}"
+    )))
 }
 
 /// What preparing line art reads of [`ColorizeOptions`], and nothing else: the preparation
@@ -563,5 +583,113 @@ impl PreparedLineArt {
                 scribble_pixels_on_lines: dropped,
             },
         })
+    }
+}
+
+#[cfg(test)]
+mod check_tests {
+    use super::*;
+
+    /// Sets one option of [`ColorizeOptions`] to a value.
+    type Set = fn(&mut ColorizeOptions, f64);
+
+    #[test]
+    fn each_option_out_of_its_range_is_refused_by_its_own_name() {
+        const INF: f64 = f64::INFINITY;
+        const NAN: f64 = f64::NAN;
+        assert_eq!(ColorizeOptions::default().check(), Ok(()));
+        // Each option: its name in the message, values refused, and its limits (accepted).
+        let options: [(&str, Set, &[f64], &[f64]); 8] = [
+            (
+                "scale",
+                |o, v| o.scale = v,
+                &[-1e-9, MAX_LIFT_SCALE_PX * 1.001, 1e300, NAN, INF, -INF],
+                &[0.0, MAX_LIFT_SCALE_PX],
+            ),
+            (
+                "line_threshold",
+                |o, v| o.line_threshold = v as f32,
+                &[0.0, -0.5, 1.01, NAN, INF],
+                &[1e-6, 1.0],
+            ),
+            (
+                "split_depth_px",
+                |o, v| o.split_depth_px = v,
+                &[0.49, -1.0, NAN, INF],
+                &[0.5, 1e9],
+            ),
+            (
+                "split_depth_exponent",
+                |o, v| o.split_depth_exponent = v,
+                &[-0.1, MAX_SPLIT_DEPTH_EXPONENT + 0.5, NAN, INF],
+                &[0.0, MAX_SPLIT_DEPTH_EXPONENT],
+            ),
+            (
+                "split_blur_px",
+                |o, v| o.split_blur_px = v,
+                &[-0.1, MAX_SPLIT_BLUR_PX + 0.5, NAN, INF],
+                &[0.0, MAX_SPLIT_BLUR_PX],
+            ),
+            (
+                "split_fine_blur_px",
+                |o, v| o.split_fine_blur_px = v,
+                &[-0.1, MAX_SPLIT_BLUR_PX + 0.5, NAN, INF],
+                &[0.0, MAX_SPLIT_BLUR_PX],
+            ),
+            (
+                "soft_radius_px",
+                |o, v| o.soft_radius_px = v as u32,
+                &[f64::from(MAX_SOFT_RADIUS_PX + 1), f64::from(u32::MAX)],
+                &[0.0, f64::from(MAX_SOFT_RADIUS_PX)],
+            ),
+            (
+                "gap_closing_px",
+                |o, v| o.gap_closing_px = v,
+                &[-0.1, NAN, INF],
+                &[0.0, 1e9],
+            ),
+        ];
+        for (name, set, refused, accepted) in options {
+            for &value in refused {
+                let mut o = ColorizeOptions::default();
+                set(&mut o, value);
+                let Err(ColorizeError::InvalidOptions(message)) = o.check() else {
+                    panic!("{name} = {value} was accepted");
+                };
+                assert!(message.starts_with(name), "{name} = {value}: {message}");
+                let others: Vec<_> = options.iter().map(|o| o.0).filter(|n| *n != name).collect();
+                assert!(
+                    others.iter().all(|other| !message.contains(other)),
+                    "{name} = {value}: {message}"
+                );
+            }
+            for &value in accepted {
+                let mut o = ColorizeOptions::default();
+                set(&mut o, value);
+                assert_eq!(o.check(), Ok(()), "{name} = {value}");
+            }
+        }
+        // The wording, as `sinew colorize` and `sinew batch` print it.
+        let refused = |set: &dyn Fn(&mut ColorizeOptions)| {
+            let mut o = ColorizeOptions::default();
+            set(&mut o);
+            o.check().unwrap_err().to_string()
+        };
+        assert_eq!(
+            refused(&|o| o.scale = 1e300),
+            "invalid colorize option: scale (the lift scale) must lie in [0, 100000] px, not 1e300"
+        );
+        assert_eq!(
+            refused(&|o| o.split_depth_exponent = 99.0),
+            "invalid colorize option: split_depth_exponent must lie in [0, 32], not 99"
+        );
+        assert_eq!(
+            refused(&|o| o.line_threshold = 0.0),
+            "invalid colorize option: line_threshold must lie in (0, 1], not 0"
+        );
+        assert_eq!(
+            refused(&|o| o.gap_closing_px = f64::NAN),
+            "invalid colorize option: gap_closing_px must lie in [0, inf), not NaN"
+        );
     }
 }

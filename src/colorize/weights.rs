@@ -20,7 +20,9 @@ use crate::weights::{
 use serde::{Deserialize, Serialize};
 
 /// Which energy the color weights minimize.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum ColorWeights {
     /// Harmonic weights: one Laplace solve per color over one factorization. Fast.

@@ -1,8 +1,9 @@
 //! The editor driven through egui_kittest: real frames, simulated pointer and keys, checked
 //! against the document. Widgets are clicked through [`click_shown`] and [`click_shown_by`]
 //! (or [`press_shown_by`] where frames are stepped), which fail where a user could not click
-//! them, and brought into view with the mouse wheel ([`wheel_into_view`]); clippy.toml
-//! disallows kittest's own clicks and scrolls, so an exception says so at its place.
+//! them ([`shown`], shared with the integration test `tests/editor_portal.rs`), and brought
+//! into view with the mouse wheel ([`wheel_into_view`]); clippy.toml disallows kittest's own
+//! clicks and scrolls, so an exception says so at its place.
 
 use super::rig_mode::distance;
 use crate::geom::Point;
@@ -45,6 +46,13 @@ mod tree_height;
 mod tree_points;
 mod tree_view;
 mod workflow;
+
+/// The checked clicks, shared with `tests/editor_portal.rs` (which includes the file by path).
+mod shown;
+use shown::{
+    assert_shown, click_shown, click_shown_by, press_point, press_shown, press_shown_by,
+    under_pointer,
+};
 
 /// Frames a background weight build may take before a test gives up (50 ms apart).
 const BUILD_FRAMES: usize = 1200;
@@ -280,54 +288,6 @@ fn type_into(h: &mut Harness<'_, EditorApp>, label: &str, text: &str) {
     h.run();
 }
 
-/// Where kittest's `click` presses `node`: its id and its rect's centre.
-fn press_point(node: &egui_kittest::Node<'_>) -> (egui::accesskit::NodeId, Pos2) {
-    (node.accesskit_node().locate().0, node.rect().center())
-}
-
-/// Fails unless a user pointing where kittest's `click` presses (`at`, the centre of the
-/// widget `id`'s rect) would be on that widget: the pointer is moved there and egui's own hit
-/// test of the next frame must find the widget under it. So a widget scrolled out of its
-/// area, clipped, off the screen or under a window or popup fails the test, where `click`
-/// would press whatever is drawn there instead. So does input still queued when the widget was
-/// located (a key press whose frames have not run): the place was read from a frame that input
-/// had yet to change, where a user sees the key's effect before pointing.
-fn assert_shown(
-    h: &mut Harness<'_, EditorApp>,
-    (id, at): (egui::accesskit::NodeId, Pos2),
-    what: &str,
-) {
-    let screen = h.ctx.content_rect();
-    assert!(
-        screen.contains(at),
-        "{what}: at {at:?}, off the screen {screen:?}"
-    );
-    let frame = h.ctx.cumulative_frame_nr();
-    let on_it = under_pointer(h, at, id);
-    // One frame per queued event: more than the pointer's one means input was still queued.
-    assert_eq!(
-        h.ctx.cumulative_frame_nr(),
-        frame + 1,
-        "{what}: located while input was still queued (run a key's frames before clicking)"
-    );
-    assert!(
-        on_it,
-        "{what}: not under the pointer at its centre {at:?} (scrolled away, clipped or covered)"
-    );
-}
-
-/// Moves the pointer to `at` and steps one frame: whether egui's hit test then finds the
-/// widget (or Ui) `id` under it.
-fn under_pointer(h: &mut Harness<'_, EditorApp>, at: Pos2, id: egui::accesskit::NodeId) -> bool {
-    h.hover_at(at);
-    h.step();
-    h.ctx.interaction_snapshot(|s| {
-        s.contains_pointer
-            .iter()
-            .any(|widget| widget.accesskit_id() == id)
-    })
-}
-
 /// Lines (egui's `line_scroll_speed`, 40 pt) one turn of [`wheel_into_view`]'s wheel scrolls
 /// at most; fewer when the widget is nearer its area's edge.
 const WHEEL_LINES: f32 = 3.0;
@@ -450,25 +410,6 @@ fn holding_area(h: &mut Harness<'_, EditorApp>, by: &By<'_>, what: &str) -> egui
     panic!("{what}: nothing around it is in view");
 }
 
-/// How the editor tests click a widget: the one widget `by` finds, once [`assert_shown`] says
-/// a user would be on it (kittest's own `click` presses a widget even where it is hidden). The
-/// caller runs the frames: `step` while the editor keeps repainting (playing, computing),
-/// [`click_shown_by`] otherwise.
-fn press_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
-    let what = format!("{by:?}");
-    let at = press_point(&h.get(by.clone()));
-    assert_shown(h, at, &what);
-    // The one place the editor tests call kittest's click (clippy.toml disallows it elsewhere).
-    #[allow(clippy::disallowed_methods)]
-    h.get(by).click();
-}
-
-/// [`press_shown_by`], then the frames run to rest.
-fn click_shown_by(h: &mut Harness<'_, EditorApp>, by: By<'_>) {
-    press_shown_by(h, by);
-    h.run();
-}
-
 /// Wheels the widget labelled `label` (a tree row, say) into view ([`wheel_into_view`]), then
 /// [`click_shown`]s it.
 fn click_label(h: &mut Harness<'_, EditorApp>, label: &str) {
@@ -513,16 +454,6 @@ fn drag_row(h: &mut Harness<'_, EditorApp>, from: &str, onto: &str) {
 /// Whether the tree shows `name` selected (egui reports a selectable label as toggled).
 fn tree_selected(h: &Harness<'_, EditorApp>, name: &str) -> bool {
     h.get_by_label(name).accesskit_node().toggled() == Some(egui::accesskit::Toggled::True)
-}
-
-/// [`click_shown_by`] the widget labelled `label`.
-fn click_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
-    click_shown_by(h, By::new().label(label));
-}
-
-/// [`press_shown_by`] the widget labelled `label`; the caller steps the frames.
-fn press_shown(h: &mut Harness<'_, EditorApp>, label: &str) {
-    press_shown_by(h, By::new().label(label));
 }
 
 /// The combo box labelled `label`, for [`click_shown_by`] and lookups.
