@@ -142,7 +142,8 @@ pub fn heat_color(w: f64) -> Color32 {
     )
 }
 
-/// Bones as tapered outlines from head to tail, points as rings; `selected` highlighted.
+/// Bones as tapered outlines from head to tail, points as rings (a carried point dashed to its
+/// bone); `selected` highlighted.
 pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Vec<Shape> {
     let mut shapes = Vec::new();
     let color = |name: &str| {
@@ -168,8 +169,20 @@ pub fn handles(placed: &Placed, handles: &Handles, selected: Option<&str>) -> Ve
         ));
         shapes.push(Shape::circle_stroke(h, 3.0, stroke));
     }
-    for point in &handles.points {
+    for (i, point) in handles.points.iter().enumerate() {
         let s = placed.screen_from_canvas(point.at);
+        // A carried point: a faint line to the nearest point of its bone.
+        if let Some(bone) = handles.point_parent(i).map(|b| &handles.bones[b]) {
+            let (_, t) = crate::geom::segment_distance(point.at, bone.head, bone.tail);
+            let on_bone = bone.head + (bone.tail - bone.head) * t;
+            let faint = color(&point.name).gamma_multiply(0.5);
+            shapes.extend(Shape::dashed_line(
+                &[s, placed.screen_from_canvas(on_bone)],
+                Stroke::new(1.0, faint),
+                4.0,
+                3.0,
+            ));
+        }
         shapes.push(Shape::circle_stroke(
             s,
             5.0,
