@@ -5,7 +5,8 @@
 //! time (one transform per handle column, from the one path: forward kinematics, bone IK,
 //! skinning IK). Out: the transforms at a time with the physics constraints applied: each
 //! constrained bone's world frame moved by [`PhysicsState::update`] and its descendant bones
-//! carried along (as Spine's children inherit their parent's world transform), constraints in
+//! and the points they carry taken along (as Spine's children inherit their parent's world
+//! transform), constraints in
 //! list order (list a constrained ancestor first).
 //!
 //! The skeleton is updated at [`UPDATE_HZ`] from time 0 (its clock advancing by 1/[`UPDATE_HZ`]
@@ -200,4 +201,66 @@ pub fn transforms_at(
         return Ok(run.last.clone());
     }
     Ok(run.pose(handles, posed(time_s)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Point;
+    use crate::rig::physics::PhysicsConstraint;
+    use crate::rig::pose::BonePose;
+    use crate::rig::{handle_transforms, Bone, PointHandle, Pose};
+
+    #[test]
+    fn a_point_carried_by_a_constrained_bone_moves_with_it() {
+        let handles = Handles {
+            bones: vec![Bone {
+                name: "b".into(),
+                parent: None,
+                head: Point::new(0.0, 0.0),
+                tail: Point::new(40.0, 0.0),
+            }],
+            points: vec![
+                PointHandle {
+                    name: "on".into(),
+                    at: Point::new(30.0, 5.0),
+                    parent: Some("b".into()),
+                },
+                PointHandle {
+                    name: "loose".into(),
+                    at: Point::new(30.0, 5.0),
+                    parent: None,
+                },
+            ],
+            physics: vec![
+                serde_json::from_value::<PhysicsConstraint>(serde_json::json!(
+                    {"name": "sway", "bone": "b", "x": 1, "rotate": 1}
+                ))
+                .unwrap(),
+            ],
+            ..Default::default()
+        };
+        // The bone jumps 50 px right after the first update: the simulation holds it back.
+        let mut pose = Pose::default();
+        pose.bones.insert(
+            "b".into(),
+            BonePose {
+                translate: [50.0, 0.0],
+                ..Default::default()
+            },
+        );
+        let posed = handle_transforms(&handles, &pose).unwrap();
+        let rest = handle_transforms(&handles, &Pose::default()).unwrap();
+        let mut run = PhysicsRun::new(&handles);
+        run.update(&handles, rest);
+        let mut out = Vec::new();
+        for _ in 0..3 {
+            out = run.update(&handles, posed.clone());
+        }
+        let at = Point::new(30.0, 5.0);
+        let held_back = (out[0].apply(at) - posed[0].apply(at)).norm();
+        assert!(held_back > 1.0, "the physics moved nothing: {held_back}");
+        assert_eq!(out[1], out[0], "the carried point stayed behind");
+        assert_eq!(out[2], posed[2], "the loose point moved");
+    }
 }
