@@ -495,6 +495,20 @@ fn first_points_land_on_the_extremities_and_all_lie_inside() {
             .fold(f64::INFINITY, f64::min);
         assert!(d < 20.0, "no early point near tip {tip:?} ({d:.1} px)");
     }
+    // Each is carried by its nearest bone, so a tip's point turns with the arm it ends.
+    for p in &h.points {
+        let distance = |b: &sinew::rig::Bone| sinew::geom::segment_distance(p.at, b.head, b.tail).0;
+        let carrier = h.bones.iter().find(|b| Some(&b.name) == p.parent.as_ref());
+        let carrier = carrier.unwrap_or_else(|| panic!("{} is loose", p.name));
+        let nearest = h.bones.iter().map(distance).fold(f64::INFINITY, f64::min);
+        assert_eq!(
+            distance(carrier),
+            nearest,
+            "{} rides on {}",
+            p.name,
+            carrier.name
+        );
+    }
 }
 
 #[test]

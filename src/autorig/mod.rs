@@ -12,7 +12,8 @@
 //!   through overlaps ([`layers`]); each part's bones are bound to that part (`bind`), as in
 //!   cutout animation.
 //! - `cage_vertices`: a containing cage of the union ([`cage`]); `point_count`: point handles by
-//!   geodesic farthest-point sampling ([`points`]). [`preview`] draws the result.
+//!   geodesic farthest-point sampling ([`points`]), each carried by its nearest bone.
+//!   [`preview`] draws the result.
 
 pub mod budget;
 pub mod cage;
@@ -234,7 +235,7 @@ pub fn autorig(
         .map(|(k, p)| PointHandle {
             name: format!("point_{}", k + 1),
             at: p,
-            parent: None,
+            parent: nearest_bone(&bones, p),
         })
         .collect();
     let cages = match options.cage_vertices {
@@ -258,6 +259,16 @@ pub fn autorig(
     };
     handles.validate()?;
     Ok(Proposal { handles, notes })
+}
+
+/// The bone nearest to `p` (distance to its head–tail segment; the first of equals), which
+/// carries a proposed point so that the point turns with the limb it sits on.
+fn nearest_bone(bones: &[Bone], p: Point) -> Option<String> {
+    let distance = |b: &Bone| crate::geom::segment_distance(p, b.head, b.tail).0;
+    let nearest = bones
+        .iter()
+        .min_by(|a, b| distance(a).total_cmp(&distance(b)))?;
+    Some(nearest.name.clone())
 }
 
 /// One bone along the principal axis of `shape`, through its centroid, shortened to stay
