@@ -76,6 +76,37 @@ impl Skeleton {
     }
 }
 
+/// The setup pose, local to `parent`, of a bone at `origin` (Spine world) whose x axis points
+/// at `world_rotation_deg`. Every setup frame is a rotation and a translation (unscaled,
+/// unsheared), so the local one is too: the relative rotation alone, as sinew's pose computes
+/// it.
+fn setup_under(
+    parent: &SpineBone,
+    origin: Point,
+    world_rotation_deg: f64,
+) -> Result<BoneLocal, SpineError> {
+    let world = BoneLocal {
+        x: origin[0],
+        y: origin[1],
+        rotation_deg: world_rotation_deg,
+        ..Default::default()
+    }
+    .matrix();
+    let local = parent
+        .setup_world
+        .inverse()
+        .ok_or_else(|| SpineError::Singular(parent.name.clone()))?
+        .then_after(&world);
+    Ok(BoneLocal {
+        x: local.translation.x,
+        y: local.translation.y,
+        rotation_deg: local.linear[(1, 0)]
+            .atan2(local.linear[(0, 0)])
+            .to_degrees(),
+        ..Default::default()
+    })
+}
+
 /// Builds the skeleton; fails on a handle name that collides with the root's or a cage
 /// vertex's generated name (`cage.k`).
 pub fn build_skeleton(
@@ -116,27 +147,8 @@ pub fn build_skeleton(
         let dir = rest.linear.column(0);
         let world_rotation_deg = (-dir[1]).atan2(dir[0]).to_degrees();
         let head = frame.spine_from_canvas(bone.head);
-        let world = BoneLocal {
-            x: head[0],
-            y: head[1],
-            rotation_deg: world_rotation_deg,
-            ..Default::default()
-        }
-        .matrix();
         let parent_world = bones[parent].setup_world;
-        let local = parent_world
-            .inverse()
-            .ok_or_else(|| SpineError::Singular(bones[parent].name.clone()))?
-            .then_after(&world);
-        // Unscaled, unsheared frames: the relative rotation alone, as sinew's pose computes it.
-        let setup = BoneLocal {
-            x: local.translation.x,
-            y: local.translation.y,
-            rotation_deg: local.linear[(1, 0)]
-                .atan2(local.linear[(0, 0)])
-                .to_degrees(),
-            ..Default::default()
-        };
+        let setup = setup_under(&bones[parent], head, world_rotation_deg)?;
         let index = bones.len();
         let column = column_index[bone.name.as_str()];
         column_bone[column] = index;
@@ -166,27 +178,8 @@ pub fn build_skeleton(
             .map(|b| column_bone[b])
             .filter(|&k| k < bones.len())
             .unwrap_or(0);
-        let p = frame.spine_from_canvas(at);
-        let world = BoneLocal {
-            x: p[0],
-            y: p[1],
-            ..Default::default()
-        }
-        .matrix();
         let parent_world = bones[parent].setup_world;
-        let local = parent_world
-            .inverse()
-            .ok_or_else(|| SpineError::Singular(bones[parent].name.clone()))?
-            .then_after(&world);
-        // The parent frames are rotations and translations: so is the local one.
-        let setup = BoneLocal {
-            x: local.translation.x,
-            y: local.translation.y,
-            rotation_deg: local.linear[(1, 0)]
-                .atan2(local.linear[(0, 0)])
-                .to_degrees(),
-            ..Default::default()
-        };
+        let setup = setup_under(&bones[parent], frame.spine_from_canvas(at), 0.0)?;
         let column = column_index[name.as_str()];
         column_bone[column] = bones.len();
         bones.push(SpineBone {
