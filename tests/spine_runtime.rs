@@ -599,6 +599,16 @@ fn a_rig_with_every_handle_kind_and_timeline_plays_in_spine_core() {
         &defaults,
         Compare::RuntimeMode,
     );
+    // The carried knuckle's keys are written natively (turned into its bone's axes), the tip's
+    // (its channels' Bézier time handles differ) baked at 30 fps; point shear is written.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("export/rig.json")).unwrap())
+            .unwrap();
+    let bones = &json["animations"]["move"]["bones"];
+    let keys = |bone: &str, timeline: &str| bones[bone][timeline].as_array().map_or(0, Vec::len);
+    assert_eq!(keys("knuckle", "translate"), 2, "{}", bones["knuckle"]);
+    assert!(keys("tip", "translate") > 20, "{}", bones["tip"]);
+    assert_eq!((keys("nose", "shear"), keys("knuckle", "shear")), (2, 3));
     // Everything baked: exact at the keys.
     let baked = SpineOptions {
         bake: BakeMode::All,

@@ -107,12 +107,14 @@ pub fn generated_rig(dir: &Path) -> PathBuf {
                 "translate": [{"time": 0, "value": [0, 0], "curve": [0.2, 4, 0.3, 6, 0.2, 0, 0.3, -3]},
                               {"time": 0.6, "value": [6, -5]}],
                 "rotate": [{"time": 0, "value": 0}, {"time": 0.6, "value": 30}],
-                "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.3, 0.7]}]},
+                "scale": [{"time": 0.3, "value": [1, 1]}, {"time": 0.9, "value": [1.3, 0.7]}],
+                "shear": [{"time": 0, "value": [0, 0]}, {"time": 0.7, "value": [-8, 12]}]},
                 // Carried by a turned bone: offsets turned into its axes, Bézier handles too.
                 "knuckle": {
                 "translate": [{"time": 0, "value": [0, 0], "curve": [0.25, 3, 0.5, 5, 0.25, -2, 0.5, -6]},
                               {"time": 0.7, "value": [5, -7]}],
-                "rotate": [{"time": 0.1, "value": 0}, {"time": 0.8, "value": -40}]},
+                "rotate": [{"time": 0.1, "value": 0}, {"time": 0.8, "value": -40}],
+                "shear": [{"time": 0.2, "value": [0, 0]}, {"time": 0.9, "value": [10, -6]}]},
                 // Its channels' time handles differ: no turned Bézier says that, so it is baked.
                 "tip": {
                 "translate": [{"time": 0, "value": [0, 0], "curve": [0.1, 2, 0.6, 4, 0.4, 0, 0.5, 3]},

@@ -10,9 +10,10 @@
 //!   count angles counter-clockwise on screen, both add rotate/shear to the setup value and
 //!   multiply scale into a setup scale of 1); `translate` flips y, and so do the y channel's
 //!   Bézier `cy` values (a Bézier is affine-invariant in its values);
-//! - point handles: `translate` (y flipped), `rotate`, `scale` on their zero-length bone (a
-//!   point's pose turns and scales about its rest position, which is its bone's origin); a
-//!   point carried by a bone has its `translate` turned into that bone's setup axes, Bézier
+//! - point handles: `translate` (y flipped), `rotate`, `scale`, `shear` on their zero-length
+//!   bone (a point's pose turns, scales and shears about its rest position, which is its bone's
+//!   origin); a point carried by a bone has its `translate` turned into that bone's setup axes,
+//!   Bézier
 //!   handles too (a point whose channels' time handles differ is baked instead);
 //! - cage keys: one `translate` timeline per cage-vertex bone (posed − rest, y flipped); the
 //!   cage's single 0..1 Bézier becomes per-channel absolute handles `v0 + (v1 − v0)·cy`;
@@ -306,6 +307,9 @@ pub fn native_timelines(
         }
         if let Some(k) = &t.scale {
             put(name, "scale", timeline2(k, false));
+        }
+        if let Some(k) = &t.shear {
+            put(name, "shear", timeline2(k, false));
         }
     }
     for (name, keys) in &animation.cages {
