@@ -165,7 +165,7 @@ pub struct BoneTimelines {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct PointTimelines {
-    /// px, canvas axes.
+    /// px, canvas axes (a carried point: at rest, before its bone's motion).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub translate: Option<Vec<Key<[f64; 2]>>>,
     /// Degrees, counter-clockwise on screen, about the point's rest position.

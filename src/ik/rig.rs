@@ -6,7 +6,8 @@
 //! Which handles the solver may move: a bone or point or cage the pose names is *keyed* and
 //! keeps what the pose gives it — relative to its nearest unkeyed ancestor bone if it has one
 //! (a keyed forearm under a free upper arm turns with it, and so does a keyed point it
-//! carries), absolutely otherwise. Every other
+//! carries), absolutely otherwise. An unkeyed point is free under drags whether a bone carries
+//! it or not, as an unkeyed child bone is: its freedom is what lets the shape around it bend. Every other
 //! handle is free: bones rigid (rotation and translation, [`IkOptions::bones`]), regions
 //! near-rigid,
 //! points and cage vertices as

@@ -1,4 +1,5 @@
-//! Handles and posing: bones (a forest of skeletons), loose points, cages and regions; the pose
+//! Handles and posing: bones (a forest of skeletons), points (loose or carried by a bone), cages
+//! and regions; the pose
 //! file and forward kinematics, with classic bone IK constraints ([`bone_ik`]).
 //!
 //! Imports go one way: [`handles`] ← [`frames`] (the pose model, bone frames) ← [`bone_ik`] ←
