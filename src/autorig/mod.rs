@@ -12,7 +12,8 @@
 //!   through overlaps ([`layers`]); each part's bones are bound to that part (`bind`), as in
 //!   cutout animation.
 //! - `cage_vertices`: a containing cage of the union ([`cage`]); `point_count`: point handles by
-//!   geodesic farthest-point sampling ([`points`]), each carried by its nearest bone.
+//!   geodesic farthest-point sampling ([`points`]), each carried by its nearest bone among those
+//!   that may weigh the layer under it.
 //!   [`preview`] draws the result.
 
 pub mod budget;
@@ -235,7 +236,7 @@ pub fn autorig(
         .map(|(k, p)| PointHandle {
             name: format!("point_{}", k + 1),
             at: p,
-            parent: nearest_bone(&bones, p),
+            parent: carrier(&bones, &bind, layers, options.trace.alpha_threshold, p),
         })
         .collect();
     let cages = match options.cage_vertices {
@@ -261,14 +262,49 @@ pub fn autorig(
     Ok(Proposal { handles, notes })
 }
 
-/// The bone nearest to `p` (distance to its head–tail segment; the first of equals), which
-/// carries a proposed point so that the point turns with the limb it sits on.
-fn nearest_bone(bones: &[Bone], p: Point) -> Option<String> {
-    let distance = |b: &Bone| crate::geom::segment_distance(p, b.head, b.tail).0;
-    let nearest = bones
+/// The bone that carries a proposed point at `p` (canvas px), so that the point turns with the
+/// limb it sits on: the nearest (distance to its head–tail segment; the first of equals) among
+/// the bones that may weigh a layer opaque at `p` (alpha at least `alpha_threshold`; a bone
+/// `bind` does not list weighs every layer), or among all bones when none may.
+fn carrier(
+    bones: &[Bone],
+    bind: &BTreeMap<String, Vec<String>>,
+    layers: &[LayerRef],
+    alpha_threshold: u8,
+    p: Point,
+) -> Option<String> {
+    let under: Vec<&str> = layers
         .iter()
-        .min_by(|a, b| distance(a).total_cmp(&distance(b)))?;
-    Some(nearest.name.clone())
+        .filter(|l| {
+            let (x, y) = (
+                (p.x - f64::from(l.offset_px[0])).floor(),
+                (p.y - f64::from(l.offset_px[1])).floor(),
+            );
+            let inside = x >= 0.0
+                && y >= 0.0
+                && x < f64::from(l.image.width())
+                && y < f64::from(l.image.height());
+            inside && l.image.get_pixel(x as u32, y as u32)[3] >= alpha_threshold
+        })
+        .map(|l| l.name)
+        .collect();
+    let weighs_under = |b: &&Bone| {
+        bind.get(&b.name)
+            .is_none_or(|parts| parts.iter().any(|part| under.contains(&part.as_str())))
+    };
+    let distance = |b: &&Bone| crate::geom::segment_distance(p, b.head, b.tail).0;
+    let nearest = |candidates: Vec<&Bone>| {
+        candidates
+            .into_iter()
+            .min_by(|a, b| distance(a).total_cmp(&distance(b)))
+            .map(|b| b.name.clone())
+    };
+    let allowed: Vec<&Bone> = bones.iter().filter(weighs_under).collect();
+    if allowed.is_empty() {
+        nearest(bones.iter().collect())
+    } else {
+        nearest(allowed)
+    }
 }
 
 /// One bone along the principal axis of `shape`, through its centroid, shortened to stay
@@ -327,4 +363,47 @@ fn name_bones(bones: Vec<ProtoBone>) -> Vec<Bone> {
 /// far below the distance of any axis point to the outline).
 fn round_px(p: Point) -> Point {
     p.map(|v| (v * 1000.0).round() / 1000.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_point_is_carried_by_the_nearest_bone_that_weighs_the_layer_under_it() {
+        // "body" opaque over x < 100, "arm" over x ≥ 100 (two 200 × 100 layers).
+        let layer = |opaque: std::ops::Range<u32>| {
+            RgbaImage::from_fn(200, 100, |x, _| {
+                image::Rgba([0, 0, 0, if opaque.contains(&x) { 255 } else { 0 }])
+            })
+        };
+        let (body, arm) = (layer(0..100), layer(100..200));
+        let layers = [LayerRef::whole("body", &body), LayerRef::whole("arm", &arm)];
+        let bone = |name: &str, head: [f64; 2], tail: [f64; 2]| Bone {
+            name: name.into(),
+            parent: None,
+            head: head.into(),
+            tail: tail.into(),
+        };
+        let bones = [
+            bone("spine", [10.0, 20.0], [10.0, 80.0]),
+            bone("upper_arm", [100.0, 50.0], [190.0, 50.0]),
+        ];
+        let mut bind = BTreeMap::new();
+        bind.insert("spine".to_string(), vec!["body".to_string()]);
+        bind.insert("upper_arm".to_string(), vec!["arm".to_string()]);
+        let carrier_at = |bind: &BTreeMap<String, Vec<String>>, x: f64| {
+            carrier(&bones, bind, &layers, 1, Point::new(x, 50.0))
+        };
+        // On the body, 5 px from the arm's bone and 85 px from the spine: the spine carries it.
+        assert_eq!(carrier_at(&bind, 95.0).as_deref(), Some("spine"));
+        assert_eq!(carrier_at(&bind, 105.0).as_deref(), Some("upper_arm"));
+        // Unbound bones weigh every layer: then the nearest wins.
+        assert_eq!(
+            carrier_at(&BTreeMap::new(), 95.0).as_deref(),
+            Some("upper_arm")
+        );
+        // Under no layer (beyond the canvas), the nearest of all.
+        assert_eq!(carrier_at(&bind, 250.0).as_deref(), Some("upper_arm"));
+    }
 }
