@@ -349,6 +349,26 @@ mod tests {
     }
 
     #[test]
+    fn a_carried_point_hangs_from_its_bone_with_the_worlds_axes_at_rest() {
+        let mut h = handles();
+        // "lower" points down the screen: −90° in Spine's world.
+        h.points[0].parent = Some("lower".into());
+        let frame = SpineFrame::for_canvas([100, 100]);
+        let s = build_skeleton(&h, &frame, "root").unwrap();
+        let point = &s.bones[s.column_bone[3]];
+        let lower = s.bones.iter().position(|b| b.name == "lower").unwrap();
+        assert_eq!(point.parent, Some(lower));
+        assert!(
+            (point.setup.rotation_deg - 90.0).abs() < 1e-9,
+            "{:?}",
+            point.setup
+        );
+        assert!((point.setup_world.linear - nalgebra::Matrix2::identity()).norm() < 1e-12);
+        let at = frame.spine_from_canvas(Point::new(5.0, 6.0));
+        assert!((point.setup_world.translation - at.coords).norm() < 1e-9);
+    }
+
+    #[test]
     fn a_handle_named_like_the_root_is_refused() {
         let mut h = handles();
         h.points[0].name = "root".into();
