@@ -235,17 +235,8 @@ impl EditorApp {
                 .map(|b| b.name.clone())
                 .collect();
             // A bone's parent, or the bone that carries a point.
-            let handles = &self.doc.state().handles;
-            let now = handles
-                .bones
-                .iter()
-                .find(|b| b.name == name)
-                .map(|b| b.parent.clone())
-                .or_else(|| {
-                    let point = handles.points.iter().find(|p| p.name == name);
-                    point.map(|p| p.parent.clone())
-                });
-            if let Some(before) = now {
+            let now = self.doc.state().handles.parent_of(&name);
+            if let Some(before) = now.map(|p| p.map(str::to_string)) {
                 let mut parent = before.clone();
                 egui::ComboBox::from_label("Parent")
                     .selected_text(parent.clone().unwrap_or_else(|| "(none)".into()))

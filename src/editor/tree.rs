@@ -287,13 +287,8 @@ impl EditorApp {
     /// document's message.
     pub fn reparent(&mut self, handle: &str, parent: Option<&str>) {
         let handles = &self.doc.state().handles;
-        let bone = handles.bones.iter().find(|b| b.name == handle);
-        let is_bone = bone.is_some();
-        let now = bone.map(|b| b.parent.clone()).or_else(|| {
-            let point = handles.points.iter().find(|p| p.name == handle);
-            point.map(|p| p.parent.clone())
-        });
-        if now.as_ref().map(|p| p.as_deref()) == Some(parent) {
+        let is_bone = handles.bones.iter().any(|b| b.name == handle);
+        if handles.parent_of(handle) == Some(parent) {
             return;
         }
         if self.apply(Command::Reparent {

@@ -235,6 +235,16 @@ fn check_reach<'a>(
 pub const MIN_BONE_LENGTH_PX: f64 = 1e-6;
 
 impl Handles {
+    /// The parent of bone or point `name` (a bone's parent bone, a point's carrying bone):
+    /// `Some(None)` for a root bone or a loose point, `None` when no bone or point has that name.
+    pub fn parent_of(&self, name: &str) -> Option<Option<&str>> {
+        let bone = self.bones.iter().find(|b| b.name == name);
+        bone.map(|b| b.parent.as_deref()).or_else(|| {
+            let point = self.points.iter().find(|p| p.name == name)?;
+            Some(point.parent.as_deref())
+        })
+    }
+
     /// The index in `bones` of the bone carrying point `points[i]`, if it has one (a parent
     /// named but missing, as in [`Handles::for_part`]'s subsets, counts as none).
     pub fn point_parent(&self, i: usize) -> Option<usize> {
