@@ -365,15 +365,14 @@ pub fn plan_bake(
     )?;
     // A carried point's offsets turn into its parent's axes; with different time handles per
     // channel no Bézier expresses that turn, so the point is baked.
-    for (name, t) in &animation.points {
-        let mixed = t
-            .translate
-            .as_ref()
-            .is_some_and(|k| !timelines::channels_share_time_handles(k));
-        if mixed && timelines::carrier_from_world(&doc.handles, skeleton, name).is_some() {
-            if let Some(i) = doc.handles.points.iter().position(|p| &p.name == name) {
-                baked.insert(skeleton.column_bone[doc.handles.bones.len() + i]);
-            }
+    for (i, point) in doc.handles.points.iter().enumerate() {
+        let translate = animation
+            .points
+            .get(&point.name)
+            .and_then(|t| t.translate.as_ref());
+        let mixed = translate.is_some_and(|k| !timelines::channels_share_time_handles(k));
+        if mixed && doc.handles.point_parent(i).is_some() {
+            baked.insert(skeleton.column_bone[doc.handles.bones.len() + i]);
         }
     }
     let switched_off =

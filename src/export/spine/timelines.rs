@@ -13,8 +13,7 @@
 //! - point handles: `translate` (y flipped), `rotate`, `scale`, `shear` on their zero-length
 //!   bone (a point's pose turns, scales and shears about its rest position, which is its bone's
 //!   origin); a point carried by a bone has its `translate` turned into that bone's setup axes,
-//!   Bézier
-//!   handles too (a point whose channels' time handles differ is baked instead);
+//!   Bézier handles too (a point whose channels' time handles differ is baked instead);
 //! - cage keys: one `translate` timeline per cage-vertex bone (posed − rest, y flipped); the
 //!   cage's single 0..1 Bézier becomes per-channel absolute handles `v0 + (v1 − v0)·cy`;
 //! - part colour → slot `rgba` (Bézier `cy` are channel values, as in sinew); visibility →
