@@ -36,6 +36,15 @@ PINGUS = ("pingus-data", "0.7.6-5.1", "usr/share/games/pingus/data/images/pingus
 TEEWORLDS = ("teeworlds-data", "0.7.5-2", "usr/share/games/teeworlds/data/skins/",
              "CC-BY-SA-3.0 (debian/copyright: Files: data/*, Copyright Magnus Auvinen and contributors)")
 
+# Who drew it, where the file itself does not say (SVG metadata `dc:creator` wins).
+DEFAULT_AUTHOR = {
+    "tuxpaint-stamps-default": "not stated per file (Tux Paint stamp contributors, debian/copyright)",
+    "openclipart-svg": "not stated in the file",
+    "flare-game": "Flare contributors (credits.txt: lead visual artists Clint Bellanger, Justin Nichol)",
+    "pingus-data": "Pingus contributors (debian/copyright: Ingo Ruhnke and others)",
+    "teeworlds-data": "Teeworlds contributors (debian/copyright: Magnus Auvinen and contributors)",
+}
+
 # name: (package, source kind, path under the package's data folder, options)
 CHARACTERS = {
     # Tux Paint stamps
@@ -217,6 +226,10 @@ def build(pkg_dir, name):
         source["composed"] = "body, eyes, one hand and two feet placed as the game draws a standing tee; tint " + str(opt["color"])
     else:
         raise SystemExit(kind)
+    if "author" not in source:
+        source["author"] = DEFAULT_AUTHOR[package]
+        if "ganson" in rel:
+            source["author"] = "ganson (Open Clip Art user, from the file name)"
     scale = opt.get("scale", 1)
     if scale != 1:
         image = image.resize((image.width * scale, image.height * scale), Image.NEAREST)
