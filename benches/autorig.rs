@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use image::imageops::FilterType;
-use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
+use sinew::autorig::{autorig, AutorigOptions, LayerRef, TemplateChoice};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -25,7 +25,7 @@ fn bench_autorig(c: &mut Criterion) {
     let mut group = c.benchmark_group("autorig");
     group.sample_size(10);
     let everything = AutorigOptions {
-        template: Some(Template::Humanoid),
+        template: TemplateChoice::Humanoid,
         cage_vertices: Some(16),
         point_count: 8,
         ..AutorigOptions::default()

@@ -12,7 +12,7 @@ use choices::{BakeModeArg, BlendArg, SchemaKindArg, SpinePresetArg, TemplateArg,
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use serde::Serialize;
 use sinew::anim::{self, CurveEvaluation, SampleOptions};
-use sinew::autorig::Template;
+use sinew::autorig::TemplateChoice;
 use sinew::export::spine::played::ExportPlayed;
 use sinew::export::spine::{self, BakeMode, SpineOptions, SpinePreset, SpineVersion};
 use sinew::io::outputs::check_outputs;
@@ -201,9 +201,11 @@ pub struct AutorigArgs {
     /// Also propose N point handles.
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub points: usize,
-    /// Fit a known skeleton, naming and parenting its limbs.
-    #[arg(long, value_parser = choices::parser::<TemplateArg, Template>())]
-    pub template: Option<Template>,
+    /// The skeleton to fit, naming and parenting its limbs (auto: from the layer names, else
+    /// the drawing's shape; the choice and its reason are printed).
+    #[arg(long, value_parser = choices::parser::<TemplateArg, TemplateChoice>(),
+          default_value = choices::default_name!(TemplateArg, TemplateChoice::default()))]
+    pub template: TemplateChoice,
     /// Also draw the proposed rig over the images as a PNG.
     #[arg(long)]
     pub preview: Option<PathBuf>,
@@ -531,7 +533,17 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         h.points.len(),
         h.cages.len()
     );
-    for note in &proposal.notes {
+    // The template line first and unindented: what the proposal follows, and why.
+    let (chosen, rest): (Vec<&String>, Vec<&String>) =
+        proposal.notes.iter().partition(|n| n.starts_with("template: "));
+    match chosen.first() {
+        Some(line) => println!("{line}"),
+        None => println!(
+            "template: {}",
+            sinew::autorig::template_name(proposal.template)
+        ),
+    }
+    for note in rest {
         println!("  {note}");
     }
     Ok(())

@@ -17,7 +17,7 @@ use command::{scratch, sinew};
 use image::RgbaImage;
 use shapes::{blob, capsules, letter_p, quadruped, star, stick_figure, stick_tips, to_rgba};
 use sinew::autorig::shape::Shape;
-use sinew::autorig::{autorig, AutorigOptions, LayerRef, Template};
+use sinew::autorig::{autorig, AutorigOptions, LayerRef, TemplateChoice};
 use sinew::geom::segments_touch;
 use sinew::geom::{point_in_ring, Point};
 use sinew::rig::Handles;
@@ -48,15 +48,20 @@ fn propose(images: &[(&str, &RgbaImage)], options: &AutorigOptions) -> Handles {
     autorig(&layers, &[], options).expect("autorig").handles
 }
 
+/// Bones of the medial axis (no template).
 fn one(image: &RgbaImage) -> Handles {
-    propose(&[("shape", image)], &AutorigOptions::default())
+    let options = AutorigOptions {
+        template: TemplateChoice::None,
+        ..AutorigOptions::default()
+    };
+    propose(&[("shape", image)], &options)
 }
 
 /// With `SINEW_AUTORIG_DUMP=DIR`, writes the proposal drawn over `image` to DIR/`name`.png
 /// (to look at a failing case).
 fn dump(name: &str, image: &RgbaImage, handles: &Handles) {
     if let Some(dir) = std::env::var_os("SINEW_AUTORIG_DUMP") {
-        let picture = sinew::autorig::draw_preview(&[image], handles).unwrap();
+        let picture = sinew::autorig::draw_preview(&[LayerRef::whole("sprite", image)], handles).unwrap();
         sinew::io::save_png(&Path::new(&dir).join(format!("{name}.png")), &picture).unwrap();
     }
 }
@@ -201,7 +206,7 @@ fn character_flat() -> RgbaImage {
 
 fn humanoid(image: &RgbaImage) -> Handles {
     let options = AutorigOptions {
-        template: Some(Template::Humanoid),
+        template: TemplateChoice::Humanoid,
         ..AutorigOptions::default()
     };
     propose(&[("flat", image)], &options)
@@ -262,7 +267,7 @@ fn humanoid_template_names_and_parents_the_characters_limbs() {
 fn quadruped_template_finds_head_tail_and_four_legs() {
     let image = quadruped();
     let options = AutorigOptions {
-        template: Some(Template::Quadruped),
+        template: TemplateChoice::Quadruped,
         ..AutorigOptions::default()
     };
     dump("dog", &image, &one(&image));
@@ -515,7 +520,7 @@ fn first_points_land_on_the_extremities_and_all_lie_inside() {
 fn proposals_are_deterministic() {
     let image = character_flat();
     let options = AutorigOptions {
-        template: Some(Template::Humanoid),
+        template: TemplateChoice::Humanoid,
         cage_vertices: Some(16),
         point_count: 5,
         ..AutorigOptions::default()
@@ -728,13 +733,13 @@ fn autorig_bad_input_is_one_line_and_exit_2() {
 fn proposed_rig_over_the_character_matches_golden() {
     let image = character_flat();
     let options = AutorigOptions {
-        template: Some(Template::Humanoid),
+        template: TemplateChoice::Humanoid,
         cage_vertices: Some(16),
         point_count: 6,
         ..AutorigOptions::default()
     };
     let h = propose(&[("flat", &image)], &options);
-    let actual = sinew::autorig::draw_preview(&[&image], &h).unwrap();
+    let actual = sinew::autorig::draw_preview(&[LayerRef::whole("flat", &image)], &h).unwrap();
     common::golden::check(
         "autorig_character",
         &actual,
@@ -750,7 +755,7 @@ fn proposed_rig_over_the_character_matches_golden() {
 struct EvalCharacter {
     image: RgbaImage,
     budget: [usize; 2],
-    template: Option<Template>,
+    template: TemplateChoice,
     joints: Vec<(String, Point)>,
 }
 
@@ -760,9 +765,9 @@ fn eval_character(name: &str) -> EvalCharacter {
         serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap())
             .unwrap();
     let template = match meta["kind"].as_str().unwrap() {
-        "humanoid" => Some(Template::Humanoid),
-        "quadruped" => Some(Template::Quadruped),
-        _ => None,
+        "humanoid" => TemplateChoice::Humanoid,
+        "quadruped" => TemplateChoice::Quadruped,
+        _ => TemplateChoice::None,
     };
     let budget = [0, 1].map(|k| meta["budget"][k].as_u64().unwrap() as usize);
     let joints = meta["joints"]
@@ -875,7 +880,7 @@ fn proposed_rigs_over_two_evaluation_characters_match_golden() {
     ] {
         let c = eval_character(name);
         let h = propose_for(&c);
-        let actual = sinew::autorig::draw_preview(&[&c.image], &h).unwrap();
+        let actual = sinew::autorig::draw_preview(&[LayerRef::whole("sprite", &c.image)], &h).unwrap();
         common::golden::check(
             golden,
             &actual,

@@ -18,10 +18,13 @@
 //! bone runs upward from its lower end, as a hip does. Where the artist marked a group's pivot
 //! (a pivot layer, [`Pivot`]), the bone of the group's first part starts at the pivot instead.
 
+use super::attach::{continues, part_tree, Overlaps, PartTree};
+use super::labels::{End, Label, Part as LabelPart};
 use super::medial::{medial_axis, MedialError, MedialOptions};
 use super::shape::Shape;
 use super::skeleton::{BoneBuilder, NodeTree, ProtoBone, SkeletonOptions};
-use crate::geom::{Point, Vec2};
+use super::Template;
+use crate::geom::{point_segment_distance, Point, Vec2};
 use crate::io::layered::Pivot;
 
 /// One part's principal axis: centroid, unit direction, extent along it (px from the centroid).
@@ -107,10 +110,11 @@ const END_MARGIN_PX: f64 = 0.5;
 /// otherwise the part is too curved for one and gets its medial-axis bones.
 const STRAIGHT_SPAN_FRACTION: f64 = 0.8;
 
-/// A part with its overlap relations.
+/// A part: its name (the layer's path), traced shape and label.
 pub struct Part<'a> {
     pub name: &'a str,
     pub shape: &'a Shape,
+    pub label: Label,
 }
 
 /// Whether the part named by its path (`arm_l/hand`) lies in the group `group` (a path; the
@@ -133,138 +137,276 @@ fn pivot_of(part: &str, parent: Option<&str>, pivots: &[Pivot]) -> Option<Point>
         .map(|p| p.at_px)
 }
 
-/// The layered skeleton: bones (parents first) and, per bone, the index of its part. A part
-/// with a pivot ([`pivot_of`]) starts its bone there (its joint with its parent is the pivot).
+/// A layered skeleton: bones (parents first) and, per bone, the index of its part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayeredSkeleton {
+    pub bones: Vec<ProtoBone>,
+    pub bone_part: Vec<usize>,
+}
+
+/// The layered skeleton of `parts` ([`super::attach::part_tree`] for the hierarchy). Each part
+/// gets its bones: a straight bone from its joint through its centroid to its far side, split
+/// in two for a whole limb (upper and lower) and for a torso under a template (hip and chest),
+/// or the bones of its own medial axis when the part is too curved for a straight bone (a
+/// tail). The root part's bone starts at the hips: the end of its axis nearer the legs and
+/// tail (or its lower end). A part with a pivot ([`pivot_of`]) starts its bone there. A child
+/// hangs from the nearest bone of its parent part, and where it continues its parent's limb
+/// ([`super::attach::continues`]) the parent's bone ends at their joint. Bones are named by
+/// the template ([`Label::bone_names`]) or after their layer.
 pub fn layered_skeleton(
     parts: &[Part],
     pivots: &[Pivot],
+    template: Option<Template>,
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
-) -> Result<(Vec<ProtoBone>, Vec<usize>), MedialError> {
-    let n = parts.len();
-    let axes: Vec<Option<PrincipalAxis>> = parts.iter().map(|p| principal_axis(p.shape)).collect();
-    // Overlap area and centroid per pair.
-    let mut overlap = vec![vec![(0.0f64, Vec2::zeros()); n]; n];
-    let boxes: Vec<[usize; 4]> = parts.iter().map(|p| p.shape.cell_box()).collect();
-    for i in 0..n {
-        for j in (i + 1)..n {
-            let (a, b) = (&parts[i].shape.inside, &parts[j].shape.inside);
-            let w = parts[i].shape.width as usize;
-            // Only where both boxes meet, row by row (the order of the sums over the whole
-            // canvas).
-            let [x0, y0] = [0, 1].map(|k| boxes[i][k].max(boxes[j][k]));
-            let [x1, y1] = [2, 3].map(|k| boxes[i][k].min(boxes[j][k]));
-            let (mut count, mut sum) = (0.0, Vec2::zeros());
-            for y in y0..y1.max(y0) {
-                for x in x0..x1.max(x0) {
-                    let k = y * w + x;
-                    if a[k] && b[k] {
-                        count += 1.0;
-                        sum += Vec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                    }
-                }
-            }
-            let c = if count > 0.0 { sum / count } else { sum };
-            overlap[i][j] = (count, c);
-            overlap[j][i] = (count, c);
-        }
-    }
-    // Prim's maximum spanning forest, each tree grown from its largest part.
-    let mut parent: Vec<Option<usize>> = vec![None; n];
-    let mut order = Vec::new();
-    let mut joined = vec![false; n];
-    while order.len() < n {
-        let root = (0..n)
-            .filter(|&i| !joined[i])
-            .max_by(|&a, &b| {
-                parts[a]
-                    .shape
-                    .area_px2
-                    .total_cmp(&parts[b].shape.area_px2)
-                    .then(b.cmp(&a))
-            })
-            .unwrap_or(0);
-        joined[root] = true;
-        order.push(root);
-        loop {
-            let best = order
-                .iter()
-                .flat_map(|&i| (0..n).filter(|&j| !joined[j]).map(move |j| (i, j)))
-                .filter(|&(i, j)| overlap[i][j].0 > 0.0)
-                .max_by(|a, b| {
-                    overlap[a.0][a.1]
-                        .0
-                        .total_cmp(&overlap[b.0][b.1].0)
-                        .then(b.1.cmp(&a.1))
-                });
-            let Some((i, j)) = best else { break };
-            joined[j] = true;
-            parent[j] = Some(i);
-            order.push(j);
-        }
-    }
+) -> Result<LayeredSkeleton, MedialError> {
+    let shapes: Vec<&Shape> = parts.iter().map(|p| p.shape).collect();
+    let labels: Vec<Label> = parts.iter().map(|p| p.label).collect();
+    let overlaps = Overlaps::new(&shapes);
+    let tree = part_tree(&shapes, &labels, &overlaps);
     let mut bones: Vec<ProtoBone> = Vec::new();
     let mut bone_part = Vec::new();
-    // The last bone of each part (what its children hang from).
-    let mut part_bone: Vec<Option<usize>> = vec![None; n];
-    for &i in &order {
-        let Some(axis) = axes[i] else { continue };
-        let parent_bone = parent[i].and_then(|p| part_bone[p]);
-        let pivot = pivot_of(parts[i].name, parent[i].map(|p| parts[p].name), pivots);
-        let joint = pivot.or(parent[i].map(|p| Point::from(overlap[i][p].1)));
-        // The axis line clipped to the part around the centroid: a straight bone needs it to
-        // span most of the part's extent.
-        let shape = parts[i].shape;
-        let [t0, t1] = axis.extent;
-        let span = inside_reach(shape, &axis, 0.0, t0)
-            .zip(inside_reach(shape, &axis, 0.0, t1))
-            .filter(|&(lo, hi)| hi - lo >= STRAIGHT_SPAN_FRACTION * (t1 - t0))
-            .filter(|&(lo, hi)| hi - lo >= skeleton.min_bone_px);
-        // Head: the joint's projection (children) or the lower end (roots); tail: the far end.
-        let straight = span.map(|(lo, hi)| {
-            let t_head = match joint {
-                Some(j) => axis.project(j).clamp(lo, hi),
-                None if axis.at(lo).y >= axis.at(hi).y => lo,
-                None => hi,
-            };
-            let t_tail = if t_head - lo > hi - t_head { lo } else { hi };
-            (t_head, t_tail)
-        });
+    let mut names = UniqueNames::default();
+    // Per part, its bones' range in `bones`.
+    let mut part_bones: Vec<std::ops::Range<usize>> = vec![0..0; parts.len()];
+    for &i in &tree.order {
+        let part = &parts[i];
+        let joint = tree.joints[i];
+        let parent_name = joint.map(|j| parts[j.parent].name);
+        let pivot = pivot_of(part.name, parent_name, pivots);
+        let split = split_names(part, template);
+        let grown = match (joint, pivot) {
+            (None, _) => {
+                let hips = hip_hint(i, parts, &tree);
+                root_bones(part.shape, pivot, hips, split.len(), medial, skeleton)?
+            }
+            (Some(j), _) => child_bones(part.shape, pivot.unwrap_or(j.at_px), split.len(), medial, skeleton)?,
+        };
         let first = bones.len();
-        match straight {
-            Some((t_head, t_tail)) => bones.push(ProtoBone {
-                // A marked pivot is the bone's origin itself, not its projection on the axis.
-                head: pivot.unwrap_or(axis.at(t_head)),
-                tail: axis.at(t_tail),
-                parent: parent_bone,
-                name: None,
-            }),
-            None => {
-                let anchor = joint.unwrap_or(axis.centroid);
-                let mut grown = medial_bones(shape, anchor, medial, skeleton)?;
-                for b in &mut grown {
-                    b.parent = match b.parent {
-                        Some(p) => Some(p + first),
-                        None => parent_bone,
-                    };
+        let parent_bone = joint.and_then(|j| nearest_bone(&bones, part_bones[j.parent].clone(), j.at_px));
+        for (k, mut b) in grown.into_iter().enumerate() {
+            b.parent = match b.parent {
+                Some(p) => Some(p + first),
+                None => parent_bone,
+            };
+            let base = split.get(k).or(split.last()).cloned().unwrap_or_default();
+            let name = if k < split.len() { base } else { format!("{base}_{}", k + 1) };
+            b.name = Some(names.take(&name));
+            bones.push(b);
+            bone_part.push(i);
+        }
+        part_bones[i] = first..bones.len();
+        // A limb continued: the parent's bone ends where this part's first bone starts.
+        if let (Some(j), Some(pb)) = (joint, parent_bone) {
+            if first < bones.len() && ends_at_joint(&parts[j.parent], part, &tree, j.parent) {
+                let seam = bones[first].head;
+                let parent_shape = parts[j.parent].shape;
+                let b = &bones[pb];
+                let along = (seam - b.head).dot(&(b.tail - b.head)) / b.length_px().powi(2).max(1e-12);
+                if along > 0.3
+                    && (seam - b.head).norm() >= skeleton.min_bone_px
+                    && parent_shape.segment_inside(b.head, seam)
+                {
+                    bones[pb].tail = seam;
                 }
-                bones.extend(grown);
             }
         }
         if bones.len() > first {
-            part_bone[i] = Some(first);
-        }
-        for (k, bone) in bones.iter_mut().enumerate().skip(first) {
-            let name = if k == first {
-                parts[i].name.to_string()
-            } else {
-                format!("{}_{}", parts[i].name, k - first + 1)
-            };
-            bone.name = Some(name);
-            bone_part.push(i);
+            // Children of this part's bones placed before (none: parents come first).
         }
     }
-    Ok((bones, bone_part))
+    Ok(LayeredSkeleton { bones, bone_part })
+}
+
+/// Whether `child`'s joint ends its parent part's bone: the labels say the child continues
+/// the parent's limb, or (unlabelled) the child is the parent's only child part.
+fn ends_at_joint(parent: &Part, child: &Part, tree: &PartTree, parent_index: usize) -> bool {
+    if continues(&parent.label, &child.label) {
+        return true;
+    }
+    let unlabelled = !parent.label.is_known() && !child.label.is_known();
+    let children = tree
+        .joints
+        .iter()
+        .filter(|j| j.is_some_and(|j| j.parent == parent_index))
+        .count();
+    unlabelled && children == 1
+}
+
+/// The names of a part's bones in chain order: the template's ([`Label::bone_names`]; a
+/// torso under a template is `hip` then `chest`), else the layer's own name (its last path
+/// segment).
+fn split_names(part: &Part, template: Option<Template>) -> Vec<String> {
+    if template.is_some() && part.label.part == LabelPart::Torso {
+        return vec!["hip".into(), "chest".into()];
+    }
+    template
+        .and_then(|_| part.label.bone_names(template))
+        .unwrap_or_else(|| vec![layer_bone_name(part.name)])
+}
+
+/// A bone name from a layer's path: its last segment, trimmed.
+fn layer_bone_name(path: &str) -> String {
+    let last = path.rsplit('/').next().unwrap_or(path).trim();
+    if last.is_empty() {
+        "part".into()
+    } else {
+        last.to_string()
+    }
+}
+
+/// Bone names made unique by a numeric suffix (`arm`, `arm_2`).
+#[derive(Default)]
+struct UniqueNames(std::collections::HashSet<String>);
+
+impl UniqueNames {
+    fn take(&mut self, name: &str) -> String {
+        let mut candidate = name.to_string();
+        let mut k = 1;
+        while !self.0.insert(candidate.clone()) {
+            k += 1;
+            candidate = format!("{name}_{k}");
+        }
+        candidate
+    }
+}
+
+/// The bone among `range` nearest to `p` (distance to its segment; the first of equals).
+fn nearest_bone(bones: &[ProtoBone], range: std::ops::Range<usize>, p: Point) -> Option<usize> {
+    range.min_by(|&a, &b| {
+        let d = |k: usize| point_segment_distance(p, bones[k].head, bones[k].tail);
+        d(a).total_cmp(&d(b)).then(a.cmp(&b))
+    })
+}
+
+/// Where the root part's bone should start: the mean joint of its children that hang at the
+/// hips (legs, a tail), if any.
+fn hip_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
+    let at_hips: Vec<Point> = tree
+        .joints
+        .iter()
+        .enumerate()
+        .filter_map(|(c, j)| j.filter(|j| j.parent == root).map(|j| (c, j.at_px)))
+        .filter(|(c, _)| {
+            matches!(parts[*c].label.part, LabelPart::Leg(_) | LabelPart::Tail)
+                && parts[*c].label.end != Some(End::Front)
+        })
+        .map(|(_, p)| p)
+        .collect();
+    (!at_hips.is_empty()).then(|| {
+        Point::from(at_hips.iter().fold(Vec2::zeros(), |s, p| s + p.coords) / at_hips.len() as f64)
+    })
+}
+
+/// The root part's bones: along its principal axis from the end nearer `hips` (else the lower
+/// end; a `pivot` is the head itself) to the other, split into `count` equal bones; or its
+/// medial-axis bones when the axis leaves the part.
+fn root_bones(
+    shape: &Shape,
+    pivot: Option<Point>,
+    hips: Option<Point>,
+    count: usize,
+    medial: &MedialOptions,
+    skeleton: &SkeletonOptions,
+) -> Result<Vec<ProtoBone>, MedialError> {
+    let Some(axis) = principal_axis(shape) else {
+        return Ok(Vec::new());
+    };
+    let [t0, t1] = axis.extent;
+    let span = inside_reach(shape, &axis, 0.0, t0)
+        .zip(inside_reach(shape, &axis, 0.0, t1))
+        .filter(|&(lo, hi)| hi - lo >= STRAIGHT_SPAN_FRACTION * (t1 - t0))
+        .filter(|&(lo, hi)| hi - lo >= skeleton.min_bone_px);
+    match span {
+        Some((lo, hi)) => {
+            let lo_first = match hips.or(pivot) {
+                Some(h) => (axis.at(lo) - h).norm() <= (axis.at(hi) - h).norm(),
+                None => axis.at(lo).y >= axis.at(hi).y,
+            };
+            let (a, b) = if lo_first { (axis.at(lo), axis.at(hi)) } else { (axis.at(hi), axis.at(lo)) };
+            Ok(chain(pivot.unwrap_or(a), b, count, shape, skeleton))
+        }
+        None => medial_bones(shape, hips.or(pivot).unwrap_or(axis.centroid), medial, skeleton),
+    }
+}
+
+/// A child part's bones from its joint `joint` (canvas px): a straight bone from the joint
+/// through the part's centroid to its far side, split into `count`; or the part's medial-axis
+/// bones rooted nearest the joint when that line leaves the part early (a curved part).
+fn child_bones(
+    shape: &Shape,
+    joint: Point,
+    count: usize,
+    medial: &MedialOptions,
+    skeleton: &SkeletonOptions,
+) -> Result<Vec<ProtoBone>, MedialError> {
+    let Some(axis) = principal_axis(shape) else {
+        return Ok(Vec::new());
+    };
+    // Start inside the part: at the joint, or at the inside pixel nearest to it.
+    let start = if shape.contains(joint) {
+        joint
+    } else {
+        shape
+            .inside_centers()
+            .min_by(|a, b| (a - joint).norm().total_cmp(&(b - joint).norm()))
+            .unwrap_or(axis.centroid)
+    };
+    let to_centroid = axis.centroid - start;
+    let extent = axis.extent[1] - axis.extent[0];
+    // The direction: through the centroid, or along the axis away from the start when the
+    // start lies near the centroid (a part overlapping its parent mostly).
+    let direction = if to_centroid.norm() > 0.15 * extent {
+        to_centroid / to_centroid.norm()
+    } else if axis.project(start) <= 0.0 {
+        axis.direction
+    } else {
+        -axis.direction
+    };
+    let line = PrincipalAxis {
+        centroid: start,
+        direction,
+        extent: [0.0, 0.0],
+    };
+    let far = shape
+        .inside_centers()
+        .map(|p| line.project(p))
+        .fold(0.0f64, f64::max);
+    let reach = inside_reach(shape, &line, 0.0, far);
+    match reach {
+        Some(t) if t >= STRAIGHT_SPAN_FRACTION * far && t >= skeleton.min_bone_px.min(far) && t > 0.0 => {
+            Ok(chain(start, line.at(t), count, shape, skeleton))
+        }
+        _ => {
+            let grown = medial_bones(shape, start, medial, skeleton)?;
+            if grown.is_empty() && far > 0.0 {
+                // Too small for an axis: one bone as far as it stays inside.
+                let t = reach.unwrap_or(0.0).max(far.min(1.0));
+                return Ok(vec![ProtoBone {
+                    head: start,
+                    tail: line.at(t),
+                    parent: None,
+                    name: None,
+                }]);
+            }
+            Ok(grown)
+        }
+    }
+}
+
+/// `count` bones in a chain from `a` to `b` (equal lengths; one bone when shorter pieces
+/// would fall under the minimum bone length).
+fn chain(a: Point, b: Point, count: usize, _shape: &Shape, skeleton: &SkeletonOptions) -> Vec<ProtoBone> {
+    let length = (b - a).norm();
+    let count = if count > 1 && length / count as f64 >= skeleton.min_bone_px { count } else { 1 };
+    (0..count)
+        .map(|k| ProtoBone {
+            head: a + (b - a) * (k as f64 / count as f64),
+            tail: a + (b - a) * ((k + 1) as f64 / count as f64),
+            parent: k.checked_sub(1),
+            name: None,
+        })
+        .collect()
 }
 
 /// The medial-axis bones of one part, rooted at the axis node nearest to `anchor`; parents

@@ -16,8 +16,11 @@
 //!   that may weigh the layer under it.
 //!   [`preview`] draws the result.
 
+pub mod attach;
 pub mod budget;
 pub mod cage;
+pub mod choose;
+pub mod labels;
 pub mod layers;
 pub mod medial;
 pub mod points;
@@ -31,7 +34,7 @@ pub use medial::{MedialError, MedialOptions};
 pub use points::PointOptions;
 pub use preview::draw_preview;
 pub use skeleton::{ProtoBone, SkeletonOptions};
-pub use template::Template;
+pub use template::{Template, TemplateChoice};
 
 use crate::geom::Point;
 use crate::rig::{Bone, Cage, HandleError, Handles, PointHandle};
@@ -51,8 +54,9 @@ pub struct AutorigOptions {
     pub medial: MedialOptions,
     /// Bone splitting and the bone budget (`max_bones`).
     pub skeleton: SkeletonOptions,
-    /// Fit this topology to the union silhouette. Default: none.
-    pub template: Option<Template>,
+    /// The template: one named, none, or (default) the one the layer names or the drawing
+    /// suggest.
+    pub template: TemplateChoice,
     /// Propose a cage of at most this many vertices. Default: none.
     pub cage_vertices: Option<usize>,
     pub cage: CageOptions,
@@ -88,6 +92,8 @@ impl<'a> LayerRef<'a> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Proposal {
     pub handles: Handles,
+    /// The template the proposal follows (`None`: none).
+    pub template: Option<Template>,
     /// Remarks for the person (a part with nothing to trace, a fallback taken).
     pub notes: Vec<String>,
 }
@@ -126,110 +132,22 @@ pub fn autorig(
     if let Some(l) = layers.iter().find(|l| l.canvas_px != first.canvas_px) {
         return Err(AutorigError::SizeMismatch(l.name.to_string()));
     }
-    let so = &options.skeleton;
-    let positive = so.bend_ratio.is_finite() && so.bend_ratio > 0.0;
-    let fraction_ok = |f: f64| f.is_finite() && (0.0..=1.0).contains(&f);
-    if !(positive && so.min_bone_px.is_finite() && so.min_bone_px >= 0.0) {
-        return Err(AutorigError::InvalidOptions(
-            "bend_ratio must be positive and min_bone_px at least 0".into(),
-        ));
-    }
-    if !(fraction_ok(so.min_bone_fraction) && fraction_ok(so.prop_branch_fraction)) {
-        return Err(AutorigError::InvalidOptions(
-            "min_bone_fraction and prop_branch_fraction must lie in [0, 1]".into(),
-        ));
-    }
-    if so.prop_max_bones == 0 {
-        return Err(AutorigError::InvalidOptions(
-            "prop_max_bones must be at least 1".into(),
-        ));
-    }
-    if so.max_bones == Some(0) {
-        return Err(AutorigError::InvalidOptions(
-            "the bone budget must be at least 1".into(),
-        ));
-    }
+    check_options(&options.skeleton)?;
     let union = shape::union_alpha(layers);
     let silhouette = Shape::trace(&union, &options.trace)?
         .ok_or(AutorigError::NoShape(options.trace.min_area_px2))?;
     let mut notes = Vec::new();
-    let mut bind: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    let min_bone_px = budget::min_bone_length_px(so, &silhouette);
+    let min_bone_px = budget::min_bone_length_px(&options.skeleton, &silhouette);
     let so = &SkeletonOptions {
         min_bone_px,
-        ..so.clone()
+        ..options.skeleton.clone()
     };
-
-    let mut bones = if layers.len() == 1 || options.template.is_some() {
-        let medial_options = match options.template {
-            // Limbs leaving a round torso meet within its radius: merged, the arms' and the
-            // legs' junctions would be one, and the template could not tell chest from pelvis.
-            Some(_) => MedialOptions {
-                junction_merge_ratio: 0.0,
-                ..options.medial.clone()
-            },
-            None => options.medial.clone(),
-        };
-        let axis = medial::medial_axis(&silhouette, &medial_options)?;
-        match options.template {
-            Some(t) => match template::fit_template(&axis, &silhouette, t, so) {
-                Some(bones) => bones,
-                None => {
-                    notes.push(format!(
-                        "the drawing does not match the {t:?} template (no assignment of its \
-                         limbs to the shape's extremities fits): bones from the medial axis"
-                    ));
-                    skeleton::medial_skeleton(&axis, &silhouette, so)
-                }
-            },
-            None => skeleton::medial_skeleton(&axis, &silhouette, so),
-        }
+    let (bones, bind, template) = if layers.len() > 1 {
+        layered_bones(layers, pivots, &silhouette, options, so, &mut notes)?
     } else {
-        let mut shapes = Vec::new();
-        for layer in layers {
-            match Shape::trace_placed(layer, &options.trace) {
-                Ok(Some(s)) => shapes.push((layer.name, s)),
-                Ok(None) | Err(TraceError::NoOpaquePixels { .. }) => notes.push(format!(
-                    "layer '{}' has nothing to trace: no bone",
-                    layer.name
-                )),
-                Err(e) => return Err(e.into()),
-            }
-        }
-        let parts: Vec<layers::Part> = shapes
-            .iter()
-            .map(|(name, shape)| layers::Part { name, shape })
-            .collect();
-        let (bones, bone_part) = layers::layered_skeleton(&parts, pivots, &options.medial, so)?;
-        for (b, &p) in bones.iter().zip(&bone_part) {
-            if let Some(name) = &b.name {
-                bind.insert(name.clone(), vec![parts[p].name.to_string()]);
-            }
-        }
-        bones
+        let (bones, template) = drawing_bones(&silhouette, options, so, &mut notes)?;
+        (bones, BTreeMap::new(), template)
     };
-    if bones.is_empty() {
-        // A round blob has no significant axis: one bone along its principal axis.
-        if let Some(b) = principal_bone(&silhouette) {
-            notes.push("no significant medial axis: one bone along the principal axis".into());
-            bones.push(b);
-        }
-    }
-    let added = budget::rig_free_pieces(&mut bones, &silhouette, min_bone_px);
-    if added > 0 {
-        notes.push(format!(
-            "{added} separate pieces got a bone each (piece_N), parented to the nearest bone"
-        ));
-    }
-    budget::keep_inside(&mut bones, &silhouette, min_bone_px);
-    budget::drop_short_bones(&mut bones, &silhouette, min_bone_px);
-    let max_bones = budget::bone_budget(so, options.template);
-    skeleton::limit_bones(&mut bones, Some(max_bones), &silhouette);
-    let min_bones = budget::bone_minimum(so, options.template);
-    budget::reach_minimum(&mut bones, min_bones.min(max_bones), min_bone_px);
-    let bones = name_bones(bones);
-    bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
-
     let points = points::propose_points(&silhouette, options.point_count, &options.points)
         .into_iter()
         .enumerate()
@@ -259,7 +177,208 @@ pub fn autorig(
         physics: Vec::new(),
     };
     handles.validate()?;
-    Ok(Proposal { handles, notes })
+    Ok(Proposal {
+        handles,
+        template,
+        notes,
+    })
+}
+
+fn check_options(so: &SkeletonOptions) -> Result<(), AutorigError> {
+    let positive = so.bend_ratio.is_finite() && so.bend_ratio > 0.0;
+    let fraction_ok = |f: f64| f.is_finite() && (0.0..=1.0).contains(&f);
+    if !(positive && so.min_bone_px.is_finite() && so.min_bone_px >= 0.0) {
+        return Err(AutorigError::InvalidOptions(
+            "bend_ratio must be positive and min_bone_px at least 0".into(),
+        ));
+    }
+    if !(fraction_ok(so.min_bone_fraction) && fraction_ok(so.prop_branch_fraction)) {
+        return Err(AutorigError::InvalidOptions(
+            "min_bone_fraction and prop_branch_fraction must lie in [0, 1]".into(),
+        ));
+    }
+    if so.prop_max_bones == 0 {
+        return Err(AutorigError::InvalidOptions(
+            "prop_max_bones must be at least 1".into(),
+        ));
+    }
+    if so.max_bones == Some(0) {
+        return Err(AutorigError::InvalidOptions(
+            "the bone budget must be at least 1".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The bones of one drawing (a single image: its union silhouette), fitted to the chosen
+/// template, with the budget applied; and the template used.
+fn drawing_bones(
+    silhouette: &Shape,
+    options: &AutorigOptions,
+    so: &SkeletonOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Bone>, Option<Template>), AutorigError> {
+    let min_bone_px = so.min_bone_px;
+    // Limbs leaving a round torso meet within its radius: merged, the arms' and the legs'
+    // junctions would be one, and a template could not tell chest from pelvis.
+    let unmerged = MedialOptions {
+        junction_merge_ratio: 0.0,
+        ..options.medial.clone()
+    };
+    let (mut bones, template) = match options.template.fixed() {
+        Some(Some(t)) => {
+            let axis = medial::medial_axis(silhouette, &unmerged)?;
+            match template::fit_template(&axis, silhouette, t, so) {
+                Some(bones) => (bones, Some(t)),
+                None => {
+                    notes.push(format!(
+                        "the drawing does not match the {} template (no assignment of its \
+                         limbs to the shape's extremities fits): bones from the medial axis",
+                        template_name(Some(t))
+                    ));
+                    let axis = medial::medial_axis(silhouette, &options.medial)?;
+                    (skeleton::medial_skeleton(&axis, silhouette, so), Some(t))
+                }
+            }
+        }
+        Some(None) => {
+            let axis = medial::medial_axis(silhouette, &options.medial)?;
+            (skeleton::medial_skeleton(&axis, silhouette, so), None)
+        }
+        None => {
+            let axis = medial::medial_axis(silhouette, &unmerged)?;
+            match choose::choose_template(&axis, silhouette, so) {
+                Some((t, bones, why)) => {
+                    notes.push(format!("template: {} ({why})", template_name(Some(t))));
+                    (bones, Some(t))
+                }
+                None => {
+                    notes.push(format!(
+                        "template: none (neither the humanoid nor the quadruped template fits \
+                         the drawing's limbs): bones from the medial axis"
+                    ));
+                    let axis = medial::medial_axis(silhouette, &options.medial)?;
+                    (skeleton::medial_skeleton(&axis, silhouette, so), None)
+                }
+            }
+        }
+    };
+    if bones.is_empty() {
+        // A round blob has no significant axis: one bone along its principal axis.
+        if let Some(b) = principal_bone(silhouette) {
+            notes.push("no significant medial axis: one bone along the principal axis".into());
+            bones.push(b);
+        }
+    }
+    let added = budget::rig_free_pieces(&mut bones, silhouette, min_bone_px);
+    if added > 0 {
+        notes.push(format!(
+            "{added} separate pieces got a bone each (piece_N), parented to the nearest bone"
+        ));
+    }
+    budget::keep_inside(&mut bones, silhouette, min_bone_px);
+    budget::drop_short_bones(&mut bones, silhouette, min_bone_px);
+    let max_bones = budget::bone_budget(so, template);
+    skeleton::limit_bones(&mut bones, Some(max_bones), silhouette);
+    let min_bones = budget::bone_minimum(so, template);
+    budget::reach_minimum(&mut bones, min_bones.min(max_bones), min_bone_px);
+    Ok((name_bones(bones), template))
+}
+
+/// The bones of a layered character: every layer a body part with its own bones
+/// ([`layers::layered_skeleton`]), each bone bound to its part; the template from the
+/// option, else from the layer names ([`labels::template_from_labels`]), else from the
+/// drawing's shape.
+#[allow(clippy::type_complexity)]
+fn layered_bones(
+    layers: &[LayerRef],
+    pivots: &[crate::io::layered::Pivot],
+    silhouette: &Shape,
+    options: &AutorigOptions,
+    so: &SkeletonOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<Bone>, BTreeMap<String, Vec<String>>, Option<Template>), AutorigError> {
+    let mut shapes = Vec::new();
+    for layer in layers {
+        match Shape::trace_placed(layer, &options.trace) {
+            Ok(Some(s)) => shapes.push((layer.name, s)),
+            Ok(None) | Err(TraceError::NoOpaquePixels { .. }) => notes.push(format!(
+                "layer '{}' has nothing to trace: no bone",
+                layer.name
+            )),
+            Err(e) => return Err(e.into()),
+        }
+    }
+    let mut part_labels: Vec<labels::Label> =
+        shapes.iter().map(|(name, _)| labels::label(name)).collect();
+    let centroids: Vec<Point> = shapes
+        .iter()
+        .map(|(_, s)| layers::principal_axis(s).map_or(Point::origin(), |a| a.centroid))
+        .collect();
+    attach::complete_sides(&mut part_labels, &centroids);
+    let template = match options.template.fixed() {
+        Some(t) => t,
+        None => match labels::template_from_labels(&part_labels) {
+            Some((t, why)) => {
+                notes.push(format!("template: {} ({why})", template_name(Some(t))));
+                Some(t)
+            }
+            None => {
+                let unmerged = MedialOptions {
+                    junction_merge_ratio: 0.0,
+                    ..options.medial.clone()
+                };
+                let axis = medial::medial_axis(silhouette, &unmerged)?;
+                match choose::choose_template(&axis, silhouette, so) {
+                    Some((t, _, why)) => {
+                        notes.push(format!(
+                            "template: {} ({why}; the layer names tell no limbs, so bones are \
+                             named after the layers)",
+                            template_name(Some(t))
+                        ));
+                        Some(t)
+                    }
+                    None => {
+                        notes.push(
+                            "template: none (the layer names tell no limbs and neither \
+                             template fits the drawing): one bone per layer, named after it"
+                                .into(),
+                        );
+                        None
+                    }
+                }
+            }
+        },
+    };
+    let parts: Vec<layers::Part> = shapes
+        .iter()
+        .zip(&part_labels)
+        .map(|((name, shape), &label)| layers::Part { name, shape, label })
+        .collect();
+    let skeleton = layers::layered_skeleton(&parts, pivots, template, &options.medial, so)?;
+    // Each bone weighs only its own part.
+    let mut bind: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for (b, &p) in skeleton.bones.iter().zip(&skeleton.bone_part) {
+        if let Some(name) = &b.name {
+            bind.entry(name.clone()).or_default().push(parts[p].name.to_string());
+        }
+    }
+    let mut bones = skeleton.bones;
+    if let Some(max) = options.skeleton.max_bones {
+        skeleton::limit_bones(&mut bones, Some(max), silhouette);
+    }
+    let bones = name_bones(bones);
+    bind.retain(|name, _| bones.iter().any(|b| &b.name == name));
+    Ok((bones, bind, template))
+}
+
+/// A template's name as the person writes it (`humanoid`, `quadruped`, `none`).
+pub fn template_name(t: Option<Template>) -> &'static str {
+    match t {
+        None => "none",
+        Some(Template::Humanoid) => "humanoid",
+        Some(Template::Quadruped) => "quadruped",
+    }
 }
 
 /// The bone that carries a proposed point at `p` (canvas px), so that the point turns with the

@@ -1,12 +1,13 @@
 //! A picture of a proposed rig: the layers on white with the cage, the bones and the point
 //! handles drawn over them.
 //!
-//! In: the layers (straight RGBA, one canvas, back to front) and the [`Handles`] (canvas px).
-//! Out: an RGBA image of the canvas size. Bones are drawn as kites from a wide head to a
+//! In: the layers (straight RGBA, each at its offset on one canvas, back to front) and the
+//! [`Handles`] (canvas px). Out: an RGBA image of the canvas size. Bones are drawn as kites from a wide head to a
 //! pointed tail (root bones in red, the others in blue), with a ring at each head; points as
 //! orange dots; cages as green polygons with square vertices.
 
 use crate::render::{pixmap_from_rgba, rgba_from_pixmap, RenderError};
+use super::LayerRef;
 use crate::rig::Handles;
 use image::RgbaImage;
 use tiny_skia::{
@@ -25,19 +26,19 @@ fn paint(r: u8, g: u8, b: u8, a: u8) -> Paint<'static> {
     p
 }
 
-/// Draws the rig over the layers.
-pub fn draw_preview(layers: &[&RgbaImage], handles: &Handles) -> Result<RgbaImage, RenderError> {
-    let (w, h) = layers.first().map_or((0, 0), |l| l.dimensions());
+/// Draws the rig over the layers, each placed at its offset on the first layer's canvas.
+pub fn draw_preview(layers: &[LayerRef], handles: &Handles) -> Result<RgbaImage, RenderError> {
+    let [w, h] = layers.first().map_or([0, 0], |l| l.canvas_px);
     let mut canvas = Pixmap::new(w, h).ok_or(RenderError::EmptyImage {
         width: w,
         height: h,
     })?;
     canvas.fill(Color::WHITE);
     for layer in layers {
-        let pixmap = pixmap_from_rgba(layer)?;
+        let pixmap = pixmap_from_rgba(layer.image)?;
         canvas.draw_pixmap(
-            0,
-            0,
+            layer.offset_px[0],
+            layer.offset_px[1],
             pixmap.as_ref(),
             &PixmapPaint::default(),
             Transform::identity(),

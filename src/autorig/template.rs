@@ -39,6 +39,42 @@ pub enum Template {
     Quadruped,
 }
 
+/// Which template a proposal uses: one named, none, or the one the art suggests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TemplateChoice {
+    /// Chosen from the layer names, else from the drawing's shape
+    /// ([`super::choose_template`]); the proposal says which and why.
+    #[default]
+    Auto,
+    /// No template: bones from the medial axis, or one per layer named after it.
+    None,
+    Humanoid,
+    Quadruped,
+}
+
+impl TemplateChoice {
+    /// The template fixed by the choice: `Some(None)` for none, `None` for automatic.
+    pub fn fixed(self) -> Option<Option<Template>> {
+        match self {
+            TemplateChoice::Auto => None,
+            TemplateChoice::None => Some(None),
+            TemplateChoice::Humanoid => Some(Some(Template::Humanoid)),
+            TemplateChoice::Quadruped => Some(Some(Template::Quadruped)),
+        }
+    }
+}
+
+impl From<Option<Template>> for TemplateChoice {
+    fn from(t: Option<Template>) -> Self {
+        match t {
+            None => TemplateChoice::None,
+            Some(Template::Humanoid) => TemplateChoice::Humanoid,
+            Some(Template::Quadruped) => TemplateChoice::Quadruped,
+        }
+    }
+}
+
 /// Candidate leaves kept per search (the most extreme ones); bounds the exhaustive search.
 const MAX_CANDIDATE_LEAVES: usize = 14;
 

@@ -8,7 +8,7 @@
 
 use clap::builder::{EnumValueParser, TypedValueParser};
 use clap::ValueEnum;
-use sinew::autorig::Template;
+use sinew::autorig::TemplateChoice;
 use sinew::colorize::{ColorWeights, FillMode, RegionSplit};
 use sinew::export::spine::{BakeMode, SpinePreset};
 use sinew::schema::SchemaKind;
@@ -105,7 +105,11 @@ mirror!(SpinePresetArg => SpinePreset {
     Game,
 });
 
-mirror!(TemplateArg => Template {
+mirror!(TemplateArg => TemplateChoice {
+    /// The template the layer names or the drawing suggest, or none; says which and why.
+    Auto,
+    /// No template: bones from the medial axis, or one per layer named after it.
+    None,
     /// Spine (hip, chest), head, two arms and two legs of two bones each.
     Humanoid,
     /// Spine (hip, chest), head, a tail of two bones and four legs of two bones each.
@@ -185,7 +189,7 @@ mod tests {
         check::<WeightMethodArg, WeightMethod>();
         check::<BakeModeArg, BakeMode>();
         check::<SpinePresetArg, SpinePreset>();
-        check::<TemplateArg, Template>();
+        check::<TemplateArg, TemplateChoice>();
         check::<FillModeArg, FillMode>();
         check::<ColorWeightsArg, ColorWeights>();
         check::<RegionSplitArg, RegionSplit>();

@@ -242,17 +242,16 @@ impl EditorApp {
         ui.horizontal(|ui| {
             ui.label("Template");
             egui::ComboBox::from_id_salt("autorig template")
-                .selected_text(match options.template {
-                    None => "none".to_string(),
-                    Some(t) => format!("{t:?}"),
-                })
+                .selected_text(format!("{:?}", options.template))
                 .show_ui(ui, |ui| {
-                    ui.selectable_value(&mut options.template, None, "none");
+                    use crate::autorig::TemplateChoice;
                     for t in [
-                        crate::autorig::Template::Humanoid,
-                        crate::autorig::Template::Quadruped,
+                        TemplateChoice::Auto,
+                        TemplateChoice::None,
+                        TemplateChoice::Humanoid,
+                        TemplateChoice::Quadruped,
                     ] {
-                        ui.selectable_value(&mut options.template, Some(t), format!("{t:?}"));
+                        ui.selectable_value(&mut options.template, t, format!("{t:?}"));
                     }
                 });
         });

@@ -201,8 +201,17 @@ pub fn autorig_files(
     let text = serde_json::to_string_pretty(&proposal.handles).map_err(JobError::Serialize)? + "\n";
     let preview = match &files.preview {
         Some(_) => {
-            let images: Vec<_> = art.layers.iter().map(|l| &l.image).collect();
-            Some(autorig::draw_preview(&images, &proposal.handles)?)
+            let refs: Vec<autorig::LayerRef> = art
+                .layers
+                .iter()
+                .map(|l| autorig::LayerRef {
+                    name: &l.name,
+                    image: &l.image,
+                    offset_px: l.offset_px,
+                    canvas_px: l.canvas_px,
+                })
+                .collect();
+            Some(autorig::draw_preview(&refs, &proposal.handles)?)
         }
         None => None,
     };
