@@ -58,6 +58,29 @@ pub struct RigDocument {
     /// [`super::slots`]). Absent when none.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub skins: super::slots::Skins,
+    /// What the last automatic rig installed in the editor followed (its template), so the
+    /// editor offers it again on reopen. Absent when no proposal was installed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub autorig: Option<AutorigRecord>,
+}
+
+/// What an automatic rig (`sinew autorig`, the editor's *Propose handles*) followed, as the
+/// rig document records it (`"autorig": {"template": "humanoid"}`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AutorigRecord {
+    /// The template the proposal followed.
+    pub template: RecordedTemplate,
+}
+
+/// The template an automatic rig followed: one of the autorig's templates, or none (bones from
+/// the drawing's shape or one per layer).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum RecordedTemplate {
+    None,
+    Humanoid,
+    Quadruped,
 }
 
 /// How the document's meshes were built.
@@ -231,6 +254,7 @@ impl RigDocument {
             options: BuildOptions::default(),
             locked: Vec::new(),
             skins: BTreeMap::new(),
+            autorig: None,
         }
     }
 
@@ -379,6 +403,13 @@ impl RigDocument {
             }
             validate_part(part).map_err(|e| format!("part '{}': {e}", part.name))?;
         }
+        for (handle, parts) in &self.handles.bind {
+            if let Some(part) = parts.iter().find(|p| !names.contains(p.as_str())) {
+                return Err(format!(
+                    "handles: 'bind' gives handle '{handle}' the part '{part}', which is not a part"
+                ));
+            }
+        }
         super::slots::validate_slots(self)
     }
 }
@@ -499,6 +530,45 @@ mod tests {
             RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
             doc
         );
+    }
+
+    #[test]
+    fn the_autorig_record_round_trips_and_is_left_out_when_absent() {
+        let mut doc = sample();
+        let text = serde_json::to_string(&doc).unwrap();
+        assert!(!text.contains("autorig"), "{text}");
+        doc.autorig = Some(AutorigRecord {
+            template: RecordedTemplate::Humanoid,
+        });
+        let text = serde_json::to_string(&doc).unwrap();
+        assert!(
+            text.contains(r#""autorig":{"template":"humanoid"}"#),
+            "{text}"
+        );
+        assert_eq!(
+            RigDocument::from_json(&text, Path::new("r.json")).unwrap(),
+            doc
+        );
+        let wrong = text.replace("humanoid", "octopus");
+        assert!(RigDocument::from_json(&wrong, Path::new("r.json")).is_err());
+    }
+
+    #[test]
+    fn a_bind_naming_no_part_is_refused() {
+        let mut doc = sample();
+        doc.handles.bones.push(crate::rig::Bone {
+            name: "b".into(),
+            parent: None,
+            head: Point::new(0.0, 0.0),
+            tail: Point::new(1.0, 0.0),
+        });
+        doc.handles.bind.insert("b".into(), vec!["body".into()]);
+        assert_eq!(doc.validate(), Ok(()));
+        doc.handles
+            .bind
+            .insert("b".into(), vec!["body".into(), "wing".into()]);
+        let reason = doc.validate().unwrap_err();
+        assert!(reason.contains("'wing', which is not a part"), "{reason}");
     }
 
     /// Whether two JSON values say the same: numbers compared as numbers (`0` and `0.0` alike).

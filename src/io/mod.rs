@@ -11,7 +11,8 @@ pub mod slots;
 
 pub use atomic::write_atomic;
 pub use document::{
-    BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RigDocument, WeightsDoc,
+    AutorigRecord, BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RecordedTemplate,
+    RigDocument, WeightsDoc,
 };
 pub use image::{load_png, save_png, ImageError};
 pub use slots::{Skin, Skins, SlotError};
