@@ -171,6 +171,9 @@ pub struct State {
     /// Which parts are other attachments of a slot, and the skins: kept as opened and given to
     /// every rig built (the editor does not edit them yet).
     pub slots: SlotLayout,
+    /// What the last automatic rig installed followed ([`Command::Propose`]); saved with the
+    /// document (`autorig`), so the editor offers the same template on reopen.
+    pub autorig: Option<io::AutorigRecord>,
 }
 
 /// A document's slots and skins (see [`crate::io::slots`]): each part that is another
@@ -307,9 +310,22 @@ pub enum Command {
         animation: String,
         time_s: f64,
     },
-    /// Replaces every handle (an automatic rig's proposal, say); the pose forgets handles that
-    /// are gone.
+    /// Replaces every handle; the pose forgets handles that are gone.
     SetHandles(Handles),
+    /// Installs an automatic rig's proposal: replaces every handle, as [`Command::SetHandles`]
+    /// does, and records what the proposal followed (its template) in the document, in one
+    /// undo step.
+    Propose {
+        handles: Handles,
+        record: io::AutorigRecord,
+    },
+    /// Sets the parts (layer names) handle `handle` may weigh ([`Handles::bind`]): none
+    /// unbinds it, so it weighs every part again. A part that is not a layer, or a handle that
+    /// does not exist, is refused. The weights need computing again.
+    SetBind {
+        handle: String,
+        parts: Vec<String>,
+    },
     /// Adds a cage: a closed polygon (canvas px) whose vertices are handles.
     AddCage(Cage),
     /// Adds a region: a closed polygon (canvas px) whose inside moves rigidly.
@@ -444,6 +460,7 @@ impl Document {
                 pose: Pose::default(),
                 locked: BTreeSet::new(),
                 slots: SlotLayout::default(),
+                autorig: None,
             },
             path: None,
             undo: Vec::new(),
@@ -493,6 +510,7 @@ impl Document {
             rig_current: weighted,
             locked: doc.locked.iter().cloned().collect(),
             slots: SlotLayout::of(&doc),
+            autorig: doc.autorig,
             rig: Some(Arc::new(Scene::new(doc, &images)?)),
             pose: Pose::default(),
         };

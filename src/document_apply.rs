@@ -37,6 +37,9 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
             for parts in next.handles.bind.values_mut() {
                 parts.retain(|p| *p != name);
             }
+            // A handle bound to that part alone is bound to nothing: it weighs every part again
+            // (a binding lists at least one part).
+            next.handles.bind.retain(|_, parts| !parts.is_empty());
         }
         Command::AddBone(bone) => next.handles.bones.push(bone),
         Command::MoveBone { name, head, tail } => {
@@ -181,13 +184,33 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
             next.slots.shown = skins;
             inputs_changed = false;
         }
-        Command::SetHandles(handles) => {
-            next.handles = handles;
-            let names: BTreeSet<&str> = next.handles.names().collect();
-            next.pose.bones.retain(|n, _| names.contains(n.as_str()));
-            next.pose.points.retain(|n, _| names.contains(n.as_str()));
-            next.pose.cages.retain(|n, _| names.contains(n.as_str()));
-            next.locked.retain(|n| names.contains(n.as_str()));
+        Command::SetHandles(handles) => set_handles(&mut next, handles),
+        Command::Propose { handles, record } => {
+            set_handles(&mut next, handles);
+            next.autorig = Some(record);
+        }
+        Command::SetBind { handle, parts } => {
+            if !state.handles.names().any(|n| n == handle) {
+                return Err(DocumentError::UnknownHandle(handle));
+            }
+            if let Some(part) = parts
+                .iter()
+                .find(|p| !state.layers.iter().any(|l| l.name == **p))
+            {
+                return Err(DocumentError::UnknownLayer(part.clone()));
+            }
+            if parts.is_empty() {
+                next.handles.bind.remove(&handle);
+            } else {
+                // In draw order, each once: the same binding reads the same in the file.
+                let bound: Vec<String> = state
+                    .layers
+                    .iter()
+                    .map(|l| l.name.clone())
+                    .filter(|l| parts.contains(l))
+                    .collect();
+                next.handles.bind.insert(handle, bound);
+            }
         }
         Command::AddCage(cage) => next.handles.cages.push(cage),
         Command::AddRegion(region) => next.handles.regions.push(region),
@@ -334,6 +357,16 @@ pub(super) fn apply_to(state: &State, command: Command) -> Result<State, Documen
     Ok(next)
 }
 
+/// Replaces the handles; the pose and the locks forget handles that are gone.
+fn set_handles(next: &mut State, handles: Handles) {
+    next.handles = handles;
+    let names: BTreeSet<&str> = next.handles.names().collect();
+    next.pose.bones.retain(|n, _| names.contains(n.as_str()));
+    next.pose.points.retain(|n, _| names.contains(n.as_str()));
+    next.pose.cages.retain(|n, _| names.contains(n.as_str()));
+    next.locked.retain(|n| names.contains(n.as_str()));
+}
+
 pub(super) fn rig_inputs_of(state: &State) -> RigInputs {
     RigInputs {
         layers: state.layers.clone(),
@@ -389,4 +422,109 @@ fn reparent_bone(
         .ok_or(DocumentError::UnknownHandle(bone))?;
     b.parent = parent;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two 8×8 layers, `body` behind `arm`, and two bones.
+    fn two_parts() -> Document {
+        let mut doc = Document::new();
+        for name in ["body", "arm"] {
+            let image = image::RgbaImage::new(8, 8);
+            doc.apply(Command::AddLayer(Layer::whole(
+                name,
+                format!("{name}.png"),
+                image,
+            )))
+            .unwrap();
+        }
+        for (name, y) in [("a", 2.0), ("b", 5.0)] {
+            doc.apply(Command::AddBone(Bone {
+                name: name.into(),
+                parent: None,
+                head: Point::new(1.0, y),
+                tail: Point::new(6.0, y),
+            }))
+            .unwrap();
+        }
+        doc
+    }
+
+    fn bind(doc: &Document, handle: &str) -> Option<Vec<String>> {
+        doc.state().handles.bind.get(handle).cloned()
+    }
+
+    fn set_bind(doc: &mut Document, handle: &str, parts: &[&str]) -> Result<(), DocumentError> {
+        doc.apply(Command::SetBind {
+            handle: handle.into(),
+            parts: parts.iter().map(|p| p.to_string()).collect(),
+        })
+    }
+
+    #[test]
+    fn set_bind_binds_in_draw_order_unbinds_with_no_part_and_refuses_unknown_names() {
+        let mut doc = two_parts();
+        set_bind(&mut doc, "a", &["arm", "body"]).unwrap();
+        assert_eq!(bind(&doc, "a"), Some(vec!["body".into(), "arm".into()]));
+        assert!(!doc.state().rig_current, "the weights need computing again");
+        set_bind(&mut doc, "a", &[]).unwrap();
+        assert_eq!(bind(&doc, "a"), None);
+        assert!(doc.undo());
+        assert_eq!(bind(&doc, "a"), Some(vec!["body".into(), "arm".into()]));
+        assert!(matches!(
+            set_bind(&mut doc, "a", &["wing"]),
+            Err(DocumentError::UnknownLayer(p)) if p == "wing"
+        ));
+        assert!(matches!(
+            set_bind(&mut doc, "ghost", &["arm"]),
+            Err(DocumentError::UnknownHandle(h)) if h == "ghost"
+        ));
+        assert_eq!(bind(&doc, "a"), Some(vec!["body".into(), "arm".into()]));
+    }
+
+    #[test]
+    fn renaming_deleting_and_removing_a_layer_keep_the_bindings_valid() {
+        let mut doc = two_parts();
+        set_bind(&mut doc, "a", &["arm"]).unwrap();
+        set_bind(&mut doc, "b", &["arm", "body"]).unwrap();
+        doc.apply(Command::Rename {
+            from: "a".into(),
+            to: "upper".into(),
+        })
+        .unwrap();
+        assert_eq!(bind(&doc, "a"), None);
+        assert_eq!(bind(&doc, "upper"), Some(vec!["arm".into()]));
+        // The arm's layer goes: `upper`, bound to it alone, weighs every part again; `b`
+        // keeps the body.
+        doc.apply(Command::RemoveLayer { name: "arm".into() })
+            .unwrap();
+        assert_eq!(bind(&doc, "upper"), None);
+        assert_eq!(bind(&doc, "b"), Some(vec!["body".into()]));
+        doc.apply(Command::Delete { name: "b".into() }).unwrap();
+        assert!(doc.state().handles.bind.is_empty());
+        doc.state().handles.validate().unwrap();
+    }
+
+    #[test]
+    fn a_proposal_and_its_template_are_one_undo_step() {
+        let mut doc = two_parts();
+        let before = doc.state().handles.clone();
+        let mut proposed = before.clone();
+        proposed.bones.truncate(1);
+        let record = io::AutorigRecord {
+            template: io::RecordedTemplate::Humanoid,
+        };
+        doc.apply(Command::Propose {
+            handles: proposed.clone(),
+            record,
+        })
+        .unwrap();
+        assert_eq!(doc.state().handles, proposed);
+        assert_eq!(doc.state().autorig, Some(record));
+        assert!(doc.undo());
+        assert_eq!(doc.state().handles, before);
+        assert_eq!(doc.state().autorig, None);
+    }
 }

@@ -36,6 +36,7 @@ pub(super) fn rig_document(state: &State, path: &Path) -> Result<RigDocument, Do
     doc.animations = state.animations.clone();
     doc.events = state.events.clone();
     doc.locked = state.locked.iter().cloned().collect();
+    doc.autorig = state.autorig;
     state.slots.apply_to(&mut doc)?;
     Ok(doc)
 }

@@ -161,7 +161,8 @@ pub fn render_animation(
 }
 
 /// Handles proposed by the automatic rig (`sinew autorig`) for `layers`, to install with
-/// [`crate::document::Command::SetHandles`] and edit like hand-placed ones.
+/// [`crate::document::Command::Propose`] (which records the template followed) and edit like
+/// hand-placed ones.
 pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
     layers: &[L],
     pivots: &[crate::io::layered::Pivot],
