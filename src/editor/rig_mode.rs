@@ -4,7 +4,8 @@
 //! [`super::rig_tools`]'s; the Paint tool, the locks and the weights readout [`super::paint`]'s.
 //!
 //! In: pointer and keys on the canvas at rest. Out: document commands (`AddBone`, `MoveBone`,
-//! `AddPoint`, `Rename`, `Reparent`, `Delete`, `SetOptions`, `SetRig` once a build is done).
+//! `AddPoint`, `Rename`, `Reparent`, `SetBind` (the parts a handle weighs), `Delete`,
+//! `SetOptions`, `SetRig` once a build is done).
 
 use super::canvas::{self, Placed};
 use super::worker::Worker;
@@ -253,6 +254,7 @@ impl EditorApp {
                     });
                 }
             }
+            self.bind_boxes(ui, &name);
             if ui.button("Delete").clicked() {
                 self.apply(Command::Delete { name });
                 self.selected = None;
@@ -434,6 +436,51 @@ impl EditorApp {
         }
     }
 
+    /// The parts handle `name` may weigh (the handles' `bind`): a box per part, front to back
+    /// as the tree lists them. None ticked, the handle weighs every part it touches; ticking
+    /// one binds it to the ticked parts only. Each tick is one undoable `SetBind`, and the
+    /// weights need computing again.
+    fn bind_boxes(&mut self, ui: &mut egui::Ui, name: &str) {
+        let state = self.doc.state();
+        if state.layers.is_empty() {
+            return;
+        }
+        let bound = state.handles.bind.get(name).cloned();
+        let parts: Vec<String> = state.layers.iter().rev().map(|l| l.name.clone()).collect();
+        // Folded, one line: what the handle weighs; unfolded (kept so from one selection to
+        // the next), the boxes.
+        let header = match &bound {
+            None => "Weighs: all parts".to_string(),
+            Some(bound) => format!("Weighs only: {}", bound.join(", ")),
+        };
+        let mut toggled = None;
+        egui::CollapsingHeader::new(header)
+            .id_salt("weighs")
+            .show(ui, |ui| {
+                ui.label("None ticked: every part. Ticked: only those.");
+                let ticked = bound.as_deref().unwrap_or(&[]);
+                ui.horizontal_wrapped(|ui| toggled = part_boxes(ui, name, &parts, ticked));
+            });
+        let Some((part, on)) = toggled else {
+            return;
+        };
+        let mut parts = bound.unwrap_or_default();
+        parts.retain(|p| *p != part);
+        if on {
+            parts.push(part);
+        }
+        let message = match parts.as_slice() {
+            [] => format!("'{name}' weighs every part again"),
+            bound => format!("'{name}' weighs only {}", bound.join(", ")),
+        };
+        if self.apply(Command::SetBind {
+            handle: name.to_string(),
+            parts,
+        }) {
+            self.message = Some(message);
+        }
+    }
+
     /// The bone a new point is carried by: the selected bone, or the one carrying the
     /// selected point (so points placed one after another share it); none otherwise.
     fn new_point_parent(&self) -> Option<String> {
@@ -453,6 +500,33 @@ impl EditorApp {
             .find(|n| !handles.names().any(|m| m == n))
             .unwrap_or_else(|| stem.to_string())
     }
+}
+
+/// A box per part in `parts` for handle `name`, ticked when `ticked` lists it. Returns the
+/// part toggled this frame, if any, and whether it is ticked now.
+fn part_boxes(
+    ui: &mut egui::Ui,
+    name: &str,
+    parts: &[String],
+    ticked: &[String],
+) -> Option<(String, bool)> {
+    let mut toggled = None;
+    for part in parts {
+        let mut on = ticked.contains(part);
+        let response = ui
+            .checkbox(&mut on, part.as_str())
+            .on_hover_text(format!("whether '{name}' may weigh part '{part}'"));
+        // Parts and bones often share names: the box is "weighs PART" to screen readers (and
+        // UI tests).
+        let label = format!("weighs {part}");
+        response.widget_info(|| {
+            egui::WidgetInfo::selected(egui::WidgetType::Checkbox, true, on, &label)
+        });
+        if response.changed() {
+            toggled = Some((part.clone(), on));
+        }
+    }
+    toggled
 }
 
 /// Height of the heat map legend above the canvas' bottom edge, screen points.

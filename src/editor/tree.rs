@@ -251,7 +251,11 @@ impl EditorApp {
                 }
             }
             let selected = self.selected.as_deref() == Some(name);
-            let response = ui.selectable_label(selected, name);
+            let mut response = ui.selectable_label(selected, name);
+            if let Some(parts) = self.doc.state().handles.bind.get(name) {
+                // The binding (rig mode's selection panel edits it).
+                response = response.on_hover_text(format!("weighs only {}", parts.join(", ")));
+            }
             if selected && self.tree.reveal_frames > 0 {
                 self.tree.reveal_frames -= 1;
                 // At once, not animated: the panel was just laid out anew. Again over the next
