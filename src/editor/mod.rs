@@ -213,6 +213,7 @@ impl EditorApp {
             .as_ref()
             .map(|p| p.display().to_string())
             .unwrap_or_default();
+        let rig_tools = rig_tools::RigTools::for_document(doc.state().autorig);
         EditorApp {
             doc,
             mode: Mode::Rig,
@@ -249,7 +250,7 @@ impl EditorApp {
             repaint: None,
             screenshot: None,
             render_settings: Default::default(),
-            rig_tools: Default::default(),
+            rig_tools,
             colorize: Default::default(),
             paint: paint::PaintSettings::default(),
             timeline: Default::default(),

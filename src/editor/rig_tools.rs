@@ -2,19 +2,19 @@
 //! tracing and meshing parameters with a live preview of the mesh they make.
 //!
 //! In: clicks on the canvas (polygon vertices), the side panel's fields. Out: document
-//! commands ([`Command::AddCage`], [`Command::AddRegion`], [`Command::SetHandles`] with the
-//! automatic rig's proposal, [`Command::SetOptions`] once per slider gesture) and shapes to
-//! draw. The automatic rig and the preview mesh run on background threads; the newest request
-//! wins and the UI never waits for them.
+//! commands ([`Command::AddCage`], [`Command::AddRegion`], [`Command::Propose`] with the
+//! automatic rig's proposal and the template it followed, [`Command::SetOptions`] once per
+//! slider gesture) and shapes to draw. The automatic rig and the preview mesh run on background
+//! threads; the newest request wins and the UI never waits for them.
 
 use super::canvas::{self, Placed};
 use super::identity::Identity;
 use super::number_field::{number_field, slider};
 use super::{EditorApp, Gesture};
-use crate::autorig::{AutorigOptions, Proposal};
+use crate::autorig::{AutorigOptions, Proposal, Template, TemplateChoice};
 use crate::document::Command;
 use crate::geom::Point;
-use crate::io::{BuildOptions, MeshDoc};
+use crate::io::{AutorigRecord, BuildOptions, MeshDoc, RecordedTemplate};
 use crate::pipeline::Layer;
 use crate::rig::{Cage, Handles, Region};
 use eframe::egui::{self, Color32, Pos2, Shape, Stroke};
@@ -69,10 +69,67 @@ pub struct RigTools {
 }
 
 impl RigTools {
+    /// Rig tools for a document just opened: the automatic rig's Template box shows the
+    /// template the document's last proposal followed (the user's choice replaces it).
+    pub fn for_document(recorded: Option<AutorigRecord>) -> Self {
+        let mut tools = RigTools::default();
+        if let Some(record) = recorded {
+            tools.autorig.template = template_choice(record.template);
+        }
+        tools
+    }
+
     /// Whether the automatic rig is running.
     pub fn proposing(&self) -> bool {
         self.autorig_job.is_some()
     }
+}
+
+/// How the rig document records the template a proposal followed.
+pub fn recorded_template(template: Option<Template>) -> RecordedTemplate {
+    match template {
+        None => RecordedTemplate::None,
+        Some(Template::Humanoid) => RecordedTemplate::Humanoid,
+        Some(Template::Quadruped) => RecordedTemplate::Quadruped,
+    }
+}
+
+/// The Template box's choice for a recorded template.
+pub fn template_choice(recorded: RecordedTemplate) -> TemplateChoice {
+    match recorded {
+        RecordedTemplate::None => TemplateChoice::None,
+        RecordedTemplate::Humanoid => TemplateChoice::Humanoid,
+        RecordedTemplate::Quadruped => TemplateChoice::Quadruped,
+    }
+}
+
+/// The status message for an installed proposal: how many handles, the template it followed
+/// and why (the proposal's `template: ` note when it chose; else the Template box's choice),
+/// then its other notes.
+fn proposal_message(proposal: &Proposal, chosen: TemplateChoice) -> String {
+    let count = proposal.handles.names().count();
+    let template_note = proposal.notes.iter().find(|n| n.starts_with("template: "));
+    let template = match template_note {
+        Some(note) => note.clone(),
+        None => {
+            let name = crate::autorig::template_name(proposal.template);
+            let why = match chosen {
+                TemplateChoice::Auto => "chosen automatically",
+                _ => "as chosen in the Template box",
+            };
+            format!("template: {name} ({why})")
+        }
+    };
+    let mut message = format!("proposed {count} handles; {template}");
+    for note in proposal
+        .notes
+        .iter()
+        .filter(|n| !n.starts_with("template: "))
+    {
+        message.push_str("; ");
+        message.push_str(note);
+    }
+    message
 }
 
 impl EditorApp {
@@ -244,7 +301,6 @@ impl EditorApp {
             egui::ComboBox::from_id_salt("autorig template")
                 .selected_text(format!("{:?}", options.template))
                 .show_ui(ui, |ui| {
-                    use crate::autorig::TemplateChoice;
                     for t in [
                         TemplateChoice::Auto,
                         TemplateChoice::None,
@@ -311,13 +367,14 @@ impl EditorApp {
             match job.try_recv() {
                 Ok(Ok(proposal)) => {
                     self.rig_tools.autorig_job = None;
-                    let count = proposal.handles.names().count();
-                    if self.apply(Command::SetHandles(proposal.handles)) {
-                        let mut message = format!("proposed {count} handles");
-                        for note in proposal.notes {
-                            message.push_str("; ");
-                            message.push_str(&note);
-                        }
+                    let message = proposal_message(&proposal, self.rig_tools.autorig.template);
+                    let command = Command::Propose {
+                        record: AutorigRecord {
+                            template: recorded_template(proposal.template),
+                        },
+                        handles: proposal.handles,
+                    };
+                    if self.apply(command) {
                         self.message = Some(message);
                         self.selected = None;
                     }

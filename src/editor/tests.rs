@@ -39,6 +39,7 @@ mod key_menu;
 mod outputs;
 mod physics;
 mod pose;
+mod proposal_template;
 mod rig;
 mod rows;
 mod selection;
