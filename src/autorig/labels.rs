@@ -272,21 +272,37 @@ pub fn label(path: &str) -> Label {
     found
 }
 
+/// Two-letter leg codes: end then side (`HL`: hind left).
+const LEG_CODES: &[(&str, End, Side)] = &[
+    ("fl", End::Front, Side::Left),
+    ("fr", End::Front, Side::Right),
+    ("hl", End::Back, Side::Left),
+    ("hr", End::Back, Side::Right),
+    ("bl", End::Back, Side::Left),
+    ("br", End::Back, Side::Right),
+    ("rl", End::Back, Side::Left),
+    ("rr", End::Back, Side::Right),
+];
+
 fn label_of_words(words: &[String]) -> Label {
     let has = |set: &[&str]| words.iter().any(|w| set.contains(&w.as_str()));
+    let code = LEG_CODES
+        .iter()
+        .find(|(c, _, _)| words.iter().any(|w| w == c) && has(LEG))
+        .map(|&(_, e, s)| (e, s));
     let side = if has(LEFT) {
         Some(Side::Left)
     } else if has(RIGHT) {
         Some(Side::Right)
     } else {
-        None
+        code.map(|c| c.1)
     };
     let end = if has(FRONT) {
         Some(End::Front)
     } else if has(BACK) && !has(TORSO) {
         Some(End::Back)
     } else {
-        None
+        code.map(|c| c.0)
     };
     let segment = if has(UPPER) {
         Segment::Upper
@@ -345,33 +361,51 @@ fn label_of_words(words: &[String]) -> Label {
 }
 
 /// The template a set of labels is drawn for, and why (for the person): a quadruped when
-/// legs are marked front/back or there are more than two legs and no arms; a humanoid when
-/// there are arms or legs (a bust has arms and no legs); `None` when the names tell no limb.
-pub fn template_from_labels(labels: &[Label]) -> Option<(Template, String)> {
+/// more than two legs are named (or legs at a front and a back); none for a tail without
+/// arms or four legs (a bird, a fish, a kite); a humanoid when arms or legs are named, or a
+/// head on a body (a bust); `None` when the names tell nothing of the body.
+pub fn template_from_labels(labels: &[Label]) -> Option<(Option<Template>, String)> {
     let arms = labels.iter().filter(|l| matches!(l.part, Part::Arm(_))).count();
     let legs: Vec<&Label> = labels
         .iter()
         .filter(|l| matches!(l.part, Part::Leg(_)))
         .collect();
-    let ends = legs.iter().filter(|l| l.end.is_some()).count();
     // Whole legs or thighs: one per leg.
     let limbs = legs
         .iter()
         .filter(|l| matches!(l.part, Part::Leg(Segment::Upper | Segment::Whole)))
         .count();
-    if ends > 0 || (arms == 0 && limbs > 2) {
+    // Legs at both a front and a back, more than two of them (a side view's near and far
+    // foot are "front" and "back" too).
+    let both_ends = [End::Front, End::Back]
+        .iter()
+        .all(|e| legs.iter().any(|l| l.end == Some(*e)));
+    if (both_ends && legs.len() > 2) || (arms == 0 && limbs > 2) {
         return Some((
-            Template::Quadruped,
+            Some(Template::Quadruped),
             format!("the layer names give {} leg parts at a front and a back", legs.len()),
+        ));
+    }
+    let has = |p: Part| labels.iter().any(|l| l.part == p);
+    if has(Part::Tail) && arms == 0 {
+        return Some((
+            None,
+            "the layer names give a tail and neither arms nor four legs".into(),
         ));
     }
     if arms > 0 || !legs.is_empty() {
         return Some((
-            Template::Humanoid,
+            Some(Template::Humanoid),
             format!(
                 "the layer names give {arms} arm and {} leg parts",
                 legs.len()
             ),
+        ));
+    }
+    if has(Part::Head) && (has(Part::Torso) || has(Part::Neck)) {
+        return Some((
+            Some(Template::Humanoid),
+            "the layer names give a head on a body and no limbs: a bust".into(),
         ));
     }
     None
@@ -424,6 +458,8 @@ mod tests {
         let hind = label("hind leg L");
         assert_eq!((hind.part, hind.end), (Part::Leg(Whole), Some(End::Back)));
         assert_eq!(label("foreleg_r").end, Some(End::Front));
+        let code = label("Leg.HL");
+        assert_eq!((code.end, code.side), (Some(End::Back), Some(Side::Left)));
         // "back" on a torso is the back, not a hind part.
         assert_eq!(label("back").part, Part::Unknown);
     }
@@ -448,7 +484,7 @@ mod tests {
     #[test]
     fn the_template_follows_the_limbs_named() {
         let names = |ns: &[&str]| ns.iter().map(|n| label(n)).collect::<Vec<_>>();
-        let t = |ns: &[&str]| template_from_labels(&names(ns)).map(|t| t.0);
+        let t = |ns: &[&str]| template_from_labels(&names(ns)).and_then(|t| t.0);
         assert_eq!(
             t(&["head", "body", "arm_l", "arm_r", "leg_l", "leg_r"]),
             Some(Template::Humanoid)
@@ -460,5 +496,10 @@ mod tests {
         );
         assert_eq!(t(&["head", "body", "leg 1", "leg 2", "leg 3", "leg 4"]), Some(Template::Quadruped));
         assert_eq!(t(&["blade", "hilt"]), None);
+        assert_eq!(t(&["head", "body"]), Some(Template::Humanoid));
+        assert_eq!(t(&["hand", "foot_front", "body", "foot_back"]), Some(Template::Humanoid));
+        let said = |ns: &[&str]| template_from_labels(&names(ns)).map(|t| t.0);
+        assert_eq!(said(&["feet", "head", "body", "tail"]), Some(None));
+        assert_eq!(said(&["blade", "hilt"]), None);
     }
 }

@@ -177,16 +177,27 @@ pub fn layered_skeleton(
         let split = split_names(part, template);
         let grown = match (joint, pivot) {
             (None, _) => {
-                let hips = hip_hint(i, parts, &tree);
-                root_bones(part.shape, pivot, hips, split.len(), medial, skeleton)?
+                let (hips, up) = (hip_hint(i, parts, &tree), up_hint(i, parts, &tree));
+                let max = max_part_bones(&part.label).max(split.len());
+                root_bones(part, pivot, hips, up, split.len(), max, medial, skeleton)?
             }
-            (Some(j), _) => child_bones(part.shape, pivot.unwrap_or(j.at_px), split.len(), medial, skeleton)?,
+            (Some(j), _) => ray_bones(
+                part.shape,
+                pivot.unwrap_or(j.at_px),
+                None,
+                split.len(),
+                max_part_bones(&part.label).max(split.len()),
+                medial,
+                skeleton,
+            )?,
         };
         let first = bones.len();
         let parent_bone = joint.and_then(|j| nearest_bone(&bones, part_bones[j.parent].clone(), j.at_px));
         for (k, mut b) in grown.into_iter().enumerate() {
+            // A part's further root bones (branches at its start) hang from its first bone.
             b.parent = match b.parent {
                 Some(p) => Some(p + first),
+                None if k > 0 => Some(first),
                 None => parent_bone,
             };
             let base = split.get(k).or(split.last()).cloned().unwrap_or_default();
@@ -210,9 +221,6 @@ pub fn layered_skeleton(
                     bones[pb].tail = seam;
                 }
             }
-        }
-        if bones.len() > first {
-            // Children of this part's bones placed before (none: parents come first).
         }
     }
     Ok(LayeredSkeleton { bones, bone_part })
@@ -279,39 +287,75 @@ fn nearest_bone(bones: &[ProtoBone], range: std::ops::Range<usize>, p: Point) ->
     })
 }
 
-/// Where the root part's bone should start: the mean joint of its children that hang at the
-/// hips (legs, a tail), if any.
-fn hip_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
-    let at_hips: Vec<Point> = tree
+/// The mean joint of the root's children whose labels `keep` accepts, if any.
+fn mean_joint(root: usize, parts: &[Part], tree: &PartTree, keep: impl Fn(&Label) -> bool) -> Option<Point> {
+    let at: Vec<Point> = tree
         .joints
         .iter()
         .enumerate()
         .filter_map(|(c, j)| j.filter(|j| j.parent == root).map(|j| (c, j.at_px)))
-        .filter(|(c, _)| {
-            matches!(parts[*c].label.part, LabelPart::Leg(_) | LabelPart::Tail)
-                && parts[*c].label.end != Some(End::Front)
-        })
+        .filter(|(c, _)| keep(&parts[*c].label))
         .map(|(_, p)| p)
         .collect();
-    (!at_hips.is_empty()).then(|| {
-        Point::from(at_hips.iter().fold(Vec2::zeros(), |s, p| s + p.coords) / at_hips.len() as f64)
+    (!at.is_empty())
+        .then(|| Point::from(at.iter().fold(Vec2::zeros(), |s, p| s + p.coords) / at.len() as f64))
+}
+
+/// Where the root part's children hang at the hips (legs, a tail; a quadruped's back legs).
+fn hip_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
+    mean_joint(root, parts, tree, |l| {
+        matches!(l.part, LabelPart::Leg(_) | LabelPart::Tail) && l.end != Some(End::Front)
     })
 }
 
-/// The root part's bones: along its principal axis from the end nearer `hips` (else the lower
-/// end; a `pivot` is the head itself) to the other, split into `count` equal bones; or its
-/// medial-axis bones when the axis leaves the part.
+/// Where the root part's children hang at the top of the spine (a torso over a pelvis, the
+/// neck, the head, the arms; a quadruped's front legs).
+fn up_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
+    mean_joint(root, parts, tree, |l| {
+        matches!(
+            l.part,
+            LabelPart::Torso | LabelPart::Neck | LabelPart::Head | LabelPart::Arm(_)
+        ) || (matches!(l.part, LabelPart::Leg(_)) && l.end == Some(End::Front))
+    })
+}
+
+/// The root part's bones, `count` in a chain (at most `max` medial bones when the part is
+/// too curved for a straight spine). The spine starts at the hips: a marked `pivot`, else the
+/// centroid of a pelvis part, else where the legs and tail join (`hips`); it runs toward
+/// where the torso, head and arms join (`up`). Without either, it runs along the principal
+/// axis from its lower end.
+#[allow(clippy::too_many_arguments)]
 fn root_bones(
-    shape: &Shape,
+    part: &Part,
     pivot: Option<Point>,
     hips: Option<Point>,
+    up: Option<Point>,
     count: usize,
+    max: usize,
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, MedialError> {
+    let shape = part.shape;
     let Some(axis) = principal_axis(shape) else {
         return Ok(Vec::new());
     };
+    let pelvis = (part.label.part == LabelPart::Pelvis).then_some(axis.centroid);
+    if let Some(start) = pivot.or(pelvis) {
+        return ray_bones(shape, start, up, count, max, medial, skeleton);
+    }
+    if let Some(hips) = hips {
+        // The spine runs through the part's middle, parallel to hips → top, from the hips'
+        // level: a quadruped's hips sit on its spine, not at its belly where the legs join.
+        let (start, toward) = match up.filter(|u| (u - hips).norm() > 1e-9) {
+            Some(u) => {
+                let d = (u - hips) / (u - hips).norm();
+                let c = axis.centroid;
+                (c + d * (hips - c).dot(&d), Some(c + d * (u - c).dot(&d)))
+            }
+            None => (hips, None),
+        };
+        return ray_bones(shape, start, toward, count, max, medial, skeleton);
+    }
     let [t0, t1] = axis.extent;
     let span = inside_reach(shape, &axis, 0.0, t0)
         .zip(inside_reach(shape, &axis, 0.0, t1))
@@ -319,43 +363,77 @@ fn root_bones(
         .filter(|&(lo, hi)| hi - lo >= skeleton.min_bone_px);
     match span {
         Some((lo, hi)) => {
-            let lo_first = match hips.or(pivot) {
-                Some(h) => (axis.at(lo) - h).norm() <= (axis.at(hi) - h).norm(),
+            // The end farther from the top's joints, else the lower end.
+            let lo_first = match up {
+                Some(u) => (axis.at(lo) - u).norm() >= (axis.at(hi) - u).norm(),
                 None => axis.at(lo).y >= axis.at(hi).y,
             };
             let (a, b) = if lo_first { (axis.at(lo), axis.at(hi)) } else { (axis.at(hi), axis.at(lo)) };
-            Ok(chain(pivot.unwrap_or(a), b, count, shape, skeleton))
+            Ok(chain(a, b, count, skeleton))
         }
-        None => medial_bones(shape, hips.or(pivot).unwrap_or(axis.centroid), medial, skeleton),
+        None => {
+            let mut grown = medial_bones(shape, axis.centroid, medial, skeleton)?;
+            super::skeleton::limit_bones(&mut grown, Some(max), shape);
+            Ok(grown)
+        }
     }
 }
 
-/// A child part's bones from its joint `joint` (canvas px): a straight bone from the joint
-/// through the part's centroid to its far side, split into `count`; or the part's medial-axis
-/// bones rooted nearest the joint when that line leaves the part early (a curved part).
-fn child_bones(
+/// The most bones a part of this label gets: one for rigid pieces (a head, a hand, a held
+/// prop), two for a whole limb or a torso, a chain for a tail.
+pub fn max_part_bones(label: &Label) -> usize {
+    use super::labels::Segment;
+    match label.part {
+        LabelPart::Tail => 10,
+        LabelPart::Unknown | LabelPart::BodyAccessory => 4,
+        LabelPart::Torso | LabelPart::HeadAccessory => 2,
+        LabelPart::Arm(Segment::Whole) | LabelPart::Leg(Segment::Whole) => 2,
+        _ => 1,
+    }
+}
+
+/// The share of a part's area a straight bone's far end may leave beyond it (thin tips: an
+/// antenna, fingertips): the far end is this upper quantile of the inside pixels' projections.
+const FAR_QUANTILE: f64 = 0.97;
+
+/// Directions tried for a one-bone part, each side of the one through its centroid, degrees.
+const ONE_BONE_SWEEP_DEG: f64 = 60.0;
+const ONE_BONE_STEP_DEG: f64 = 5.0;
+
+/// A part's bones from its joint `joint` (canvas px), at most `max` of them: a straight bone
+/// from the joint toward `toward` (default: through the part's centroid) to its far side (the
+/// [`FAR_QUANTILE`] of its pixels along that line), split into `count`; when that line leaves
+/// the part early (a curved part), the part's medial-axis bones rooted nearest the joint (at
+/// most `max`), or for a one-bone part the longest straight bone inside among directions near
+/// the first.
+fn ray_bones(
     shape: &Shape,
     joint: Point,
+    toward: Option<Point>,
     count: usize,
+    max: usize,
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, MedialError> {
     let Some(axis) = principal_axis(shape) else {
         return Ok(Vec::new());
     };
-    // Start inside the part: at the joint, or at the inside pixel nearest to it.
-    let start = if shape.contains(joint) {
+    // Start inside the part, clear of its outline: at the joint, or at the nearest inside
+    // pixel that is.
+    let clear = |p: Point| shape.segment_inside(p, p);
+    let start = if clear(joint) {
         joint
     } else {
         shape
             .inside_centers()
+            .filter(|&p| clear(p))
             .min_by(|a, b| (a - joint).norm().total_cmp(&(b - joint).norm()))
             .unwrap_or(axis.centroid)
     };
-    let to_centroid = axis.centroid - start;
+    let to_centroid = toward.unwrap_or(axis.centroid) - start;
     let extent = axis.extent[1] - axis.extent[0];
-    // The direction: through the centroid, or along the axis away from the start when the
-    // start lies near the centroid (a part overlapping its parent mostly).
+    // The direction: toward `toward` or the centroid, or along the axis away from the start
+    // when the start lies near it (a part overlapping its parent mostly).
     let direction = if to_centroid.norm() > 0.15 * extent {
         to_centroid / to_centroid.norm()
     } else if axis.project(start) <= 0.0 {
@@ -363,40 +441,74 @@ fn child_bones(
     } else {
         -axis.direction
     };
-    let line = PrincipalAxis {
+    let far_along = |d: Vec2| -> f64 {
+        let line = PrincipalAxis {
+            centroid: start,
+            direction: d,
+            extent: [0.0, 0.0],
+        };
+        let mut t: Vec<f64> = shape.inside_centers().map(|p| line.project(p)).collect();
+        t.sort_by(f64::total_cmp);
+        let k = ((t.len() as f64 - 1.0) * FAR_QUANTILE).round() as usize;
+        t.get(k).copied().unwrap_or(0.0).max(0.0)
+    };
+    let ray = |d: Vec2| PrincipalAxis {
         centroid: start,
-        direction,
+        direction: d,
         extent: [0.0, 0.0],
     };
-    let far = shape
-        .inside_centers()
-        .map(|p| line.project(p))
-        .fold(0.0f64, f64::max);
-    let reach = inside_reach(shape, &line, 0.0, far);
-    match reach {
-        Some(t) if t >= STRAIGHT_SPAN_FRACTION * far && t >= skeleton.min_bone_px.min(far) && t > 0.0 => {
-            Ok(chain(start, line.at(t), count, shape, skeleton))
-        }
-        _ => {
-            let grown = medial_bones(shape, start, medial, skeleton)?;
-            if grown.is_empty() && far > 0.0 {
-                // Too small for an axis: one bone as far as it stays inside.
-                let t = reach.unwrap_or(0.0).max(far.min(1.0));
-                return Ok(vec![ProtoBone {
-                    head: start,
-                    tail: line.at(t),
-                    parent: None,
-                    name: None,
-                }]);
-            }
-            Ok(grown)
+    let far = far_along(direction);
+    let reach = inside_reach(shape, &ray(direction), 0.0, far);
+
+    if let Some(t) = reach.filter(|&t| t >= STRAIGHT_SPAN_FRACTION * far && t > 0.0) {
+        if t >= skeleton.min_bone_px.min(far) {
+            return Ok(chain(start, ray(direction).at(t), count.min(max), skeleton));
         }
     }
+    if max > 1 {
+        let mut grown = medial_bones(shape, start, medial, skeleton)?;
+        if !grown.is_empty() {
+            super::skeleton::limit_bones(&mut grown, Some(max), shape);
+            return Ok(grown);
+        }
+    }
+    // One straight bone: the longest inside among directions near the centroid's.
+    let steps = (ONE_BONE_SWEEP_DEG / ONE_BONE_STEP_DEG) as i32;
+    let mut best: Option<(f64, Point)> = None;
+    for k in -steps..=steps {
+        let angle = (k as f64 * ONE_BONE_STEP_DEG).to_radians();
+        let (sin, cos) = angle.sin_cos();
+        let d = Vec2::new(
+            direction.x * cos - direction.y * sin,
+            direction.x * sin + direction.y * cos,
+        );
+        let far = far_along(d);
+        if far <= 0.0 {
+            continue;
+        }
+        let Some(t) = inside_reach(shape, &ray(d), 0.0, far) else {
+            continue;
+        };
+        // Longer is better; straying from the centroid's direction costs.
+        let score = t * cos;
+        if best.is_none_or(|b| score > b.0) {
+            best = Some((score, ray(d).at(t)));
+        }
+    }
+    Ok(match best {
+        Some((_, tail)) if (tail - start).norm() > 1e-6 => vec![ProtoBone {
+            head: start,
+            tail,
+            parent: None,
+            name: None,
+        }],
+        _ => Vec::new(),
+    })
 }
 
 /// `count` bones in a chain from `a` to `b` (equal lengths; one bone when shorter pieces
 /// would fall under the minimum bone length).
-fn chain(a: Point, b: Point, count: usize, _shape: &Shape, skeleton: &SkeletonOptions) -> Vec<ProtoBone> {
+fn chain(a: Point, b: Point, count: usize, skeleton: &SkeletonOptions) -> Vec<ProtoBone> {
     let length = (b - a).norm();
     let count = if count > 1 && length / count as f64 >= skeleton.min_bone_px { count } else { 1 };
     (0..count)

@@ -320,8 +320,8 @@ fn layered_bones(
         Some(t) => t,
         None => match labels::template_from_labels(&part_labels) {
             Some((t, why)) => {
-                notes.push(format!("template: {} ({why})", template_name(Some(t))));
-                Some(t)
+                notes.push(format!("template: {} ({why})", template_name(t)));
+                t
             }
             None => {
                 let unmerged = MedialOptions {
