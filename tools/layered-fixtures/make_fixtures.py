@@ -2,6 +2,7 @@
 most art pipelines use), and each file's flattened image as psd-tools composites it.
 
 Usage: make_fixtures.py OUT_DIR | --krita-source FILE.psd | --pivots FILE.psd
+                         | --bundled FILE.psd
 
 Writes (all small):
   character.psd           RGB, groups (arm_l/upper, arm_l/hand), a hidden layer, an [ignore]
@@ -18,6 +19,12 @@ Writes (all small):
   spine/character.json + spine/*.png
                           the layout GimpToSpine.py writes (trimmed PNGs, centre positions
                           relative to the canvas's bottom centre, y up), from character.psd
+  bundled_character.psd   the bundled demo character (assets/character): 512x512 RGB, one RLE
+                          pixel layer per name in layers.json, same names, same order (first =
+                          bottom), each trimmed to its non-transparent bounding box and placed at
+                          its offset, alpha as the transparency channel, no masks (as Photoshop
+                          stores layers); merged composite on white
+                          (--bundled FILE.psd writes just this one)
 """
 
 import json
@@ -32,6 +39,8 @@ from psd_tools.api.layers import Group, PixelLayer
 from psd_tools.constants import Compression
 
 W, H = 120, 160
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+CHARACTER = os.path.join(ROOT, "assets", "character")
 
 
 def shape(size, color, kind="ellipse", alpha=255):
@@ -140,6 +149,7 @@ def main(out):
     PSDImage.new("CMYK", (4, 4)).save(os.path.join(out, "cmyk.psd"))
     spine_layout(PSDImage.open(os.path.join(out, "character.psd")), os.path.join(out, "spine"))
     pivots(os.path.join(out, "pivots.psd"))
+    bundled(os.path.join(out, "bundled_character.psd"))
 
 
 def pivots(path):
@@ -159,6 +169,28 @@ def pivots(path):
     psd.save(path)
 
 
+def bundled(path):
+    """assets/character's layers (512x512 straight-alpha PNGs, named back to front in
+    layers.json) as a layered PSD: each layer cropped to the box of its non-transparent pixels
+    and placed at that box's offset, alpha in its transparency channel (no layer mask), RLE
+    compressed; the merged image is psd-tools' composite() over white (as Photoshop's
+    "maximize compatibility" composite)."""
+    with open(os.path.join(CHARACTER, "layers.json")) as f:
+        doc = json.load(f)
+    w, h = doc["canvas"]
+    psd = PSDImage.new("RGB", (w, h), color=255, compression=Compression.RLE)
+    for name in doc["layers"]:
+        im = Image.open(os.path.join(CHARACTER, name + ".png")).convert("RGBA")
+        assert im.size == (w, h), (name, im.size)
+        box = im.getchannel("A").getbbox()
+        assert box is not None, name
+        # fromarray() with a fourth channel stores it as the layer's transparency channel,
+        # as Photoshop does (frompil() on an RGB document stores it as a user mask instead).
+        PixelLayer.fromarray(np.asarray(im.crop(box)), psd, name, top=box[1], left=box[0],
+                             compression=Compression.RLE)
+    psd.save(path)
+
+
 def krita_source(path):
     """The character with its `[ignore]` layer hidden: what Krita opens and re-exports (Krita
     draws every visible layer in its merged image; sinew drops tagged ones)."""
@@ -174,5 +206,7 @@ if __name__ == "__main__":
         krita_source(sys.argv[2])
     elif sys.argv[1] == "--pivots":
         pivots(sys.argv[2])
+    elif sys.argv[1] == "--bundled":
+        bundled(sys.argv[2])
     else:
         main(sys.argv[1])
