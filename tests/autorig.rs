@@ -342,73 +342,109 @@ fn character_layers() -> Vec<(String, RgbaImage)> {
         .collect()
 }
 
-#[test]
-fn layers_give_one_bone_per_part_parented_through_overlaps() {
+/// The bundled character's layers, proposed as a layered file is (automatic template).
+fn character_proposal() -> (Vec<(String, RgbaImage)>, sinew::autorig::Proposal) {
     let layers = character_layers();
-    let refs: Vec<(&str, &RgbaImage)> = layers.iter().map(|(n, i)| (n.as_str(), i)).collect();
-    let h = propose(&refs, &AutorigOptions::default());
-    let by_name: HashMap<&str, &sinew::rig::Bone> =
-        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    let refs: Vec<LayerRef> = layers.iter().map(|(n, i)| LayerRef::whole(n, i)).collect();
+    let proposal = autorig(&refs, &[], &AutorigOptions::default()).expect("autorig");
+    (layers, proposal)
+}
+
+#[test]
+fn layers_are_body_parts_with_their_own_bones_bound_to_them() {
+    let (layers, proposal) = character_proposal();
+    let h = &proposal.handles;
+    assert_eq!(proposal.template, Some(sinew::autorig::Template::Humanoid));
     for (name, image) in &layers {
-        let bone = by_name
-            .get(name.as_str())
-            .unwrap_or_else(|| panic!("part {name} has no bone"));
-        // Each part's bones lie inside it and are bound to it.
+        // Every part has a bone; each bone is bound to its part alone and lies inside it.
+        let own: Vec<&sinew::rig::Bone> =
+            h.bones.iter().filter(|b| h.bind[&b.name] == vec![name.clone()]).collect();
+        assert!(!own.is_empty(), "part {name} has no bone");
         let shape = traced(image);
-        for b in h
-            .bones
-            .iter()
-            .filter(|b| h.bind[&b.name] == vec![name.clone()])
-        {
-            let (p, q) = (pt(b.head), pt(b.tail));
+        for b in own {
             assert!(
-                shape.segment_inside(p, q),
+                shape.segment_inside(pt(b.head), pt(b.tail)),
                 "bone {} leaves part {name}",
                 b.name
             );
         }
-        assert_eq!(h.bind[&bone.name], vec![name.clone()]);
     }
-    let parent = |n: &str| by_name[n].parent.as_deref();
-    assert_eq!(parent("arm_lower_l"), Some("arm_upper_l"));
-    assert_eq!(parent("arm_lower_r"), Some("arm_upper_r"));
-    assert_eq!(parent("leg_lower_l"), Some("leg_upper_l"));
-    assert_eq!(parent("leg_lower_r"), Some("leg_upper_r"));
-    assert_eq!(
-        parent("bag"),
-        Some("arm_lower_r"),
-        "the lantern hangs from the hand"
-    );
-    assert_eq!(parent("arm_upper_l"), Some("torso"));
-    assert_eq!(parent("leg_upper_r"), Some("torso"));
-    // One skeleton, rooted at the largest part.
-    let roots: Vec<&str> = h
-        .bones
-        .iter()
-        .filter(|b| b.parent.is_none())
-        .map(|b| b.name.as_str())
-        .collect();
-    let largest = layers
-        .iter()
-        .max_by(|a, b| traced(&a.1).area_px2.total_cmp(&traced(&b.1).area_px2))
-        .unwrap();
-    assert_eq!(roots, vec![largest.0.as_str()]);
+    assert!(h.bones.iter().all(|b| h.bind[&b.name].len() == 1), "a bone weighs two parts");
 }
 
 #[test]
-fn parts_that_overlap_nothing_start_their_own_skeleton() {
+fn layered_hierarchy_is_what_an_animator_builds() {
+    let (layers, proposal) = character_proposal();
+    let h = &proposal.handles;
+    let by_name: HashMap<&str, &sinew::rig::Bone> =
+        h.bones.iter().map(|b| (b.name.as_str(), b)).collect();
+    let parent = |n: &str| by_name[n].parent.as_deref();
+    let part_of = |n: &str| h.bind[n][0].as_str();
+    // The root at the hips: the torso's lower bone, from its bottom up.
+    let roots: Vec<&str> = h.bones.iter().filter(|b| b.parent.is_none()).map(|b| b.name.as_str()).collect();
+    assert_eq!(roots, ["hip"]);
+    assert_eq!(part_of("hip"), "torso");
+    assert_eq!(parent("chest"), Some("hip"));
+    assert!(by_name["hip"].head[1] > by_name["chest"].tail[1], "the spine runs up");
+    // Limbs: template names from the layer names, chains joined at the layers' seams.
+    for side in ["l", "r"] {
+        let bone = |n: &str| format!("{n}_{side}");
+        assert_eq!(parent(&bone("arm_upper")), Some("chest"));
+        assert_eq!(parent(&bone("arm_lower")), Some(bone("arm_upper").as_str()));
+        assert_eq!(parent(&bone("leg_upper")), Some("hip"));
+        assert_eq!(parent(&bone("leg_lower")), Some(bone("leg_upper").as_str()));
+        for limb in ["arm", "leg"] {
+            let (upper, lower) = (by_name[bone(&format!("{limb}_upper")).as_str()], by_name[bone(&format!("{limb}_lower")).as_str()]);
+            assert_eq!(upper.tail, lower.head, "{limb}_{side} is not one chain");
+        }
+    }
+    // The tail hangs from the hips, not from a thigh it passes behind; the lantern from the
+    // hand that holds it; the head from the chest, turning at the neck.
+    let tail_root = h
+        .bones
+        .iter()
+        .find(|b| part_of(&b.name) == "tail" && by_name[b.parent.as_deref().unwrap()].name != b.name && part_of(b.parent.as_deref().unwrap()) != "tail")
+        .expect("a tail bone hangs from another part");
+    assert_eq!(tail_root.parent.as_deref(), Some("hip"));
+    let bag = h.bones.iter().find(|b| part_of(&b.name) == "bag").expect("the lantern has a bone");
+    assert_eq!(bag.parent.as_deref(), Some("arm_lower_r"));
+    assert_eq!(parent("head"), Some("chest"));
+    let head_image = &layers.iter().find(|l| l.0 == "head").unwrap().1;
+    let head_shape = traced(head_image);
+    let torso_shape = traced(&layers.iter().find(|l| l.0 == "torso").unwrap().1);
+    let pivot = pt(by_name["head"].head);
+    assert!(
+        head_shape.contains(pivot) && torso_shape.contains(pivot),
+        "the head turns where it overlaps the torso (the neck), not at {pivot:?}"
+    );
+    assert!(by_name["head"].tail[1] < by_name["head"].head[1], "the head bone points up");
+    // Nothing is named extra_N or bone_N: every bone has a template or layer name.
+    assert!(h.bones.iter().all(|b| !b.name.starts_with("extra_") && !b.name.starts_with("bone_")));
+}
+
+#[test]
+fn parts_that_overlap_nothing_hang_from_the_nearest_part() {
     let mut a = Pixmap::new(200, 100).unwrap();
     capsules(&mut a, &[((20.0, 50.0), (80.0, 50.0))], 20.0);
     let mut b = Pixmap::new(200, 100).unwrap();
     capsules(&mut b, &[((120.0, 30.0), (180.0, 70.0))], 20.0);
     let (a, b) = (to_rgba(&a), to_rgba(&b));
-    let h = propose(&[("a", &a), ("b", &b)], &AutorigOptions::default());
+    let options = AutorigOptions {
+        template: TemplateChoice::None,
+        ..AutorigOptions::default()
+    };
+    let h = propose(&[("a", &a), ("b", &b)], &options);
     assert_eq!(h.bones.len(), 2);
-    assert!(h.bones.iter().all(|b| b.parent.is_none()));
-    // Along the principal axis: the capsules' axes.
+    // The larger capsule is the root, along its axis; the other hangs from it, its bone
+    // from the joint (their closest points) along its own axis.
     let bb = h.bones.iter().find(|x| x.name == "b").unwrap();
+    assert_eq!(bb.parent, None);
     let dir = pt(bb.tail) - pt(bb.head);
     assert!((dir.y / dir.x - 40.0 / 60.0).abs() < 0.05, "{dir:?}");
+    let ba = h.bones.iter().find(|x| x.name == "a").unwrap();
+    assert_eq!(ba.parent.as_deref(), Some("b"));
+    assert!(ba.head[0] > ba.tail[0], "a's bone starts at its end nearer b");
+    assert!((ba.head[1] - ba.tail[1]).abs() < 3.0, "a's bone follows its axis");
 }
 
 // ---------------------------------------------------------------- cages and points
@@ -746,6 +782,106 @@ fn proposed_rig_over_the_character_matches_golden() {
         "autorig",
         common::golden::premultiplied_tolerance,
     );
+}
+
+#[test]
+fn layered_proposal_over_the_character_matches_golden() {
+    let (layers, proposal) = character_proposal();
+    let refs: Vec<LayerRef> = layers.iter().map(|(n, i)| LayerRef::whole(n, i)).collect();
+    let actual = sinew::autorig::draw_preview(&refs, &proposal.handles).unwrap();
+    common::golden::check(
+        "autorig_layered_character",
+        &actual,
+        "autorig",
+        common::golden::premultiplied_tolerance,
+    );
+}
+
+/// The bundled character's layers rigged with the automatic proposal (template, binding) and
+/// posed: the head turned at the neck, an arm raised, the tail swung, a knee bent. Every part
+/// must move with its own bones only (no tearing across the layers' seams).
+#[cfg(feature = "cli")]
+#[test]
+fn layered_proposal_rigged_and_posed_matches_golden() {
+    let tmp = scratch("layered-posed");
+    let dir = tmp.path();
+    let paths: Vec<String> = character_layers()
+        .into_iter()
+        .map(|(n, _)| assets().join(format!("{n}.png")).to_str().unwrap().to_string())
+        .collect();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let (handles, rig, posed, pose) = (
+        dir.join("h.json"),
+        dir.join("rig.json"),
+        dir.join("posed.png"),
+        dir.join("pose.json"),
+    );
+    let run = |head: &[&str], tail: &[String]| {
+        let mut args: Vec<String> = head.iter().map(|a| a.to_string()).collect();
+        args.extend(tail.iter().cloned());
+        let argv: Vec<&str> = args.iter().map(String::as_str).collect();
+        sinew(&argv)
+    };
+    let out = run(&["autorig"], &[paths.clone(), vec!["-o".into(), s(&handles)]].concat());
+    ok(&out, "autorig");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("template: humanoid"));
+    ok(
+        &run(&["rig"], &[paths, vec!["--handles".into(), s(&handles), "-o".into(), s(&rig)]].concat()),
+        "rig",
+    );
+    std::fs::write(
+        &pose,
+        r#"{"bones": {"head": {"rotate": -20}, "arm_upper_l": {"rotate": 70},
+            "arm_lower_l": {"rotate": 30}, "leg_lower_r": {"rotate": 25},
+            "tail": {"rotate": 20}, "chest": {"rotate": 8}}}"#,
+    )
+    .unwrap();
+    ok(
+        &sinew(&["pose", &s(&rig), "--pose", &s(&pose), "-o", &s(&posed)]),
+        "pose",
+    );
+    common::golden::check(
+        "autorig_layered_posed",
+        &load(&posed),
+        "autorig",
+        common::golden::premultiplied_tolerance,
+    );
+}
+
+/// `sinew autorig` on a PSD of the bundled character's layers (written by psd-tools, each
+/// layer trimmed to its pixels and placed at its offset) proposes the rig the PNG layers get,
+/// and its `--preview` is the whole canvas with the bones drawn over the composite.
+#[cfg(feature = "cli")]
+#[test]
+fn a_psd_of_the_layers_gets_the_same_rig_and_a_whole_canvas_preview() {
+    let tmp = scratch("psd");
+    let dir = tmp.path();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let psd = root().join("tests/fixtures/layered/bundled_character.psd");
+    let (from_psd, preview) = (dir.join("psd.json"), dir.join("preview.png"));
+    ok(
+        &sinew(&["autorig", &s(&psd), "-o", &s(&from_psd), "--preview", &s(&preview)]),
+        "autorig psd",
+    );
+    let psd_handles: Handles =
+        serde_json::from_str(&std::fs::read_to_string(&from_psd).unwrap()).unwrap();
+    let (_, png) = character_proposal();
+    let png_handles = png.handles;
+    assert_eq!(psd_handles.bind, png_handles.bind);
+    assert_eq!(psd_handles.bones.len(), png_handles.bones.len());
+    for (a, b) in psd_handles.bones.iter().zip(&png_handles.bones) {
+        assert_eq!((&a.name, &a.parent), (&b.name, &b.parent));
+        // Trimmed layers trace to within a tenth of a pixel of whole-canvas ones.
+        let d = (pt(a.head) - pt(b.head)).norm().max((pt(a.tail) - pt(b.tail)).norm());
+        assert!(d < 0.1, "{}: {d} px", a.name);
+    }
+    let picture = load(&preview);
+    assert_eq!(picture.dimensions(), (512, 512));
+    // The hip bone's kite (a root bone, drawn red) over the torso.
+    let hip = &psd_handles.bones.iter().find(|b| b.name == "hip").unwrap();
+    let mid = pt(hip.head) + (pt(hip.tail) - pt(hip.head)) * 0.5;
+    let px = picture.get_pixel(mid.x as u32, mid.y as u32);
+    assert!(px[0] > px[1] + 40 && px[0] > px[2] + 40, "no red root bone at {mid:?}: {px:?}");
 }
 
 // ---------------------------------------------------------------- the evaluation set

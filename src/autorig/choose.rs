@@ -108,20 +108,28 @@ fn quadruped_doubt(bones: &[ProtoBone], frame: &Frame) -> Option<String> {
     None
 }
 
-/// The plausible template for the drawing, its fitted bones and why; `None` when neither
-/// fits plausibly.
+/// The plausible template for the drawing, its fitted bones and why; or, when neither fits
+/// plausibly, why not (each template's first doubt).
 pub fn choose_template(
     axis: &AxisGraph,
     shape: &Shape,
     options: &SkeletonOptions,
-) -> Option<(Template, Vec<ProtoBone>, String)> {
+) -> Result<(Template, Vec<ProtoBone>, String), String> {
     let frame = Frame::of(shape);
-    let fit = |t: Template| -> Option<Vec<ProtoBone>> { fit_template(axis, shape, t, options) };
-    let humanoid = fit(Template::Humanoid).filter(|b| humanoid_doubt(b, &frame).is_none());
-    let quadruped = fit(Template::Quadruped).filter(|b| quadruped_doubt(b, &frame).is_none());
+    let judge = |t: Template, doubt: fn(&[ProtoBone], &Frame) -> Option<String>| {
+        match fit_template(axis, shape, t, options) {
+            None => Err("no assignment of its limbs to the drawing's extremities".to_string()),
+            Some(bones) => match doubt(&bones, &frame) {
+                Some(why) => Err(why),
+                None => Ok(bones),
+            },
+        }
+    };
+    let humanoid = judge(Template::Humanoid, humanoid_doubt);
+    let quadruped = judge(Template::Quadruped, quadruped_doubt);
     let aspect = frame.w / frame.h;
     match (humanoid, quadruped) {
-        (Some(h), Some(q)) => Some(if aspect > 1.0 {
+        (Ok(h), Ok(q)) => Ok(if aspect > 1.0 {
             (
                 Template::Quadruped,
                 q,
@@ -134,16 +142,16 @@ pub fn choose_template(
                 format!("both fit; the drawing is taller than wide ({aspect:.2})"),
             )
         }),
-        (Some(h), None) => Some((
+        (Ok(h), Err(_)) => Ok((
             Template::Humanoid,
             h,
             "two arms, two legs standing on the ground and a head above the hips".into(),
         )),
-        (None, Some(q)) => Some((
+        (Err(_), Ok(q)) => Ok((
             Template::Quadruped,
             q,
             "four legs standing on the ground under a level spine".into(),
         )),
-        (None, None) => None,
+        (Err(h), Err(q)) => Err(format!("humanoid: {h}; quadruped: {q}")),
     }
 }

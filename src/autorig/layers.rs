@@ -421,20 +421,37 @@ fn ray_bones(
     // Start inside the part, clear of its outline: at the joint, or at the nearest inside
     // pixel that is.
     let clear = |p: Point| shape.segment_inside(p, p);
-    let start = if clear(joint) {
-        joint
+    // A part drawn apart from its parent (the joint outside it) starts at the end of its own
+    // axis nearer the joint, and runs along that axis: a floating hand along the hand.
+    let apart = toward.is_none() && !shape.contains(joint);
+    let axis_end = {
+        let toward_joint = if axis.project(joint) >= 0.0 { axis.extent[1] } else { axis.extent[0] };
+        inside_reach(shape, &axis, 0.0, toward_joint).map(|t| axis.at(t))
+    };
+    let anchor = match axis_end {
+        Some(end) if apart => end,
+        _ => joint,
+    };
+    let start = if clear(anchor) {
+        anchor
     } else {
         shape
             .inside_centers()
             .filter(|&p| clear(p))
-            .min_by(|a, b| (a - joint).norm().total_cmp(&(b - joint).norm()))
+            .min_by(|a, b| (a - anchor).norm().total_cmp(&(b - anchor).norm()))
             .unwrap_or(axis.centroid)
     };
     let to_centroid = toward.unwrap_or(axis.centroid) - start;
     let extent = axis.extent[1] - axis.extent[0];
     // The direction: toward `toward` or the centroid, or along the axis away from the start
-    // when the start lies near it (a part overlapping its parent mostly).
-    let direction = if to_centroid.norm() > 0.15 * extent {
+    // when the start lies near it (a part overlapping its parent mostly) or the part is apart.
+    let direction = if apart && axis_end.is_some() {
+        if axis.project(start) <= 0.0 {
+            axis.direction
+        } else {
+            -axis.direction
+        }
+    } else if to_centroid.norm() > 0.15 * extent {
         to_centroid / to_centroid.norm()
     } else if axis.project(start) <= 0.0 {
         axis.direction

@@ -248,14 +248,14 @@ fn drawing_bones(
         None => {
             let axis = medial::medial_axis(silhouette, &unmerged)?;
             match choose::choose_template(&axis, silhouette, so) {
-                Some((t, bones, why)) => {
+                Ok((t, bones, why)) => {
                     notes.push(format!("template: {} ({why})", template_name(Some(t))));
                     (bones, Some(t))
                 }
-                None => {
+                Err(why) => {
                     notes.push(format!(
-                        "template: none (neither the humanoid nor the quadruped template fits \
-                         the drawing's limbs): bones from the medial axis"
+                        "template: none (neither template fits: {why}); bones from the medial \
+                         axis"
                     ));
                     let axis = medial::medial_axis(silhouette, &options.medial)?;
                     (skeleton::medial_skeleton(&axis, silhouette, so), None)
@@ -330,7 +330,7 @@ fn layered_bones(
                 };
                 let axis = medial::medial_axis(silhouette, &unmerged)?;
                 match choose::choose_template(&axis, silhouette, so) {
-                    Some((t, _, why)) => {
+                    Ok((t, _, why)) => {
                         notes.push(format!(
                             "template: {} ({why}; the layer names tell no limbs, so bones are \
                              named after the layers)",
@@ -338,12 +338,11 @@ fn layered_bones(
                         ));
                         Some(t)
                     }
-                    None => {
-                        notes.push(
+                    Err(why) => {
+                        notes.push(format!(
                             "template: none (the layer names tell no limbs and neither \
-                             template fits the drawing): one bone per layer, named after it"
-                                .into(),
-                        );
+                             template fits the drawing: {why}): bones per layer, named after it"
+                        ));
                         None
                     }
                 }
