@@ -1,20 +1,20 @@
-//! Which template a drawing is: humanoid, quadruped or neither, from its shape alone.
+//! Which template a drawing is: humanoid, quadruped or neither, from its shape alone, and
+//! whether a template's fit is plausible.
 //!
-//! In: the drawing's medial axis (unmerged junctions, as [`super::template`] fits on), its
-//! [`Shape`] and the [`SkeletonOptions`]. Out: the template, the fitted bones and a reason
-//! for the person, or `None` when no template is plausible (then the caller rigs the medial
-//! axis, and no limb names land on props).
+//! In: the drawing's [`Shape`] (canvas px, y down); for a fit, its medial axis (unmerged
+//! junctions, as [`super::template`] fits on) and the [`SkeletonOptions`].
 //!
-//! Each template is fitted ([`fit_template`]) and its fit judged by what its named bones say
-//! of the body in the drawing's box (y down, heights as fractions of the box):
+//! [`classify`] reads the silhouette's box and the runs of pixels across its rows (legs
+//! below, a body across the middle). [`fit_plausibly`] fits a template ([`fit_template`])
+//! and judges the fit by what its named bones say of the body in the drawing's box (heights
+//! as fractions of the box), so that a fit that would put limb names on props is refused
+//! (the caller then rigs the medial axis):
 //! - humanoid: the head above the hips; each leg reaches the lowest [`FOOT_BAND`] of the
 //!   box and is at least [`MIN_LEG_FRACTION`] of the height long; legs long enough for a
 //!   body and not arms alone. A bust (head and shoulders, nothing reaching the bottom as
 //!   legs do) is no humanoid here: its arms and head stay on the medial axis.
 //! - quadruped: a spine more level than upright, four legs reaching the lowest
 //!   [`FOOT_BAND`], the box wider than tall.
-//!
-//! When both are plausible, the box's aspect decides (wider than tall: quadruped).
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
@@ -108,50 +108,113 @@ fn quadruped_doubt(bones: &[ProtoBone], frame: &Frame) -> Option<String> {
     None
 }
 
-/// The plausible template for the drawing, its fitted bones and why; or, when neither fits
-/// plausibly, why not (each template's first doubt).
-pub fn choose_template(
+/// Rows (fractions of the box's height from the top) where legs are counted.
+const LEG_ROWS: [f64; 2] = [0.88, 0.94];
+/// A run of opaque pixels narrower than this fraction of the box's width is noise, not a leg.
+const MIN_RUN_FRACTION: f64 = 0.015;
+/// A leg's run is at most this fraction of the box's width (wider: a bust's shoulders, a
+/// dress's hem, a belly).
+const MAX_LEG_FRACTION: f64 = 0.3;
+/// Wider than tall by this much (width / height): drawn lying or walking on four legs.
+const WIDE_ASPECT: f64 = 1.0;
+/// Rows across the body's middle (fractions of the height from the top): a quadruped's
+/// trunk fills at least [`MIN_TRUNK_FRACTION`] of the width on one of them.
+const TRUNK_ROWS: [f64; 3] = [0.4, 0.5, 0.6];
+const MIN_TRUNK_FRACTION: f64 = 0.45;
+
+/// The runs of inside pixels along the row at height `v` of the box (fractions of the width).
+fn runs(shape: &Shape, frame: &Frame, v: f64) -> Vec<f64> {
+    let y = (frame.lo.y + v * frame.h).floor();
+    if y < 0.0 || y >= f64::from(shape.height) {
+        return Vec::new();
+    }
+    let (w, row) = (shape.width as usize, y as usize);
+    let x0 = frame.lo.x.max(0.0) as usize;
+    let x1 = ((frame.lo.x + frame.w).ceil() as usize + 1).min(w);
+    let mut out = Vec::new();
+    let mut run = 0usize;
+    for x in x0..=x1 {
+        if x < x1 && shape.inside[row * w + x] {
+            run += 1;
+        } else if run > 0 {
+            out.push(run as f64 / frame.w);
+            run = 0;
+        }
+    }
+    out.retain(|&r| r >= MIN_RUN_FRACTION);
+    out
+}
+
+/// What the drawing's shape says it is, and why: wider than tall and standing on two or more
+/// legs (narrow runs of pixels across its lowest rows) is a quadruped; wider than tall with
+/// nothing standing under it (a fish, a bird in flight, a kite on its side) is no template;
+/// standing on three or more legs is a quadruped; anything else upright is a humanoid (a bust
+/// too: its shoulders fill its lowest rows).
+pub fn classify(shape: &Shape) -> (Option<Template>, String) {
+    let frame = Frame::of(shape);
+    let aspect = frame.w / frame.h;
+    // Legs: narrow runs on every leg row (the fewest); a wide run is a base, not legs.
+    let (legs, wide) = LEG_ROWS
+        .iter()
+        .map(|&v| {
+            let r = runs(shape, &frame, v);
+            let legs = r.iter().filter(|&&x| x <= MAX_LEG_FRACTION).count();
+            let wide = r.iter().any(|&x| x > MAX_LEG_FRACTION);
+            (legs, wide)
+        })
+        .fold((usize::MAX, false), |(l, w), (l2, w2)| (l.min(l2), w || w2));
+    let trunk = TRUNK_ROWS
+        .iter()
+        .flat_map(|&v| runs(shape, &frame, v))
+        .fold(0.0f64, f64::max);
+    if aspect >= WIDE_ASPECT {
+        if legs >= 2 && trunk >= MIN_TRUNK_FRACTION {
+            return (
+                Some(Template::Quadruped),
+                format!("{aspect:.2} times wider than tall, standing on {legs} legs"),
+            );
+        }
+        if wide {
+            return (
+                Some(Template::Humanoid),
+                format!("{aspect:.2} times wider than tall, on a wide base: a bust"),
+            );
+        }
+        if legs < 2 {
+            return (
+                None,
+                format!("{aspect:.2} times wider than tall with no legs under it"),
+            );
+        }
+    }
+    if legs >= 3 {
+        return (
+            Some(Template::Quadruped),
+            format!("standing on {legs} legs"),
+        );
+    }
+    (
+        Some(Template::Humanoid),
+        format!("upright ({aspect:.2} as wide as tall) on {legs} legs or a base"),
+    )
+}
+
+/// `template` fitted to the drawing, or why it does not fit plausibly.
+pub fn fit_plausibly(
     axis: &AxisGraph,
     shape: &Shape,
+    template: Template,
     options: &SkeletonOptions,
-) -> Result<(Template, Vec<ProtoBone>, String), String> {
+) -> Result<Vec<ProtoBone>, String> {
     let frame = Frame::of(shape);
-    let judge = |t: Template, doubt: fn(&[ProtoBone], &Frame) -> Option<String>| {
-        match fit_template(axis, shape, t, options) {
-            None => Err("no assignment of its limbs to the drawing's extremities".to_string()),
-            Some(bones) => match doubt(&bones, &frame) {
-                Some(why) => Err(why),
-                None => Ok(bones),
-            },
-        }
+    let bones = fit_template(axis, shape, template, options)
+        .ok_or_else(|| "no assignment of its limbs to the drawing's extremities".to_string())?;
+    let doubt = match template {
+        Template::Humanoid => humanoid_doubt(&bones, &frame),
+        Template::Quadruped => quadruped_doubt(&bones, &frame),
     };
-    let humanoid = judge(Template::Humanoid, humanoid_doubt);
-    let quadruped = judge(Template::Quadruped, quadruped_doubt);
-    let aspect = frame.w / frame.h;
-    match (humanoid, quadruped) {
-        (Ok(h), Ok(q)) => Ok(if aspect > 1.0 {
-            (
-                Template::Quadruped,
-                q,
-                format!("both fit; the drawing is {aspect:.2} times wider than tall"),
-            )
-        } else {
-            (
-                Template::Humanoid,
-                h,
-                format!("both fit; the drawing is taller than wide ({aspect:.2})"),
-            )
-        }),
-        (Ok(h), Err(_)) => Ok((
-            Template::Humanoid,
-            h,
-            "two arms, two legs standing on the ground and a head above the hips".into(),
-        )),
-        (Err(_), Ok(q)) => Ok((
-            Template::Quadruped,
-            q,
-            "four legs standing on the ground under a level spine".into(),
-        )),
-        (Err(h), Err(q)) => Err(format!("humanoid: {h}; quadruped: {q}")),
+    match doubt {
+        Some(why) => Err(why),
+        None => Ok(bones),
     }
 }

@@ -375,12 +375,14 @@ pub fn template_from_labels(labels: &[Label]) -> Option<(Option<Template>, Strin
         .iter()
         .filter(|l| matches!(l.part, Part::Leg(Segment::Upper | Segment::Whole)))
         .count();
-    // Legs at both a front and a back, more than two of them (a side view's near and far
-    // foot are "front" and "back" too).
-    let both_ends = [End::Front, End::Back]
-        .iter()
-        .all(|e| legs.iter().any(|l| l.end == Some(*e)));
-    if (both_ends && legs.len() > 2) || (arms == 0 && limbs > 2) {
+    // Legs (thighs or whole legs, not feet: a side view's near and far foot are "front" and
+    // "back" too) at both a front and a back.
+    let both_ends = [End::Front, End::Back].iter().all(|e| {
+        legs.iter().any(|l| {
+            l.end == Some(*e) && matches!(l.part, Part::Leg(Segment::Upper | Segment::Whole))
+        })
+    });
+    if both_ends || (arms == 0 && limbs > 2) {
         return Some((
             Some(Template::Quadruped),
             format!("the layer names give {} leg parts at a front and a back", legs.len()),
@@ -496,6 +498,8 @@ mod tests {
         );
         assert_eq!(t(&["head", "body", "leg 1", "leg 2", "leg 3", "leg 4"]), Some(Template::Quadruped));
         assert_eq!(t(&["blade", "hilt"]), None);
+        assert_eq!(t(&["head", "front legs", "body", "tail", "hind legs"]), Some(Template::Quadruped));
+        assert_eq!(t(&["Flipper_Front", "Foot_Front", "Head", "Body", "Foot_Back"]), Some(Template::Humanoid));
         assert_eq!(t(&["head", "body"]), Some(Template::Humanoid));
         assert_eq!(t(&["hand", "foot_front", "body", "foot_back"]), Some(Template::Humanoid));
         let said = |ns: &[&str]| template_from_labels(&names(ns)).map(|t| t.0);

@@ -465,9 +465,13 @@ fn ray_bones(
             extent: [0.0, 0.0],
         };
         let mut t: Vec<f64> = shape.inside_centers().map(|p| line.project(p)).collect();
-        t.sort_by(f64::total_cmp);
+        if t.is_empty() {
+            return 0.0;
+        }
         let k = ((t.len() as f64 - 1.0) * FAR_QUANTILE).round() as usize;
-        t.get(k).copied().unwrap_or(0.0).max(0.0)
+        // The quantile by selection: no full sort (this runs once per direction tried).
+        let (_, far, _) = t.select_nth_unstable_by(k, f64::total_cmp);
+        far.max(0.0)
     };
     let ray = |d: Vec2| PrincipalAxis {
         centroid: start,

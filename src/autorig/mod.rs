@@ -246,17 +246,22 @@ fn drawing_bones(
             (skeleton::medial_skeleton(&axis, silhouette, so), None)
         }
         None => {
+            let (class, why) = choose::classify(silhouette);
+            notes.push(format!("template: {} ({why})", template_name(class)));
             let axis = medial::medial_axis(silhouette, &unmerged)?;
-            match choose::choose_template(&axis, silhouette, so) {
-                Ok((t, bones, why)) => {
-                    notes.push(format!("template: {} ({why})", template_name(Some(t))));
-                    (bones, Some(t))
-                }
-                Err(why) => {
+            match class.map(|t| (t, choose::fit_plausibly(&axis, silhouette, t, so))) {
+                Some((t, Ok(bones))) => (bones, Some(t)),
+                Some((t, Err(doubt))) => {
+                    // No limb names on what may be a prop: a clean generic skeleton.
                     notes.push(format!(
-                        "template: none (neither template fits: {why}); bones from the medial \
-                         axis"
+                        "the drawing does not match the {} template ({doubt}): bones from the \
+                         medial axis",
+                        template_name(Some(t))
                     ));
+                    let axis = medial::medial_axis(silhouette, &options.medial)?;
+                    (skeleton::medial_skeleton(&axis, silhouette, so), Some(t))
+                }
+                None => {
                     let axis = medial::medial_axis(silhouette, &options.medial)?;
                     (skeleton::medial_skeleton(&axis, silhouette, so), None)
                 }
@@ -324,28 +329,13 @@ fn layered_bones(
                 t
             }
             None => {
-                let unmerged = MedialOptions {
-                    junction_merge_ratio: 0.0,
-                    ..options.medial.clone()
-                };
-                let axis = medial::medial_axis(silhouette, &unmerged)?;
-                match choose::choose_template(&axis, silhouette, so) {
-                    Ok((t, _, why)) => {
-                        notes.push(format!(
-                            "template: {} ({why}; the layer names tell no limbs, so bones are \
-                             named after the layers)",
-                            template_name(Some(t))
-                        ));
-                        Some(t)
-                    }
-                    Err(why) => {
-                        notes.push(format!(
-                            "template: none (the layer names tell no limbs and neither \
-                             template fits the drawing: {why}): bones per layer, named after it"
-                        ));
-                        None
-                    }
-                }
+                let (class, why) = choose::classify(silhouette);
+                notes.push(format!(
+                    "template: {} ({why}; the layer names tell no body parts, so bones are \
+                     named after the layers)",
+                    template_name(class)
+                ));
+                class
             }
         },
     };
