@@ -61,7 +61,8 @@ fn one(image: &RgbaImage) -> Handles {
 /// (to look at a failing case).
 fn dump(name: &str, image: &RgbaImage, handles: &Handles) {
     if let Some(dir) = std::env::var_os("SINEW_AUTORIG_DUMP") {
-        let picture = sinew::autorig::draw_preview(&[LayerRef::whole("sprite", image)], handles).unwrap();
+        let picture =
+            sinew::autorig::draw_preview(&[LayerRef::whole("sprite", image)], handles).unwrap();
         sinew::io::save_png(&Path::new(&dir).join(format!("{name}.png")), &picture).unwrap();
     }
 }
@@ -357,8 +358,11 @@ fn layers_are_body_parts_with_their_own_bones_bound_to_them() {
     assert_eq!(proposal.template, Some(sinew::autorig::Template::Humanoid));
     for (name, image) in &layers {
         // Every part has a bone; each bone is bound to its part alone and lies inside it.
-        let own: Vec<&sinew::rig::Bone> =
-            h.bones.iter().filter(|b| h.bind[&b.name] == vec![name.clone()]).collect();
+        let own: Vec<&sinew::rig::Bone> = h
+            .bones
+            .iter()
+            .filter(|b| h.bind[&b.name] == vec![name.clone()])
+            .collect();
         assert!(!own.is_empty(), "part {name} has no bone");
         let shape = traced(image);
         for b in own {
@@ -369,7 +373,10 @@ fn layers_are_body_parts_with_their_own_bones_bound_to_them() {
             );
         }
     }
-    assert!(h.bones.iter().all(|b| h.bind[&b.name].len() == 1), "a bone weighs two parts");
+    assert!(
+        h.bones.iter().all(|b| h.bind[&b.name].len() == 1),
+        "a bone weighs two parts"
+    );
 }
 
 #[test]
@@ -381,11 +388,19 @@ fn layered_hierarchy_is_what_an_animator_builds() {
     let parent = |n: &str| by_name[n].parent.as_deref();
     let part_of = |n: &str| h.bind[n][0].as_str();
     // The root at the hips: the torso's lower bone, from its bottom up.
-    let roots: Vec<&str> = h.bones.iter().filter(|b| b.parent.is_none()).map(|b| b.name.as_str()).collect();
+    let roots: Vec<&str> = h
+        .bones
+        .iter()
+        .filter(|b| b.parent.is_none())
+        .map(|b| b.name.as_str())
+        .collect();
     assert_eq!(roots, ["hip"]);
     assert_eq!(part_of("hip"), "torso");
     assert_eq!(parent("chest"), Some("hip"));
-    assert!(by_name["hip"].head[1] > by_name["chest"].tail[1], "the spine runs up");
+    assert!(
+        by_name["hip"].head[1] > by_name["chest"].tail[1],
+        "the spine runs up"
+    );
     // Limbs: template names from the layer names, chains joined at the layers' seams.
     for side in ["l", "r"] {
         let bone = |n: &str| format!("{n}_{side}");
@@ -394,7 +409,10 @@ fn layered_hierarchy_is_what_an_animator_builds() {
         assert_eq!(parent(&bone("leg_upper")), Some("hip"));
         assert_eq!(parent(&bone("leg_lower")), Some(bone("leg_upper").as_str()));
         for limb in ["arm", "leg"] {
-            let (upper, lower) = (by_name[bone(&format!("{limb}_upper")).as_str()], by_name[bone(&format!("{limb}_lower")).as_str()]);
+            let (upper, lower) = (
+                by_name[bone(&format!("{limb}_upper")).as_str()],
+                by_name[bone(&format!("{limb}_lower")).as_str()],
+            );
             assert_eq!(upper.tail, lower.head, "{limb}_{side} is not one chain");
         }
     }
@@ -403,10 +421,18 @@ fn layered_hierarchy_is_what_an_animator_builds() {
     let tail_root = h
         .bones
         .iter()
-        .find(|b| part_of(&b.name) == "tail" && by_name[b.parent.as_deref().unwrap()].name != b.name && part_of(b.parent.as_deref().unwrap()) != "tail")
+        .find(|b| {
+            part_of(&b.name) == "tail"
+                && by_name[b.parent.as_deref().unwrap()].name != b.name
+                && part_of(b.parent.as_deref().unwrap()) != "tail"
+        })
         .expect("a tail bone hangs from another part");
     assert_eq!(tail_root.parent.as_deref(), Some("hip"));
-    let bag = h.bones.iter().find(|b| part_of(&b.name) == "bag").expect("the lantern has a bone");
+    let bag = h
+        .bones
+        .iter()
+        .find(|b| part_of(&b.name) == "bag")
+        .expect("the lantern has a bone");
     assert_eq!(bag.parent.as_deref(), Some("arm_lower_r"));
     assert_eq!(parent("head"), Some("chest"));
     let head_image = &layers.iter().find(|l| l.0 == "head").unwrap().1;
@@ -417,9 +443,15 @@ fn layered_hierarchy_is_what_an_animator_builds() {
         head_shape.contains(pivot) && torso_shape.contains(pivot),
         "the head turns where it overlaps the torso (the neck), not at {pivot:?}"
     );
-    assert!(by_name["head"].tail[1] < by_name["head"].head[1], "the head bone points up");
+    assert!(
+        by_name["head"].tail[1] < by_name["head"].head[1],
+        "the head bone points up"
+    );
     // Nothing is named extra_N or bone_N: every bone has a template or layer name.
-    assert!(h.bones.iter().all(|b| !b.name.starts_with("extra_") && !b.name.starts_with("bone_")));
+    assert!(h
+        .bones
+        .iter()
+        .all(|b| !b.name.starts_with("extra_") && !b.name.starts_with("bone_")));
 }
 
 #[test]
@@ -443,8 +475,14 @@ fn parts_that_overlap_nothing_hang_from_the_nearest_part() {
     assert!((dir.y / dir.x - 40.0 / 60.0).abs() < 0.05, "{dir:?}");
     let ba = h.bones.iter().find(|x| x.name == "a").unwrap();
     assert_eq!(ba.parent.as_deref(), Some("b"));
-    assert!(ba.head[0] > ba.tail[0], "a's bone starts at its end nearer b");
-    assert!((ba.head[1] - ba.tail[1]).abs() < 3.0, "a's bone follows its axis");
+    assert!(
+        ba.head[0] > ba.tail[0],
+        "a's bone starts at its end nearer b"
+    );
+    assert!(
+        (ba.head[1] - ba.tail[1]).abs() < 3.0,
+        "a's bone follows its axis"
+    );
 }
 
 // ---------------------------------------------------------------- cages and points
@@ -807,7 +845,13 @@ fn layered_proposal_rigged_and_posed_matches_golden() {
     let dir = tmp.path();
     let paths: Vec<String> = character_layers()
         .into_iter()
-        .map(|(n, _)| assets().join(format!("{n}.png")).to_str().unwrap().to_string())
+        .map(|(n, _)| {
+            assets()
+                .join(format!("{n}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
         .collect();
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let (handles, rig, posed, pose) = (
@@ -822,11 +866,21 @@ fn layered_proposal_rigged_and_posed_matches_golden() {
         let argv: Vec<&str> = args.iter().map(String::as_str).collect();
         sinew(&argv)
     };
-    let out = run(&["autorig"], &[paths.clone(), vec!["-o".into(), s(&handles)]].concat());
+    let out = run(
+        &["autorig"],
+        &[paths.clone(), vec!["-o".into(), s(&handles)]].concat(),
+    );
     ok(&out, "autorig");
     assert!(String::from_utf8_lossy(&out.stdout).contains("template: humanoid"));
     ok(
-        &run(&["rig"], &[paths, vec!["--handles".into(), s(&handles), "-o".into(), s(&rig)]].concat()),
+        &run(
+            &["rig"],
+            &[
+                paths,
+                vec!["--handles".into(), s(&handles), "-o".into(), s(&rig)],
+            ]
+            .concat(),
+        ),
         "rig",
     );
     std::fs::write(
@@ -860,7 +914,14 @@ fn a_psd_of_the_layers_gets_the_same_rig_and_a_whole_canvas_preview() {
     let psd = root().join("tests/fixtures/layered/bundled_character.psd");
     let (from_psd, preview) = (dir.join("psd.json"), dir.join("preview.png"));
     ok(
-        &sinew(&["autorig", &s(&psd), "-o", &s(&from_psd), "--preview", &s(&preview)]),
+        &sinew(&[
+            "autorig",
+            &s(&psd),
+            "-o",
+            &s(&from_psd),
+            "--preview",
+            &s(&preview),
+        ]),
         "autorig psd",
     );
     let psd_handles: Handles =
@@ -872,7 +933,9 @@ fn a_psd_of_the_layers_gets_the_same_rig_and_a_whole_canvas_preview() {
     for (a, b) in psd_handles.bones.iter().zip(&png_handles.bones) {
         assert_eq!((&a.name, &a.parent), (&b.name, &b.parent));
         // Trimmed layers trace to within a tenth of a pixel of whole-canvas ones.
-        let d = (pt(a.head) - pt(b.head)).norm().max((pt(a.tail) - pt(b.tail)).norm());
+        let d = (pt(a.head) - pt(b.head))
+            .norm()
+            .max((pt(a.tail) - pt(b.tail)).norm());
         assert!(d < 0.1, "{}: {d} px", a.name);
     }
     let picture = load(&preview);
@@ -881,7 +944,10 @@ fn a_psd_of_the_layers_gets_the_same_rig_and_a_whole_canvas_preview() {
     let hip = &psd_handles.bones.iter().find(|b| b.name == "hip").unwrap();
     let mid = pt(hip.head) + (pt(hip.tail) - pt(hip.head)) * 0.5;
     let px = picture.get_pixel(mid.x as u32, mid.y as u32);
-    assert!(px[0] > px[1] + 40 && px[0] > px[2] + 40, "no red root bone at {mid:?}: {px:?}");
+    assert!(
+        px[0] > px[1] + 40 && px[0] > px[2] + 40,
+        "no red root bone at {mid:?}: {px:?}"
+    );
 }
 
 // ---------------------------------------------------------------- the evaluation set
@@ -1016,7 +1082,8 @@ fn proposed_rigs_over_two_evaluation_characters_match_golden() {
     ] {
         let c = eval_character(name);
         let h = propose_for(&c);
-        let actual = sinew::autorig::draw_preview(&[LayerRef::whole("sprite", &c.image)], &h).unwrap();
+        let actual =
+            sinew::autorig::draw_preview(&[LayerRef::whole("sprite", &c.image)], &h).unwrap();
         common::golden::check(
             golden,
             &actual,

@@ -193,7 +193,8 @@ pub fn part_tree(shapes: &[&Shape], labels: &[Label], overlaps: &Overlaps) -> Pa
         .or_else(|| largest(&|i| labels[i].part == Part::Torso))
         .or_else(|| largest(&|_| true))
         .unwrap_or(0);
-    let rank = |c: usize, p: usize| parent_rank(&labels[c], &labels[p], overlaps.area_px2(c, p) > 0.0);
+    let rank =
+        |c: usize, p: usize| parent_rank(&labels[c], &labels[p], overlaps.area_px2(c, p) > 0.0);
     // Each part's best rank among the parts present: it hangs only from a part of that rank.
     let best_rank: Vec<Option<u8>> = (0..n)
         .map(|c| (0..n).filter(|&p| p != c).filter_map(|p| rank(c, p)).min())
@@ -264,7 +265,11 @@ pub fn complete_sides(labels: &mut [Label], centroids: &[Point]) {
             .collect();
         if unsided.len() == 2 {
             let (a, b) = (unsided[0], unsided[1]);
-            let (left, right) = if centroids[a].x >= centroids[b].x { (a, b) } else { (b, a) };
+            let (left, right) = if centroids[a].x >= centroids[b].x {
+                (a, b)
+            } else {
+                (b, a)
+            };
             labels[left].side = Some(Side::Left);
             labels[right].side = Some(Side::Right);
         } else if unsided.len() == 1 {
@@ -314,7 +319,12 @@ mod tests {
         let sides: Vec<Option<Side>> = labels.iter().map(|l| l.side).collect();
         assert_eq!(
             sides,
-            [Some(Side::Right), Some(Side::Left), Some(Side::Left), Some(Side::Right)]
+            [
+                Some(Side::Right),
+                Some(Side::Left),
+                Some(Side::Left),
+                Some(Side::Right)
+            ]
         );
     }
 }

@@ -123,7 +123,9 @@ impl Label {
             Part::Arm(Segment::Upper) => limb("arm", &["upper"]),
             Part::Arm(Segment::Lower) => limb("arm", &["lower"]),
             Part::Arm(Segment::Whole) => limb("arm", &["upper", "lower"]),
-            Part::Arm(Segment::Extremity) => self.side.map(|s| vec![format!("hand_{}", s.suffix())]),
+            Part::Arm(Segment::Extremity) => {
+                self.side.map(|s| vec![format!("hand_{}", s.suffix())])
+            }
             Part::Leg(Segment::Upper) => limb("leg", &["upper"]),
             Part::Leg(Segment::Lower) => limb("leg", &["lower"]),
             Part::Leg(Segment::Whole) => limb("leg", &["upper", "lower"]),
@@ -147,17 +149,23 @@ const TORSO: &[&str] = &[
     "torso", "body", "chest", "trunk", "belly", "spine", "shirt", "abdomen", "stomach", "breast",
     "ribcage", "thorax", "bust", "coat", "jacket",
 ];
-const PELVIS: &[&str] = &["pelvis", "hip", "hips", "waist", "shorts", "pants", "skirt", "butt"];
+const PELVIS: &[&str] = &[
+    "pelvis", "hip", "hips", "waist", "shorts", "pants", "skirt", "butt",
+];
 const ARM: &[&str] = &["arm", "arms"];
 const LEG: &[&str] = &["leg", "legs"];
 const UPPER: &[&str] = &["upper", "up", "top", "u"];
 const LOWER: &[&str] = &["lower", "low", "bottom", "bot"];
 const UPPER_ARM: &[&str] = &["bicep", "biceps", "shoulder", "sleeve", "humerus"];
 const LOWER_ARM: &[&str] = &["forearm", "elbow", "wrist", "cuff"];
-const HAND: &[&str] = &["hand", "hands", "fist", "palm", "glove", "paw", "claw", "fingers"];
+const HAND: &[&str] = &[
+    "hand", "hands", "fist", "palm", "glove", "paw", "claw", "fingers",
+];
 const UPPER_LEG: &[&str] = &["thigh", "femur"];
 const LOWER_LEG: &[&str] = &["shin", "calf", "knee", "tibia", "shank"];
-const FOOT: &[&str] = &["foot", "feet", "shoe", "boot", "hoof", "toe", "toes", "ankle", "sock"];
+const FOOT: &[&str] = &[
+    "foot", "feet", "shoe", "boot", "hoof", "toe", "toes", "ankle", "sock",
+];
 const TAIL: &[&str] = &["tail"];
 const HEAD_ACCESSORY: &[&str] = &[
     "hair", "ear", "ears", "hat", "cap", "helmet", "antenna", "horn", "horns", "eye", "eyes",
@@ -355,8 +363,16 @@ fn label_of_words(words: &[String]) -> Label {
     let limb = matches!(part, Part::Arm(_) | Part::Leg(_));
     Label {
         part,
-        side: if limb || part == Part::Unknown { side } else { None },
-        end: if matches!(part, Part::Leg(_) | Part::Arm(_)) { end } else { None },
+        side: if limb || part == Part::Unknown {
+            side
+        } else {
+            None
+        },
+        end: if matches!(part, Part::Leg(_) | Part::Arm(_)) {
+            end
+        } else {
+            None
+        },
     }
 }
 
@@ -365,7 +381,10 @@ fn label_of_words(words: &[String]) -> Label {
 /// arms or four legs (a bird, a fish, a kite); a humanoid when arms or legs are named, or a
 /// head on a body (a bust); `None` when the names tell nothing of the body.
 pub fn template_from_labels(labels: &[Label]) -> Option<(Option<Template>, String)> {
-    let arms = labels.iter().filter(|l| matches!(l.part, Part::Arm(_))).count();
+    let arms = labels
+        .iter()
+        .filter(|l| matches!(l.part, Part::Arm(_)))
+        .count();
     let legs: Vec<&Label> = labels
         .iter()
         .filter(|l| matches!(l.part, Part::Leg(_)))
@@ -385,7 +404,10 @@ pub fn template_from_labels(labels: &[Label]) -> Option<(Option<Template>, Strin
     if both_ends || (arms == 0 && limbs > 2) {
         return Some((
             Some(Template::Quadruped),
-            format!("the layer names give {} leg parts at a front and a back", legs.len()),
+            format!(
+                "the layer names give {} leg parts at a front and a back",
+                legs.len()
+            ),
         ));
     }
     let has = |p: Part| labels.iter().any(|l| l.part == p);
@@ -491,17 +513,40 @@ mod tests {
             t(&["head", "body", "arm_l", "arm_r", "leg_l", "leg_r"]),
             Some(Template::Humanoid)
         );
-        assert_eq!(t(&["head", "torso", "left arm", "right arm"]), Some(Template::Humanoid));
         assert_eq!(
-            t(&["head", "body", "front leg l", "front leg r", "hind leg l", "hind leg r", "tail"]),
+            t(&["head", "torso", "left arm", "right arm"]),
+            Some(Template::Humanoid)
+        );
+        assert_eq!(
+            t(&[
+                "head",
+                "body",
+                "front leg l",
+                "front leg r",
+                "hind leg l",
+                "hind leg r",
+                "tail"
+            ]),
             Some(Template::Quadruped)
         );
-        assert_eq!(t(&["head", "body", "leg 1", "leg 2", "leg 3", "leg 4"]), Some(Template::Quadruped));
+        assert_eq!(
+            t(&["head", "body", "leg 1", "leg 2", "leg 3", "leg 4"]),
+            Some(Template::Quadruped)
+        );
         assert_eq!(t(&["blade", "hilt"]), None);
-        assert_eq!(t(&["head", "front legs", "body", "tail", "hind legs"]), Some(Template::Quadruped));
-        assert_eq!(t(&["Flipper_Front", "Foot_Front", "Head", "Body", "Foot_Back"]), Some(Template::Humanoid));
+        assert_eq!(
+            t(&["head", "front legs", "body", "tail", "hind legs"]),
+            Some(Template::Quadruped)
+        );
+        assert_eq!(
+            t(&["Flipper_Front", "Foot_Front", "Head", "Body", "Foot_Back"]),
+            Some(Template::Humanoid)
+        );
         assert_eq!(t(&["head", "body"]), Some(Template::Humanoid));
-        assert_eq!(t(&["hand", "foot_front", "body", "foot_back"]), Some(Template::Humanoid));
+        assert_eq!(
+            t(&["hand", "foot_front", "body", "foot_back"]),
+            Some(Template::Humanoid)
+        );
         let said = |ns: &[&str]| template_from_labels(&names(ns)).map(|t| t.0);
         assert_eq!(said(&["feet", "head", "body", "tail"]), Some(None));
         assert_eq!(said(&["blade", "hilt"]), None);

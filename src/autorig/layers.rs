@@ -192,7 +192,8 @@ pub fn layered_skeleton(
             )?,
         };
         let first = bones.len();
-        let parent_bone = joint.and_then(|j| nearest_bone(&bones, part_bones[j.parent].clone(), j.at_px));
+        let parent_bone =
+            joint.and_then(|j| nearest_bone(&bones, part_bones[j.parent].clone(), j.at_px));
         for (k, mut b) in grown.into_iter().enumerate() {
             // A part's further root bones (branches at its start) hang from its first bone.
             b.parent = match b.parent {
@@ -201,7 +202,11 @@ pub fn layered_skeleton(
                 None => parent_bone,
             };
             let base = split.get(k).or(split.last()).cloned().unwrap_or_default();
-            let name = if k < split.len() { base } else { format!("{base}_{}", k + 1) };
+            let name = if k < split.len() {
+                base
+            } else {
+                format!("{base}_{}", k + 1)
+            };
             b.name = Some(names.take(&name));
             bones.push(b);
             bone_part.push(i);
@@ -213,7 +218,8 @@ pub fn layered_skeleton(
                 let seam = bones[first].head;
                 let parent_shape = parts[j.parent].shape;
                 let b = &bones[pb];
-                let along = (seam - b.head).dot(&(b.tail - b.head)) / b.length_px().powi(2).max(1e-12);
+                let along =
+                    (seam - b.head).dot(&(b.tail - b.head)) / b.length_px().powi(2).max(1e-12);
                 if along > 0.3
                     && (seam - b.head).norm() >= skeleton.min_bone_px
                     && parent_shape.segment_inside(b.head, seam)
@@ -288,7 +294,12 @@ fn nearest_bone(bones: &[ProtoBone], range: std::ops::Range<usize>, p: Point) ->
 }
 
 /// The mean joint of the root's children whose labels `keep` accepts, if any.
-fn mean_joint(root: usize, parts: &[Part], tree: &PartTree, keep: impl Fn(&Label) -> bool) -> Option<Point> {
+fn mean_joint(
+    root: usize,
+    parts: &[Part],
+    tree: &PartTree,
+    keep: impl Fn(&Label) -> bool,
+) -> Option<Point> {
     let at: Vec<Point> = tree
         .joints
         .iter()
@@ -368,7 +379,11 @@ fn root_bones(
                 Some(u) => (axis.at(lo) - u).norm() >= (axis.at(hi) - u).norm(),
                 None => axis.at(lo).y >= axis.at(hi).y,
             };
-            let (a, b) = if lo_first { (axis.at(lo), axis.at(hi)) } else { (axis.at(hi), axis.at(lo)) };
+            let (a, b) = if lo_first {
+                (axis.at(lo), axis.at(hi))
+            } else {
+                (axis.at(hi), axis.at(lo))
+            };
             Ok(chain(a, b, count, skeleton))
         }
         None => {
@@ -425,7 +440,11 @@ fn ray_bones(
     // axis nearer the joint, and runs along that axis: a floating hand along the hand.
     let apart = toward.is_none() && !shape.contains(joint);
     let axis_end = {
-        let toward_joint = if axis.project(joint) >= 0.0 { axis.extent[1] } else { axis.extent[0] };
+        let toward_joint = if axis.project(joint) >= 0.0 {
+            axis.extent[1]
+        } else {
+            axis.extent[0]
+        };
         inside_reach(shape, &axis, 0.0, toward_joint).map(|t| axis.at(t))
     };
     let anchor = match axis_end {
@@ -531,7 +550,11 @@ fn ray_bones(
 /// would fall under the minimum bone length).
 fn chain(a: Point, b: Point, count: usize, skeleton: &SkeletonOptions) -> Vec<ProtoBone> {
     let length = (b - a).norm();
-    let count = if count > 1 && length / count as f64 >= skeleton.min_bone_px { count } else { 1 };
+    let count = if count > 1 && length / count as f64 >= skeleton.min_bone_px {
+        count
+    } else {
+        1
+    };
     (0..count)
         .map(|k| ProtoBone {
             head: a + (b - a) * (k as f64 / count as f64),

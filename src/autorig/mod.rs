@@ -349,7 +349,9 @@ fn layered_bones(
     let mut bind: BTreeMap<String, Vec<String>> = BTreeMap::new();
     for (b, &p) in skeleton.bones.iter().zip(&skeleton.bone_part) {
         if let Some(name) = &b.name {
-            bind.entry(name.clone()).or_default().push(parts[p].name.to_string());
+            bind.entry(name.clone())
+                .or_default()
+                .push(parts[p].name.to_string());
         }
     }
     let mut bones = skeleton.bones;

@@ -6,8 +6,8 @@
 //! pointed tail (root bones in red, the others in blue), with a ring at each head; points as
 //! orange dots; cages as green polygons with square vertices.
 
-use crate::render::{pixmap_from_rgba, rgba_from_pixmap, RenderError};
 use super::LayerRef;
+use crate::render::{pixmap_from_rgba, rgba_from_pixmap, RenderError};
 use crate::rig::Handles;
 use image::RgbaImage;
 use tiny_skia::{
