@@ -255,7 +255,7 @@ fn argument_errors_are_one_line() {
     assert_bad_input(&["rig"], "required arguments were not provided: --output");
     assert_bad_input(
         &["autorig", "x.png", "--template", "robot", "-o", "x.json"],
-        "[possible values: humanoid, quadruped]",
+        "[possible values: auto, none, humanoid, quadruped]",
     );
     assert_bad_input(
         &["render", "r.json", "--fps", "abc", "-o", "x.gif"],
