@@ -146,7 +146,9 @@ fn krita_ora_rig_rest_pose_renders_kritas_merged_image() {
 }
 
 /// A group's pivot layer (`shoulder [origin]` in `arm_l`) starts the bone of the group's first
-/// part there; the next part of the group joins it where they overlap, as without pivots.
+/// part there; the next part of the group joins it where they overlap, as without pivots. The
+/// group's name gives the side, so the bones take the template's names (`arm_l/upper` is
+/// `arm_upper_l`, `arm_l/forearm` is `arm_lower_l`).
 #[test]
 fn a_groups_pivot_layer_is_where_its_first_bone_starts() {
     let tmp = scratch("pivots");
@@ -167,13 +169,13 @@ fn a_groups_pivot_layer_is_where_its_first_bone_starts() {
     let distance = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
     // The dot's centre: pixels 74..78 × 49..53.
     let pivot = [76.0, 51.0];
-    let upper = head("arm_l/upper");
+    let upper = head("arm_upper_l");
     assert!(
         distance(upper, pivot) < 1.0,
         "the upper arm starts at {upper:?}, not at the pivot {pivot:?}"
     );
     // The forearm hangs from the upper arm where they overlap (x 100..112, y 50..58).
-    let forearm = head("arm_l/forearm");
+    let forearm = head("arm_lower_l");
     assert!(
         distance(forearm, pivot) > 20.0 && (99.0..=113.0).contains(&forearm[0]),
         "the forearm starts at {forearm:?}"
