@@ -534,8 +534,10 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         h.cages.len()
     );
     // The template line first and unindented: what the proposal follows, and why.
-    let (chosen, rest): (Vec<&String>, Vec<&String>) =
-        proposal.notes.iter().partition(|n| n.starts_with("template: "));
+    let (chosen, rest): (Vec<&String>, Vec<&String>) = proposal
+        .notes
+        .iter()
+        .partition(|n| n.starts_with("template: "));
     match chosen.first() {
         Some(line) => println!("{line}"),
         None => println!(
