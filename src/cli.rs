@@ -233,7 +233,7 @@ pub struct RenderArgs {
     /// How handle transformations blend.
     #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, playback::RenderSettings::default().blend))]
     pub blend: Blend,
-    /// Play curves as this runtime does instead of exactly (see README, "Spine export").
+    /// Play curves as this runtime does instead of exactly (see docs/guide.md, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// With --match-runtime spine: the Spine line the export was written for (`sinew spine

@@ -75,7 +75,7 @@ mirror!(BlendArg => Blend {
     /// Dual-quaternion skinning: keeps limbs' thickness at strongly rotated joints.
     Dqs,
     /// Linear blending with stretchable bones: a bone scaled along its length stretches its
-    /// limb and carries what lies past its tail ([`stretchable_blend`]).
+    /// limb and carries what lies past its tail.
     Stretch,
 });
 
@@ -87,7 +87,7 @@ mirror!(WeightMethodArg => WeightMethod {
     /// Unconstrained biharmonic weights: smooth but not bounded nor local (for comparison).
     Biharmonic,
     /// Rigid cutout weights: the nearest handle inside the shape, blended over
-    /// `rigid_blend_px` around joints (see [`super::rigid`]).
+    /// `--blend PX` around joints.
     Rigid,
 });
 

@@ -37,7 +37,7 @@ if [[ ${#targets[@]} -eq 0 ]]; then
     targets=(rig_document handles pose animations scribbles png_trace_mesh)
 fi
 
-# Seeds: every bundled file of each kind (a rig document is made by hand from the README's
+# Seeds: every bundled file of each kind (a rig document is made by hand from the
 # example in docs/formats.md when no rig has been written).
 seeds=fuzz/seeds
 mkdir -p "$seeds"/{rig_document,handles,pose,animations,scribbles,png_trace_mesh}
