@@ -327,6 +327,21 @@ fn quadruped_template_finds_head_tail_and_four_legs() {
     }
 }
 
+/// The bundled character's layer files, back to front, as command-line arguments.
+#[cfg(feature = "cli")]
+fn character_layer_paths() -> Vec<String> {
+    character_layers()
+        .into_iter()
+        .map(|(n, _)| {
+            assets()
+                .join(format!("{n}.png"))
+                .to_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect()
+}
+
 fn character_layers() -> Vec<(String, RgbaImage)> {
     let list: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(assets().join("layers.json")).unwrap())
@@ -716,17 +731,7 @@ fn autorig_then_rig_then_pose_works_with_no_manual_step() {
 fn layered_autorig_then_rig_then_pose_moves_each_part_with_its_bone() {
     let tmp = scratch("layers");
     let dir = tmp.path();
-    let list: Vec<String> = character_layers().into_iter().map(|l| l.0).collect();
-    let paths: Vec<String> = list
-        .iter()
-        .map(|n| {
-            assets()
-                .join(format!("{n}.png"))
-                .to_str()
-                .unwrap()
-                .to_string()
-        })
-        .collect();
+    let paths = character_layer_paths();
     let (handles, rig, posed) = (dir.join("h.json"), dir.join("rig.json"), dir.join("p.png"));
     let mut args = vec!["autorig".to_string()];
     args.extend(paths.iter().cloned());
@@ -843,16 +848,7 @@ fn layered_proposal_over_the_character_matches_golden() {
 fn layered_proposal_rigged_and_posed_matches_golden() {
     let tmp = scratch("layered-posed");
     let dir = tmp.path();
-    let paths: Vec<String> = character_layers()
-        .into_iter()
-        .map(|(n, _)| {
-            assets()
-                .join(format!("{n}.png"))
-                .to_str()
-                .unwrap()
-                .to_string()
-        })
-        .collect();
+    let paths = character_layer_paths();
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let (handles, rig, posed, pose) = (
         dir.join("h.json"),

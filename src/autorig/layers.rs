@@ -115,6 +115,8 @@ pub struct Part<'a> {
     pub name: &'a str,
     pub shape: &'a Shape,
     pub label: Label,
+    /// The shape's [`principal_axis`] (`None`: nothing inside), computed once per part.
+    pub axis: Option<PrincipalAxis>,
 }
 
 /// Whether the part named by its path (`arm_l/hand`) lies in the group `group` (a path; the
@@ -175,21 +177,16 @@ pub fn layered_skeleton(
         let parent_name = joint.map(|j| parts[j.parent].name);
         let pivot = pivot_of(part.name, parent_name, pivots);
         let split = split_names(part, template);
-        let grown = match (joint, pivot) {
-            (None, _) => {
+        let max = max_part_bones(&part.label).max(split.len());
+        let grown = match joint {
+            None => {
                 let (hips, up) = (hip_hint(i, parts, &tree), up_hint(i, parts, &tree));
-                let max = max_part_bones(&part.label).max(split.len());
                 root_bones(part, pivot, hips, up, split.len(), max, medial, skeleton)?
             }
-            (Some(j), _) => ray_bones(
-                part.shape,
-                pivot.unwrap_or(j.at_px),
-                None,
-                split.len(),
-                max_part_bones(&part.label).max(split.len()),
-                medial,
-                skeleton,
-            )?,
+            Some(j) => {
+                let from = pivot.unwrap_or(j.at_px);
+                ray_bones(part, from, None, split.len(), max, medial, skeleton)?
+            }
         };
         let first = bones.len();
         let parent_bone =
@@ -347,12 +344,12 @@ fn root_bones(
     skeleton: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, MedialError> {
     let shape = part.shape;
-    let Some(axis) = principal_axis(shape) else {
+    let Some(axis) = part.axis else {
         return Ok(Vec::new());
     };
     let pelvis = (part.label.part == LabelPart::Pelvis).then_some(axis.centroid);
     if let Some(start) = pivot.or(pelvis) {
-        return ray_bones(shape, start, up, count, max, medial, skeleton);
+        return ray_bones(part, start, up, count, max, medial, skeleton);
     }
     if let Some(hips) = hips {
         // The spine runs through the part's middle, parallel to hips → top, from the hips'
@@ -365,7 +362,7 @@ fn root_bones(
             }
             None => (hips, None),
         };
-        return ray_bones(shape, start, toward, count, max, medial, skeleton);
+        return ray_bones(part, start, toward, count, max, medial, skeleton);
     }
     let [t0, t1] = axis.extent;
     let span = inside_reach(shape, &axis, 0.0, t0)
@@ -422,7 +419,7 @@ const ONE_BONE_STEP_DEG: f64 = 5.0;
 /// most `max`), or for a one-bone part the longest straight bone inside among directions near
 /// the first.
 fn ray_bones(
-    shape: &Shape,
+    part: &Part,
     joint: Point,
     toward: Option<Point>,
     count: usize,
@@ -430,7 +427,8 @@ fn ray_bones(
     medial: &MedialOptions,
     skeleton: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, MedialError> {
-    let Some(axis) = principal_axis(shape) else {
+    let shape = part.shape;
+    let Some(axis) = part.axis else {
         return Ok(Vec::new());
     };
     // Start inside the part, clear of its outline: at the joint, or at the nearest inside
@@ -477,12 +475,13 @@ fn ray_bones(
     } else {
         -axis.direction
     };
+    let ray = |d: Vec2| PrincipalAxis {
+        centroid: start,
+        direction: d,
+        extent: [0.0, 0.0],
+    };
     let far_along = |d: Vec2| -> f64 {
-        let line = PrincipalAxis {
-            centroid: start,
-            direction: d,
-            extent: [0.0, 0.0],
-        };
+        let line = ray(d);
         let mut t: Vec<f64> = shape.inside_centers().map(|p| line.project(p)).collect();
         if t.is_empty() {
             return 0.0;
@@ -491,11 +490,6 @@ fn ray_bones(
         // The quantile by selection: no full sort (this runs once per direction tried).
         let (_, far, _) = t.select_nth_unstable_by(k, f64::total_cmp);
         far.max(0.0)
-    };
-    let ray = |d: Vec2| PrincipalAxis {
-        centroid: start,
-        direction: d,
-        extent: [0.0, 0.0],
     };
     let far = far_along(direction);
     let reach = inside_reach(shape, &ray(direction), 0.0, far);

@@ -316,9 +316,13 @@ fn layered_bones(
     }
     let mut part_labels: Vec<labels::Label> =
         shapes.iter().map(|(name, _)| labels::label(name)).collect();
-    let centroids: Vec<Point> = shapes
+    let axes: Vec<Option<layers::PrincipalAxis>> = shapes
         .iter()
-        .map(|(_, s)| layers::principal_axis(s).map_or(Point::origin(), |a| a.centroid))
+        .map(|(_, s)| layers::principal_axis(s))
+        .collect();
+    let centroids: Vec<Point> = axes
+        .iter()
+        .map(|a| a.map_or(Point::origin(), |a| a.centroid))
         .collect();
     attach::complete_sides(&mut part_labels, &centroids);
     let template = match options.template.fixed() {
@@ -341,8 +345,13 @@ fn layered_bones(
     };
     let parts: Vec<layers::Part> = shapes
         .iter()
-        .zip(&part_labels)
-        .map(|((name, shape), &label)| layers::Part { name, shape, label })
+        .zip(part_labels.iter().zip(&axes))
+        .map(|((name, shape), (&label, &axis))| layers::Part {
+            name,
+            shape,
+            label,
+            axis,
+        })
         .collect();
     let skeleton = layers::layered_skeleton(&parts, pivots, template, &options.medial, so)?;
     // Each bone weighs only its own part.
