@@ -1122,3 +1122,32 @@ fn rig_binds_pieces_no_handle_reaches_with_a_one_line_warning() {
     assert!(warnings[0].contains("mesh vertices") && warnings[0].contains("body"));
     assert!(rig.exists());
 }
+
+/// The template chosen for real sprites nobody here drew (`tests/fixtures/autorig-real`,
+/// sources in tools/autorig-real/LICENSES.md), with no template given: animals whose head is
+/// carried ahead of the body (a three-quarter lion, a tall fawn) are quadrupeds, a wide
+/// policeman whose head sits over his middle is a person, a kite and its tails is neither.
+#[test]
+fn real_sprites_get_the_template_of_their_kind() {
+    let dir = root().join("tests/fixtures/autorig-real");
+    for (name, want) in [
+        ("lion", Some(sinew::autorig::Template::Quadruped)),
+        ("fawn", Some(sinew::autorig::Template::Quadruped)),
+        ("cow", Some(sinew::autorig::Template::Quadruped)),
+        ("police_man", Some(sinew::autorig::Template::Humanoid)),
+        ("skeleton", Some(sinew::autorig::Template::Humanoid)),
+        ("kid", Some(sinew::autorig::Template::Humanoid)),
+        ("kite", None),
+        ("swallow", None),
+    ] {
+        let image = load(&dir.join(format!("{name}.png")));
+        let layers = [LayerRef::whole("sprite", &image)];
+        let proposal = autorig(&layers, &[], &AutorigOptions::default()).expect("autorig");
+        assert_eq!(proposal.template, want, "{name}: {:?}", proposal.notes);
+        assert!(
+            proposal.notes.iter().any(|n| n.starts_with("template: ")),
+            "{name}: the choice is explained: {:?}",
+            proposal.notes
+        );
+    }
+}

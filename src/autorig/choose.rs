@@ -145,11 +145,43 @@ fn runs(shape: &Shape, frame: &Frame, v: f64) -> Vec<f64> {
     out
 }
 
-/// What the drawing's shape says it is, and why: wider than tall and standing on two or more
-/// legs (narrow runs of pixels across its lowest rows) is a quadruped; wider than tall with
-/// nothing standing under it (a fish, a bird in flight, a kite on its side) is no template;
-/// standing on three or more legs is a quadruped; anything else upright is a humanoid (a bust
-/// too: its shoulders fill its lowest rows).
+/// The top of the drawing whose centre tells where the head is (fraction of the height).
+const HEAD_BAND: f64 = 0.12;
+/// A head this far (fraction of the width) to one side of the drawing's centre is carried
+/// ahead of the body, as a standing animal carries it; a person's head sits above the middle.
+const HEAD_ASIDE_FRACTION: f64 = 0.12;
+/// Wider than tall by more than this, with no legs and the head above the middle, is a
+/// long body (a fish, a snake), not a figure holding something out.
+const FIGURE_MAX_ASPECT: f64 = 1.5;
+
+/// How far the top [`HEAD_BAND`] of the drawing lies to one side of the whole drawing's
+/// centre, as a fraction of the width (centroids of the inside pixels).
+fn head_offset(shape: &Shape, frame: &Frame) -> f64 {
+    let w = shape.width as usize;
+    let head_rows = frame.lo.y + HEAD_BAND * frame.h;
+    let (mut all, mut top) = ((0.0, 0usize), (0.0, 0usize));
+    for (k, _) in shape.inside.iter().enumerate().filter(|(_, &i)| i) {
+        let (x, y) = ((k % w) as f64 + 0.5, (k / w) as f64 + 0.5);
+        all = (all.0 + x, all.1 + 1);
+        if y <= head_rows {
+            top = (top.0 + x, top.1 + 1);
+        }
+    }
+    if all.1 == 0 || top.1 == 0 {
+        return 0.0;
+    }
+    (top.0 / top.1 as f64 - all.0 / all.1 as f64) / frame.w
+}
+
+/// What the drawing's shape says it is, and why, from its box, the narrow runs of pixels
+/// across its lowest rows (legs) and where its top lies (the head):
+/// - standing on three or more legs and wider than tall, or on two or more with the head
+///   carried to one side ([`HEAD_ASIDE_FRACTION`]): a quadruped;
+/// - wider than tall with nothing standing under it: no template (a fish, a bird in flight),
+///   unless its head sits above its middle and it is not long ([`FIGURE_MAX_ASPECT`]): a
+///   figure holding something out; on a wide base: a bust;
+/// - upright on three or more strands with the head above the middle: no template (a kite
+///   and its tails, a tassel); anything else upright: a humanoid.
 pub fn classify(shape: &Shape) -> (Option<Template>, String) {
     let frame = Frame::of(shape);
     let aspect = frame.w / frame.h;
@@ -167,20 +199,30 @@ pub fn classify(shape: &Shape) -> (Option<Template>, String) {
         .iter()
         .flat_map(|&v| runs(shape, &frame, v))
         .fold(0.0f64, f64::max);
+    let offset = head_offset(shape, &frame);
+    let aside = offset.abs() >= HEAD_ASIDE_FRACTION;
+    let head = if aside {
+        format!(
+            "the head {:.0} % of the width to one side",
+            100.0 * offset.abs()
+        )
+    } else {
+        "the head above the middle".to_string()
+    };
+    if legs >= 2 && (aside || (aspect >= WIDE_ASPECT && legs >= 3 && trunk >= MIN_TRUNK_FRACTION)) {
+        return (
+            Some(Template::Quadruped),
+            format!("{aspect:.2} as wide as tall, standing on {legs} legs, {head}"),
+        );
+    }
     if aspect >= WIDE_ASPECT {
-        if legs >= 2 && trunk >= MIN_TRUNK_FRACTION {
-            return (
-                Some(Template::Quadruped),
-                format!("{aspect:.2} times wider than tall, standing on {legs} legs"),
-            );
-        }
-        if wide {
+        if wide && !aside {
             return (
                 Some(Template::Humanoid),
                 format!("{aspect:.2} times wider than tall, on a wide base: a bust"),
             );
         }
-        if legs < 2 {
+        if legs < 2 && (aside || aspect > FIGURE_MAX_ASPECT) {
             return (
                 None,
                 format!("{aspect:.2} times wider than tall with no legs under it"),
@@ -189,13 +231,13 @@ pub fn classify(shape: &Shape) -> (Option<Template>, String) {
     }
     if legs >= 3 {
         return (
-            Some(Template::Quadruped),
-            format!("standing on {legs} legs"),
+            None,
+            format!("upright on {legs} thin strands with {head}: no body a template knows"),
         );
     }
     (
         Some(Template::Humanoid),
-        format!("upright ({aspect:.2} as wide as tall) on {legs} legs or a base"),
+        format!("upright ({aspect:.2} as wide as tall) on {legs} legs or a base, {head}"),
     )
 }
 
