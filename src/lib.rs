@@ -20,6 +20,7 @@ pub mod ik;
 pub mod io;
 pub mod jobs;
 pub mod mesh;
+pub mod motion;
 pub mod pipeline;
 pub mod playback;
 pub mod render;
