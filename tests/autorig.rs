@@ -1151,3 +1151,49 @@ fn real_sprites_get_the_template_of_their_kind() {
         );
     }
 }
+
+/// A real T-posed kid (openclipart-svg `kid_01.svg`, public domain) whose fingers touch: the
+/// outline nearly meets itself at the hand, the medial axis closes a small cycle there and has
+/// no end at that hand. The humanoid template still fits (the cycle's cut is a candidate hand):
+/// both arms and legs are named, and every wrist and ankle placed by hand has a bone end near it.
+#[test]
+fn the_humanoid_template_fits_a_hand_whose_fingers_touch() {
+    let dir = root().join("tests/fixtures/autorig-real");
+    let image = load(&dir.join("kid.png"));
+    let layers = [LayerRef::whole("sprite", &image)];
+    let proposal = autorig(&layers, &[], &AutorigOptions::default()).expect("autorig");
+    assert_eq!(proposal.template, Some(sinew::autorig::Template::Humanoid));
+    assert!(
+        !proposal.notes.iter().any(|n| n.contains("does not match")),
+        "{:?}",
+        proposal.notes
+    );
+    for name in [
+        "arm_upper_l",
+        "arm_lower_r",
+        "leg_upper_l",
+        "leg_lower_r",
+        "head",
+    ] {
+        assert!(
+            proposal.handles.bones.iter().any(|b| b.name == name),
+            "{name} in {:?}",
+            proposal.handles.bones
+        );
+    }
+    let height = opaque_height(&image);
+    // Reference joints from tests/fixtures/autorig-real/kid.json (placed by hand).
+    for (joint, at) in [
+        ("wrist_l", Point::new(430.0, 125.0)),
+        ("wrist_r", Point::new(60.0, 140.0)),
+        ("ankle_l", Point::new(312.0, 590.0)),
+        ("ankle_r", Point::new(196.0, 590.0)),
+    ] {
+        let miss = nearest_bone_end(&proposal.handles, at) / height;
+        assert!(
+            miss < 0.06,
+            "{joint}: the nearest bone end is {:.1} % of the height away",
+            100.0 * miss
+        );
+    }
+}

@@ -7,7 +7,8 @@
 //! [`classify`] reads the silhouette's box and the runs of pixels across its rows (legs
 //! below, a body across the middle). [`fit_plausibly`] fits a template ([`fit_template`])
 //! and judges the fit by what its named bones say of the body in the drawing's box (heights
-//! as fractions of the box), so that a fit that would put limb names on props is refused
+//! as fractions of the box; the axis's ends as extremities first, then the cuts of its
+//! cycles, [`super::template::Extremities`]), so that a fit that would put limb names on props is refused
 //! (the caller then rigs the medial axis):
 //! - humanoid: the head above the hips; each leg reaches the lowest [`FOOT_BAND`] of the
 //!   box and is at least [`MIN_LEG_FRACTION`] of the height long; legs long enough for a
@@ -19,7 +20,7 @@
 use super::medial::AxisGraph;
 use super::shape::Shape;
 use super::skeleton::{ProtoBone, SkeletonOptions};
-use super::template::{fit_template, Template};
+use super::template::{fit_template_with, Template, EXTREMITIES};
 use crate::geom::Point;
 
 /// A foot must end in the lowest this fraction of the box.
@@ -249,14 +250,22 @@ pub fn fit_plausibly(
     options: &SkeletonOptions,
 ) -> Result<Vec<ProtoBone>, String> {
     let frame = Frame::of(shape);
-    let bones = fit_template(axis, shape, template, options)
-        .ok_or_else(|| "no assignment of its limbs to the drawing's extremities".to_string())?;
-    let doubt = match template {
-        Template::Humanoid => humanoid_doubt(&bones, &frame),
-        Template::Quadruped => quadruped_doubt(&bones, &frame),
-    };
-    match doubt {
-        Some(why) => Err(why),
-        None => Ok(bones),
+    let mut first_doubt = None;
+    for ends in EXTREMITIES {
+        let Some(bones) = fit_template_with(axis, shape, template, options, ends) else {
+            continue;
+        };
+        let doubt = match template {
+            Template::Humanoid => humanoid_doubt(&bones, &frame),
+            Template::Quadruped => quadruped_doubt(&bones, &frame),
+        };
+        match doubt {
+            None => return Ok(bones),
+            Some(why) => {
+                first_doubt.get_or_insert(why);
+            }
+        }
     }
+    Err(first_doubt
+        .unwrap_or_else(|| "no assignment of its limbs to the drawing's extremities".to_string()))
 }

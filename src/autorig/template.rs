@@ -168,12 +168,40 @@ impl Frame {
     }
 }
 
-/// Fits `template` to the largest piece of `axis`.
+/// Which axis nodes may be the template's extremities (head, hands, feet, tail).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Extremities {
+    /// The axis's own ends (nodes with one neighbour).
+    AxisEnds,
+    /// The leaves of the spanning tree: the axis's ends and the cuts of its cycles. Fingers
+    /// drawn touching, or an outline that nearly meets itself, close small cycles at a hand,
+    /// which then has no axis end; the cut leaves a candidate there.
+    TreeLeaves,
+}
+
+/// Both ways of choosing extremities, the stricter first.
+pub const EXTREMITIES: [Extremities; 2] = [Extremities::AxisEnds, Extremities::TreeLeaves];
+
+/// Fits `template` to the largest piece of `axis`: with the axis's ends as extremities, else
+/// with the spanning tree's leaves ([`Extremities`]).
 pub fn fit_template(
     axis: &AxisGraph,
     shape: &Shape,
     template: Template,
     options: &SkeletonOptions,
+) -> Option<Vec<ProtoBone>> {
+    EXTREMITIES
+        .iter()
+        .find_map(|&ends| fit_template_with(axis, shape, template, options, ends))
+}
+
+/// Fits `template` to the largest piece of `axis`, its extremities chosen among `ends`.
+pub fn fit_template_with(
+    axis: &AxisGraph,
+    shape: &Shape,
+    template: Template,
+    options: &SkeletonOptions,
+    ends: Extremities,
 ) -> Option<Vec<ProtoBone>> {
     // The largest piece, rooted at its thickest node.
     let mut done = vec![false; axis.nodes.len()];
@@ -202,7 +230,10 @@ pub fn fit_template(
         .order
         .iter()
         .copied()
-        .filter(|&v| axis.adjacency[v].len() == 1)
+        .filter(|&v| match ends {
+            Extremities::AxisEnds => axis.adjacency[v].len() == 1,
+            Extremities::TreeLeaves => v != root && tree.children[v].is_empty(),
+        })
         .collect();
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
     for ring in shape.rings() {
