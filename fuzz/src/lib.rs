@@ -110,12 +110,26 @@ pub fn png_trace_mesh(data: &[u8]) {
     let _ = sinew::mesh::triangulate(&outlines, area, &Default::default());
 }
 
+/// A BVH motion-capture file: parsed with the default limits; what parses is posed by forward
+/// kinematics at rest and at its first, middle and last frames.
+pub fn bvh(data: &[u8]) {
+    let Ok(clip) = sinew::motion::parse(data, &Default::default()) else {
+        return;
+    };
+    let _ = sinew::motion::rest_positions(&clip);
+    let last = clip.frame_count().saturating_sub(1);
+    for f in [0, last / 2, last, last + 1] {
+        let _ = sinew::motion::frame_positions(&clip, f);
+    }
+}
+
 /// Every target by name, for the replay test and the run script.
-pub const TARGETS: [(&str, fn(&[u8])); 6] = [
+pub const TARGETS: [(&str, fn(&[u8])); 7] = [
     ("rig_document", rig_document),
     ("handles", handles),
     ("pose", pose),
     ("animations", animations),
     ("scribbles", scribbles),
     ("png_trace_mesh", png_trace_mesh),
+    ("bvh", bvh),
 ];

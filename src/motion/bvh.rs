@@ -1106,6 +1106,45 @@ Frame Time: 0.5
         assert!(error_at(text, 7).contains("nothing to animate"));
     }
 
+    /// The fuzz target's hand-written seeds: a forest with CRLF line ends, names with spaces,
+    /// lower-case channels and joined `Frames:`; and a file with a NaN that is also short.
+    #[test]
+    fn the_fuzz_seeds_parse_or_fail_as_meant() {
+        let limits = BvhLimits::default();
+        let forest = parse(
+            include_bytes!("../../tools/fuzz/seeds/bvh/forest-crlf.bvh"),
+            &limits,
+        )
+        .unwrap();
+        let names: Vec<_> = forest
+            .joints
+            .iter()
+            .map(|j| (j.name.as_str(), j.parent))
+            .collect();
+        assert_eq!(names, [("a b", None), ("c", None)]);
+        assert_eq!(
+            forest.joints[0].channels,
+            [Channel::Yrotation, Channel::Xposition]
+        );
+        assert_eq!(forest.frames, [45.0, -1000.0, 7.0, 0.0, 0.0, 0.0]);
+        assert_eq!(forest.frame_time_s, 0.0083333);
+        let tiny = parse(
+            include_bytes!("../../tools/fuzz/seeds/bvh/tiny.bvh"),
+            &limits,
+        )
+        .unwrap();
+        assert_eq!(tiny, parse_str(TINY).unwrap());
+        let bad = parse(
+            include_bytes!("../../tools/fuzz/seeds/bvh/bad-nan-truncated.bvh"),
+            &limits,
+        )
+        .unwrap_err();
+        assert_eq!(
+            bad.to_string(),
+            "line 20: frame 2 (Xrotation of 'r') is 'nan', not a finite number"
+        );
+    }
+
     #[test]
     fn limits_round_trip_through_json_with_defaults() {
         let limits: BvhLimits = serde_json::from_str(r#"{"max_joints": 5}"#).unwrap();

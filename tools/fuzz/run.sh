@@ -11,10 +11,11 @@
 # `cargo afl test --release` runs fuzz/tests/replay.rs over the seeds and whatever AFL++ saved
 # (its crashes and its queue), with the fuzz build's compiled crates.
 #
-# Targets (fuzz/src/lib.rs): rig_document, handles, pose, animations, scribbles, png_trace_mesh.
-# The seed corpus (fuzz/seeds/TARGET) comes from the bundled assets. cargo-afl is installed into
-# tools/fuzz/.root (a local cargo root, never ~/.cargo) on first use, and AFL++ built by it.
-# Where that cannot be done (no network to crates.io, no make or C compiler), the script says so
+# Targets (fuzz/src/lib.rs): rig_document, handles, pose, animations, scribbles, png_trace_mesh,
+# bvh. The seed corpus (fuzz/seeds/TARGET) comes from the bundled assets (bvh: three frames of
+# two bundled motions, small enough for AFL++, and the hand-written tools/fuzz/seeds/bvh).
+# cargo-afl is installed into tools/fuzz/.root (a local cargo root, never ~/.cargo) on first
+# use, and AFL++ built by it. Where that cannot be done (no network to crates.io, no make or C compiler), the script says so
 # and exits 0 without fuzzing: the run is skipped, not failed. A crash fails the run (exit 1);
 # each is saved under fuzz/out/TARGET/default/crashes and replayed by `cargo test` in fuzz/.
 #
@@ -34,13 +35,13 @@ if [[ "$seconds" == --seeds-only ]]; then seconds=0; fi
 shift || true
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-    targets=(rig_document handles pose animations scribbles png_trace_mesh)
+    targets=(rig_document handles pose animations scribbles png_trace_mesh bvh)
 fi
 
 # Seeds: every bundled file of each kind (a rig document is made by hand from the
 # example in docs/formats.md when no rig has been written).
 seeds=fuzz/seeds
-mkdir -p "$seeds"/{rig_document,handles,pose,animations,scribbles,png_trace_mesh}
+mkdir -p "$seeds"/{rig_document,handles,pose,animations,scribbles,png_trace_mesh,bvh}
 cp assets/character/handles.json "$seeds/handles/"
 cp assets/character/poses/*.json "$seeds/pose/"
 cp assets/character/animations.json "$seeds/animations/"
@@ -55,6 +56,11 @@ for n, (tag, body) in enumerate(re.findall(r"```json (\w+)\n(.*?)```", text, re.
     if kind:
         (out / kind / f"formats-{n}.json").write_text(body)
 PY
+# BVH: hand-written files (odd layouts, a bad one) and three frames of a DeepMimic and of a CMU
+# clip of the bundled library.
+cp tools/fuzz/seeds/bvh/*.bvh "$seeds/bvh/"
+python3 tools/motions/cut_bvh.py assets/motions/walk.bvh "$seeds/bvh/walk-3.bvh" 0 2
+python3 tools/motions/cut_bvh.py assets/motions/idle.bvh "$seeds/bvh/idle-3.bvh" 0 2
 for png in assets/character/head.png assets/character/tail.png assets/character/bag.png; do
     cp "$png" "$seeds/png_trace_mesh/"
 done
