@@ -3,6 +3,7 @@
 //! Every failure reaches [`main`](crate) as one `anyhow` error; the binary prints it on one line
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
+mod animate;
 mod batch;
 mod choices;
 mod colorize;
@@ -54,6 +55,9 @@ pub enum Command {
     Export(ExportArgs),
     /// Propose handles (a skeleton, a cage, points) from the drawing.
     Autorig(AutorigArgs),
+    /// Add an animation to a rig from motion capture: a clip of the bundled library (idle,
+    /// walk, run, jump, jump_forward, wave) or a BVH file, retargeted onto the rig's bones.
+    Animate(animate::AnimateArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
     /// Run the jobs of a manifest (rig, autorig, render, export, colorize) in parallel, here
@@ -462,6 +466,7 @@ pub fn run(cli: Cli) -> Result<()> {
             format: ExportFormat::Spine(args),
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
+        Command::Animate(args) => animate::run(&args),
         Command::Colorize(args) => colorize::run(&args),
         Command::Batch(args) => batch::run(&args),
         Command::Schema(args) => print_schema(&args),
