@@ -429,6 +429,40 @@ fn bend_sign(hip: Point, knee: Point, ankle: Point) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
+/// Poses `leg` (world angles in `world`, degrees) so that its ankle reaches `target`, the knee
+/// bending as it did (`now`: hip, knee and ankle before); bones below the leg that the capture
+/// does not drive (`driven`) follow it.
+fn solve_leg(
+    world: &mut [f64],
+    leg: &Leg,
+    (hip, knee, ankle): (Point, Point, Point),
+    target: Point,
+    rest: &[RestBone],
+    order: &[usize],
+    driven: &dyn Fn(usize) -> bool,
+) {
+    let (upper, lower) = two_bone(
+        hip,
+        target,
+        rest[leg.thigh].length_px,
+        rest[leg.shin].length_px,
+        bend_sign(hip, knee, ankle),
+    );
+    world[leg.thigh] = upper;
+    world[leg.shin] = lower;
+    for &i in order {
+        let mut at = rest[i].parent;
+        while at.is_some_and(|p| p != leg.thigh) {
+            at = at.and_then(|p| rest[p].parent);
+        }
+        if at.is_some() && i != leg.shin && !driven(i) {
+            if let Some(p) = rest[i].parent {
+                world[i] = world[p] + rest[i].angle_deg - rest[p].angle_deg;
+            }
+        }
+    }
+}
+
 /// One leg of the rig: its thigh and shin bones (indices), and its side.
 struct Leg {
     thigh: usize,
@@ -444,6 +478,7 @@ fn contacts(
     ground_y: f64,
     leg_len: f64,
     options: &RetargetOptions,
+    cyclic: bool,
 ) -> Vec<bool> {
     let Some(foot) = SourceJoint::Foot(side).resolve(clip) else {
         return vec![false; frames.len()];
@@ -451,18 +486,27 @@ fn contacts(
     let toe = SourceJoint::Toe(side).resolve(clip);
     let dt = clip.frame_time_s;
     let n = frames.len();
+    let hips = SourceJoint::Hips.resolve(clip).map_or(0, |h| h.index());
+    // One cycle's travel: in a loop, the frame before the first is the one before the last,
+    // moved back by it.
+    let cycle = frames[n - 1].joints[hips] - frames[0].joints[hips];
+    let at = |f: usize| frames[f].joints[foot.index()];
     let mut on: Vec<bool> = (0..n)
         .map(|f| {
-            let p = frames[f].joints[foot.index()];
+            let p = at(f);
             let low = toe.map_or(p.y, |t| p.y.min(frames[f].joints[t.index()].y));
-            let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
-            let span = (b - a).max(1) as f64 * dt;
-            let v = frames[b].joints[foot.index()] - frames[a].joints[foot.index()];
-            let speed = Vector3::new(v.x, 0.0, v.z).norm() / span;
+            let v = if cyclic && n >= 3 && (f == 0 || f == n - 1) {
+                (at(1) - (at(n - 2) - cycle)) / (2.0 * dt)
+            } else {
+                let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
+                (at(b) - at(a)) / ((b - a).max(1) as f64 * dt)
+            };
+            let speed = Vector3::new(v.x, 0.0, v.z).norm();
             low - ground_y <= options.contact_height_fraction * leg_len
                 && speed <= options.contact_speed_fraction * leg_len
         })
         .collect();
+
     // Drop runs shorter than the minimum.
     let mut f = 0;
     while f < n {
@@ -477,6 +521,12 @@ fn contacts(
         if f - start < options.min_contact_frames {
             on[start..f].iter_mut().for_each(|c| *c = false);
         }
+    }
+    if cyclic && n >= 2 {
+        // The last frame is the first: a contact at either end runs across the seam.
+        let both = on[0] || on[n - 1];
+        on[0] = both;
+        on[n - 1] = both;
     }
     on
 }
@@ -510,7 +560,12 @@ fn source_leg(clip: &Clip, rest: &FramePositions) -> f64 {
 
 /// Per side whose foot the capture has, the frames where that foot is on the ground
 /// ([`RetargetOptions::contact_height_fraction`], [`RetargetOptions::contact_speed_fraction`]).
-pub fn foot_contacts(clip: &Clip, options: &RetargetOptions) -> Vec<(Side, Vec<bool>)> {
+/// `cyclic`: the clip is one loop of a cycle (as [`RetargetReport::looped`] says).
+pub fn foot_contacts(
+    clip: &Clip,
+    options: &RetargetOptions,
+    cyclic: bool,
+) -> Vec<(Side, Vec<bool>)> {
     let frames: Vec<FramePositions> = (0..clip.frame_count())
         .filter_map(|f| frame_positions(clip, f))
         .collect();
@@ -522,7 +577,7 @@ pub fn foot_contacts(clip: &Clip, options: &RetargetOptions) -> Vec<(Side, Vec<b
     [Side::Left, Side::Right]
         .into_iter()
         .filter(|&s| SourceJoint::Foot(s).resolve(clip).is_some())
-        .map(|s| (s, contacts(clip, &frames, s, ground, leg, options)))
+        .map(|s| (s, contacts(clip, &frames, s, ground, leg, options, cyclic)))
         .collect()
 }
 
@@ -803,7 +858,7 @@ pub fn retarget(
         .iter()
         .map(|l| {
             if ground_src.is_finite() {
-                contacts(clip, &frames, l.side, ground_src, leg_src, options)
+                contacts(clip, &frames, l.side, ground_src, leg_src, options, looped)
             } else {
                 vec![false; n]
             }
@@ -818,6 +873,28 @@ pub fn retarget(
     if !legs.is_empty() {
         let mut planted: Vec<Option<Point>> = vec![None; legs.len()];
         let mut released: Vec<(usize, Point)> = vec![(usize::MAX, Point::origin()); legs.len()];
+        // A loop's contact that runs across the seam is one contact: it is planted where its
+        // last run begins, one cycle's travel back at frame 0, so that the last frame and the
+        // first stand the same.
+        if looped {
+            let cycle_travel = root_x[n - 1] - root_x[0];
+            for (k, leg) in legs.iter().enumerate() {
+                if !(on[k][0] && on[k][n - 1]) || on[k].iter().all(|&c| c) {
+                    continue;
+                }
+                let begin = (0..n)
+                    .rev()
+                    .take_while(|&f| on[k][f])
+                    .last()
+                    .unwrap_or(n - 1);
+                let frames_px = bone_world_frames(
+                    handles,
+                    &pose_at(&world[begin], root_x[begin], root_y[begin]),
+                )?;
+                let (_, _, ankle) = ankle_of(&frames_px, leg);
+                planted[k] = Some(Point::new(ankle.x - cycle_travel, ground_px));
+            }
+        }
         for f in 0..n {
             // Lower the root where a planted leg cannot reach.
             let frames_px = bone_world_frames(handles, &pose_at(&world[f], root_x[f], root_y[f]))?;
@@ -861,30 +938,15 @@ pub fn retarget(
                     }
                 };
                 let Some(target) = target else { continue };
-                let (upper, lower) = two_bone(
-                    hip,
+                solve_leg(
+                    &mut world[f],
+                    leg,
+                    (hip, knee, ankle),
                     target,
-                    rest[leg.thigh].length_px,
-                    rest[leg.shin].length_px,
-                    bend_sign(hip, knee, ankle),
+                    &rest,
+                    &order,
+                    &|i| driven_at.contains_key(&i),
                 );
-                world[f][leg.thigh] = upper;
-                world[f][leg.shin] = lower;
-                // Bones below the leg that the capture does not drive follow it.
-                for &i in &order {
-                    let below = {
-                        let mut at = rest[i].parent;
-                        while at.is_some_and(|p| p != leg.thigh) {
-                            at = at.and_then(|p| rest[p].parent);
-                        }
-                        at.is_some()
-                    };
-                    if below && i != leg.shin && !driven_at.contains_key(&i) {
-                        if let Some(p) = rest[i].parent {
-                            world[f][i] = world[f][p] + rest_local(i);
-                        }
-                    }
-                }
             }
         }
     }
