@@ -25,8 +25,9 @@ pub enum MapError {
     #[error("the map names joint '{joint}' for bone '{bone}', which the capture does not have")]
     UnknownJoint { bone: String, joint: String },
     #[error(
-        "no bone of the rig is driven by the capture: name the bones as the humanoid template \
-         does (hip, chest, head, arm_upper_l, leg_upper_l, ...) or give a map file (--map)"
+        "no bone of the rig is driven by the capture (no bone with a humanoid template name, \
+         hip, chest, head, arm_upper_l, leg_upper_l..., has both its joints in the capture): \
+         rename the bones or give a map file (--map)"
     )]
     Empty,
 }
