@@ -4,6 +4,7 @@
 //! and exits with code 2. Outputs are computed first and written last, each atomically.
 
 mod animate;
+mod auto;
 mod batch;
 mod choices;
 mod colorize;
@@ -58,6 +59,9 @@ pub enum Command {
     /// Add an animation to a rig from motion capture: a clip of the bundled library (idle,
     /// walk, run, jump, jump_forward, wave) or a BVH file, retargeted onto the rig's bones.
     Animate(animate::AnimateArgs),
+    /// Art in, a character that moves out: the automatic rig, weights, the library's motions,
+    /// GIF and sprite-sheet renders and the Spine export, with a summary of what was chosen.
+    Auto(auto::AutoArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
     /// Run the jobs of a manifest (rig, autorig, render, export, colorize) in parallel, here
@@ -467,6 +471,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }) => export_spine(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Animate(args) => animate::run(&args),
+        Command::Auto(args) => auto::run(&args),
         Command::Colorize(args) => colorize::run(&args),
         Command::Batch(args) => batch::run(&args),
         Command::Schema(args) => print_schema(&args),

@@ -7,6 +7,7 @@
 //! jobs of the command line and of `sinew batch` ([`crate::batch`]). [`crate::document`] stays
 //! about the editable document: it does not reach into export, playback or the automatic rig.
 
+pub mod auto;
 mod files;
 
 pub use files::*;
