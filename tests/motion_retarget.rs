@@ -268,3 +268,73 @@ fn walking_and_running_from_capture_match_golden() {
         common::golden::check(name, &actual, "motion_retarget", premultiplied_tolerance);
     }
 }
+
+/// A dog proposed with the quadruped template (`tests/fixtures/autorig-eval/dog.png`) walks
+/// on a person's walk: its legs driven in diagonal pairs and planted, its level spine left
+/// level (a person's upright spine is no model for it).
+#[test]
+fn a_quadruped_walks_on_diagonal_pairs_with_a_level_spine() {
+    use sinew::autorig::{autorig, AutorigOptions, LayerRef, TemplateChoice};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/autorig-eval/dog.png");
+    let image = sinew::io::load_png(&path).expect("dog.png");
+    let options = AutorigOptions {
+        template: TemplateChoice::Quadruped,
+        ..AutorigOptions::default()
+    };
+    let h = autorig(&[LayerRef::whole("dog", &image)], &[], &options)
+        .expect("autorig")
+        .handles;
+    let walk = clip("walk");
+    let names: Vec<&str> = h.bones.iter().map(|b| b.name.as_str()).collect();
+    let map = JointMap::for_rig(&walk, &names).expect("a quadruped map");
+    assert_eq!(
+        map.bones.len(),
+        8,
+        "{:?}",
+        map.bones.keys().collect::<Vec<_>>()
+    );
+    let r = retarget(&h, &walk, &map, &RetargetOptions::default()).expect("retargets");
+    assert_eq!(r.report.views.get(&Group::Legs), Some(&View::Side));
+    assert!(r.report.contacts >= 4, "{:?}", r.report);
+    let ground = h
+        .bones
+        .iter()
+        .filter(|b| b.name.starts_with("leg_") && b.name.contains("_lower_"))
+        .map(|b| b.tail.y)
+        .fold(f64::MIN, f64::max);
+    for (f, pose) in r.poses.iter().enumerate() {
+        assert!(
+            pose.bones["hip"].rotate.abs() < 1e-9,
+            "frame {f}: the spine stays level"
+        );
+        for (b, (_, tail)) in h.bones.iter().zip(bone_ends(&h, pose)) {
+            if b.name.contains("_lower_") {
+                assert!(
+                    tail.y <= ground + 1e-6,
+                    "frame {f}: {} below the ground",
+                    b.name
+                );
+            }
+        }
+    }
+    // Diagonal pairs: the front left leg swings with the back right one.
+    let swing = |name: &str| -> Vec<f64> { r.poses.iter().map(|p| p.bones[name].rotate).collect() };
+    let (fl, br, bl) = (
+        swing("leg_front_upper_l"),
+        swing("leg_back_upper_r"),
+        swing("leg_back_upper_l"),
+    );
+    let corr = |a: &[f64], b: &[f64]| {
+        let n = a.len() as f64;
+        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+        let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+        let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+        let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+        cov / (va * vb).sqrt()
+    };
+    assert!(
+        corr(&fl, &br) > corr(&fl, &bl),
+        "front left moves with back right"
+    );
+}

@@ -39,7 +39,7 @@ pub fn apply_motion(
     let bones: Vec<&str> = doc.handles.bones.iter().map(|b| b.name.as_str()).collect();
     let joint_map = match map {
         Some(file) => JointMap::from_file(file, clip, &bones)?,
-        None => JointMap::humanoid(clip, &bones)?,
+        None => JointMap::for_rig(clip, &bones)?,
     };
     let retargeted = retarget(&doc.handles, clip, &joint_map, options)?;
     let previous = doc

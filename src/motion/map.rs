@@ -11,7 +11,9 @@
 //! ones (`l_hip`, `lknee`, `L_Elbow`…). The rig side is the humanoid template's bone names
 //! ([`crate::autorig::Template::Humanoid`]: `hip`, `chest`, `neck`, `head`, `arm_upper_l`,
 //! `arm_lower_l`, `hand_l`, `leg_upper_l`, `leg_lower_l`, `foot_l`, and `_r`). Any other rig
-//! gets a user map file ([`MapFile`]): bone name → source joint names.
+//! gets a user map file ([`MapFile`]): bone name → source joint names. A quadruped rig
+//! (`leg_front_upper_l`, `leg_back_lower_r`…) has its legs driven by the performer's, in
+//! diagonal pairs ([`JointMap::quadruped`]).
 
 use super::bvh::{Clip, JointId};
 use serde::{Deserialize, Serialize};
@@ -234,6 +236,36 @@ fn humanoid_pairs() -> Vec<(String, SourceJoint, Option<SourceJoint>)> {
     pairs
 }
 
+/// The quadruped template's legs and the performer's legs that drive them: back legs from the
+/// legs of their side, front legs from the legs of the other side, so that diagonal pairs
+/// step together as in a trot (a person's arms swing with the opposite leg for the same
+/// reason). The spine, neck, head and tail keep their pose: a person's upright spine is no
+/// model for a level one.
+fn quadruped_pairs() -> Vec<(String, SourceJoint, Option<SourceJoint>)> {
+    use SourceJoint as J;
+    let mut pairs = Vec::new();
+    for (end, s, side) in [
+        ("back", "l", Side::Left),
+        ("back", "r", Side::Right),
+        ("front", "l", Side::Right),
+        ("front", "r", Side::Left),
+    ] {
+        pairs.extend([
+            (
+                format!("leg_{end}_upper_{s}"),
+                J::Thigh(side),
+                Some(J::Shin(side)),
+            ),
+            (
+                format!("leg_{end}_lower_{s}"),
+                J::Shin(side),
+                Some(J::Foot(side)),
+            ),
+        ]);
+    }
+    pairs
+}
+
 /// The end of a segment leaving `from` when no joint names it: its end site, else its only
 /// child.
 fn default_end(clip: &Clip, from: JointId) -> Option<SegmentEnd> {
@@ -251,8 +283,34 @@ impl JointMap {
     /// The humanoid template's map onto `clip`, for the bones `rig_bones` has: every bone of
     /// the template whose two joints the capture has (by any known naming scheme).
     pub fn humanoid(clip: &Clip, rig_bones: &[&str]) -> Result<JointMap, MapError> {
+        Self::from_pairs(clip, rig_bones, humanoid_pairs())
+    }
+
+    /// The quadruped template's legs driven by a person's legs ([`quadruped_pairs`]).
+    pub fn quadruped(clip: &Clip, rig_bones: &[&str]) -> Result<JointMap, MapError> {
+        Self::from_pairs(clip, rig_bones, quadruped_pairs())
+    }
+
+    /// The map for a rig named by a template: the quadruped's when the rig has a front or a
+    /// back leg (`leg_front_*`, `leg_back_*`), else the humanoid's.
+    pub fn for_rig(clip: &Clip, rig_bones: &[&str]) -> Result<JointMap, MapError> {
+        let four_legged = rig_bones
+            .iter()
+            .any(|b| b.starts_with("leg_front_") || b.starts_with("leg_back_"));
+        if four_legged {
+            Self::quadruped(clip, rig_bones)
+        } else {
+            Self::humanoid(clip, rig_bones)
+        }
+    }
+
+    fn from_pairs(
+        clip: &Clip,
+        rig_bones: &[&str],
+        pairs: Vec<(String, SourceJoint, Option<SourceJoint>)>,
+    ) -> Result<JointMap, MapError> {
         let mut bones = BTreeMap::new();
-        for (bone, from, to) in humanoid_pairs() {
+        for (bone, from, to) in pairs {
             if !rig_bones.contains(&bone.as_str()) {
                 continue;
             }

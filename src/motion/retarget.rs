@@ -674,14 +674,20 @@ pub fn retarget(
     if roots.is_empty() {
         return Err(RetargetError::NoRoot);
     }
-    let legs: Vec<Leg> = [(Side::Left, "l"), (Side::Right, "r")]
+    // The rig's legs (a person's two, an animal's four), each with the capture foot whose
+    // contacts plant it: the side of the thigh's driving joint.
+    let legs: Vec<Leg> = ["", "back_", "front_"]
         .into_iter()
-        .filter_map(|(side, s)| {
-            Some(Leg {
-                thigh: *index.get(format!("leg_upper_{s}").as_str())?,
-                shin: *index.get(format!("leg_lower_{s}").as_str())?,
-                side,
-            })
+        .flat_map(|end| ["l", "r"].map(move |s| (end, s)))
+        .filter_map(|(end, s)| {
+            let thigh_name = format!("leg_{end}upper_{s}");
+            let thigh = *index.get(thigh_name.as_str())?;
+            let shin = *index.get(format!("leg_{end}lower_{s}").as_str())?;
+            let from = map.bones.get(&thigh_name)?.from;
+            let side = [Side::Left, Side::Right]
+                .into_iter()
+                .find(|&side| SourceJoint::Thigh(side).resolve(clip) == Some(from))?;
+            Some(Leg { thigh, shin, side })
         })
         .collect();
 
