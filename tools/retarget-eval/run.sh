@@ -36,14 +36,17 @@ for n in "${real[@]}"; do
   args+=("$n=$work/$n.handles.json")
 done
 
-head_hash="$(git show HEAD:src/motion/retarget.rs | sha256sum | cut -d' ' -f1)"
 echo "Run $(date -u +%Y-%m-%dT%H:%MZ) at commit $(git rev-parse --short HEAD)."
 "$eval_bin" "${args[@]}" > "$work/out.md"
 built="$(sed -n 's/.*sha256 \([0-9a-f]*\).*/\1/p' "$work/out.md" | head -1)"
-if [[ "$built" == "$head_hash" ]]; then
-  echo "src/motion/retarget.rs as committed at $(git rev-parse --short HEAD)."
-else
-  echo "src/motion/retarget.rs NOT as committed: built from a working tree that differs from HEAD (sha256 $built)."
-fi
+# Which commit's src/motion/retarget.rs the example was built with (the newest that matches).
+state="a version no commit has (uncommitted changes; sha256 $built)"
+for c in $(git log --format=%h -n 50 -- src/motion/retarget.rs); do
+  if [[ "$(git show "$c:src/motion/retarget.rs" | sha256sum | cut -d' ' -f1)" == "$built" ]]; then
+    state="as of commit $c"
+    break
+  fi
+done
+echo "src/motion/retarget.rs $state."
 echo
 sed '1,2d' "$work/out.md"
