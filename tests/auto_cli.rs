@@ -1,6 +1,6 @@
-//! `sinew auto ART -o DIR` end to end through the binary: the bundled layered PSD and a flat
-//! sprite become a rig with the library's motions, GIFs, sprite sheets and a Spine export; a rig
-//! the library cannot drive (a quadruped) still gets everything else; bad input is refused with
+//! `sinew auto ART -o DIR` end to end through the binary: the bundled layered PSD, a flat
+//! sprite and a quadruped become a rig with the library's motions, GIFs, sprite sheets and a
+//! Spine export; a rig the library cannot drive (no template) still gets everything else; bad input is refused with
 //! one line, exit code 2 and nothing written; an earlier output is replaced whole, keeping what
 //! the person added, and survives a failed run.
 //!
@@ -169,15 +169,32 @@ fn a_flat_sprite_works_too() {
 }
 
 #[test]
-fn a_rig_the_library_cannot_drive_gets_no_motion_but_everything_else() {
+fn a_quadruped_walks_on_four_legs() {
     let tmp = scratch("quadruped");
     let out = tmp.path().join("cat");
     let stdout = auto(&fixture("autorig-real/cat.png"), &out);
     assert!(stdout.contains("template: quadruped"), "{stdout}");
+    let rig = json(&out.join("rig.json"));
+    assert_eq!(names(&rig["animations"]), ALL);
+    let summary = json(&out.join("summary.json"));
+    for m in summary["motions"].as_array().unwrap() {
+        assert!(m["report"]["views"].get("legs").is_some(), "{m}");
+    }
+    assert!(out.join("walk.gif").is_file());
+    assert!(out.join("spine/cat.json").is_file());
+}
+
+#[test]
+fn a_rig_the_library_cannot_drive_gets_no_motion_but_everything_else() {
+    let tmp = scratch("none");
+    let out = tmp.path().join("fish");
+    let stdout = auto(&fixture("autorig-real/fish.png"), &out);
+    assert!(stdout.contains("template: none"), "{stdout}");
     assert!(stdout.contains("motions skipped"), "{stdout}");
     let rig = json(&out.join("rig.json"));
     assert!(names(&rig["animations"]).is_empty());
-    assert!(out.join("spine/cat.json").is_file());
+    assert!(out.join("spine/fish.json").is_file());
+    assert!(!out.join("walk.gif").exists());
     let summary = json(&out.join("summary.json"));
     assert!(summary["motions"].as_array().unwrap().is_empty());
     assert_eq!(summary["motions_skipped"].as_array().unwrap().len(), 1);
@@ -247,12 +264,13 @@ fn a_rerun_replaces_the_earlier_output_and_a_failed_one_keeps_it() {
     assert_bad_input(&["auto", s(&png), "-o", s(&out)], "garbage.png");
     assert_eq!(std::fs::read(out.join("rig.json")).unwrap(), before);
 
-    // Another character into the same folder: the kid's files are gone, the person's kept.
-    auto(&fixture("autorig-real/cat.png"), &out);
+    // Another character (one no motion drives) into the same folder: the kid's files are
+    // gone, the person's kept.
+    auto(&fixture("autorig-real/fish.png"), &out);
     assert!(!out.join("rig.parts/kid.png").exists());
     assert!(!out.join("walk.gif").exists());
     assert!(!out.join("spine/kid.json").exists());
-    assert!(out.join("rig.parts/cat.png").is_file());
+    assert!(out.join("rig.parts/fish.png").is_file());
     assert_eq!(std::fs::read(out.join("notes.txt")).unwrap(), b"mine");
     assert_eq!(std::fs::read(out.join("mine/a.txt")).unwrap(), b"mine");
     let leftovers = std::fs::read_dir(dir).unwrap().count();

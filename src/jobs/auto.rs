@@ -12,8 +12,8 @@
 //! 4. **motions**: every clip of the bundled library ([`crate::motion::library::MOTIONS`])
 //!    retargeted onto the rig ([`crate::motion::apply_motion`]); walk, run and idle in place
 //!    ([`IN_PLACE`]) so their renders stay in the frame. A rig none of whose arm or leg bones
-//!    carries a humanoid template name (a quadruped, whose spine alone the human captures would
-//!    drive; no template) gets no motion: the summary says so;
+//!    the captures drive (no template: a fish, a kite; a rig whose spine alone has template
+//!    names) gets no motion: the summary says so;
 //! 5. **render**: each animation drawn ([`crate::playback::render_animation`]) at
 //!    [`AutoOptions::fps`], the canvas scaled down to [`AutoOptions::render_side_px`];
 //! 6. **spine**: the Spine 4.2 export ([`crate::export::spine::export_spine`]);
@@ -92,8 +92,9 @@ impl Default for AutoOptions {
 /// Why `sinew auto` stopped; nothing was written.
 #[derive(Debug, thiserror::Error)]
 pub enum AutoError {
+    /// A stage's own error (boxed: it is large).
     #[error(transparent)]
-    Job(#[from] JobError),
+    Job(Box<JobError>),
     #[error(
         "{}: the folder is not empty and not one sinew auto wrote (no {SUMMARY_FILE}): choose a new or empty folder",
         .0.display()
@@ -114,12 +115,13 @@ macro_rules! via_job {
     ($($t:ty),*) => {$(
         impl From<$t> for AutoError {
             fn from(e: $t) -> Self {
-                AutoError::Job(e.into())
+                AutoError::Job(Box::new(e.into()))
             }
         }
     )*};
 }
 via_job!(
+    JobError,
     OutputError,
     pipeline::PipelineError,
     autorig::AutorigError,
@@ -471,13 +473,13 @@ pub fn auto_files(files: &AutoFiles, options: &AutoOptions) -> Result<AutoSummar
         };
         let no_limbs = || {
             format!(
-                "no arm or leg bone of the rig (template {template}) has a humanoid template name, \
-                 and the library's captures are human; animate it with `sinew animate --map`"
+                "the library's captures drive no arm or leg bone of this rig (template {template}); \
+                 animate it with `sinew animate --map`"
             )
         };
         match motion::apply_motion(&mut doc, &clip, None, m.name, &retarget) {
-            // A quadruped shares the spine's names (hip, chest, neck, head): a human capture
-            // would sway its torso and leave its legs still. Not a walk: none is applied.
+            // A rig with only the spine's names (hip, chest, neck, head) would sway its torso
+            // and keep its limbs still: not a walk. None is applied.
             Ok(report)
                 if !report.views.contains_key(&Group::Legs)
                     && !report.views.contains_key(&Group::Arms) =>
