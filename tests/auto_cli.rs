@@ -87,7 +87,7 @@ fn the_bundled_psd_becomes_a_moving_character() {
         .filter(|m| m["in_place"] == true)
         .map(|m| m["name"].as_str().unwrap())
         .collect();
-    assert_eq!(in_place, ["idle", "walk", "run"]);
+    assert_eq!(in_place, ["idle", "walk", "run", "jump", "jump_forward"]);
     let shares: f64 = summary["stages"]
         .as_array()
         .unwrap()

@@ -10,8 +10,8 @@
 //! 3. **rig**: trace, mesh and weigh every part with those handles
 //!    ([`crate::pipeline::build_rig`], as `sinew rig --handles` does);
 //! 4. **motions**: every clip of the bundled library ([`crate::motion::library::MOTIONS`])
-//!    retargeted onto the rig ([`crate::motion::apply_motion`]); walk, run and idle in place
-//!    ([`IN_PLACE`]) so their renders stay in the frame. A rig none of whose arm or leg bones
+//!    retargeted onto the rig ([`crate::motion::apply_motion`]); every one that travels in place
+//!    ([`IN_PLACE`]) so their renders stay in the frame, as games play them. A rig none of whose arm or leg bones
 //!    the captures drive (no template: a fish, a kite; a rig whose spine alone has template
 //!    names) gets no motion: the summary says so;
 //! 5. **render**: each animation drawn ([`crate::playback::render_animation`]) at
@@ -50,7 +50,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The motions applied in place (no travel): their renders stay in the canvas.
-pub const IN_PLACE: &[&str] = &["walk", "run", "idle"];
+pub const IN_PLACE: &[&str] = &["walk", "run", "idle", "jump", "jump_forward"];
 /// The summary's file name in the output folder; its presence marks a folder `sinew auto` wrote.
 pub const SUMMARY_FILE: &str = "summary.json";
 /// The rig document's file name in the output folder.
