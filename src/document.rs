@@ -385,7 +385,8 @@ pub enum Command {
         animation: String,
         curves: Vec<(KeyRef, Curve)>,
     },
-    /// Adds, renames, duplicates or deletes an animation.
+    /// Adds, renames, duplicates or deletes an animation, or stores a computed one under a name
+    /// (*Apply motion…*'s retargeted capture, [`AnimationEdit::Put`]).
     Animations(AnimationEdit),
     /// Defines events, adds event keys, sets their payloads.
     Events(EventEdit),

@@ -1,5 +1,5 @@
 //! The document's list of animations and auto-keying: [`AnimationEdit`] (add, rename,
-//! duplicate, delete an animation) and [`key_changes`] (key only the channels a pose changed).
+//! duplicate, delete an animation, or put a computed one under a name) and [`key_changes`] (key only the channels a pose changed).
 //!
 //! In: the state's animations by name. Out: the animations after the edit, or why it is
 //! refused (an empty name, a name taken, an animation that does not exist); the caller
@@ -29,6 +29,12 @@ pub enum AnimationEdit {
     },
     Delete {
         name: String,
+    },
+    /// Stores a computed animation (*Apply motion…*'s retargeted capture) under `name`,
+    /// replacing one of that name: one undo step either way.
+    Put {
+        name: String,
+        animation: Box<Animation>,
     },
 }
 
@@ -72,6 +78,15 @@ pub(super) fn apply(next: &mut State, edit: AnimationEdit) -> Result<(), Documen
         AnimationEdit::Delete { name } => {
             existing(next, &name)?;
             next.animations.remove(&name);
+        }
+        AnimationEdit::Put { name, animation } => {
+            // A name taken is replaced, but it must still be a name.
+            if let Err(e) = check_new_name(next, &name) {
+                if !next.animations.contains_key(&name) {
+                    return Err(e);
+                }
+            }
+            super::store_animation(next, &name, *animation)?;
         }
     }
     Ok(())
@@ -359,6 +374,47 @@ mod tests {
         assert_eq!(doc.state().animations.len(), 1);
         assert!(doc.undo());
         assert!(doc.state().animations.contains_key("stroll"));
+    }
+
+    #[test]
+    fn put_stores_or_replaces_an_animation_in_one_undo_step() {
+        let mut doc = Document::new();
+        let keyed = |rotate: f64| {
+            let mut anim = Animation::default();
+            put_key(
+                anim.bones
+                    .entry("arm".into())
+                    .or_default()
+                    .rotate
+                    .get_or_insert_with(Vec::new),
+                0.0,
+                rotate,
+            );
+            anim
+        };
+        let put = |name: &str, anim: Animation| {
+            Command::Animations(AnimationEdit::Put {
+                name: name.into(),
+                animation: Box::new(anim),
+            })
+        };
+        doc.apply(put("walk", keyed(10.0))).expect("put");
+        assert_eq!(doc.state().animations["walk"], keyed(10.0));
+        // A name taken is replaced; undo brings the old keys back, redo the new ones.
+        doc.apply(put("walk", keyed(20.0))).expect("replaced");
+        assert_eq!(doc.state().animations["walk"], keyed(20.0));
+        assert!(doc.undo());
+        assert_eq!(doc.state().animations["walk"], keyed(10.0));
+        assert!(doc.redo());
+        assert_eq!(doc.state().animations["walk"], keyed(20.0));
+        // Blank or padded names are refused, the document unchanged.
+        for bad in ["", " ", " walk"] {
+            assert!(doc.apply(put(bad, keyed(5.0))).is_err(), "{bad:?} accepted");
+        }
+        assert_eq!(doc.state().animations.len(), 1);
+        assert!(doc.undo());
+        assert!(doc.undo());
+        assert!(doc.state().animations.is_empty());
     }
 
     #[test]

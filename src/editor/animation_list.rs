@@ -1,5 +1,6 @@
 //! Animate mode's list of animations: pick the one edited, create, rename, duplicate and
-//! delete animations (the document's [`AnimationEdit`] commands, undoable like any edit).
+//! delete animations, or add one from a capture (*Apply motion…*, [`super::apply_motion`]):
+//! the document's [`AnimationEdit`] commands, undoable like any edit.
 //! No name is ever typed to pick an animation, so none is created by a typo.
 //!
 //! In: the document's animations, clicks and the typed new name. Out: `Animations` commands
@@ -40,7 +41,20 @@ impl EditorApp {
 
     /// The side panel's section in animate mode.
     pub(super) fn animation_list(&mut self, ui: &mut egui::Ui) {
-        ui.heading("Animations");
+        // Beside the heading: the panel keeps its height for the tree.
+        ui.horizontal(|ui| {
+            ui.heading("Animations");
+            if ui
+                .button("Apply motion…")
+                .on_hover_text(
+                    "a walk, run, jump… from the motion library or a BVH capture, retargeted \
+                     onto this rig's bones as an animation",
+                )
+                .clicked()
+            {
+                self.ask_motion();
+            }
+        });
         let current = self.animate.animation.clone();
         let exists = self.doc.state().animations.contains_key(&current);
         if self.animations.filled_for != current {

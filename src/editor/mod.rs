@@ -7,7 +7,8 @@
 //! This module is the app: its state, the menu bar, the shortcuts and the dispatch to the
 //! modes, each with its own state and UI: **Rig** ([`rig_mode`], with [`rig_tools`] and
 //! [`paint`]), **Pose** ([`pose_mode`], with the FK [`gizmo`]), **Animate** ([`animate_mode`]:
-//! playhead, playback, onion skins; [`timeline`]: dopesheet and curves) and **Colorize**
+//! playhead, playback, onion skins; [`timeline`]: dopesheet and curves; [`apply_motion`]: a
+//! capture retargeted as an animation) and **Colorize**
 //! ([`colorize`]). The canvas ([`drawing`], helpers in [`canvas`]) draws a pose as `sinew
 //! render` does: posed through [`pose_mode::pose_frame`] (or [`crate::scene::Playhead`] at the
 //! playhead), drawn from the library's draw list
@@ -17,6 +18,7 @@
 
 pub mod animate_mode;
 pub mod animation_list;
+pub mod apply_motion;
 pub mod canvas;
 pub mod closing;
 pub mod colorize;
@@ -144,6 +146,8 @@ pub struct EditorApp {
     pub animate: animate_mode::AnimateMode,
     /// Animate mode's list of animations.
     pub animations: animation_list::AnimationList,
+    /// Animate mode's *Apply motion* window.
+    pub motion: apply_motion::ApplyMotionWindow,
     /// The canvas: layer textures and the picture of the posed drawing.
     pub drawing: drawing::Drawing,
     /// The File menu's path field (rigs to open, PNGs to import, where to save).
@@ -232,6 +236,7 @@ impl EditorApp {
             pose_mode: Default::default(),
             animate: animate_mode::AnimateMode::new(first_animation),
             animations: Default::default(),
+            motion: Default::default(),
             drawing: Default::default(),
             open_path,
             files: Default::default(),
@@ -324,6 +329,7 @@ impl EditorApp {
         if self.mode == Mode::Animate {
             self.graph_view_window(&ctx);
             self.define_event_window(&ctx);
+            self.apply_motion_window(&ctx);
         }
         self.log_window(&ctx);
         self.close_dialog(&ctx);

@@ -32,6 +32,8 @@ pub enum DialogFor {
     ExportFolder,
     /// Render's output path field.
     RenderPath,
+    /// *Apply motion*'s capture file (animate mode).
+    MotionFile,
 }
 
 impl DialogFor {
@@ -42,6 +44,7 @@ impl DialogFor {
             DialogFor::Path(PathAction::SaveAs) => "Save as",
             DialogFor::ExportFolder => "Export Spine to folder",
             DialogFor::RenderPath => "Render to",
+            DialogFor::MotionFile => "Apply motion from a capture file",
         }
     }
 }
@@ -143,6 +146,9 @@ fn run_dialog(purpose: DialogFor, current: Option<PathBuf>) -> Option<PathBuf> {
         DialogFor::RenderPath => dialog
             .add_filter("GIF, PNG sheet or folder", &["gif", "png"])
             .save_file(),
+        DialogFor::MotionFile => dialog
+            .add_filter("BVH motion capture", &["bvh", "BVH"])
+            .pick_file(),
     }
 }
 
@@ -218,6 +224,10 @@ impl EditorApp {
             DialogFor::Path(PathAction::SaveAs) => self.save_as(&path),
             DialogFor::ExportFolder => self.export_dir = path.display().to_string(),
             DialogFor::RenderPath => self.render_path = path.display().to_string(),
+            DialogFor::MotionFile => {
+                self.motion.source = super::apply_motion::MotionSource::File;
+                self.motion.file = path.display().to_string();
+            }
         }
     }
 
@@ -229,6 +239,7 @@ impl EditorApp {
         let current = match purpose {
             DialogFor::ExportFolder => Some(PathBuf::from(self.export_dir.trim())),
             DialogFor::RenderPath => Some(PathBuf::from(self.render_path.trim())),
+            DialogFor::MotionFile => Some(PathBuf::from(self.motion.file.trim())),
             DialogFor::Path(_) => None,
         };
         if ui

@@ -25,6 +25,7 @@ use tempfile::TempDir;
 use std::sync::Arc;
 
 mod animate;
+mod apply_motion;
 mod bind;
 mod carried_points;
 mod colorize;
