@@ -234,6 +234,7 @@ fn strip(motion: &str, times: &[f64]) -> RgbaImage {
         &clip(motion),
         &RetargetOptions {
             in_place: true,
+            loop_mode: library::find(motion).expect("a bundled motion").loop_mode(),
             ..RetargetOptions::default()
         },
     );

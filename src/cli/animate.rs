@@ -29,7 +29,9 @@ pub struct AnimateArgs {
     /// No horizontal travel: the character walks or runs on the spot.
     #[arg(long)]
     pub in_place: bool,
-    /// Make the clip loop (blend its seam), or not; auto: when its ends nearly match.
+    /// Make the clip loop (cut at the frame that best matches its start, the rest of the
+    /// seam blended), or not; auto: the library knows its cycles, a capture file loops when
+    /// a frame of its second half nearly matches its first.
     #[arg(long = "loop", value_enum, default_value_t = LoopArg::Auto)]
     pub loop_mode: LoopArg,
     /// A joint map for a rig whose bones do not have the humanoid template's names:
@@ -115,6 +117,11 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     .flatten()
     .collect();
     check_outputs(inputs, [Some(output.as_path())])?;
+    let library_motion = if is_file {
+        None
+    } else {
+        library::find(&args.motion)
+    };
     let (clip, default_name) = if is_file {
         let path = Path::new(&args.motion);
         let clip = motion::read(path, &motion::BvhLimits::default())
@@ -140,7 +147,12 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     };
     let mut doc = RigDocument::load(&args.rig)?;
     let name = args.name.clone().unwrap_or(default_name);
-    let report = motion::apply_motion(&mut doc, &clip, map.as_ref(), &name, &options(args))?;
+    let mut options = options(args);
+    // A library motion knows whether it is a cycle.
+    if let (LoopArg::Auto, Some(m)) = (args.loop_mode, library_motion) {
+        options.loop_mode = m.loop_mode();
+    }
+    let report = motion::apply_motion(&mut doc, &clip, map.as_ref(), &name, &options)?;
     rebase_images(&mut doc, &args.rig, &output)?;
     doc.save(&output)?;
     let views: Vec<String> = report

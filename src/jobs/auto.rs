@@ -469,6 +469,7 @@ pub fn auto_files(files: &AutoFiles, options: &AutoOptions) -> Result<AutoSummar
         let in_place = IN_PLACE.contains(&m.name);
         let retarget = RetargetOptions {
             in_place,
+            loop_mode: m.loop_mode(),
             ..Default::default()
         };
         let no_limbs = || {

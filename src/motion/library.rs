@@ -11,6 +11,9 @@ pub struct Motion {
     pub about: &'static str,
     /// The BVH file's bytes.
     pub bvh: &'static [u8],
+    /// Whether it is a cycle, made to loop ([`crate::motion::LoopMode::Blend`]), or a one-off
+    /// ([`crate::motion::LoopMode::Off`]).
+    pub looping: bool,
 }
 
 /// Every clip of the library, in the order `sinew animate` lists them.
@@ -19,31 +22,37 @@ pub const MOTIONS: &[Motion] = &[
         name: "idle",
         about: "standing, weight shifting slightly (CMU 01_01)",
         bvh: include_bytes!("../../assets/motions/idle.bvh"),
+        looping: true,
     },
     Motion {
         name: "walk",
         about: "one walk cycle, two steps, loops (DeepMimic)",
         bvh: include_bytes!("../../assets/motions/walk.bvh"),
+        looping: true,
     },
     Motion {
         name: "run",
         about: "one run cycle, two strides, loops (DeepMimic)",
         bvh: include_bytes!("../../assets/motions/run.bvh"),
+        looping: true,
     },
     Motion {
         name: "jump",
         about: "a two-footed jump forward with an arm swing (DeepMimic)",
         bvh: include_bytes!("../../assets/motions/jump.bvh"),
+        looping: false,
     },
     Motion {
         name: "jump_forward",
         about: "a standing jump forward: crouch, flight, landing (CMU 01_01)",
         bvh: include_bytes!("../../assets/motions/jump_forward.bvh"),
+        looping: false,
     },
     Motion {
         name: "wave",
         about: "the right hand raised and waved three times (keyed by hand)",
         bvh: include_bytes!("../../assets/motions/wave.bvh"),
+        looping: false,
     },
 ];
 
@@ -53,6 +62,15 @@ pub fn find(name: &str) -> Option<&'static Motion> {
 }
 
 impl Motion {
+    /// How its loop is made when the person leaves it to sinew.
+    pub fn loop_mode(&self) -> crate::motion::LoopMode {
+        if self.looping {
+            crate::motion::LoopMode::Blend
+        } else {
+            crate::motion::LoopMode::Off
+        }
+    }
+
     /// The clip, parsed.
     pub fn clip(&self) -> Result<Clip, BvhError> {
         parse(self.bvh, &BvhLimits::default())

@@ -30,10 +30,11 @@
 //!    where the leg cannot reach, the root is lowered. Out of contact, no ankle goes below the
 //!    ground line. After a contact the foot eases back to the capture's motion over
 //!    [`RetargetOptions::release_frames`].
-//! 5. **Loops without a seam.** A clip whose last pose is within
-//!    [`RetargetOptions::loop_max_seam_deg`] of its first (every driven angle) is a cycle; the
-//!    difference is spread linearly over the clip so the last frame is the first
-//!    ([`LoopMode`]). `in_place` removes the root's horizontal travel (its least-squares line),
+//! 5. **Loops without a seam.** A clip with a frame in its second half within
+//!    [`RetargetOptions::loop_max_seam_deg`] of its first pose (every driven angle) is a cycle:
+//!    it is cut at the best such frame and the remaining difference is blended into its last
+//!    [`RetargetOptions::loop_blend_fraction`], so the last frame is the first ([`LoopMode`]; the library says which of its
+//!    clips loop). `in_place` removes the root's horizontal travel (its least-squares line),
 //!    keeping the sway.
 //! 6. **Editable keys.** Every channel is reduced to Bézier keys within
 //!    [`RetargetOptions::rotate_tolerance_deg`] / [`RetargetOptions::translate_tolerance_px`]
@@ -107,14 +108,16 @@ pub struct RetargetOptions {
     pub in_place: bool,
     /// Default [`LoopMode::Auto`].
     pub loop_mode: LoopMode,
-    /// A clip is a cycle when no driven angle differs by more between its last and first
-    /// frames, degrees. Default 25.
+    /// A clip is a cycle when one of the frames of its second half has no driven angle more
+    /// than this from the first frame's, degrees (the clip is then cut there). Default 12.
     pub loop_max_seam_deg: f64,
     /// A foot within this many leg lengths of the capture's ground may be in contact.
     /// Default 0.08.
     pub contact_height_fraction: f64,
     /// ... and moving slower than this many leg lengths per second. Default 0.6.
     pub contact_speed_fraction: f64,
+    /// A loop's remaining seam is blended into this last fraction of the clip. Default 0.3.
+    pub loop_blend_fraction: f64,
     /// Contacts shorter than this many frames are ignored. Default 2.
     pub min_contact_frames: usize,
     /// Frames over which a released foot eases back to the capture's motion. Default 3.
@@ -135,7 +138,8 @@ impl Default for RetargetOptions {
             facing: Facing::Right,
             in_place: false,
             loop_mode: LoopMode::Auto,
-            loop_max_seam_deg: 25.0,
+            loop_max_seam_deg: 12.0,
+            loop_blend_fraction: 0.3,
             contact_height_fraction: 0.08,
             contact_speed_fraction: 0.6,
             min_contact_frames: 2,
@@ -581,9 +585,11 @@ pub fn foot_contacts(
         .collect()
 }
 
-/// Spreads the difference between the last and the first value over the series, so that the
-/// last value is the first (plus whole turns for angles when `turn` is 360).
-fn spread_seam(values: &mut [f64], turn: Option<f64>) {
+/// Blends the difference between the last and the first value into the series' last
+/// `window` fraction (a smoothstep ramp from 0 to the whole difference), so that the last
+/// value is the first (plus whole turns for angles when `turn` is 360) and the frames before
+/// the window are untouched.
+fn spread_seam(values: &mut [f64], turn: Option<f64>, window: f64) {
     let n = values.len();
     if n < 2 {
         return;
@@ -592,8 +598,11 @@ fn spread_seam(values: &mut [f64], turn: Option<f64>) {
     if let Some(turn) = turn {
         drift -= turn * (drift / turn).round();
     }
+    let last = (n - 1) as f64;
+    let start = last * (1.0 - window.clamp(1.0 / last, 1.0));
     for (i, v) in values.iter_mut().enumerate() {
-        *v -= drift * i as f64 / (n - 1) as f64;
+        let s = ((i as f64 - start) / (last - start)).clamp(0.0, 1.0);
+        *v -= drift * s * s * (3.0 - 2.0 * s);
     }
 }
 
@@ -611,14 +620,14 @@ pub fn retarget(
     map: &JointMap,
     options: &RetargetOptions,
 ) -> Result<Retargeted, RetargetError> {
-    let n = clip.frame_count();
+    let mut n = clip.frame_count();
     if n == 0 {
         return Err(RetargetError::NoFrames);
     }
     if !(clip.frame_time_s.is_finite() && clip.frame_time_s > 0.0) {
         return Err(RetargetError::BadFrameTime);
     }
-    let frames: Vec<FramePositions> = (0..n)
+    let mut frames: Vec<FramePositions> = (0..n)
         .map(|f| frame_positions(clip, f).ok_or(RetargetError::NoFrames))
         .collect::<Result<_, _>>()?;
     if frames.iter().any(|f| {
@@ -746,18 +755,34 @@ pub fn retarget(
         unwrap(&mut series);
         angles.push(series);
     }
-    let looped = match options.loop_mode {
-        LoopMode::Off => false,
-        LoopMode::Blend => true,
-        LoopMode::Auto => {
-            n >= 3
-                && angles
-                    .iter()
-                    .all(|s| wrap_deg(s[n - 1] - s[0]).abs() <= options.loop_max_seam_deg)
-        }
+    // A loop ends at the frame of the clip's second half that best matches the first (a
+    // capture rarely ends exactly one cycle after it starts): the clip is cut there, and what
+    // differences remain are spread.
+    let seam_at = |k: usize| -> f64 {
+        angles
+            .iter()
+            .map(|s| wrap_deg(s[k] - s[0]).abs())
+            .fold(0.0, f64::max)
     };
+    let cut = (n / 2).max(2)..n;
+    let best = cut
+        .clone()
+        .min_by(|&a, &b| seam_at(a).total_cmp(&seam_at(b)).then(b.cmp(&a)))
+        .filter(|_| n >= 3);
+    let looped = match (options.loop_mode, best) {
+        (LoopMode::Off, _) | (_, None) => false,
+        (LoopMode::Blend, Some(_)) => true,
+        (LoopMode::Auto, Some(k)) => seam_at(k) <= options.loop_max_seam_deg,
+    };
+    if let (true, Some(k)) = (looped, best) {
+        n = k + 1;
+        frames.truncate(n);
+        angles.iter_mut().for_each(|s| s.truncate(n));
+    }
     if looped {
-        angles.iter_mut().for_each(|s| spread_seam(s, Some(360.0)));
+        angles
+            .iter_mut()
+            .for_each(|s| spread_seam(s, Some(360.0), options.loop_blend_fraction));
     }
 
     // Root translation: hips on screen, scaled; height above the capture's ground.
@@ -801,11 +826,11 @@ pub fn retarget(
         move |t: f64| mean_x + slope * (t - mean_t)
     };
     if looped {
-        spread_seam(&mut root_y, None);
+        spread_seam(&mut root_y, None, options.loop_blend_fraction);
         // The sway loops; the travel is kept (or removed below).
         let trend: Vec<f64> = times.iter().map(|&t| travel(t)).collect();
         let mut sway: Vec<f64> = root_x.iter().zip(&trend).map(|(x, t)| x - t).collect();
-        spread_seam(&mut sway, None);
+        spread_seam(&mut sway, None, options.loop_blend_fraction);
         root_x = sway.iter().zip(&trend).map(|(s, t)| s + t).collect();
     }
 
