@@ -166,10 +166,26 @@ fn walk_plants_the_feet_keeps_the_bones_and_loops() {
         "{} keys for {channels} channels of {n} frames",
         r.report.keys
     );
+    // What plays keeps the ankles on the ground line within the keys' ground tolerance.
+    let leg_px = ["leg_upper_l", "leg_lower_l"]
+        .iter()
+        .map(|b| {
+            let b = &h.bones[index(&h, b)];
+            (b.tail - b.head).norm()
+        })
+        .sum::<f64>();
+    let shins = [index(&h, "leg_lower_l"), index(&h, "leg_lower_r")];
     let worst = (0..n)
         .map(|f| {
-            let played = r.animation.sample(f as f64 * walk.frame_time_s, false);
-            bone_ends(&h, &played)
+            let played = bone_ends(&h, &r.animation.sample(f as f64 * walk.frame_time_s, false));
+            for &shin in &shins {
+                let below = played[shin].1.y - ground;
+                assert!(
+                    below <= options.ground_tolerance_fraction * leg_px,
+                    "frame {f}: the keys put an ankle {below} px below the ground"
+                );
+            }
+            played
                 .iter()
                 .zip(&ends[f])
                 .map(|(p, q)| (p.0 - q.0).norm().max((p.1 - q.1).norm()))

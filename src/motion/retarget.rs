@@ -129,6 +129,10 @@ pub struct RetargetOptions {
     pub rotate_tolerance_deg: f64,
     /// ... and translations within this, px. Default 0.5.
     pub translate_tolerance_px: f64,
+    /// The bones from the root to each ankle are keyed tighter, so that the keys move no ankle
+    /// more than this many leg lengths from its frame's pose (the ground line and planted
+    /// feet hold in what plays, not only in the frames). Default 0.006.
+    pub ground_tolerance_fraction: f64,
 }
 
 impl Default for RetargetOptions {
@@ -147,6 +151,7 @@ impl Default for RetargetOptions {
             foreshortened_fraction: 0.2,
             rotate_tolerance_deg: 0.5,
             translate_tolerance_px: 0.5,
+            ground_tolerance_fraction: 0.006,
         }
     }
 }
@@ -994,6 +999,31 @@ pub fn retarget(
     let mut animation = Animation::default();
     let mut key_count = 0;
     let cyclic = looped;
+    // The bones between the root and an ankle share the ground's tolerance: keys within it
+    // leave no ankle more than `ground_tolerance_fraction` of a leg from where its frame put it
+    // (three bones, each turning the ankle by at most its angle error times a leg length).
+    let mut on_leg_chain = vec![false; rest.len()];
+    for leg in &legs {
+        let mut at = Some(leg.shin);
+        while let Some(i) = at {
+            on_leg_chain[i] = true;
+            at = rest[i].parent;
+        }
+    }
+    let chain_deg = (options.ground_tolerance_fraction / 3.0).to_degrees();
+    let chain_px = options.ground_tolerance_fraction / 3.0 * rig_leg;
+    let rotate_tolerance = |i: usize| {
+        if on_leg_chain[i] {
+            options.rotate_tolerance_deg.min(chain_deg)
+        } else {
+            options.rotate_tolerance_deg
+        }
+    };
+    let translate_tolerance = if legs.is_empty() {
+        options.translate_tolerance_px
+    } else {
+        options.translate_tolerance_px.min(chain_px)
+    };
     for (i, bone) in handles.bones.iter().enumerate() {
         let mut rotate: Vec<f64> = poses.iter().map(|p| p.bones[&bone.name].rotate).collect();
         unwrap(&mut rotate);
@@ -1001,7 +1031,7 @@ pub fn retarget(
         let mut timelines = BoneTimelines::default();
         if moves {
             let values: Vec<[f64; 1]> = rotate.iter().map(|&r| [r]).collect();
-            let k = keys::reduce(&times, &values, options.rotate_tolerance_deg, cyclic);
+            let k = keys::reduce(&times, &values, rotate_tolerance(i), cyclic);
             key_count += k.len();
             timelines.rotate = Some(
                 k.into_iter()
@@ -1018,7 +1048,7 @@ pub fn retarget(
             let k = keys::reduce(
                 &times,
                 &values,
-                options.translate_tolerance_px,
+                translate_tolerance,
                 cyclic && options.in_place,
             );
             key_count += k.len();
