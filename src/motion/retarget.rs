@@ -20,7 +20,8 @@
 //!    [`RetargetOptions::foreshortened_fraction`] of its length holds its last angle.
 //! 3. **The root travels** by the hips' projected motion scaled by the rig's leg length over
 //!    the performer's (`leg_scale`); the height is the hips' height above the capture's ground,
-//!    so that legs at full stretch stand on the rig's ground (its lowest ankle at rest). Every
+//!    so that legs at full stretch stand on the rig's ground (its lowest ankle at rest; legs
+//!    drawn splayed or bent lift the root until, straight, they reach it). Every
 //!    root bone takes that translation (rigs whose arms are roots move them along).
 //! 4. **Feet stay planted.** A foot is in contact where it is within
 //!    [`RetargetOptions::contact_height_fraction`] of leg length of the capture's ground and
@@ -805,11 +806,33 @@ pub fn retarget(
         .iter()
         .map(|p| (p.x - hips_screen[0].x) * leg_scale)
         .collect();
+    // Standing straight in the capture, the rig's legs stand straight too: its thigh heads a
+    // leg's length above its ground line (legs drawn splayed or bent reach less far down at
+    // rest, so the root rises by the difference).
+    let stand_px = if legs.is_empty() {
+        0.0
+    } else {
+        let ground = legs
+            .iter()
+            .map(|l| handles.bones[l.shin].tail.y)
+            .fold(f64::MIN, f64::max);
+        let thighs = legs
+            .iter()
+            .map(|l| handles.bones[l.thigh].head.y)
+            .sum::<f64>()
+            / legs.len() as f64;
+        let reach = legs
+            .iter()
+            .map(|l| rest[l.thigh].length_px + rest[l.shin].length_px)
+            .sum::<f64>()
+            / legs.len() as f64;
+        (ground - reach - thighs).min(0.0)
+    };
     let mut root_y: Vec<f64> = frames
         .iter()
         .map(|f| {
             if ground_src.is_finite() {
-                -(f.joints[hips].y - ground_src - stand_src) * leg_scale
+                stand_px - (f.joints[hips].y - ground_src - stand_src) * leg_scale
             } else {
                 (axes.project(root_view, options.facing, f.joints[hips]).y - hips_screen[0].y)
                     * leg_scale
