@@ -218,6 +218,45 @@ pub fn remove_stale_temporaries(target: &Path) {
     }
 }
 
+/// Swaps the names of two folders in one step where the system can (Linux), else by two
+/// renames (with a moment between them when `target` is missing).
+pub fn exchange_folders(staging: &Path, target: &Path) -> io::Result<()> {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes());
+        let (a, b) = (c(staging)?, c(target)?);
+        // SAFETY: both are valid NUL-terminated paths that live across the call.
+        let rc = unsafe {
+            libc::renameat2(
+                libc::AT_FDCWD,
+                a.as_ptr(),
+                libc::AT_FDCWD,
+                b.as_ptr(),
+                libc::RENAME_EXCHANGE,
+            )
+        };
+        if rc == 0 {
+            return Ok(());
+        }
+        let error = io::Error::last_os_error();
+        // A file system or kernel without the exchange: fall back to two renames.
+        if !matches!(
+            error.raw_os_error(),
+            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::ENOTSUP)
+        ) {
+            return Err(error);
+        }
+    }
+    let aside = temporary_sibling(target);
+    fs::rename(target, &aside)?;
+    if let Err(e) = fs::rename(staging, target) {
+        let _ = fs::rename(&aside, target);
+        return Err(e);
+    }
+    fs::rename(&aside, staging)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

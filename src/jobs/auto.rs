@@ -689,7 +689,7 @@ fn commit(staging: &Path, target: &Path) -> std::io::Result<()> {
     if let Ok(meta) = fs::metadata(target) {
         let _ = fs::set_permissions(staging, meta.permissions());
     }
-    exchange(staging, target)?;
+    atomic::exchange_folders(staging, target)?;
     // `staging` now holds the earlier output.
     for name in after {
         fs::rename(staging.join(&name), target.join(&name))?;
@@ -732,44 +732,6 @@ fn tidy_stale(target: &Path) {
         }
         let _ = fs::remove_dir(&stale);
     }
-}
-
-/// Swaps the names of two folders in one step where the system can (Linux), else by two
-/// renames.
-fn exchange(staging: &Path, target: &Path) -> std::io::Result<()> {
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::ffi::OsStrExt;
-        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes());
-        let (a, b) = (c(staging)?, c(target)?);
-        // SAFETY: both are valid NUL-terminated paths that live across the call.
-        let rc = unsafe {
-            libc::renameat2(
-                libc::AT_FDCWD,
-                a.as_ptr(),
-                libc::AT_FDCWD,
-                b.as_ptr(),
-                libc::RENAME_EXCHANGE,
-            )
-        };
-        if rc == 0 {
-            return Ok(());
-        }
-        let error = std::io::Error::last_os_error();
-        if !matches!(
-            error.raw_os_error(),
-            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::ENOTSUP)
-        ) {
-            return Err(error);
-        }
-    }
-    let aside = atomic::temporary_sibling(target);
-    fs::rename(target, &aside)?;
-    if let Err(e) = fs::rename(staging, target) {
-        let _ = fs::rename(&aside, target);
-        return Err(e);
-    }
-    fs::rename(&aside, staging)
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@
 use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
 use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::io::atomic::{
-    resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind,
+    exchange_folders, resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind,
 };
 use crate::io::image::encode_png;
 use rayon::prelude::*;
@@ -144,7 +144,7 @@ fn fill_and_swap<S: FrameSource + ?Sized>(
     if let Ok(meta) = fs::metadata(target) {
         let _ = fs::set_permissions(staging, meta.permissions());
     }
-    exchange(staging, target).map_err(write_error(target))?;
+    exchange_folders(staging, target).map_err(write_error(target))?;
     // `staging` now holds the previous render.
     for name in after_swap {
         let from = staging.join(&name);
@@ -153,45 +153,6 @@ fn fill_and_swap<S: FrameSource + ?Sized>(
     let _ = fs::remove_dir_all(staging);
     removed.sort();
     Ok(removed)
-}
-
-/// Swaps the names of two folders in one step where the system can (Linux), else by two
-/// renames (with a moment between them when `target` is missing).
-fn exchange(staging: &Path, target: &Path) -> std::io::Result<()> {
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::ffi::OsStrExt;
-        let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes());
-        let (a, b) = (c(staging)?, c(target)?);
-        // SAFETY: both are valid NUL-terminated paths that live across the call.
-        let rc = unsafe {
-            libc::renameat2(
-                libc::AT_FDCWD,
-                a.as_ptr(),
-                libc::AT_FDCWD,
-                b.as_ptr(),
-                libc::RENAME_EXCHANGE,
-            )
-        };
-        if rc == 0 {
-            return Ok(());
-        }
-        let error = std::io::Error::last_os_error();
-        // A file system or kernel without the exchange: fall back to two renames.
-        if !matches!(
-            error.raw_os_error(),
-            Some(libc::EINVAL) | Some(libc::ENOSYS) | Some(libc::ENOTSUP)
-        ) {
-            return Err(error);
-        }
-    }
-    let aside = temporary_sibling(target);
-    fs::rename(target, &aside)?;
-    if let Err(e) = fs::rename(staging, target) {
-        let _ = fs::rename(&aside, target);
-        return Err(e);
-    }
-    fs::rename(&aside, staging)
 }
 
 /// Tidies a temporary folder a killed run left beside `target`: frames and links to files that
