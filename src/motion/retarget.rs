@@ -372,41 +372,26 @@ struct RestBone {
     length_px: f64,
 }
 
-/// Bones in an order where each parent comes before its children.
-fn parents_first(handles: &Handles) -> Vec<usize> {
-    let index: BTreeMap<&str, usize> = handles
-        .bones
-        .iter()
-        .enumerate()
-        .map(|(i, b)| (b.name.as_str(), i))
-        .collect();
-    let mut order = Vec::with_capacity(handles.bones.len());
-    let mut placed = vec![false; handles.bones.len()];
-    fn place(
-        i: usize,
-        handles: &Handles,
-        index: &BTreeMap<&str, usize>,
-        placed: &mut [bool],
-        order: &mut Vec<usize>,
-        depth: usize,
-    ) {
-        if placed[i] || depth > handles.bones.len() {
-            return;
+/// Bones in an order where each parent comes before its children (a cycle, which validated
+/// handles never have, is cut where the walk up meets it again).
+fn parents_first(rest: &[RestBone]) -> Vec<usize> {
+    let mut order = Vec::with_capacity(rest.len());
+    let mut placed = vec![false; rest.len()];
+    for i in 0..rest.len() {
+        // The unplaced ancestors of `i`, nearest first, then placed root-most first.
+        let mut chain = vec![i];
+        while let Some(p) = rest[*chain.last().unwrap_or(&i)].parent {
+            if placed[p] || chain.contains(&p) {
+                break;
+            }
+            chain.push(p);
         }
-        if let Some(p) = handles.bones[i]
-            .parent
-            .as_deref()
-            .and_then(|p| index.get(p))
-        {
-            place(*p, handles, index, placed, order, depth + 1);
+        for &b in chain.iter().rev() {
+            if !placed[b] {
+                placed[b] = true;
+                order.push(b);
+            }
         }
-        if !placed[i] {
-            placed[i] = true;
-            order.push(i);
-        }
-    }
-    for i in 0..handles.bones.len() {
-        place(i, handles, &index, &mut placed, &mut order, 0);
     }
     order
 }
@@ -682,7 +667,7 @@ pub fn retarget(
         .collect();
     let rest_local =
         |i: usize| -> f64 { rest[i].angle_deg - rest[i].parent.map_or(0.0, |p| rest[p].angle_deg) };
-    let order = parents_first(handles);
+    let order = parents_first(&rest);
     let roots: Vec<usize> = (0..rest.len())
         .filter(|&i| rest[i].parent.is_none())
         .collect();
@@ -809,13 +794,14 @@ pub fn retarget(
     // Standing straight in the capture, the rig's legs stand straight too: its thigh heads a
     // leg's length above its ground line (legs drawn splayed or bent reach less far down at
     // rest, so the root rises by the difference).
+    // The rig's ground line: its lowest ankle at rest.
+    let ground_px = legs
+        .iter()
+        .map(|l| handles.bones[l.shin].tail.y)
+        .fold(f64::MIN, f64::max);
     let stand_px = if legs.is_empty() {
         0.0
     } else {
-        let ground = legs
-            .iter()
-            .map(|l| handles.bones[l.shin].tail.y)
-            .fold(f64::MIN, f64::max);
         let thighs = legs
             .iter()
             .map(|l| handles.bones[l.thigh].head.y)
@@ -826,7 +812,7 @@ pub fn retarget(
             .map(|l| rest[l.thigh].length_px + rest[l.shin].length_px)
             .sum::<f64>()
             / legs.len() as f64;
-        (ground - reach - thighs).min(0.0)
+        (ground_px - reach - thighs).min(0.0)
     };
     let mut root_y: Vec<f64> = frames
         .iter()
@@ -909,10 +895,6 @@ pub fn retarget(
     };
 
     // Feet: contacts from the capture, planted by IK.
-    let ground_px = legs
-        .iter()
-        .map(|l| handles.bones[l.shin].tail.y)
-        .fold(f64::MIN, f64::max);
     let on: Vec<Vec<bool>> = legs
         .iter()
         .map(|l| {
