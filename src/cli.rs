@@ -8,6 +8,7 @@ mod auto;
 mod batch;
 mod choices;
 mod colorize;
+mod export_gltf;
 
 use anyhow::{anyhow, bail, Context, Result};
 use choices::{BakeModeArg, BlendArg, SchemaKindArg, SpinePresetArg, TemplateArg, WeightMethodArg};
@@ -134,6 +135,9 @@ pub struct ExportArgs {
 pub enum ExportFormat {
     /// Spine skeleton JSON + .atlas + page PNGs (DIR/NAME.json, DIR/NAME.atlas, DIR/NAME.png).
     Spine(SpineArgs),
+    /// Binary glTF 2.0 (FILE.glb): skinned meshes, textures and baked animations, for Godot,
+    /// Bevy, Unity, Blender and three.js.
+    Gltf(export_gltf::GltfArgs),
 }
 
 #[derive(Args, Debug)]
@@ -469,6 +473,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Export(ExportArgs {
             format: ExportFormat::Spine(args),
         }) => export_spine(&args),
+        Command::Export(ExportArgs {
+            format: ExportFormat::Gltf(args),
+        }) => export_gltf::run(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Animate(args) => animate::run(&args),
         Command::Auto(args) => auto::run(&args),

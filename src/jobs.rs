@@ -35,6 +35,8 @@ pub enum JobError {
     #[error(transparent)]
     Spine(#[from] SpineError),
     #[error(transparent)]
+    Gltf(#[from] crate::export::gltf::GltfError),
+    #[error(transparent)]
     Playback(#[from] PlaybackError),
     #[error(transparent)]
     Render(#[from] RenderAnimationError),

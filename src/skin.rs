@@ -66,6 +66,30 @@ impl SkinWeights {
     }
 }
 
+/// A vertex's `row` of (handle, weight) kept as a runtime with at most `max_influences`
+/// influences per vertex keeps it: the positive weights, strongest first (ties by handle, so the
+/// choice is deterministic), the `max_influences` strongest (all when `None`), renormalized to
+/// sum to one. Empty when no weight is positive. The one rule of every export that limits
+/// influences (Spine's `--max-influences`, glTF's four) and of the scenes that play them.
+pub fn strongest_influences<H: Copy + Ord>(
+    row: &[(H, f64)],
+    max_influences: Option<usize>,
+) -> Vec<(H, f64)> {
+    let mut kept: Vec<(H, f64)> = row.iter().copied().filter(|&(_, w)| w > 0.0).collect();
+    kept.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    if let Some(k) = max_influences {
+        kept.truncate(k);
+    }
+    let total: f64 = kept.iter().map(|&(_, w)| w).sum();
+    if total.is_nan() || total <= 0.0 {
+        return Vec::new();
+    }
+    for (_, w) in &mut kept {
+        *w /= total;
+    }
+    kept
+}
+
 /// Runs `f` on every (index, (rest, out)) pair, across threads for large meshes.
 fn for_each_vertex<F>(rest: &[Point], out: &mut [Point], f: F)
 where

@@ -251,13 +251,27 @@ mod tests {
         let Command::Export(export) = parse(&["export", "spine", "rig.json", "-o", "out"]) else {
             panic!("not export")
         };
-        let ExportFormat::Spine(a) = export.format;
+        let ExportFormat::Spine(a) = export.format else {
+            panic!("not spine")
+        };
         let d = SpineOptions::default();
         assert_eq!(
             (a.preset, a.bake, a.fps),
             (SpinePreset::default(), d.bake, d.bake_fps)
         );
         assert_eq!(SpineVersion::parse(&a.spine_version).ok(), Some(d.version));
+
+        let Command::Export(export) = parse(&["export", "gltf", "rig.json", "-o", "o.glb"]) else {
+            panic!("not export")
+        };
+        let ExportFormat::Gltf(a) = export.format else {
+            panic!("not gltf")
+        };
+        let d = sinew::export::gltf::GltfOptions::default();
+        assert_eq!(
+            (a.fps, a.px_per_unit, a.layer_spacing),
+            (d.bake_fps, d.px_per_unit, d.layer_spacing)
+        );
 
         let Command::Render(a) = parse(&["render", "rig.json", "--anim", "walk", "-o", "o.gif"])
         else {

@@ -352,6 +352,27 @@ pub fn export_spine_files(
     Ok((export, written))
 }
 
+/// Exports the rig at `rig` as binary glTF to `output` (a `.glb` file; `sinew export gltf`):
+/// refused before anything is written when `output` would overwrite the rig or its images.
+pub fn export_gltf_file(
+    rig: &Path,
+    output: &Path,
+    options: &crate::export::gltf::GltfOptions,
+) -> Result<crate::export::gltf::GltfExport, JobError> {
+    let doc = RigDocument::load(rig)?;
+    let images = pipeline::load_part_images(rig, &doc)?;
+    let scene = Scene::new(doc, &images)?;
+    let export = crate::export::gltf::export_gltf(&scene, &images, options)?;
+    check_output_kind(output, io::atomic::OutputKind::File)?;
+    let sprites = part_images(rig, &scene.doc);
+    check_not_overwriting(
+        std::iter::once(rig).chain(sprites.iter().map(PathBuf::as_path)),
+        std::iter::once(Some(output)),
+    )?;
+    export.write(output)?;
+    Ok(export)
+}
+
 /// The files of a colorize job (`sinew colorize`).
 #[derive(Clone, Debug, Default)]
 pub struct ColorizeFiles {

@@ -148,6 +148,26 @@ impl Scene {
         })
     }
 
+    /// This scene with every vertex keeping its `max_influences` strongest weights,
+    /// renormalized ([`crate::skin::strongest_influences`]): what a runtime that skins with
+    /// that many influences draws (glTF's four). Handles, meshes and textures are kept and
+    /// shared; the skinning plans are made afresh.
+    pub fn with_influences_limited(&self, max_influences: usize) -> Scene {
+        let mut doc = self.doc.clone();
+        for weights in doc.parts.iter_mut().filter_map(|p| p.weights.as_mut()) {
+            for row in &mut weights.rows {
+                *row = crate::skin::strongest_influences(row, Some(max_influences));
+            }
+        }
+        Scene {
+            doc,
+            parts: self.parts.clone(),
+            ik: std::sync::OnceLock::new(),
+            plans: Default::default(),
+            skins: self.skins.clone(),
+        }
+    }
+
     /// This scene with the weight columns named in `renamed` (old name → new name) renamed in
     /// every part, textures shared: after a handle is renamed, the weights computed before
     /// still name its column, so a recompute can keep them if it is locked. Only the weights'

@@ -168,15 +168,8 @@ pub fn mesh_attachment(
     }
     let mut influences = Vec::with_capacity(order.len());
     for &v in &order {
-        let mut row: Vec<(usize, f64)> =
-            rows[v].iter().copied().filter(|&(_, w)| w > 0.0).collect();
-        // Strongest first; ties by column for determinism.
-        row.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-        if let Some(k) = max_influences {
-            row.truncate(k);
-        }
-        let total: f64 = row.iter().map(|&(_, w)| w).sum();
-        if total.is_nan() || total <= 0.0 {
+        let row = crate::skin::strongest_influences(&rows[v], max_influences);
+        if row.is_empty() {
             return Err(SpineError::UnweightedVertex {
                 part: part.to_string(),
                 vertex: v,
@@ -194,7 +187,7 @@ pub fn mesh_attachment(
             out.push(Influence {
                 bone,
                 bind,
-                weight: w / total,
+                weight: w,
             });
         }
         // Spine lists a vertex's bones in any order; by bone index reads best.
