@@ -138,6 +138,9 @@ pub enum ExportFormat {
     /// Binary glTF 2.0 (FILE.glb): skinned meshes, textures and baked animations, for Godot,
     /// Bevy, Unity, Blender and three.js.
     Gltf(export_gltf::GltfArgs),
+    /// DragonBones 5.5 JSON + texture atlas (DIR/NAME_ske.json, DIR/NAME_tex.json,
+    /// DIR/NAME_tex.png), every motion baked on the armature's frames.
+    Dragonbones(export_gltf::DragonBonesArgs),
 }
 
 #[derive(Args, Debug)]
@@ -476,6 +479,9 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Export(ExportArgs {
             format: ExportFormat::Gltf(args),
         }) => export_gltf::run(&args),
+        Command::Export(ExportArgs {
+            format: ExportFormat::Dragonbones(args),
+        }) => export_gltf::run_dragonbones(&args),
         Command::Autorig(args) => autorig(&args),
         Command::Animate(args) => animate::run(&args),
         Command::Auto(args) => auto::run(&args),

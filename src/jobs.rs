@@ -37,6 +37,8 @@ pub enum JobError {
     #[error(transparent)]
     Gltf(#[from] crate::export::gltf::GltfError),
     #[error(transparent)]
+    DragonBones(#[from] crate::export::dragonbones::DragonBonesError),
+    #[error(transparent)]
     Playback(#[from] PlaybackError),
     #[error(transparent)]
     Render(#[from] RenderAnimationError),

@@ -1,8 +1,10 @@
-//! `sinew export gltf RIG.json -o FILE.glb`: the rig as binary glTF for Godot, Bevy, Unity,
-//! Blender and three.js.
+//! The exports that play without a Spine licence: `sinew export gltf RIG.json -o FILE.glb` (binary
+//! glTF for Godot, Bevy, Unity, Blender and three.js) and `sinew export dragonbones RIG.json -o
+//! DIR` (DragonBones 5.5 for Cocos, Egret, Pixi, Phaser and the other DragonBones runtimes).
 
 use anyhow::Result;
 use clap::Args;
+use sinew::export::dragonbones::DragonBonesOptions;
 use sinew::export::gltf::{GltfOptions, MAX_INFLUENCES};
 use std::path::PathBuf;
 
@@ -45,5 +47,54 @@ pub fn run(args: &GltfArgs) -> Result<()> {
         println!("  not in glTF: {line}");
     }
     println!("  wrote {}", args.output.display());
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct DragonBonesArgs {
+    /// The rig document (every part must have weights).
+    pub rig: PathBuf,
+    /// The folder to write into (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The armature's frame rate: every motion is keyed on each frame.
+    #[arg(long, default_value_t = DragonBonesOptions::default().frame_rate)]
+    pub fps: u32,
+    /// Base name of the files (default: the rig file's name).
+    #[arg(long)]
+    pub name: Option<String>,
+}
+
+pub fn run_dragonbones(args: &DragonBonesArgs) -> Result<()> {
+    let options = DragonBonesOptions {
+        frame_rate: args.fps,
+        ..DragonBonesOptions::default()
+    };
+    let (export, written) = sinew::jobs::export_dragonbones_files(
+        &args.rig,
+        &args.output,
+        args.name.as_deref(),
+        &options,
+    )?;
+    println!(
+        "dragonbones {}: {} bones, {} animations",
+        export.name,
+        export.joints.len() + 1,
+        export.animations.len()
+    );
+    for animation in &export.animations {
+        println!(
+            "  {}: baked {} frames at {} fps",
+            animation.name,
+            animation.frame_count + 1,
+            export.frame_rate
+        );
+    }
+    for line in &export.left_out {
+        println!("  not in DragonBones: {line}");
+    }
+    for path in &written {
+        println!("  wrote {}", path.display());
+    }
     Ok(())
 }

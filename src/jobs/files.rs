@@ -352,6 +352,44 @@ pub fn export_spine_files(
     Ok((export, written))
 }
 
+/// Exports the rig at `rig` as DragonBones files into the folder `output` (`sinew export
+/// dragonbones`), named `name` (default: the rig file's stem): refused before anything is
+/// written when a file would overwrite the rig or its images.
+pub fn export_dragonbones_files(
+    rig: &Path,
+    output: &Path,
+    name: Option<&str>,
+    options: &crate::export::dragonbones::DragonBonesOptions,
+) -> Result<(crate::export::dragonbones::DragonBonesExport, Vec<PathBuf>), JobError> {
+    let doc = RigDocument::load(rig)?;
+    let images = pipeline::load_part_images(rig, &doc)?;
+    let scene = Scene::new(doc, &images)?;
+    let name = match name {
+        Some(n) => n.to_string(),
+        None => rig
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "skeleton".into()),
+    };
+    let export = crate::export::dragonbones::export_dragonbones(&scene, &images, &name, options)?;
+    let targets: Vec<PathBuf> = export
+        .files()
+        .into_iter()
+        .map(|(file, _)| output.join(file))
+        .collect();
+    check_output_kind(output, io::atomic::OutputKind::Folder)?;
+    for target in &targets {
+        check_output_kind(target, io::atomic::OutputKind::File)?;
+    }
+    let sprites = part_images(rig, &scene.doc);
+    check_not_overwriting(
+        std::iter::once(rig).chain(sprites.iter().map(PathBuf::as_path)),
+        targets.iter().map(|t| Some(t.as_path())),
+    )?;
+    let written = export.write(output)?;
+    Ok((export, written))
+}
+
 /// Exports the rig at `rig` as binary glTF to `output` (a `.glb` file; `sinew export gltf`):
 /// refused before anything is written when `output` would overwrite the rig or its images.
 pub fn export_gltf_file(

@@ -36,7 +36,8 @@
 //     runtime sums the steps in floating point: 30 steps of 1/60 land just below 0.5 s, so a
 //     key at exactly 0.5 s may not be reached yet (use a step such as 1/64 to avoid that).
 //   events: per [from, to]: gotoAndPlayByTime(name, from, loop ? 0 : 1), events of that call
-//     discarded, then armature.advanceTime(to - from) (in `step`s when loop); every event the
+//     discarded, then armature.advanceTime(to - from) (in `step`s when loop); with from null,
+//     play(name) and advanceTime(to), the start's events kept (as a game plays it); every event the
 //     runtime dispatches in that advance is reported (frameEvent, soundEvent, loopComplete,
 //     complete, ...; `type` says which).
 // OUT.json: {"version": runtime version, "frameRate": armature frame rate, "setup": Snapshot,
@@ -298,6 +299,14 @@ for (const [name, steps] of Object.entries(request.events || {})) {
   findAnimation(name);
   result.events[name] = steps.map(([from, to]) => {
     resetToSetup();
+    if (from === null) {
+      // From the start as a game plays it: the events of the first frame count too.
+      armature.animation.play(name, loop ? 0 : 1);
+      advance(to, loop);
+      const fired = display.events.slice();
+      display.events.length = 0;
+      return fired;
+    }
     armature.animation.gotoAndPlayByTime(name, from, loop ? 0 : 1);
     dragonBonesInstance.advanceTime(0);
     display.events.length = 0;

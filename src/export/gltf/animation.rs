@@ -8,9 +8,9 @@
 
 use super::frame::{z_quaternion, GltfFrame, Trsr};
 use super::glb::Buffer;
-use super::joints::{local_maps, Joint};
 use super::{morph_weights, GltfError, GltfOptions, WrittenPart};
 use crate::anim::Animation;
+use crate::export::joints::{local_maps, Joint};
 use crate::export::spine::{bake, MAX_BAKE_SAMPLES};
 use crate::pipeline::Scene;
 use crate::rig::Affine;
@@ -58,7 +58,7 @@ pub(super) fn bake_animation(
         .map(|a| Trsr::from_affine(a, None))
         .collect();
     for (_, transforms) in &frames {
-        let locals = local_maps(joints, transforms, frame)?;
+        let locals = local_maps(joints, transforms, frame).map_err(|e| GltfError::Singular(e.0))?;
         for (j, local) in locals.iter().enumerate() {
             let t = Trsr::from_affine(local, Some(&previous[j]));
             translation[j].extend([t.translation.x as f32, t.translation.y as f32, 0.0]);

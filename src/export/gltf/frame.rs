@@ -67,6 +67,19 @@ impl GltfFrame {
     }
 }
 
+impl crate::export::joints::Placement for GltfFrame {
+    fn place(&self, p: Point) -> Vec2 {
+        self.from_canvas(p)
+    }
+    /// Canvas angles turn clockwise on screen (y down); glTF's turn the other way.
+    fn angle_rad(&self, d: Vec2) -> f64 {
+        -d.y.atan2(d.x)
+    }
+    fn map(&self, canvas: &Affine) -> Affine {
+        self.affine(canvas)
+    }
+}
+
 /// A 2D affine map as translation · R(θ₁) · diag(s₁, s₂) · R(θ₂) (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trsr {

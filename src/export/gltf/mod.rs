@@ -29,7 +29,6 @@
 mod animation;
 pub mod frame;
 pub mod glb;
-pub mod joints;
 
 use crate::anim::{self, AnimError};
 use crate::export::spine::atlas::{self, AtlasOptions};
@@ -178,7 +177,7 @@ pub fn export_gltf(
     }
     doc.check_animations()?;
     let frame = GltfFrame::for_canvas(doc.canvas, options.px_per_unit);
-    let joints = joints::joints(&doc.handles, &frame);
+    let joints = crate::export::joints::joints(&doc.handles, &frame);
     let mut left_out = Vec::new();
 
     // The parts the setup pose draws, back to front.
@@ -348,7 +347,7 @@ pub fn export_gltf(
     let pivot_node = |j: usize| 1 + 2 * j;
     let joint_node = |j: usize| 2 + 2 * j;
     let mesh_node = |k: usize| 1 + 2 * joints.len() + k;
-    let rest_locals = joints::rest_locals(&joints);
+    let rest_locals = crate::export::joints::rest_locals(&joints);
     let mut nodes = Vec::with_capacity(1 + 2 * joints.len() + written.len());
     let top: Vec<usize> = (0..joints.len())
         .filter(|&j| joints[j].parent.is_none())

@@ -1,8 +1,9 @@
 //! Every handle a glTF joint: where it rests, what it hangs from, and its local map at a frame.
 //!
-//! In: the rig's handles and the [`GltfFrame`]. Out: one [`Joint`] per weight column
+//! In: the rig's handles and the target's frame (where a canvas point lands, which angle a canvas
+//! direction has). Out: one [`Joint`] per weight column
 //! ([`crate::rig::handle_columns`]: bones, points, cage vertices, regions): its rest frame in
-//! glTF space (a bone at its head turned along it; a point, cage vertex or region at its
+//! the target's space (a bone at its head turned along it; a point, cage vertex or region at its
 //! position or centroid, unturned) and its parent column (a bone's parent bone, a carried
 //! point's bone; the rest hang from the root node).
 //!
@@ -10,12 +11,16 @@
 //! (rest canvas → posed canvas), F the frame and B the rest frame; its inverse bind matrix is
 //! B⁻¹, so the runtime's joint matrix W(t)·B⁻¹ is F·A(t)·F⁻¹ and skinning is sinew's linear
 //! blend, exactly. [`local_maps`] gives each joint's map relative to its parent's world map, which
-//! the node hierarchy carries ([`super::frame::Trsr`]).
+//! the node (or bone) hierarchy carries. glTF ([`super::gltf::frame::Trsr`]) and DragonBones
+//! (`crate::export::dragonbones`) both build their skeletons here.
 
-use super::frame::{rotation, GltfFrame};
-use super::GltfError;
+use crate::export::gltf::frame::rotation;
 use crate::geom::Point;
 use crate::rig::{handle_columns, Affine, Handles};
+
+/// A joint whose posed map is singular (a zero scale): no child can hang from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SingularJoint(pub String);
 
 /// One handle as a joint.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,18 +33,30 @@ pub struct Joint {
     pub rest: Affine,
 }
 
-/// The joints of `handles`, in column order.
-pub fn joints(handles: &Handles, frame: &GltfFrame) -> Vec<Joint> {
+/// Where a target puts the canvas: a canvas point's position, and a canvas direction's angle
+/// (radians, the target's positive turn).
+pub trait Placement {
+    fn place(&self, p: Point) -> crate::geom::Vec2;
+    fn angle_rad(&self, direction: crate::geom::Vec2) -> f64;
+    /// A canvas map (rest → posed) as the same map of the target's space.
+    fn map(&self, canvas: &Affine) -> Affine;
+}
+
+/// The joints of `handles`, in column order, placed by `frame`.
+pub fn joints(handles: &Handles, frame: &impl Placement) -> Vec<Joint> {
     let names = handle_columns(handles);
     let at = |p: Point, angle_rad: f64| Affine {
         linear: rotation(angle_rad),
-        translation: frame.from_canvas(p),
+        translation: frame.place(p),
     };
     let mut out = Vec::with_capacity(names.len());
     for bone in &handles.bones {
         let d = bone.tail - bone.head;
-        // Canvas angles turn clockwise on screen (y down); glTF's turn the other way.
-        let angle_rad = if d.norm() > 0.0 { -d.y.atan2(d.x) } else { 0.0 };
+        let angle_rad = if d.norm() > 0.0 {
+            frame.angle_rad(d)
+        } else {
+            0.0
+        };
         out.push((
             bone.parent
                 .as_deref()
@@ -82,12 +99,12 @@ fn centroid(polygon: &[Point]) -> Point {
 pub fn local_maps(
     joints: &[Joint],
     transforms: &[Affine],
-    frame: &GltfFrame,
-) -> Result<Vec<Affine>, GltfError> {
+    frame: &impl Placement,
+) -> Result<Vec<Affine>, SingularJoint> {
     let world: Vec<Affine> = joints
         .iter()
         .zip(transforms)
-        .map(|(joint, a)| frame.affine(a).then_after(&joint.rest))
+        .map(|(joint, a)| frame.map(a).then_after(&joint.rest))
         .collect();
     joints
         .iter()
@@ -97,7 +114,7 @@ pub fn local_maps(
             Some(p) => {
                 let parent = world[p]
                     .inverse()
-                    .ok_or_else(|| GltfError::Singular(joints[p].name.clone()))?;
+                    .ok_or_else(|| SingularJoint(joints[p].name.clone()))?;
                 Ok(parent.then_after(&world[j]))
             }
         })

@@ -1,0 +1,156 @@
+//! What the DragonBones runtime plays of an export, reproduced in sinew (`--match-runtime
+//! dragonbones`).
+//!
+//! In: a [`DragonBonesExport`] and the name and time of one of its animations. Out: the handle
+//! transformations (canvas, column order) and the pose (deform offsets, slot displays, colours,
+//! draw order) that, through sinew's skinning ([`crate::pipeline::Scene::positions_from_transforms`])
+//! and drawing, give what the runtime draws at that time.
+//!
+//! The runtime (docs/dragonbones-format.md) reads the setup transforms from the file (f32
+//! numbers, rotation and skew normalized to (−π, π]); at time t it is on frame i = ⌊t·F⌋ with
+//! progress u = t·F − i and tweens each bone's stored frame values linearly (translation and
+//! rotation, skew added to the setup's, scale multiplied), composes parent · local down the
+//! bone tree, and skins each vertex by Σ w · world · bonePose⁻¹. Display and draw-order frames
+//! step; colour and deform frames tween linearly.
+
+use super::transform::DbTransform;
+use super::{BakedAnimation, DragonBonesExport};
+use crate::geom::Vec2;
+use crate::rig::pose::PartPose;
+use crate::rig::{Affine, Pose};
+use std::f64::consts::PI;
+
+/// f32 storage, as the runtime's typed arrays and the file's numbers keep them.
+fn f32s(v: f64) -> f64 {
+    f64::from(v as f32)
+}
+
+/// An angle into (−π, π], as `Transform.normalizeRadian`.
+fn normalize_radian(a: f64) -> f64 {
+    let mut a = (a + PI) % (PI * 2.0);
+    a += if a > 0.0 { -PI } else { PI };
+    a
+}
+
+/// The setup transform as the runtime parses it from the file's numbers.
+fn parsed_setup(t: &DbTransform) -> DbTransform {
+    let rotation = normalize_radian(f32s(t.rotation_rad.to_degrees()) * PI / 180.0);
+    let second = normalize_radian(f32s((t.rotation_rad + t.skew_rad).to_degrees()) * PI / 180.0);
+    DbTransform {
+        x: f32s(t.x),
+        y: f32s(t.y),
+        rotation_rad: rotation,
+        skew_rad: second - rotation,
+        scale_x: f32s(t.scale_x),
+        scale_y: f32s(t.scale_y),
+    }
+}
+
+/// What the runtime poses at `time_s` of `animation` (played once; clamped to its end).
+pub fn as_played(
+    export: &DragonBonesExport,
+    animation: &BakedAnimation,
+    slots: &[&str],
+    attachments: &dyn Fn(&str) -> Vec<String>,
+    time_s: f64,
+) -> (Vec<Affine>, Pose) {
+    let fps = f64::from(export.frame_rate);
+    let n = animation.frame_count as usize;
+    let position = (time_s.max(0.0) * fps).min(n as f64);
+    let i = (position.floor() as usize).min(n);
+    let u = if i < n { position - i as f64 } else { 0.0 };
+    let j = (i + 1).min(n);
+    let lerp = |a: f64, b: f64| a + (b - a) * u;
+
+    // Bones: setup plus the tweened frame values, composed down the tree.
+    let locals: Vec<Affine> = export
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(b, _)| {
+            let setup = parsed_setup(&export.setup[b]);
+            let (p, q) = (&animation.bones[i][b], &animation.bones[j][b]);
+            DbTransform {
+                x: setup.x + lerp(p.x, q.x),
+                y: setup.y + lerp(p.y, q.y),
+                rotation_rad: setup.rotation_rad + lerp(p.rotation_rad, q.rotation_rad),
+                skew_rad: setup.skew_rad + lerp(p.skew_rad, q.skew_rad),
+                scale_x: setup.scale_x * lerp(p.scale_x, q.scale_x),
+                scale_y: setup.scale_y * lerp(p.scale_y, q.scale_y),
+            }
+            .to_affine()
+        })
+        .collect();
+    let mut world: Vec<Option<Affine>> = vec![None; locals.len()];
+    // Parents before children, however the columns are ordered (the rig has no cycles).
+    for _ in 0..locals.len() {
+        for (b, joint) in export.joints.iter().enumerate() {
+            if world[b].is_some() {
+                continue;
+            }
+            world[b] = match joint.parent {
+                None => Some(locals[b]),
+                Some(parent) => world[parent].map(|g| g.then_after(&locals[b])),
+            };
+        }
+    }
+    let world: Vec<Affine> = world
+        .into_iter()
+        .map(|w| w.unwrap_or(Affine::identity()))
+        .collect();
+    let origin = export.frame.origin_px.coords;
+    let transforms = export
+        .joints
+        .iter()
+        .zip(&world)
+        .map(|(joint, global)| {
+            let rest = &joint.rest;
+            let bone_pose = Affine {
+                linear: rest.linear.map(f32s),
+                translation: rest.translation.map(f32s),
+            };
+            let armature = global.then_after(&bone_pose.inverse().unwrap_or(Affine::identity()));
+            // Back to the canvas: T(o)·A·T(−o).
+            Affine {
+                linear: armature.linear,
+                translation: armature.translation + origin - armature.linear * origin,
+            }
+        })
+        .collect();
+
+    let mut pose = Pose::default();
+    for (part, frames) in &animation.deforms {
+        let offsets: Vec<Vec2> = frames[i]
+            .iter()
+            .zip(&frames[j])
+            .map(|(a, b)| Vec2::new(lerp(a.x, b.x), lerp(a.y, b.y)))
+            .collect();
+        pose.deform.insert(part.clone(), offsets);
+    }
+    for (slot, values) in &animation.displays {
+        let state = pose
+            .parts
+            .entry(slot.clone())
+            .or_insert_with(PartPose::default);
+        match usize::try_from(values[i]) {
+            Ok(k) => state.attachment = attachments(slot).get(k).cloned(),
+            Err(_) => state.visible = false,
+        }
+    }
+    for (slot, values) in &animation.colors {
+        let state = pose
+            .parts
+            .entry(slot.clone())
+            .or_insert_with(PartPose::default);
+        for (c, (a, b)) in state.color.iter_mut().zip(values[i].iter().zip(&values[j])) {
+            *c = lerp(*a as f64, *b as f64) / 100.0;
+        }
+    }
+    if let Some(orders) = &animation.draw_order {
+        let order = &orders[i];
+        if order.iter().map(String::as_str).ne(slots.iter().copied()) {
+            pose.draw_order = Some(order.clone());
+        }
+    }
+    (transforms, pose)
+}
