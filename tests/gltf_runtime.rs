@@ -3,9 +3,11 @@
 //! error and no warning, and three.js — GLTFLoader, AnimationMixer and SkinnedMesh's CPU
 //! skinning with morph targets — must put every vertex of every mesh within 0.01 px of sinew's
 //! pose path (skinned with the four influences the file keeps) at every bake time of every
-//! animation, and the setup pose within 0.001 px of the rest meshes. Between bake times the
-//! runtime interpolates the baked keys; that deviation from sinew's exact playback is printed,
-//! as is the cost of keeping four influences.
+//! animation, within 0.01 px of sinew's reproduction of the runtime
+//! (`sinew::export::gltf::played`, what `--match-runtime gltf` plays) at every time, bake
+//! times and between them, and the setup pose within 0.001 px of the rest meshes. Between bake
+//! times the runtime interpolates the baked keys; that deviation from sinew's exact playback is
+//! printed, as is the cost of keeping four influences.
 //!
 //! Rigs: the bundled character as `sinew demo` writes it (physics on the tail, a deform key
 //! squashing the torso: morph targets; an attachment swap, which glTF does not carry), a
@@ -19,7 +21,7 @@ mod rigs;
 use command::{s, scratch};
 use serde::Deserialize;
 use sinew::export::gltf::frame::GltfFrame;
-use sinew::export::gltf::{export_gltf, GltfOptions, MAX_INFLUENCES};
+use sinew::export::gltf::{export_gltf, played, GltfOptions, MAX_INFLUENCES};
 use sinew::export::spine::bake::bake_times;
 use sinew::geom::{Point, Vec2};
 use sinew::io::{self, RigDocument};
@@ -97,6 +99,7 @@ fn deviation(frame: &GltfFrame, runtime: &[f64], sinew: &[Point], name: &str) ->
 /// The worst deviations of one rig: at bake times, between them, and sinew's four-influence
 /// skinning against all influences.
 struct Report {
+    reproduced_px: f64,
     at_keys_px: f64,
     between_keys_px: f64,
     four_influences_px: f64,
@@ -146,6 +149,7 @@ fn check_rig(rig: &Path, dir: &Path) -> Report {
     }
     let limited = scene.with_influences_limited(MAX_INFLUENCES);
     let mut report = Report {
+        reproduced_px: 0.0,
         at_keys_px: 0.0,
         between_keys_px: 0.0,
         four_influences_px: 0.0,
@@ -157,9 +161,14 @@ fn check_rig(rig: &Path, dir: &Path) -> Report {
         let times: Vec<f64> = played.frames.iter().map(|f| f.time).collect();
         let frames =
             sinew::scene::frames(&scene, animation, &times, PlayOptions::default()).unwrap();
+        let keyed = export.animations.iter().find(|a| &a.name == name).unwrap();
         for (runtime, f) in played.frames.iter().zip(&frames) {
             let four = limited
                 .positions_from_transforms(&f.transforms, &f.pose, Blend::Linear)
+                .unwrap();
+            let (transforms, pose) = played::as_played(&export, keyed, runtime.time);
+            let reproduced = limited
+                .positions_from_transforms(&transforms, &pose, Blend::Linear)
                 .unwrap();
             let all = scene
                 .positions_from_transforms(&f.transforms, &f.pose, Blend::Linear)
@@ -167,6 +176,13 @@ fn check_rig(rig: &Path, dir: &Path) -> Report {
             let at_key = keys.contains(&runtime.time);
             for (mesh, xyz) in &runtime.meshes {
                 let i = part(mesh);
+                let r = deviation(&frame, xyz, &reproduced[i], mesh);
+                assert!(
+                    r <= TOLERANCE_PX,
+                    "{name} at {} s, {mesh}: three.js is {r} px from sinew's reproduction",
+                    runtime.time
+                );
+                report.reproduced_px = report.reproduced_px.max(r);
                 let d = deviation(&frame, xyz, &four[i], mesh);
                 if at_key {
                     assert!(
@@ -185,10 +201,11 @@ fn check_rig(rig: &Path, dir: &Path) -> Report {
         }
     }
     println!(
-        "{}: {} KB; three.js vs sinew at the bake times max {:.2e} px, between them {:.3} px; \
-         four influences vs all {:.3} px",
+        "{}: {} KB; three.js vs sinew's reproduction max {:.2e} px; vs sinew at the bake times \
+         max {:.2e} px, between them {:.3} px; four influences vs all {:.3} px",
         rig.display(),
         report.bytes / 1024,
+        report.reproduced_px,
         report.at_keys_px,
         report.between_keys_px,
         report.four_influences_px

@@ -36,12 +36,17 @@ pub fn run(args: &GltfArgs) -> Result<()> {
     let export = sinew::jobs::export_gltf_file(&args.rig, &args.output, &options)?;
     println!(
         "gltf: {} joints, {} meshes (at most {MAX_INFLUENCES} influences per vertex), {} KB",
-        export.joints,
+        export.joints.len(),
         export.parts.len(),
         export.glb.len().div_ceil(1024)
     );
-    for (animation, keys) in &export.animations {
-        println!("  {animation}: baked {keys} keys at {} fps", args.fps);
+    for animation in &export.animations {
+        println!(
+            "  {}: baked {} keys at {} fps",
+            animation.name,
+            animation.times_s.len(),
+            args.fps
+        );
     }
     for line in &export.left_out {
         println!("  not in glTF: {line}");

@@ -19,7 +19,8 @@ use crate::rig::Affine;
 pub struct BakedAnimation {
     /// The key times.
     pub input: usize,
-    pub keys: usize,
+    /// The keys as written.
+    pub played: super::played::GltfAnimation,
     /// (node, path, output accessor) per channel.
     pub channels: Vec<(usize, &'static str, usize)>,
 }
@@ -53,24 +54,29 @@ pub(super) fn bake_animation(
     let mut scale = vec![Vec::with_capacity(3 * times.len()); n];
     let mut joint_rotation = vec![Vec::with_capacity(4 * times.len()); n];
     // Each frame's factorization nearest the previous frame's, from the rest's.
+    let mut keyed: Vec<Vec<Trsr>> = Vec::with_capacity(times.len());
     let mut previous: Vec<Trsr> = rest_locals
         .iter()
         .map(|a| Trsr::from_affine(a, None))
         .collect();
     for (_, transforms) in &frames {
         let locals = local_maps(joints, transforms, frame).map_err(|e| GltfError::Singular(e.0))?;
+        let mut row = Vec::with_capacity(n);
         for (j, local) in locals.iter().enumerate() {
             let t = Trsr::from_affine(local, Some(&previous[j]));
+            row.push(t.stored());
             translation[j].extend([t.translation.x as f32, t.translation.y as f32, 0.0]);
             pivot[j].extend(z_quaternion(t.pivot_rad).map(|v| v as f32));
             scale[j].extend([t.scale[0] as f32, t.scale[1] as f32, 1.0]);
             joint_rotation[j].extend(z_quaternion(t.joint_rad).map(|v| v as f32));
             previous[j] = t;
         }
+        keyed.push(row);
     }
     let times_f32: Vec<f32> = times.iter().map(|&t| t as f32).collect();
     let input = buffer.floats(&times_f32, "SCALAR", true, None);
     let mut channels = Vec::with_capacity(4 * n + written.len());
+    let mut morphs = std::collections::BTreeMap::new();
     for j in 0..n {
         let (pivot_node, joint_node) = (1 + 2 * j, 2 + 2 * j);
         channels.push((
@@ -110,6 +116,13 @@ pub(super) fn bake_animation(
                 None => weights.extend(std::iter::repeat_n(0.0f32, w.targets.len())),
             }
         }
+        morphs.insert(
+            part.clone(),
+            weights
+                .chunks(w.targets.len())
+                .map(|c| c.iter().map(|&v| f64::from(v)).collect())
+                .collect(),
+        );
         let node = 1 + 2 * n + k;
         channels.push((
             node,
@@ -119,7 +132,12 @@ pub(super) fn bake_animation(
     }
     Ok(BakedAnimation {
         input,
-        keys: times.len(),
+        played: super::played::GltfAnimation {
+            name: name.to_string(),
+            times_s: times_f32.iter().map(|&t| f64::from(t)).collect(),
+            locals: keyed,
+            morph_weights: morphs,
+        },
         channels,
     })
 }

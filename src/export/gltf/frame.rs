@@ -163,6 +163,22 @@ impl Trsr {
         }
     }
 
+    /// The factorization as the file stores it: translation and scale in f32, each angle as
+    /// its f32 quaternion's.
+    pub fn stored(&self) -> Trsr {
+        let angle = |a: f64| {
+            let [_, _, z, w] = z_quaternion(a).map(|v| f64::from(v as f32));
+            2.0 * z.atan2(w)
+        };
+        let f = |v: f64| f64::from(v as f32);
+        Trsr {
+            translation: Vec2::new(f(self.translation.x), f(self.translation.y)),
+            pivot_rad: angle(self.pivot_rad),
+            scale: [f(self.scale[0]), f(self.scale[1])],
+            joint_rad: angle(self.joint_rad),
+        }
+    }
+
     /// The affine map this factorization stands for.
     pub fn to_affine(&self) -> Affine {
         let scale = Matrix2::new(self.scale[0], 0.0, 0.0, self.scale[1]);

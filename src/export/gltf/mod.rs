@@ -29,6 +29,7 @@
 mod animation;
 pub mod frame;
 pub mod glb;
+pub mod played;
 
 use crate::anim::{self, AnimError};
 use crate::export::spine::atlas::{self, AtlasOptions};
@@ -138,11 +139,15 @@ pub enum GltfError {
 pub struct GltfExport {
     /// The `.glb` file's bytes.
     pub glb: Vec<u8>,
-    pub joints: usize,
+    pub frame: GltfFrame,
+    /// One per weight column.
+    pub joints: Vec<crate::export::joints::Joint>,
     /// The parts written, back to front.
     pub parts: Vec<String>,
-    /// Per animation, its name and key count.
-    pub animations: Vec<(String, usize)>,
+    /// The morph targets of the parts that have some (canvas px offsets, one per vertex).
+    pub morph_targets: std::collections::BTreeMap<String, Vec<Vec<Vec2>>>,
+    /// Per animation, its keys as written ([`played`] plays them as the runtimes do).
+    pub animations: Vec<played::GltfAnimation>,
     /// What the rig has that glTF does not carry, one line each.
     pub left_out: Vec<String>,
 }
@@ -423,7 +428,7 @@ pub fn export_gltf(
             options,
             &mut buffer,
         )?;
-        report.push((name.clone(), baked.keys));
+        report.push(baked.played);
         let mut channels = Vec::new();
         let mut samplers = Vec::new();
         for (node, path, output) in baked.channels {
@@ -445,7 +450,13 @@ pub fn export_gltf(
     }
     Ok(GltfExport {
         glb: buffer.into_glb(document),
-        joints: joints.len(),
+        frame,
+        joints,
+        morph_targets: written
+            .iter()
+            .filter(|w| !w.targets.is_empty())
+            .map(|w| (doc.parts[w.part].name.clone(), w.targets.clone()))
+            .collect(),
         parts: written
             .iter()
             .map(|w| doc.parts[w.part].name.clone())
