@@ -375,3 +375,48 @@ fn the_export_that_match_runtime_reproduces_must_be_one_sinew_writes() {
     assert_eq!(out.status.code(), Some(2));
     assert!(!png.exists());
 }
+
+/// The glTF and DragonBones exports refuse bad options and a rig without weights with one line,
+/// and write nothing: an existing output is left as it was.
+#[test]
+fn gltf_and_dragonbones_exports_refuse_bad_input_and_keep_what_was_there() {
+    let tmp = scratch("free-exports");
+    let dir = tmp.path();
+    let (mut doc, rig) = rig(dir);
+    let glb = dir.join("out.glb");
+    std::fs::write(&glb, b"earlier").unwrap();
+    let db = dir.join("db");
+    for (args, message) in [
+        (vec!["--fps", "0"], "bake rate"),
+        (vec!["--px-per-unit", "0"], "--px-per-unit"),
+        (vec!["--layer-spacing=-1"], "layer spacing"),
+    ] {
+        let mut full = vec!["export", "gltf", s(&rig), "-o", s(&glb)];
+        full.extend(args);
+        assert_bad_input(&full, message);
+    }
+    for (args, message) in [
+        (vec!["--fps", "0"], "frame rate"),
+        (vec!["--max-vertices", "2"], "--max-vertices"),
+        (vec!["--max-influences", "0"], "--max-influences"),
+    ] {
+        let mut full = vec!["export", "dragonbones", s(&rig), "-o", s(&db)];
+        full.extend(args);
+        assert_bad_input(&full, message);
+    }
+    // Weights removed: both say what to do.
+    doc["parts"][0]["weights"] = Value::Null;
+    let unweighted = write(dir, "unweighted.json", &doc);
+    assert_bad_input(
+        &["export", "gltf", s(&unweighted), "-o", s(&glb)],
+        "sinew rig --handles",
+    );
+    assert_bad_input(
+        &["export", "dragonbones", s(&unweighted), "-o", s(&db)],
+        "sinew rig --handles",
+    );
+    // Over its own rig: refused.
+    assert_bad_input(&["export", "gltf", s(&rig), "-o", s(&rig)], "");
+    assert_eq!(std::fs::read(&glb).unwrap(), b"earlier");
+    assert!(!db.exists());
+}

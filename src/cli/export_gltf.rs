@@ -65,6 +65,13 @@ pub struct DragonBonesArgs {
     /// The armature's frame rate: every motion is keyed on each frame.
     #[arg(long, default_value_t = DragonBonesOptions::default().frame_rate)]
     pub fps: u32,
+    /// Decimate each part's mesh to at most N vertices (the runtime's 16-bit offsets overflow
+    /// on fine meshes).
+    #[arg(long, value_name = "N", default_value_t = sinew::export::dragonbones::DEFAULT_MAX_VERTICES)]
+    pub max_vertices: usize,
+    /// Keep the K strongest weights per vertex, renormalized.
+    #[arg(long, value_name = "K", default_value_t = sinew::export::dragonbones::DEFAULT_MAX_INFLUENCES)]
+    pub max_influences: usize,
     /// Base name of the files (default: the rig file's name).
     #[arg(long)]
     pub name: Option<String>,
@@ -73,6 +80,8 @@ pub struct DragonBonesArgs {
 pub fn run_dragonbones(args: &DragonBonesArgs) -> Result<()> {
     let options = DragonBonesOptions {
         frame_rate: args.fps,
+        max_vertices: Some(args.max_vertices),
+        max_influences: Some(args.max_influences),
         ..DragonBonesOptions::default()
     };
     let (export, written) = sinew::jobs::export_dragonbones_files(
