@@ -236,6 +236,14 @@ pub struct Animation {
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     #[schemars(with = "BTreeMap<String, Vec<Key<Vec<[f64; 2]>>>>")]
     pub deform: BTreeMap<String, super::deform::DeformKeys>,
+    /// Whether the animation is a cycle, made to play over and over (in files `loop`, left out
+    /// when false). Its keys are unchanged by it; what it changes is motion with a history
+    /// (physics constraints, skinning-IK momentum): a looping animation shows it in its
+    /// periodic steady state, as if it had been playing for ever, so that its end runs into its
+    /// start without a jump ([`crate::scene::play`]). Default false: the motion starts from
+    /// rest at time 0.
+    #[serde(rename = "loop", skip_serializing_if = "std::ops::Not::not")]
+    pub looping: bool,
 }
 
 /// What is wrong with one timeline (the enclosing [`AnimError`] names it).
@@ -677,10 +685,15 @@ fn locate_json_error(name: &str, value: &serde_json::Value) -> Option<AnimError>
                     }
                 }
             }
+            "loop" => {
+                if !content.is_boolean() {
+                    return Some(fail("loop".into(), "expected true or false".into()));
+                }
+            }
             other => {
                 return Some(malformed(format!(
                     "unknown section '{other}' (expected bones, points, cages, parts, \
-                     draw_order, ik, events or deform)"
+                     draw_order, ik, events, deform or loop)"
                 )))
             }
         }

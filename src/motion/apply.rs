@@ -3,7 +3,9 @@
 //!
 //! In: a [`RigDocument`], a [`Clip`], an optional user [`MapFile`], the animation's name and
 //! the [`RetargetOptions`]. Out: the document with the animation added (or replaced), checked
-//! against the rig as any animation the document holds, and what retargeting chose.
+//! against the rig as any animation the document holds, and what retargeting chose. A clip
+//! made to loop ([`RetargetReport::looped`]) is stored flagged `loop` as retargeting made it (a
+//! cycle, [`crate::anim::Animation::looping`]).
 
 use super::bvh::Clip;
 use super::map::{JointMap, MapError, MapFile};

@@ -1001,7 +1001,12 @@ pub fn retarget(
     let poses: Vec<Pose> = (0..n)
         .map(|f| pose_at(&world[f], root_x[f], root_y[f]))
         .collect();
-    let mut animation = Animation::default();
+    // A clip made to loop is a cycle: flagged, so that physics and momentum play in their
+    // steady state (crate::scene::play).
+    let mut animation = Animation {
+        looping: looped,
+        ..Animation::default()
+    };
     let mut key_count = 0;
     let cyclic = looped;
     // The bones between the root and an ankle share the ground's tolerance: keys within it
