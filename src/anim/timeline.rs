@@ -715,3 +715,31 @@ fn probe_keys<K: DeserializeOwned>(keys: &serde_json::Value) -> Result<(), (Stri
             .map_err(|e| (String::new(), e.to_string())),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn the_loop_flag_reads_and_writes_as_loop_and_is_left_out_when_false() {
+        let keys = json!({"bones": {"b": {"rotate": [{"time": 0.0, "value": 0.0}, {"time": 1.0, "value": 9.0}]}}});
+        let plain = Animation::from_json("a", &keys).unwrap();
+        assert!(!plain.looping);
+        assert!(serde_json::to_value(&plain).unwrap().get("loop").is_none());
+        let mut flagged_json = keys.clone();
+        flagged_json["loop"] = json!(true);
+        let flagged = Animation::from_json("a", &flagged_json).unwrap();
+        assert!(flagged.looping);
+        assert_eq!(serde_json::to_value(&flagged).unwrap(), flagged_json);
+        // Not a boolean: the message names `loop`; unknown sections are still refused.
+        let mut bad = keys.clone();
+        bad["loop"] = json!(1);
+        let e = Animation::from_json("a", &bad).unwrap_err().to_string();
+        assert!(e.contains("loop"), "{e}");
+        let mut unknown = keys;
+        unknown["loops"] = json!(true);
+        let e = Animation::from_json("a", &unknown).unwrap_err().to_string();
+        assert!(e.contains("unknown section 'loops'"), "{e}");
+    }
+}
