@@ -16,6 +16,12 @@
 //! grid time ([`PhysicsMode::Pose`]). So the frame at t is a function of (rig, animation, t),
 //! never of the output frame rate. Static poses (pose files, the editor's pose mode) show no
 //! physics, as spine-core's `Physics.none`.
+//!
+//! That is the simulation from rest ([`transforms_at`]): an animation played once, and what
+//! Spine 4.2's runtime plays. An animation flagged `loop` is shown in its periodic steady state
+//! instead: [`crate::scene::play`] runs [`PhysicsRun`] period after period on one period's grid
+//! ([`PhysicsRun::update_after`] advances the clock by the grid's step, shorter across the loop
+//! when the duration is not a whole number of updates) until the motion repeats.
 
 use crate::pipeline::PipelineError;
 use crate::rig::physics::{PhysicsMode, PhysicsState, SpineWorld};
@@ -107,8 +113,21 @@ impl PhysicsRun {
 
     /// The next skeleton update (at time `updates / UPDATE_HZ`) on `transforms`, the pose there.
     pub fn update(&mut self, handles: &Handles, transforms: Vec<Affine>) -> Vec<Affine> {
+        self.update_after(handles, transforms, update_step_s())
+    }
+
+    /// The next skeleton update on `transforms`, the pose there, the clock advanced by
+    /// `advance_s` since the last update (the first update advances nothing). A looping
+    /// animation's grid ([`crate::scene::play::Cycle`]) advances by a shorter step across the
+    /// loop when its duration is not a whole number of steps.
+    pub fn update_after(
+        &mut self,
+        handles: &Handles,
+        transforms: Vec<Affine>,
+        advance_s: f64,
+    ) -> Vec<Affine> {
         if self.updates > 0 {
-            self.clock_s += update_step_s();
+            self.clock_s += advance_s;
         }
         self.updates += 1;
         let clock = self.clock_s;

@@ -17,6 +17,12 @@
 //! rotation, scale and shear ([`BoneLocal::from_matrix`]); rotations and shears are unwrapped
 //! from key to key, since the runtime interpolates plain numbers. Between keys the runtime
 //! interpolates linearly, so baked motion is exact at the keys only.
+//!
+//! Loops: the bake of an animation flagged `loop` is the steady state of its physics and
+//! momentum (the one pose path's, [`crate::scene::play`]): the runtime plays the keys over and
+//! over, so a simulation restarted from rest at each loop would jump at the seam (the demo's
+//! tail: 22.6 px at the walk's seam before, 4.4 px after, its largest step inside the loop
+//! 7.4 px).
 
 use super::frame::{unwrap_deg, BoneLocal, SpineFrame};
 use super::skeleton::{BoneSource, Skeleton};
@@ -60,7 +66,10 @@ pub fn bake_times(duration_s: f64, fps: f64) -> Vec<f64> {
 }
 
 /// The animation's frames at each bake time, through the one pose path
-/// ([`crate::scene::frames`]: exact curves, not looping, skinning IK and momentum included).
+/// ([`crate::scene::frames`]: exact curves, times held at the end, skinning IK, momentum and
+/// physics included). An animation flagged `loop` bakes its physics and momentum in their
+/// periodic steady state ([`crate::scene::play`]), so that its keys at the end run into its
+/// keys at 0 as the runtime loops it; otherwise that motion starts from rest at 0.
 pub fn sample_path(
     scene: &Scene,
     animation: &Animation,

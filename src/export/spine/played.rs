@@ -15,6 +15,12 @@
 //! out of the rig. Sampled with [`CurveEvaluation::SpineRuntime`] and posed by forward
 //! kinematics, it plays as the runtime does.
 //!
+//! Physics: for 4.1 and 4.3 it is baked like any other motion, so an animation flagged `loop`
+//! plays its baked steady state ([`crate::scene::play`]). 4.2's runtime simulates it itself,
+//! from rest when the animation starts and on across its loops whatever the animation's `loop`
+//! flag: [`AsPlayed::frame`] does the same ([`crate::scene::physics::transforms_at`]), times
+//! past the end wrapping when asked to loop.
+//!
 //! A cage with some vertices baked has its whole polygon keyed at the bake times (sinew keys
 //! cages as whole polygons); its unbaked vertices then follow the keys linearly between bake
 //! times where the runtime would play their authored curves.
