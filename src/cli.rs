@@ -179,14 +179,27 @@ pub struct SpineArgs {
 pub enum RuntimeMatch {
     /// Spine's official runtimes: f32 keys, each Bézier key as a 10-segment polyline.
     Spine,
+    /// The DragonBones runtimes playing `sinew export dragonbones`'s frames (default options).
+    Dragonbones,
+    /// A glTF runtime playing `sinew export gltf`'s baked keys (default options).
+    Gltf,
 }
 
 fn sample_options(runtime: Option<RuntimeMatch>) -> SampleOptions {
     SampleOptions {
         curves: match runtime {
             Some(RuntimeMatch::Spine) => CurveEvaluation::SpineRuntime,
-            None => CurveEvaluation::Exact,
+            _ => CurveEvaluation::Exact,
         },
+    }
+}
+
+/// The baked runtime `--match-runtime` names, if it names one.
+fn baked_runtime(runtime: Option<RuntimeMatch>) -> Option<playback::BakedRuntime> {
+    match runtime {
+        Some(RuntimeMatch::Dragonbones) => Some(playback::BakedRuntime::Dragonbones),
+        Some(RuntimeMatch::Gltf) => Some(playback::BakedRuntime::Gltf),
+        Some(RuntimeMatch::Spine) | None => None,
     }
 }
 
@@ -674,19 +687,15 @@ fn pose(args: &PoseArgs) -> Result<()> {
                 bail!("--time must be a finite number of seconds");
             }
             let animation = animation(&scene.doc, name)?;
-            let sampling = sample_options(args.match_runtime);
-            let export = export_played(&args.spine_version, args.bake_fps)?;
-            let frame = playback::play(
-                &scene,
-                name,
-                &animation,
-                &[time_s],
-                true,
-                &sampling,
-                &export,
-            )?
-            .pop()
-            .context("no frame")?;
+            let settings = playback::RenderSettings {
+                sampling: sample_options(args.match_runtime),
+                export: export_played(&args.spine_version, args.bake_fps)?,
+                baked_runtime: baked_runtime(args.match_runtime),
+                ..Default::default()
+            };
+            let frame = playback::play(&scene, name, &animation, &[time_s], true, &settings)?
+                .pop()
+                .context("no frame")?;
             (frame.pose, frame.transforms)
         }
         (None, None) => (Pose::default(), scene.handle_transforms(&Pose::default())?),
@@ -723,6 +732,7 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         blend: args.blend,
         sampling: sample_options(args.match_runtime),
         export: export_played(&args.spine_version, args.bake_fps)?,
+        baked_runtime: baked_runtime(args.match_runtime),
     };
     let files = sinew::jobs::RenderFiles {
         rig: args.rig.clone(),

@@ -109,6 +109,47 @@ fn run_oracle(dir: &Path, request: serde_json::Value) -> Oracle {
     serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
 }
 
+/// `sinew pose RIG --anim NAME --time T --match-runtime RUNTIME --vertices V.json`: the posed
+/// vertices the CLI writes.
+fn cli_pose(rig: &Path, dir: &Path, runtime: &str, name: &str, time_s: f64) -> Vec<Vec<Point>> {
+    #[derive(Deserialize)]
+    struct Part {
+        vertices: Vec<[f64; 2]>,
+    }
+    #[derive(Deserialize)]
+    struct Posed {
+        parts: Vec<Part>,
+    }
+    let v = dir.join(format!("{runtime}-{name}-{time_s}.json"));
+    let t = time_s.to_string();
+    sinew(&[
+        "pose",
+        s(rig),
+        "--anim",
+        name,
+        "--time",
+        &t,
+        "--match-runtime",
+        runtime,
+        "--vertices",
+        s(&v),
+    ]);
+    let posed: Posed = serde_json::from_str(&std::fs::read_to_string(&v).unwrap()).unwrap();
+    posed
+        .parts
+        .iter()
+        .map(|p| p.vertices.iter().map(|v| Point::new(v[0], v[1])).collect())
+        .collect()
+}
+
+/// Largest distance between two posings of every part, px.
+fn farthest(a: &[Vec<Point>], b: &[Vec<Point>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| p.iter().zip(q).map(|(u, v)| (u - v).norm()))
+        .fold(0.0, f64::max)
+}
+
 /// Largest distance between the runtime's vertices of each visible mesh (armature space) and
 /// `sinew`'s (canvas px).
 fn deviation(
@@ -123,7 +164,11 @@ fn deviation(
             continue;
         };
         let part = doc.parts.iter().position(|p| &p.name == display).unwrap();
-        assert_eq!(slot.name, doc.slot_of(part), "{display} shown in another slot");
+        assert_eq!(
+            slot.name,
+            doc.slot_of(part),
+            "{display} shown in another slot"
+        );
         // The runtime's mesh is the decimated one: each vertex a fine-mesh vertex.
         let source = &export.vertex_source[part];
         assert_eq!(vertices.len(), 2 * source.len(), "{display}");
@@ -269,6 +314,22 @@ fn check_rig(rig: &Path, dir: &Path) -> (f64, f64, usize) {
             assert_eq!(got.int, Some(want.2));
             assert!((got.float.unwrap_or(f64::NAN) - want.3).abs() < 1e-6);
             assert_eq!(got.string.as_deref(), Some(want.4.as_str()));
+        }
+    }
+    // `sinew pose --match-runtime dragonbones` poses through the same reproduction (its own
+    // meshes, every influence).
+    if let Some(baked) = export.animations.first() {
+        let name = &baked.name;
+        for t in [0.0, 0.51 / fps, 0.5 * doc.animations[name].duration_s()] {
+            let (transforms, pose) = played::as_played(&export, baked, &slots, &attachments, t);
+            let expected = scene
+                .positions_from_transforms(&transforms, &pose, Blend::Linear)
+                .unwrap();
+            let d = farthest(&cli_pose(rig, dir, "dragonbones", name, t), &expected);
+            assert!(
+                d < 1e-6,
+                "sinew pose --match-runtime dragonbones at {t} s: {d} px"
+            );
         }
     }
     println!(

@@ -86,6 +86,47 @@ fn run_oracle(glb: &Path, times: &BTreeMap<String, Vec<f64>>) -> Oracle {
     serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap()
 }
 
+/// `sinew pose RIG --anim NAME --time T --match-runtime RUNTIME --vertices V.json`: the posed
+/// vertices the CLI writes.
+fn cli_pose(rig: &Path, dir: &Path, runtime: &str, name: &str, time_s: f64) -> Vec<Vec<Point>> {
+    #[derive(Deserialize)]
+    struct Part {
+        vertices: Vec<[f64; 2]>,
+    }
+    #[derive(Deserialize)]
+    struct Posed {
+        parts: Vec<Part>,
+    }
+    let v = dir.join(format!("{runtime}-{name}-{time_s}.json"));
+    let t = time_s.to_string();
+    sinew(&[
+        "pose",
+        s(rig),
+        "--anim",
+        name,
+        "--time",
+        &t,
+        "--match-runtime",
+        runtime,
+        "--vertices",
+        s(&v),
+    ]);
+    let posed: Posed = serde_json::from_str(&std::fs::read_to_string(&v).unwrap()).unwrap();
+    posed
+        .parts
+        .iter()
+        .map(|p| p.vertices.iter().map(|v| Point::new(v[0], v[1])).collect())
+        .collect()
+}
+
+/// Largest distance between two posings of every part, px.
+fn farthest(a: &[Vec<Point>], b: &[Vec<Point>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| p.iter().zip(q).map(|(u, v)| (u - v).norm()))
+        .fold(0.0, f64::max)
+}
+
 /// Largest distance between three.js's vertices of `name` (glTF units) and `sinew`'s (px).
 fn deviation(frame: &GltfFrame, runtime: &[f64], sinew: &[Point], name: &str) -> f64 {
     assert_eq!(runtime.len(), 3 * sinew.len(), "{name}: vertex count");
@@ -198,6 +239,23 @@ fn check_rig(rig: &Path, dir: &Path) -> Report {
                     report.between_keys_px = report.between_keys_px.max(d);
                 }
             }
+        }
+    }
+    // `sinew pose --match-runtime gltf` poses through the same reproduction (every influence:
+    // sinew draws its own meshes).
+    if let Some(keyed) = export.animations.first() {
+        let animation = &keyed.name;
+        for t in [
+            0.0,
+            0.51 / options.bake_fps,
+            0.5 * doc.animations[animation].duration_s(),
+        ] {
+            let (transforms, pose) = played::as_played(&export, keyed, t);
+            let expected = scene
+                .positions_from_transforms(&transforms, &pose, Blend::Linear)
+                .unwrap();
+            let d = farthest(&cli_pose(rig, dir, "gltf", animation, t), &expected);
+            assert!(d < 1e-6, "sinew pose --match-runtime gltf at {t} s: {d} px");
         }
     }
     println!(

@@ -88,17 +88,10 @@ fn bundled_animations_match_golden_at_fixed_times() {
         let animation = &animations[name];
         for &t in times_s {
             // What `sinew pose --anim NAME --time T` and every frame of `sinew render` show.
-            let frame = sinew::playback::play(
-                scene(),
-                name,
-                animation,
-                &[t],
-                true,
-                &Default::default(),
-                &Default::default(),
-            )
-            .expect("plays")
-            .remove(0);
+            let frame =
+                sinew::playback::play(scene(), name, animation, &[t], true, &Default::default())
+                    .expect("plays")
+                    .remove(0);
             let positions = scene()
                 .positions_from_transforms(
                     &frame.transforms,

@@ -54,16 +54,8 @@ fn check_frames_against_single_poses(scene: &Scene, animations: &BTreeMap<String
             let images = playback::render_animation(scene, name, animation, &settings, &|| {})
                 .expect("renders");
             let times = playback::frame_times(animation.duration_s(), fps).expect("frame times");
-            let frames = playback::play(
-                scene,
-                name,
-                animation,
-                &times,
-                true,
-                &Default::default(),
-                &Default::default(),
-            )
-            .expect("plays");
+            let frames = playback::play(scene, name, animation, &times, true, &Default::default())
+                .expect("plays");
             assert_eq!(images.len(), times.len());
             let (mut worst_px, mut worst_db) = (0.0_f64, f64::INFINITY);
             for ((&time_s, frame), image) in times.iter().zip(&frames).zip(&images) {

@@ -69,6 +69,20 @@ pub struct RenderSettings {
     pub sampling: SampleOptions,
     /// With the Spine runtime's sampling: the export it plays. Default: `sinew spine`'s defaults.
     pub export: crate::export::spine::played::ExportPlayed,
+    /// Play as this runtime plays the default export of its format (the export's baked keys,
+    /// interpolated as the runtime does); `sampling` then plays no part. Default `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baked_runtime: Option<BakedRuntime>,
+}
+
+/// A runtime that plays an export's baked keys, reproduced by sinew (`--match-runtime`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BakedRuntime {
+    /// The DragonBones runtimes: [`crate::export::dragonbones::played`].
+    Dragonbones,
+    /// A glTF runtime (three.js, Godot, Bevy…): [`crate::export::gltf::played`].
+    Gltf,
 }
 
 /// The frame rate of [`RenderSettings::default`], frames per second.
@@ -84,6 +98,7 @@ impl Default for RenderSettings {
             blend: Blend::Linear,
             sampling: SampleOptions::default(),
             export: Default::default(),
+            baked_runtime: None,
         }
     }
 }
@@ -130,20 +145,31 @@ pub fn render_events(
     ))
 }
 
-/// The frames of `animation` (named `name`) at `times_s`: with exact curves, through the one
-/// pose path ([`crate::scene::frames`]); with [`CurveEvaluation::SpineRuntime`], as Spine's
-/// runtime plays the default Spine export ([`crate::export::spine::played`]: its curve
-/// evaluation, and the baked keys interpolated as it does) of an export made with `export`.
+/// The frames of `animation` (named `name`) at `times_s`, played as `settings` say (only their
+/// `sampling`, `export` and `baked_runtime` matter here): with exact curves, through the one
+/// pose path ([`crate::scene::frames`]); with [`crate::anim::CurveEvaluation::SpineRuntime`], as Spine's
+/// runtime plays the Spine export made with `export` ([`crate::export::spine::played`]: its
+/// curve evaluation, and the baked keys interpolated as it does); with a `baked_runtime`, as
+/// that runtime plays the default export of its format ([`crate::export::dragonbones::played`],
+/// [`crate::export::gltf::played`]).
 pub fn play(
     scene: &Scene,
     name: &str,
     animation: &Animation,
     times_s: &[f64],
     looping: bool,
-    sampling: &SampleOptions,
-    export: &crate::export::spine::played::ExportPlayed,
+    settings: &RenderSettings,
 ) -> Result<Vec<Frame>, RenderAnimationError> {
-    stream::Player::new(scene, name, animation, sampling, export, looping)?.frames(times_s)
+    stream::Player::new(
+        scene,
+        name,
+        animation,
+        &settings.sampling,
+        &settings.export,
+        settings.baked_runtime,
+        looping,
+    )?
+    .frames(times_s)
 }
 
 /// Why [`render_animation`] failed: its settings, or posing and drawing the rig.
@@ -155,6 +181,10 @@ pub enum RenderAnimationError {
     Pipeline(#[from] PipelineError),
     #[error(transparent)]
     Runtime(#[from] crate::export::spine::SpineError),
+    #[error(transparent)]
+    Gltf(#[from] crate::export::gltf::GltfError),
+    #[error(transparent)]
+    DragonBones(#[from] crate::export::dragonbones::DragonBonesError),
     #[error(transparent)]
     Sequence(#[from] crate::io::sequence::SequenceError),
 }

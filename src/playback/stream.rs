@@ -8,7 +8,8 @@
 //! with the animation's events to a frame folder, a GIF or a sprite sheet.
 
 use super::{
-    frame_times, render_events, render_frames, FrameView, RenderAnimationError, RenderSettings,
+    frame_times, render_events, render_frames, BakedRuntime, FrameView, RenderAnimationError,
+    RenderSettings,
 };
 use crate::anim::{Animation, CurveEvaluation, SampleOptions};
 use crate::export::spine::played::{AsPlayed, ExportPlayed};
@@ -40,7 +41,16 @@ pub(super) enum Player<'a> {
         played: Box<AsPlayed>,
         looping: bool,
     },
+    /// A runtime that interpolates an export's baked keys (DragonBones, glTF).
+    Baked {
+        at: BakedAt,
+        duration_s: f64,
+        looping: bool,
+    },
 }
+
+/// The pose a baked runtime shows at a time: handle transforms and the pose's slot state.
+type BakedAt = Box<dyn Fn(f64) -> (Vec<crate::rig::Affine>, crate::rig::Pose) + Send + Sync>;
 
 impl<'a> Player<'a> {
     /// A player of `animation` (named `name`) on `scene`; `looping`: times past the end wrap.
@@ -50,8 +60,39 @@ impl<'a> Player<'a> {
         animation: &'a Animation,
         sampling: &SampleOptions,
         export: &ExportPlayed,
+        baked_runtime: Option<BakedRuntime>,
         looping: bool,
     ) -> Result<Self, RenderAnimationError> {
+        let duration_s = animation.duration_s();
+        match baked_runtime {
+            Some(BakedRuntime::Gltf) => {
+                let played = crate::export::gltf::playback(
+                    scene,
+                    name,
+                    animation,
+                    &crate::export::gltf::GltfOptions::default(),
+                )?;
+                return Ok(Player::Baked {
+                    at: Box::new(move |t| played.at(t)),
+                    duration_s,
+                    looping,
+                });
+            }
+            Some(BakedRuntime::Dragonbones) => {
+                let played = crate::export::dragonbones::playback(
+                    scene,
+                    name,
+                    animation,
+                    &crate::export::dragonbones::DragonBonesOptions::default(),
+                )?;
+                return Ok(Player::Baked {
+                    at: Box::new(move |t| played.at(t)),
+                    duration_s,
+                    looping,
+                });
+            }
+            None => {}
+        }
         Ok(match sampling.curves {
             CurveEvaluation::Exact => {
                 let options = PlayOptions {
@@ -87,6 +128,25 @@ impl<'a> Player<'a> {
                 .iter()
                 .map(|&t| played.frame(t, *looping))
                 .collect::<Result<_, _>>()?),
+            Player::Baked {
+                at,
+                duration_s,
+                looping,
+            } => Ok(times_s
+                .iter()
+                .map(|&time_s| {
+                    let (transforms, pose) = at(crate::anim::sample::local_time_s(
+                        *duration_s,
+                        time_s,
+                        *looping,
+                    ));
+                    Frame {
+                        time_s,
+                        pose,
+                        transforms,
+                    }
+                })
+                .collect()),
         }
     }
 }
@@ -109,6 +169,7 @@ impl<'a> AnimationFrames<'a> {
             animation,
             &settings.sampling,
             &settings.export,
+            settings.baked_runtime,
             true,
         )?;
         Ok(AnimationFrames {

@@ -108,8 +108,8 @@ pub(super) fn bake(
     let times: Vec<f64> = (0..=n)
         .map(|k| (f64::from(k) / fps).min(duration))
         .collect();
-    let samples =
-        bake::sample_path(scene, animation, &times, false).map_err(DragonBonesError::Pose)?;
+    let samples = bake::sample_path(scene, animation, &times, false)
+        .map_err(|e| DragonBonesError::Pose(Box::new(e)))?;
 
     // Bones.
     let mut previous: Vec<DbTransform> = setup.to_vec();

@@ -148,11 +148,11 @@ pub enum DragonBonesError {
         offset_px: [i32; 2],
     },
     #[error("{0}")]
-    Atlas(SpineError),
+    Atlas(Box<SpineError>),
     #[error(transparent)]
     Anim(#[from] AnimError),
     #[error("baking: {0}")]
-    Pose(PipelineError),
+    Pose(Box<PipelineError>),
     #[error("{path}: {source}")]
     Write {
         path: PathBuf,
@@ -302,8 +302,8 @@ pub fn export_dragonbones(
         ..options.atlas.clone()
     };
     let tex_name = format!("{name}_tex");
-    let atlas =
-        atlas::pack_atlas(&tex_name, &regions, &atlas_options).map_err(DragonBonesError::Atlas)?;
+    let atlas = atlas::pack_atlas(&tex_name, &regions, &atlas_options)
+        .map_err(|e| DragonBonesError::Atlas(Box::new(e)))?;
     if atlas.pages.len() != 1 {
         return Err(DragonBonesError::Pages(atlas.pages.len()));
     }
@@ -419,7 +419,9 @@ pub fn export_dragonbones(
     });
     let mut png = std::io::Cursor::new(Vec::new());
     page.write_to(&mut png, image::ImageFormat::Png)
-        .map_err(|e| DragonBonesError::Atlas(SpineError::Png(tex_name.clone(), e.to_string())))?;
+        .map_err(|e| {
+            DragonBonesError::Atlas(Box::new(SpineError::Png(tex_name.clone(), e.to_string())))
+        })?;
     Ok(DragonBonesExport {
         name: name.to_string(),
         frame,
@@ -432,6 +434,66 @@ pub fn export_dragonbones(
         ske: ske.to_string(),
         tex: tex.to_string(),
         png: png.into_inner(),
+    })
+}
+
+/// What the DragonBones runtime plays of `animation` (named `name`) exported with `options`,
+/// without writing the files: the frames [`export_dragonbones`] writes for it (`--match-runtime
+/// dragonbones`). Meshes are not decimated here: sinew draws its own (as for Spine's game
+/// preset), with the runtime's motion.
+pub fn playback(
+    scene: &Scene,
+    name: &str,
+    animation: &crate::anim::Animation,
+    options: &DragonBonesOptions,
+) -> Result<played::DbPlayback, DragonBonesError> {
+    let doc = &scene.doc;
+    if options.frame_rate == 0 || f64::from(options.frame_rate) > MAX_FRAME_RATE {
+        return Err(DragonBonesError::FrameRate(options.frame_rate));
+    }
+    let frame = DbFrame::for_canvas(doc.canvas);
+    let joints = joints::joints(&doc.handles, &frame);
+    let setup: Vec<DbTransform> = joints::rest_locals(&joints)
+        .iter()
+        .map(|a| DbTransform::from_affine(a, None))
+        .collect();
+    let sources: Vec<Vec<usize>> = doc
+        .parts
+        .iter()
+        .map(|p| (0..p.mesh.vertices.len()).collect())
+        .collect();
+    let sources: Vec<&[usize]> = sources.iter().map(Vec::as_slice).collect();
+    let influences = vec![0; doc.parts.len()];
+    let (_, baked) = animation::bake(
+        scene,
+        name,
+        animation,
+        &joints,
+        &setup,
+        &frame,
+        &sources,
+        &influences,
+        options,
+    )?;
+    let slots = doc
+        .slot_names()
+        .into_iter()
+        .map(|slot| {
+            let names = doc
+                .attachments_of(slot)
+                .into_iter()
+                .map(|i| doc.parts[i].name.clone())
+                .collect();
+            (slot.to_string(), names)
+        })
+        .collect();
+    Ok(played::DbPlayback {
+        frame_rate: options.frame_rate,
+        frame,
+        joints,
+        setup,
+        animation: baked,
+        slots,
     })
 }
 

@@ -46,9 +46,78 @@ fn parsed_setup(t: &DbTransform) -> DbTransform {
     }
 }
 
-/// What the runtime poses at `time_s` of `animation` (played once; clamped to its end).
+/// What the DragonBones runtime plays of one animation: the export's bones and the animation's
+/// frames, without the files ([`super::playback`]), for `--match-runtime dragonbones`.
+#[derive(Clone, Debug)]
+pub struct DbPlayback {
+    pub frame_rate: u32,
+    pub frame: super::transform::DbFrame,
+    pub joints: Vec<crate::export::joints::Joint>,
+    pub setup: Vec<DbTransform>,
+    pub animation: BakedAnimation,
+    /// The slots in setup draw order, and each slot's displays (part names) in display order.
+    pub slots: Vec<(String, Vec<String>)>,
+}
+
+impl DbPlayback {
+    /// What the runtime poses at `time_s` (played once; clamped to the end).
+    pub fn at(&self, time_s: f64) -> (Vec<Affine>, Pose) {
+        let slots: Vec<&str> = self.slots.iter().map(|(s, _)| s.as_str()).collect();
+        let attachments = |slot: &str| {
+            self.slots
+                .iter()
+                .find(|(s, _)| s == slot)
+                .map(|(_, a)| a.clone())
+                .unwrap_or_default()
+        };
+        pose_at(
+            Bones {
+                frame_rate: self.frame_rate,
+                frame: &self.frame,
+                joints: &self.joints,
+                setup: &self.setup,
+            },
+            &self.animation,
+            &slots,
+            &attachments,
+            time_s,
+        )
+    }
+}
+
+/// The skeleton an export's frames move.
+struct Bones<'a> {
+    frame_rate: u32,
+    frame: &'a super::transform::DbFrame,
+    joints: &'a [crate::export::joints::Joint],
+    setup: &'a [DbTransform],
+}
+
+/// What the runtime poses at `time_s` of `animation` of `export` (played once; clamped to its
+/// end). `slots` are the rig's slots in setup order; `attachments` gives a slot's displays.
 pub fn as_played(
     export: &DragonBonesExport,
+    animation: &BakedAnimation,
+    slots: &[&str],
+    attachments: &dyn Fn(&str) -> Vec<String>,
+    time_s: f64,
+) -> (Vec<Affine>, Pose) {
+    pose_at(
+        Bones {
+            frame_rate: export.frame_rate,
+            frame: &export.frame,
+            joints: &export.joints,
+            setup: &export.setup,
+        },
+        animation,
+        slots,
+        attachments,
+        time_s,
+    )
+}
+
+fn pose_at(
+    export: Bones,
     animation: &BakedAnimation,
     slots: &[&str],
     attachments: &dyn Fn(&str) -> Vec<String>,

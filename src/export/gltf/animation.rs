@@ -47,7 +47,8 @@ pub(super) fn bake_animation(
         });
     }
     let times = bake::bake_times(duration, options.bake_fps);
-    let frames = bake::sample_path(scene, animation, &times, false).map_err(GltfError::Pose)?;
+    let frames = bake::sample_path(scene, animation, &times, false)
+        .map_err(|e| GltfError::Pose(Box::new(e)))?;
     let n = joints.len();
     let mut translation = vec![Vec::with_capacity(3 * times.len()); n];
     let mut pivot = vec![Vec::with_capacity(4 * times.len()); n];

@@ -122,11 +122,11 @@ pub enum GltfError {
         offset_px: [i32; 2],
     },
     #[error("{0}")]
-    Atlas(SpineError),
+    Atlas(Box<SpineError>),
     #[error(transparent)]
     Anim(#[from] AnimError),
     #[error("baking: {0}")]
-    Pose(PipelineError),
+    Pose(Box<PipelineError>),
     #[error("{path}: {source}")]
     Write {
         path: PathBuf,
@@ -185,18 +185,7 @@ pub fn export_gltf(
     let joints = crate::export::joints::joints(&doc.handles, &frame);
     let mut left_out = Vec::new();
 
-    // The parts the setup pose draws, back to front.
-    let rest = scene.rest_positions();
-    let draws = crate::playback::pose_draws(scene, &rest, &Pose::default());
-    let mut written = Vec::new();
-    for draw in &draws {
-        if draw.visible {
-            written.push(WrittenPart {
-                part: draw.part,
-                targets: morph_targets(doc, &doc.parts[draw.part].name),
-            });
-        }
-    }
+    let written = setup_parts(scene);
     let hidden: Vec<&str> = doc
         .parts
         .iter()
@@ -232,7 +221,8 @@ pub fn export_gltf(
         premultiplied_alpha: false,
         ..options.atlas.clone()
     };
-    let atlas = atlas::pack_atlas("page", &regions, &atlas_options).map_err(GltfError::Atlas)?;
+    let atlas = atlas::pack_atlas("page", &regions, &atlas_options)
+        .map_err(|e| GltfError::Atlas(Box::new(e)))?;
 
     let mut buffer = Buffer::default();
     let mut document = Map::new();
@@ -245,7 +235,7 @@ pub fn export_gltf(
     // Textures and materials, one per page.
     let mut images_json = Vec::new();
     for page in &atlas.pages {
-        let png = png_bytes(&page.image).map_err(GltfError::Atlas)?;
+        let png = png_bytes(&page.image).map_err(|e| GltfError::Atlas(Box::new(e)))?;
         let view = buffer.view(&png, None);
         images_json
             .push(json!({ "bufferView": view, "mimeType": "image/png", "name": page.file_name }));
@@ -464,6 +454,57 @@ pub fn export_gltf(
         animations: report,
         left_out,
     })
+}
+
+/// What a glTF runtime plays of `animation` (named `name`) exported with `options`, without
+/// writing the file: the keys [`export_gltf`] writes for it (`--match-runtime gltf`).
+pub fn playback(
+    scene: &Scene,
+    name: &str,
+    animation: &crate::anim::Animation,
+    options: &GltfOptions,
+) -> Result<played::GltfPlayback, GltfError> {
+    let doc = &scene.doc;
+    check_options(options)?;
+    let frame = GltfFrame::for_canvas(doc.canvas, options.px_per_unit);
+    let joints = crate::export::joints::joints(&doc.handles, &frame);
+    let rest_locals = crate::export::joints::rest_locals(&joints);
+    let written = setup_parts(scene);
+    let baked = bake_animation(
+        scene,
+        name,
+        animation,
+        &joints,
+        &rest_locals,
+        &frame,
+        &written,
+        options,
+        &mut Buffer::default(),
+    )?;
+    Ok(played::GltfPlayback {
+        frame,
+        morph_targets: written
+            .iter()
+            .filter(|w| !w.targets.is_empty())
+            .map(|w| (doc.parts[w.part].name.clone(), w.targets.clone()))
+            .collect(),
+        joints,
+        animation: baked.played,
+    })
+}
+
+/// The parts the setup pose draws, back to front, with their morph targets.
+fn setup_parts(scene: &Scene) -> Vec<WrittenPart> {
+    let doc = &scene.doc;
+    let rest = scene.rest_positions();
+    crate::playback::pose_draws(scene, &rest, &Pose::default())
+        .iter()
+        .filter(|draw| draw.visible)
+        .map(|draw| WrittenPart {
+            part: draw.part,
+            targets: morph_targets(doc, &doc.parts[draw.part].name),
+        })
+        .collect()
 }
 
 fn check_options(options: &GltfOptions) -> Result<(), GltfError> {

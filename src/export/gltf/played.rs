@@ -41,8 +41,51 @@ fn short_way(a: f64, b: f64) -> f64 {
     }
 }
 
-/// What the runtime poses at `time_s` of `animation`.
-pub fn as_played(export: &GltfExport, animation: &GltfAnimation, time_s: f64) -> (Vec<Affine>, Pose) {
+/// What a glTF runtime plays of one animation: the export's skeleton and morph targets and the
+/// animation's keys, without the file ([`super::playback`]), for `--match-runtime gltf`.
+#[derive(Clone, Debug)]
+pub struct GltfPlayback {
+    pub frame: super::frame::GltfFrame,
+    pub joints: Vec<crate::export::joints::Joint>,
+    pub morph_targets: BTreeMap<String, Vec<Vec<Vec2>>>,
+    pub animation: GltfAnimation,
+}
+
+impl GltfPlayback {
+    /// What the runtime poses at `time_s` (held at the ends).
+    pub fn at(&self, time_s: f64) -> (Vec<Affine>, Pose) {
+        pose_at(
+            &self.frame,
+            &self.joints,
+            &self.morph_targets,
+            &self.animation,
+            time_s,
+        )
+    }
+}
+
+/// What the runtime poses at `time_s` of `animation` of `export`.
+pub fn as_played(
+    export: &GltfExport,
+    animation: &GltfAnimation,
+    time_s: f64,
+) -> (Vec<Affine>, Pose) {
+    pose_at(
+        &export.frame,
+        &export.joints,
+        &export.morph_targets,
+        animation,
+        time_s,
+    )
+}
+
+fn pose_at(
+    frame: &super::frame::GltfFrame,
+    joints: &[crate::export::joints::Joint],
+    morph_targets: &BTreeMap<String, Vec<Vec<Vec2>>>,
+    animation: &GltfAnimation,
+    time_s: f64,
+) -> (Vec<Affine>, Pose) {
     let times = &animation.times_s;
     let last = times.len().saturating_sub(1);
     // The keys around t and the fraction between them.
@@ -50,10 +93,14 @@ pub fn as_played(export: &GltfExport, animation: &GltfAnimation, time_s: f64) ->
         Some(0) | None if times.is_empty() => (0, 0, 0.0),
         Some(0) => (0, 0, 0.0),
         None => (last, last, 0.0),
-        Some(k) => (k - 1, k, (time_s - times[k - 1]) / (times[k] - times[k - 1])),
+        Some(k) => (
+            k - 1,
+            k,
+            (time_s - times[k - 1]) / (times[k] - times[k - 1]),
+        ),
     };
     let lerp = |a: f64, b: f64| a + (b - a) * u;
-    let locals: Vec<Affine> = (0..export.joints.len())
+    let locals: Vec<Affine> = (0..joints.len())
         .map(|b| {
             let (p, q) = (&animation.locals[i][b], &animation.locals[j][b]);
             Trsr {
@@ -71,7 +118,7 @@ pub fn as_played(export: &GltfExport, animation: &GltfAnimation, time_s: f64) ->
     // Parents before children, however the columns are ordered (the rig has no cycles).
     let mut world: Vec<Option<Affine>> = vec![None; locals.len()];
     for _ in 0..locals.len() {
-        for (b, joint) in export.joints.iter().enumerate() {
+        for (b, joint) in joints.iter().enumerate() {
             if world[b].is_none() {
                 world[b] = match joint.parent {
                     None => Some(locals[b]),
@@ -80,9 +127,7 @@ pub fn as_played(export: &GltfExport, animation: &GltfAnimation, time_s: f64) ->
             }
         }
     }
-    let frame = &export.frame;
-    let transforms = export
-        .joints
+    let transforms = joints
         .iter()
         .zip(world)
         .map(|(joint, w)| {
@@ -104,7 +149,7 @@ pub fn as_played(export: &GltfExport, animation: &GltfAnimation, time_s: f64) ->
         .collect();
     let mut pose = Pose::default();
     for (part, per_key) in &animation.morph_weights {
-        let Some(targets) = export.morph_targets.get(part) else {
+        let Some(targets) = morph_targets.get(part) else {
             continue;
         };
         let weights: Vec<f64> = per_key[i]
