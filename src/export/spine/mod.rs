@@ -581,13 +581,20 @@ pub fn export_spine(
                 let Some(exported) = parts.iter().find(|p| &p.name == part) else {
                     continue;
                 };
-                let timeline = deform::deform_timeline(keys, &exported.mesh, &skeleton, &frame)?;
+                // Keys that change nothing are left out (deform.rs), a timeline of them too.
+                let Some(timeline) =
+                    deform::deform_timeline(keys, &exported.mesh, &skeleton, &frame)?
+                else {
+                    continue;
+                };
                 slots.insert(
                     part.clone(),
                     json!({ part.clone(): { "deform": timeline } }),
                 );
             }
-            a.insert("attachments".into(), json!({ "default": slots }));
+            if !slots.is_empty() {
+                a.insert("attachments".into(), json!({ "default": slots }));
+            }
         }
         if !animation.events.is_empty() {
             a.insert(
