@@ -487,7 +487,10 @@ pub fn export_spine(
             .collect();
         let fine = part.mesh.to_mesh();
         let (kept, triangles) = match options.max_vertices {
-            Some(n) if n < fine.vertices.len() => decimate::decimate(&fine, &rows, n),
+            Some(n) if n < fine.vertices.len() => {
+                let detail = decimate::TextureDetail::new(image, part.offset_px);
+                decimate::decimate_textured(&fine, &rows, n, Some(&detail))
+            }
             _ => ((0..fine.vertices.len()).collect(), fine.triangles.clone()),
         };
         let vertices: Vec<Point> = kept.iter().map(|&v| fine.vertices[v]).collect();
