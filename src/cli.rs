@@ -9,6 +9,7 @@ mod batch;
 mod choices;
 mod colorize;
 mod export_gltf;
+mod target;
 
 use anyhow::{anyhow, bail, Context, Result};
 use choices::{BakeModeArg, BlendArg, SchemaKindArg, SpinePresetArg, TemplateArg, WeightMethodArg};
@@ -63,6 +64,8 @@ pub enum Command {
     /// Art in, a character that moves out: the automatic rig, weights, the library's motions,
     /// GIF and sprite-sheet renders and the Spine export, with a summary of what was chosen.
     Auto(auto::AutoArgs),
+    /// The runtime a rig is made for: pose, render and the editor play as it plays the export.
+    Target(target::TargetArgs),
     /// Color line art from a few colored scribbles (content-aware weights over the image).
     Colorize(colorize::ColorizeArgs),
     /// Run the jobs of a manifest (rig, autorig, render, export, colorize) in parallel, here
@@ -261,9 +264,13 @@ pub struct RenderArgs {
     /// How handle transformations blend.
     #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, playback::RenderSettings::default().blend))]
     pub blend: Blend,
-    /// Play curves as this runtime does instead of exactly (see docs/guide.md, "Spine export").
+    /// Play as this runtime plays the export of its format instead of exactly (default: the
+    /// rig's target runtime, `sinew target`; see docs/guide.md, "Spine export").
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
+    /// Play exactly, even when the rig names a target runtime.
+    #[arg(long, conflicts_with = "match_runtime")]
+    pub exact: bool,
     /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
     #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
@@ -452,9 +459,13 @@ pub struct PoseArgs {
     /// (LBS with stretchable bones).
     #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, Blend::default()))]
     pub blend: Blend,
-    /// With --anim: sample curves as this runtime plays them instead of exactly.
+    /// With --anim: play as this runtime plays the export of its format instead of exactly
+    /// (default: the rig's target runtime, `sinew target`).
     #[arg(long, value_enum, requires = "anim")]
     pub match_runtime: Option<RuntimeMatch>,
+    /// With --anim: play exactly, even when the rig names a target runtime.
+    #[arg(long, requires = "anim", conflicts_with = "match_runtime")]
+    pub exact: bool,
     /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
     #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
@@ -498,6 +509,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Autorig(args) => autorig(&args),
         Command::Animate(args) => animate::run(&args),
         Command::Auto(args) => auto::run(&args),
+        Command::Target(args) => target::run(&args),
         Command::Colorize(args) => colorize::run(&args),
         Command::Batch(args) => batch::run(&args),
         Command::Schema(args) => print_schema(&args),
@@ -687,12 +699,17 @@ fn pose(args: &PoseArgs) -> Result<()> {
                 bail!("--time must be a finite number of seconds");
             }
             let animation = animation(&scene.doc, name)?;
-            let settings = playback::RenderSettings {
+            let mut settings = playback::RenderSettings {
                 sampling: sample_options(args.match_runtime),
                 export: export_played(&args.spine_version, args.bake_fps)?,
                 baked_runtime: baked_runtime(args.match_runtime),
                 ..Default::default()
             };
+            if let Some(target) = scene.doc.target {
+                if args.match_runtime.is_none() && !args.exact {
+                    settings = settings.playing_as(target);
+                }
+            }
             let frame = playback::play(&scene, name, &animation, &[time_s], true, &settings)?
                 .pop()
                 .context("no frame")?;
@@ -739,6 +756,7 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         animation: args.anim.clone(),
         skins: args.skins.clone(),
         output: args.output.clone(),
+        follow_target: args.match_runtime.is_none() && !args.exact,
     };
     // The frame count is known inside the job: the bar counts frames drawn.
     let bar = indicatif::ProgressBar::no_length();

@@ -174,6 +174,9 @@ pub struct State {
     /// What the last automatic rig installed followed ([`Command::Propose`]); saved with the
     /// document (`autorig`), so the editor offers the same template on reopen.
     pub autorig: Option<io::AutorigRecord>,
+    /// The runtime the rig is made for, saved with the document (`target`); the editor plays
+    /// and names it.
+    pub target: Option<io::RuntimeTarget>,
 }
 
 /// A document's slots and skins (see [`crate::io::slots`]): each part that is another
@@ -462,6 +465,7 @@ impl Document {
                 locked: BTreeSet::new(),
                 slots: SlotLayout::default(),
                 autorig: None,
+                target: None,
             },
             path: None,
             undo: Vec::new(),
@@ -512,6 +516,7 @@ impl Document {
             locked: doc.locked.iter().cloned().collect(),
             slots: SlotLayout::of(&doc),
             autorig: doc.autorig,
+            target: doc.target,
             rig: Some(Arc::new(Scene::new(doc, &images)?)),
             pose: Pose::default(),
         };

@@ -37,6 +37,7 @@ pub(super) fn rig_document(state: &State, path: &Path) -> Result<RigDocument, Do
     doc.events = state.events.clone();
     doc.locked = state.locked.iter().cloned().collect();
     doc.autorig = state.autorig;
+    doc.target = state.target;
     state.slots.apply_to(&mut doc)?;
     Ok(doc)
 }

@@ -295,3 +295,57 @@ fn bone_ik_rigs_play_in_three_js_as_sinew_solves_them() {
     let rig = rigs::ik_rig(tmp.path());
     check_rig(&rig, tmp.path());
 }
+
+/// `sinew target` records the runtime in the rig; `sinew pose` then plays as it without being
+/// told (the same vertices as `--match-runtime`), `--exact` plays exactly, and `none` forgets it.
+#[test]
+fn the_rig_remembers_its_target_runtime() {
+    let tmp = scratch("target");
+    let dir = tmp.path();
+    sinew(&["demo", "-o", s(dir)]);
+    let rig = dir.join("character.json");
+    let pose = |extra: &[&str]| -> Vec<u8> {
+        let v = dir.join("v.json");
+        let mut args = vec![
+            "pose",
+            s(&rig),
+            "--anim",
+            "hop",
+            "--time",
+            "0.41",
+            "--vertices",
+            s(&v),
+        ];
+        args.extend_from_slice(extra);
+        sinew(&args);
+        std::fs::read(&v).unwrap()
+    };
+    let exact = pose(&[]);
+    let target = |arg: Option<&str>| -> String {
+        let mut args = vec!["target", s(&rig)];
+        args.extend(arg);
+        let out = command::sinew(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).trim().to_string()
+    };
+    assert_eq!(target(None), "none");
+    for (runtime, flag) in [
+        ("gltf", "gltf"),
+        ("dragonbones", "dragonbones"),
+        ("spine-4.2", "spine"),
+    ] {
+        target(Some(runtime));
+        assert_eq!(target(None), runtime);
+        let played = pose(&[]);
+        assert_eq!(played, pose(&["--match-runtime", flag]), "{runtime}");
+        assert_ne!(played, exact, "{runtime}: plays as exact");
+        assert_eq!(pose(&["--exact"]), exact, "{runtime}: --exact");
+    }
+    target(Some("none"));
+    assert_eq!(pose(&[]), exact);
+    command::assert_bad_input(&["target", s(&rig), "godot"], "unknown runtime 'godot'");
+}

@@ -93,13 +93,17 @@ pub fn run_job(job: &Job, root: &Path) -> Result<(), BatchError> {
             jobs::autorig_files(&files, &options)?;
         }
         Job::Render(j) => {
+            let settings = j.options.settings()?;
             let files = RenderFiles {
                 rig: at(&j.inputs.rig),
                 animation: j.options.animation.clone(),
                 skins: j.options.skins.clone(),
                 output: at(&j.outputs.output),
+                // A job that names no runtime plays as the rig's target, as `sinew render` does.
+                follow_target: settings.sampling.curves == crate::anim::CurveEvaluation::Exact
+                    && settings.baked_runtime.is_none(),
             };
-            jobs::render_files(&files, &j.options.settings()?, &|| {})?;
+            jobs::render_files(&files, &settings, &|| {})?;
         }
         Job::Export(j) => {
             jobs::export_spine_files(

@@ -31,7 +31,7 @@ pub struct Posed {
     blend: Blend,
     /// The animation and time played, when the pose is a playhead's frame (its transforms may
     /// carry momentum, so the pose alone does not decide them).
-    played: Option<Played>,
+    pub(super) played: Option<Played>,
     pub pose: Pose,
     pub positions: Vec<Vec<Point>>,
     /// Per handle column, the transform shown ([`Scene::handle_transforms`]'s).
@@ -42,10 +42,10 @@ pub struct Posed {
 
 /// An animation played at a time, as [`Posed`] remembers it.
 #[derive(Clone, Debug, PartialEq)]
-struct Played {
+pub(super) struct Played {
     animation: crate::anim::Animation,
     time_s: f64,
-    options: crate::scene::PlayOptions,
+    pub(super) options: crate::scene::PlayOptions,
 }
 
 impl Posed {
@@ -235,8 +235,15 @@ impl EditorApp {
             return self.update_posed(scene, &self.sampled_pose());
         };
         let (blend, time_s) = (self.render_settings.blend, self.animate.time_s);
+        // A rig made for Spine previews Spine's curve evaluation.
+        let sampling = match self.doc.state().target {
+            Some(t) if spine_target(t) => crate::anim::SampleOptions {
+                curves: crate::anim::CurveEvaluation::SpineRuntime,
+            },
+            _ => self.render_settings.sampling,
+        };
         let options = crate::scene::PlayOptions {
-            sampling: self.render_settings.sampling,
+            sampling,
             looping: false,
         };
         let played = Played {
@@ -648,4 +655,25 @@ pub fn shown_position(
         ));
     }
     Ok(crate::ik::rig::skinned_position(&grip.row, transforms))
+}
+
+/// Whether `target` is a Spine line.
+fn spine_target(target: crate::io::RuntimeTarget) -> bool {
+    use crate::io::RuntimeTarget::*;
+    matches!(target, Spine41 | Spine42 | Spine43)
+}
+
+/// What the timeline says the preview plays for a rig made for `target`: Spine's curves, or
+/// (DragonBones, glTF, whose baked keys the editor does not replay) exactly, with where to see
+/// the runtime's playback.
+pub(super) fn target_label(target: crate::io::RuntimeTarget) -> String {
+    if spine_target(target) {
+        format!("Plays as {} (its curves)", target.label())
+    } else {
+        format!(
+            "Target {}: the preview plays exactly; sinew render plays as {}",
+            target.label(),
+            target.label()
+        )
+    }
 }

@@ -348,6 +348,10 @@ impl EditorApp {
                 });
             }
         });
+        if let Some(target) = self.doc.state().target {
+            // What the preview plays (`sinew target` sets the rig's runtime).
+            ui.label(super::pose_mode::target_label(target));
+        }
         ui.horizontal(|ui| {
             let selected = !self.timeline.selection.is_empty();
             if ui

@@ -62,6 +62,10 @@ pub struct RigDocument {
     /// editor offers it again on reopen. Absent when no proposal was installed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub autorig: Option<AutorigRecord>,
+    /// The runtime the rig is made for ([`RuntimeTarget`]). Absent: none; animations play
+    /// exactly.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<RuntimeTarget>,
 }
 
 /// What an automatic rig (`sinew autorig`, the editor's *Propose handles*) followed, as the
@@ -71,6 +75,61 @@ pub struct RigDocument {
 pub struct AutorigRecord {
     /// The template the proposal followed.
     pub template: RecordedTemplate,
+}
+
+/// The runtime a rig is made for: `pose`, `render` and the editor play its animations as that
+/// runtime plays the export of its format (`--match-runtime`), unless told to play exactly.
+/// The rig document records it (`"target": "spine-4.2"`); `sinew target` sets it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+pub enum RuntimeTarget {
+    #[serde(rename = "spine-4.1")]
+    Spine41,
+    #[serde(rename = "spine-4.2")]
+    Spine42,
+    #[serde(rename = "spine-4.3")]
+    Spine43,
+    #[serde(rename = "dragonbones")]
+    DragonBones,
+    #[serde(rename = "gltf")]
+    Gltf,
+}
+
+impl RuntimeTarget {
+    /// Every target, in the order `sinew target` lists them.
+    pub const ALL: [RuntimeTarget; 5] = [
+        RuntimeTarget::Spine41,
+        RuntimeTarget::Spine42,
+        RuntimeTarget::Spine43,
+        RuntimeTarget::DragonBones,
+        RuntimeTarget::Gltf,
+    ];
+
+    /// The name the file writes (`spine-4.2`).
+    pub fn name(self) -> &'static str {
+        match self {
+            RuntimeTarget::Spine41 => "spine-4.1",
+            RuntimeTarget::Spine42 => "spine-4.2",
+            RuntimeTarget::Spine43 => "spine-4.3",
+            RuntimeTarget::DragonBones => "dragonbones",
+            RuntimeTarget::Gltf => "gltf",
+        }
+    }
+
+    /// How people call it (`Spine 4.2`).
+    pub fn label(self) -> &'static str {
+        match self {
+            RuntimeTarget::Spine41 => "Spine 4.1",
+            RuntimeTarget::Spine42 => "Spine 4.2",
+            RuntimeTarget::Spine43 => "Spine 4.3",
+            RuntimeTarget::DragonBones => "DragonBones",
+            RuntimeTarget::Gltf => "glTF",
+        }
+    }
+
+    /// The target named `name`, as [`Self::name`] writes it.
+    pub fn parse(name: &str) -> Option<RuntimeTarget> {
+        Self::ALL.into_iter().find(|t| t.name() == name)
+    }
 }
 
 /// The template an automatic rig followed: one of the autorig's templates, or none (bones from
@@ -255,6 +314,7 @@ impl RigDocument {
             locked: Vec::new(),
             skins: BTreeMap::new(),
             autorig: None,
+            target: None,
         }
     }
 

@@ -12,7 +12,7 @@ pub mod slots;
 pub use atomic::write_atomic;
 pub use document::{
     AutorigRecord, BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RecordedTemplate,
-    RigDocument, WeightsDoc,
+    RigDocument, RuntimeTarget, WeightsDoc,
 };
 pub use image::{load_png, save_png, ImageError};
 pub use slots::{Skin, Skins, SlotError};

@@ -241,6 +241,10 @@ pub struct RenderFiles {
     pub skins: Vec<String>,
     /// A folder (numbered PNGs), a `.gif`, or a `.png` sprite sheet with its `.json` beside it.
     pub output: PathBuf,
+    /// Play as the document's target runtime when it names one
+    /// ([`RenderSettings::playing_as`]): what `sinew render` does unless told `--exact` or
+    /// another `--match-runtime`.
+    pub follow_target: bool,
 }
 
 /// Renders an animation of a rig file to `files.output` (`sinew render`), in bounded memory;
@@ -267,6 +271,14 @@ pub fn render_files(
         written.iter().map(|f| Some(f.as_path())),
     )?;
     let animation = animation(&scene.doc, &files.animation)?;
+    let targeted;
+    let settings = match scene.doc.target.filter(|_| files.follow_target) {
+        Some(target) => {
+            targeted = settings.playing_as(target);
+            &targeted
+        }
+        None => settings,
+    };
     // Check the settings and the target before rendering: a bad one fails at once.
     settings.view(scene.doc.canvas)?;
     let frame_times_s = playback::frame_times(animation.duration_s(), settings.fps)?;

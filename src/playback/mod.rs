@@ -104,6 +104,38 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// These settings playing as `target`'s runtime plays the default export of its format
+    /// (the other fields kept): the Spine runtime's curves and the export of that line, or a
+    /// baked runtime.
+    pub fn playing_as(&self, target: crate::io::RuntimeTarget) -> RenderSettings {
+        use crate::export::spine::SpineVersion;
+        use crate::io::RuntimeTarget;
+        let spine = |version| RenderSettings {
+            sampling: SampleOptions {
+                curves: crate::anim::CurveEvaluation::SpineRuntime,
+            },
+            export: crate::export::spine::played::ExportPlayed {
+                version,
+                ..Default::default()
+            },
+            baked_runtime: None,
+            ..self.clone()
+        };
+        match target {
+            RuntimeTarget::Spine41 => spine(SpineVersion::V4_1),
+            RuntimeTarget::Spine42 => spine(SpineVersion::V4_2),
+            RuntimeTarget::Spine43 => spine(SpineVersion::V4_3),
+            RuntimeTarget::DragonBones => RenderSettings {
+                baked_runtime: Some(BakedRuntime::Dragonbones),
+                ..self.clone()
+            },
+            RuntimeTarget::Gltf => RenderSettings {
+                baked_runtime: Some(BakedRuntime::Gltf),
+                ..self.clone()
+            },
+        }
+    }
+
     /// The output view for a canvas of `canvas_px`.
     pub fn view(&self, canvas_px: [u32; 2]) -> Result<FrameView, PlaybackError> {
         FrameView::new(canvas_px, self.scale, self.size_px, self.background)

@@ -328,3 +328,35 @@ fn keyboard_copy_paste_and_shift_click_in_the_dopesheet() {
     assert_eq!(times_of(&h, Rotate), vec![0.0, 0.5]);
     assert_eq!(times_of(&h, Translate), vec![0.0, 0.5]);
 }
+
+/// A rig made for Spine (`sinew target`, saved in the document) plays in animate mode as
+/// Spine's runtime evaluates its curves, and the timeline says so.
+#[test]
+fn a_rig_made_for_spine_previews_spine_curves_and_says_so() {
+    let (dir, path) = character_rig("target");
+    let mut doc = crate::io::RigDocument::load(&path).expect("loads");
+    doc.target = Some(crate::io::RuntimeTarget::Spine42);
+    doc.save(&path).expect("saved");
+    let mut h = opened_in(dir, &path);
+    h.run();
+    h.key_press(Key::Num3);
+    h.run();
+    assert_eq!(h.state().mode, Mode::Animate);
+    h.get_by_label("Plays as Spine 4.2 (its curves)");
+    // Key a pose, then step: the playhead poses the animation.
+    let grip = torso_point(&h);
+    drag(&mut h, grip, [grip[0] + 20.0, grip[1] - 10.0]);
+    click_shown(&mut h, "Set key");
+    click_shown(&mut h, "Next frame");
+    let played = h
+        .state()
+        .pose_mode
+        .posed
+        .as_ref()
+        .and_then(|p| p.played.as_ref())
+        .expect("posed at the playhead");
+    assert_eq!(
+        played.options.sampling.curves,
+        crate::anim::CurveEvaluation::SpineRuntime
+    );
+}

@@ -276,7 +276,8 @@ pub(super) fn bake(
     let mut json = Map::new();
     json.insert("name".into(), json!(name));
     json.insert("duration".into(), json!(n));
-    let play_times = 1;
+    // A cycle loops for ever; anything else plays once.
+    let play_times = if animation.looping { 0 } else { 1 };
     json.insert("playTimes".into(), json!(play_times));
     json.insert("bone".into(), Value::Array(bone_timelines));
     if !slot_timelines.is_empty() {
