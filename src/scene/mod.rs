@@ -13,7 +13,10 @@
 //!   at time t is a function of (rig, animation, t) only: without momentum each frame is the
 //!   static pose of the animation at t; with momentum ([`crate::ik::IkOptions::momentum`]) the
 //!   motion is simulated at a fixed internal step ([`crate::ik::IkOptions::momentum_step_s`])
-//!   from the animation's start, independent of the output frame rate.
+//!   from the animation's start, independent of the output frame rate; for an animation flagged
+//!   `loop` ([`crate::anim::Animation::looping`]) momentum and physics are those of the periodic
+//!   steady state (simulated period after period until one repeats the last), so the last frame
+//!   flows into the first.
 //! - Posed parts → a frame: [`draw_pose`] (the pose's draw order, tint and visibility).
 
 pub mod physics;
