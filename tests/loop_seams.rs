@@ -1,8 +1,9 @@
 //! The seam of a looping animation, measured in the real runtimes (issue 43): the bundled
 //! character's walk (flagged `loop`; its tail carries a physics constraint) exported as Spine
-//! 4.1 and 4.3 (physics baked into keys), Spine 4.2 (physics simulated live by the runtime) and
-//! glTF (everything baked), played by spine-core (tools/spine-check) and three.js
-//! (tools/gltf-check) at every bake frame (30 fps).
+//! 4.1 and 4.3 (physics baked into keys), Spine 4.2 (physics simulated live by the runtime),
+//! glTF and DragonBones (everything baked), played by spine-core (tools/spine-check), three.js
+//! (tools/gltf-check) and DragonBonesJS looping the animation for ever (tools/dragonbones-check)
+//! at every bake frame (30 fps).
 //!
 //! The seam is the step from the last frame of the loop (the last bake time before the end) to
 //! the first frame of the next loop (time 0 again); a step inside the loop is the step between
@@ -221,6 +222,71 @@ fn gltf_track(glb: &Path, doc: &RigDocument, animation: &str, times: &[f64]) -> 
     track
 }
 
+#[derive(Deserialize)]
+struct DbSlot {
+    display: Option<String>,
+    vertices: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+struct DbFrameOut {
+    slots: Vec<DbSlot>,
+}
+
+#[derive(Deserialize)]
+struct DbPlayed {
+    frames: Vec<DbFrameOut>,
+}
+
+#[derive(Deserialize)]
+struct DbOracle {
+    animations: BTreeMap<String, DbPlayed>,
+}
+
+/// `dir/rig_ske.json` looped for ever by the DragonBones runtime (advanced in small steps from
+/// the start), `animation` at `times`; vertices in canvas px by display.
+fn dragonbones_track(dir: &Path, doc: &RigDocument, animation: &str, times: &[f64]) -> Track {
+    let request = dir.join("request.json");
+    let out = dir.join("oracle.json");
+    let json =
+        serde_json::json!({ "times": { animation: times }, "loop": true, "step": 1.0 / 240.0 });
+    std::fs::write(&request, json.to_string()).unwrap();
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tools/dragonbones-check/run.sh"
+    );
+    let status = Command::new(script)
+        .args([
+            s(&dir.join("rig_ske.json")),
+            s(&dir.join("rig_tex.json")),
+            s(&request),
+            s(&out),
+        ])
+        .status()
+        .expect("run tools/dragonbones-check/run.sh (needs bash, node and npm)");
+    assert!(
+        status.success(),
+        "the DragonBones runtime refused {}",
+        dir.display()
+    );
+    let oracle: DbOracle = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    // DragonBones' origin is the canvas' bottom centre, y down.
+    let origin = Vec2::new(f64::from(doc.canvas[0]) / 2.0, f64::from(doc.canvas[1]));
+    let mut track = Track::new();
+    for f in &oracle.animations[animation].frames {
+        for slot in &f.slots {
+            if let (Some(display), Some(v)) = (&slot.display, &slot.vertices) {
+                let points = v
+                    .chunks(2)
+                    .map(|q| Point::new(q[0] + origin.x, q[1] + origin.y))
+                    .collect();
+                track.entry(display.clone()).or_default().push(points);
+            }
+        }
+    }
+    track
+}
+
 /// A key list of a Spine animation played twice in a row: the keys, then the same keys
 /// `duration` later (Bézier handle times too). The first copy's key at the end is dropped
 /// where the second copy keys time 0, as the loop would show that key's time as 0.
@@ -269,7 +335,7 @@ fn play_twice(value: &mut serde_json::Value, duration: f64) {
 }
 
 #[test]
-fn the_looping_walk_has_no_seam_in_spine_and_gltf() {
+fn the_looping_walk_has_no_seam_in_spine_gltf_and_dragonbones() {
     let tmp = scratch("walk");
     let dir = tmp.path();
     sinew(&["demo", "-o", s(dir)]);
@@ -333,6 +399,26 @@ fn the_looping_walk_has_no_seam_in_spine_and_gltf() {
     let track = gltf_track(&glb, &doc, ANIMATION, &times);
     failures.extend(report("glTF (baked)", &seams(&track, last, 0, 0..last)));
     print_end_gap(&track);
+
+    // DragonBones: playTimes 0, the runtime loops; its frames on whole frames of 30 fps, the
+    // last one the start of the next loop.
+    let out = dir.join("dragonbones");
+    sinew(&[
+        "export",
+        "dragonbones",
+        s(&rig),
+        "-o",
+        s(&out),
+        "--name",
+        "rig",
+    ]);
+    let n = (duration * BAKE_FPS).round() as usize;
+    let frame_times: Vec<f64> = (0..=n).map(|k| k as f64 / BAKE_FPS).collect();
+    let track = dragonbones_track(&out, &doc, ANIMATION, &frame_times);
+    failures.extend(report(
+        "DragonBones (baked, looping)",
+        &seams(&track, n - 1, n, 0..n - 1),
+    ));
 
     assert!(
         failures.is_empty(),
