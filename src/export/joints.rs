@@ -134,3 +134,63 @@ pub fn rest_locals(joints: &[Joint]) -> Vec<Affine> {
         )
         .collect()
 }
+
+/// Each joint's world map from its map relative to its parent (`locals`, column order):
+/// parent · local down the tree, parents first however the columns are ordered (a rig's
+/// parents have no cycles; a joint left unreached would be the identity).
+pub fn compose_down(joints: &[Joint], locals: &[Affine]) -> Vec<Affine> {
+    let mut world: Vec<Option<Affine>> = vec![None; locals.len()];
+    for _ in 0..locals.len() {
+        for (b, joint) in joints.iter().enumerate() {
+            if world[b].is_none() {
+                world[b] = match joint.parent {
+                    None => Some(locals[b]),
+                    Some(parent) => world[parent].map(|g| g.then_after(&locals[b])),
+                };
+            }
+        }
+    }
+    world
+        .into_iter()
+        .map(|w| w.unwrap_or(Affine::identity()))
+        .collect()
+}
+
+/// `angle_rad` plus the whole turns that bring it nearest `near_rad`: how the exports keep a
+/// keyed angle continuous from frame to frame.
+pub fn nearest_turn(angle_rad: f64, near_rad: f64) -> f64 {
+    use std::f64::consts::TAU;
+    angle_rad + ((near_rad - angle_rad) / TAU).round() * TAU
+}
+
+/// A part whose weights name a handle the rig does not have: (part, handle).
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnknownColumn(pub String, pub String);
+
+/// `part`'s weight rows with each handle as its index in the rig's `columns` (the document
+/// names its columns; exports address the rig's).
+pub fn column_rows(
+    part: &crate::io::PartDoc,
+    weights: &crate::io::WeightsDoc,
+    columns: &[String],
+) -> Result<Vec<Vec<(usize, f64)>>, UnknownColumn> {
+    let to_column = weights
+        .handles
+        .iter()
+        .map(|handle| {
+            columns
+                .iter()
+                .position(|c| c == handle)
+                .ok_or_else(|| UnknownColumn(part.name.clone(), handle.clone()))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(weights
+        .rows
+        .iter()
+        .map(|row| {
+            row.iter()
+                .map(|&(h, w)| (to_column[h as usize], w))
+                .collect()
+        })
+        .collect())
+}

@@ -14,6 +14,7 @@
 
 use super::transform::{DbFrame, DbTransform};
 use super::{num, DragonBonesError, DragonBonesOptions};
+use crate::anim::curve::f32_stored;
 use crate::anim::Animation;
 use crate::export::joints::{local_maps, Joint};
 use crate::export::spine::bake;
@@ -46,26 +47,21 @@ pub struct BakedAnimation {
     pub left_out: Vec<String>,
 }
 
-/// f32 storage, as the runtime's typed arrays keep numbers.
-fn f32s(v: f64) -> f64 {
-    f64::from(v as f32)
-}
-
 /// The transform a rotate/translate/scale frame triple makes of `setup` as the runtime reads
 /// it: values relative to the setup, written and stored in f32 (rotation and skew in degrees in
 /// the file, radians in the runtime).
 fn as_stored(setup: &DbTransform, t: &DbTransform) -> (DbTransform, [f64; 6]) {
-    let dx = f32s(t.x - setup.x);
-    let dy = f32s(t.y - setup.y);
-    let rotate_deg = f32s((t.rotation_rad - setup.rotation_rad).to_degrees());
-    let skew_deg = f32s((t.skew_rad - setup.skew_rad).to_degrees());
-    let sx = f32s(t.scale_x / setup.scale_x);
-    let sy = f32s(t.scale_y / setup.scale_y);
+    let dx = f32_stored(t.x - setup.x);
+    let dy = f32_stored(t.y - setup.y);
+    let rotate_deg = f32_stored((t.rotation_rad - setup.rotation_rad).to_degrees());
+    let skew_deg = f32_stored((t.skew_rad - setup.skew_rad).to_degrees());
+    let sx = f32_stored(t.scale_x / setup.scale_x);
+    let sy = f32_stored(t.scale_y / setup.scale_y);
     let stored = DbTransform {
         x: dx,
         y: dy,
-        rotation_rad: f32s(rotate_deg * std::f64::consts::PI / 180.0),
-        skew_rad: f32s(skew_deg * std::f64::consts::PI / 180.0),
+        rotation_rad: f32_stored(rotate_deg * std::f64::consts::PI / 180.0),
+        skew_rad: f32_stored(skew_deg * std::f64::consts::PI / 180.0),
         scale_x: sx,
         scale_y: sy,
     };
@@ -227,7 +223,11 @@ pub(super) fn bake(
             .map(|pose| {
                 pose.deform.get(part).map_or_else(
                     || vec![Vec2::zeros(); vertices],
-                    |o| o.iter().map(|v| Vec2::new(f32s(v.x), f32s(v.y))).collect(),
+                    |o| {
+                        o.iter()
+                            .map(|v| Vec2::new(f32_stored(v.x), f32_stored(v.y)))
+                            .collect()
+                    },
                 )
             })
             .collect();

@@ -417,11 +417,8 @@ pub fn export_dragonbones(
         "height": page.height(),
         "SubTexture": sub_textures,
     });
-    let mut png = std::io::Cursor::new(Vec::new());
-    page.write_to(&mut png, image::ImageFormat::Png)
-        .map_err(|e| {
-            DragonBonesError::Atlas(Box::new(SpineError::Png(tex_name.clone(), e.to_string())))
-        })?;
+    let png = crate::export::spine::png_bytes(page, &format!("{tex_name}.png"))
+        .map_err(|e| DragonBonesError::Atlas(Box::new(e)))?;
     Ok(DragonBonesExport {
         name: name.to_string(),
         frame,
@@ -433,7 +430,7 @@ pub fn export_dragonbones(
         left_out,
         ske: ske.to_string(),
         tex: tex.to_string(),
-        png: png.into_inner(),
+        png,
     })
 }
 
@@ -549,24 +546,12 @@ fn written_mesh(
     let Some(weights) = &part.weights else {
         return Err(DragonBonesError::NoWeights(part.name.clone()));
     };
-    let mut to_column = Vec::with_capacity(weights.handles.len());
-    for handle in &weights.handles {
-        to_column.push(columns.iter().position(|c| c == handle).ok_or_else(|| {
-            DragonBonesError::UnknownWeightHandle {
-                part: part.name.clone(),
-                handle: handle.clone(),
-            }
-        })?);
-    }
-    let rows: Vec<Vec<(usize, f64)>> = weights
-        .rows
-        .iter()
-        .map(|row| {
-            row.iter()
-                .map(|&(h, w)| (to_column[h as usize], w))
-                .collect()
-        })
-        .collect();
+    let rows = joints::column_rows(part, weights, columns).map_err(|e| {
+        DragonBonesError::UnknownWeightHandle {
+            part: e.0,
+            handle: e.1,
+        }
+    })?;
     let fine = part.mesh.to_mesh();
     let (kept, triangles) = match options.max_vertices {
         Some(n) if n < fine.vertices.len() => {

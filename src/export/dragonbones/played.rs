@@ -15,15 +15,11 @@
 
 use super::transform::DbTransform;
 use super::{BakedAnimation, DragonBonesExport};
+use crate::anim::curve::f32_stored;
 use crate::geom::Vec2;
 use crate::rig::pose::PartPose;
 use crate::rig::{Affine, Pose};
 use std::f64::consts::PI;
-
-/// f32 storage, as the runtime's typed arrays and the file's numbers keep them.
-fn f32s(v: f64) -> f64 {
-    f64::from(v as f32)
-}
 
 /// An angle into (−π, π], as `Transform.normalizeRadian`.
 fn normalize_radian(a: f64) -> f64 {
@@ -34,15 +30,16 @@ fn normalize_radian(a: f64) -> f64 {
 
 /// The setup transform as the runtime parses it from the file's numbers.
 fn parsed_setup(t: &DbTransform) -> DbTransform {
-    let rotation = normalize_radian(f32s(t.rotation_rad.to_degrees()) * PI / 180.0);
-    let second = normalize_radian(f32s((t.rotation_rad + t.skew_rad).to_degrees()) * PI / 180.0);
+    let rotation = normalize_radian(f32_stored(t.rotation_rad.to_degrees()) * PI / 180.0);
+    let second =
+        normalize_radian(f32_stored((t.rotation_rad + t.skew_rad).to_degrees()) * PI / 180.0);
     DbTransform {
-        x: f32s(t.x),
-        y: f32s(t.y),
+        x: f32_stored(t.x),
+        y: f32_stored(t.y),
         rotation_rad: rotation,
         skew_rad: second - rotation,
-        scale_x: f32s(t.scale_x),
-        scale_y: f32s(t.scale_y),
+        scale_x: f32_stored(t.scale_x),
+        scale_y: f32_stored(t.scale_y),
     }
 }
 
@@ -150,23 +147,7 @@ fn pose_at(
             .to_affine()
         })
         .collect();
-    let mut world: Vec<Option<Affine>> = vec![None; locals.len()];
-    // Parents before children, however the columns are ordered (the rig has no cycles).
-    for _ in 0..locals.len() {
-        for (b, joint) in export.joints.iter().enumerate() {
-            if world[b].is_some() {
-                continue;
-            }
-            world[b] = match joint.parent {
-                None => Some(locals[b]),
-                Some(parent) => world[parent].map(|g| g.then_after(&locals[b])),
-            };
-        }
-    }
-    let world: Vec<Affine> = world
-        .into_iter()
-        .map(|w| w.unwrap_or(Affine::identity()))
-        .collect();
+    let world = crate::export::joints::compose_down(export.joints, &locals);
     let origin = export.frame.origin_px.coords;
     let transforms = export
         .joints
@@ -175,8 +156,8 @@ fn pose_at(
         .map(|(joint, global)| {
             let rest = &joint.rest;
             let bone_pose = Affine {
-                linear: rest.linear.map(f32s),
-                translation: rest.translation.map(f32s),
+                linear: rest.linear.map(f32_stored),
+                translation: rest.translation.map(f32_stored),
             };
             let armature = global.then_after(&bone_pose.inverse().unwrap_or(Affine::identity()));
             // Back to the canvas: T(o)·A·T(−o).

@@ -9,10 +9,10 @@
 //! nearest the previous frame's, so that the runtime's linear tween between frames turns the
 //! short way.
 
+use crate::export::joints::nearest_turn;
 use crate::geom::{Point, Vec2};
 use crate::rig::Affine;
 use nalgebra::Matrix2;
-use std::f64::consts::TAU;
 
 /// The canvas point that is the armature's origin: the bottom centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,11 +103,6 @@ impl DbTransform {
             translation: Vec2::new(self.x, self.y),
         }
     }
-}
-
-/// `angle_rad` plus the whole turns that bring it nearest `near_rad`.
-fn nearest_turn(angle_rad: f64, near_rad: f64) -> f64 {
-    angle_rad + ((near_rad - angle_rad) / TAU).round() * TAU
 }
 
 #[cfg(test)]

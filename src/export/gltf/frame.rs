@@ -10,10 +10,12 @@
 //! among its equivalent forms the one nearest the previous frame's so that a runtime's
 //! interpolation between keys turns the short way.
 
+use crate::anim::curve::f32_stored;
+use crate::export::joints::nearest_turn;
 use crate::geom::{Point, Vec2};
 use crate::rig::Affine;
 use nalgebra::Matrix2;
-use std::f64::consts::{FRAC_PI_2, TAU};
+use std::f64::consts::FRAC_PI_2;
 
 /// Where the canvas sits in glTF space: canvas point `origin_px` is glTF's origin, one unit is
 /// `px_per_unit` canvas px, glTF's y points up.
@@ -167,10 +169,10 @@ impl Trsr {
     /// its f32 quaternion's.
     pub fn stored(&self) -> Trsr {
         let angle = |a: f64| {
-            let [_, _, z, w] = z_quaternion(a).map(|v| f64::from(v as f32));
+            let [_, _, z, w] = z_quaternion(a).map(f32_stored);
             2.0 * z.atan2(w)
         };
-        let f = |v: f64| f64::from(v as f32);
+        let f = f32_stored;
         Trsr {
             translation: Vec2::new(f(self.translation.x), f(self.translation.y)),
             pivot_rad: angle(self.pivot_rad),
@@ -193,11 +195,6 @@ impl Trsr {
 pub fn rotation(angle_rad: f64) -> Matrix2<f64> {
     let (s, c) = angle_rad.sin_cos();
     Matrix2::new(c, -s, s, c)
-}
-
-/// `angle_rad` plus the whole turns that bring it nearest `near_rad`.
-fn nearest_turn(angle_rad: f64, near_rad: f64) -> f64 {
-    angle_rad + ((near_rad - angle_rad) / TAU).round() * TAU
 }
 
 /// A rotation about z as a glTF quaternion `[x, y, z, w]`.

@@ -235,7 +235,8 @@ pub fn export_gltf(
     // Textures and materials, one per page.
     let mut images_json = Vec::new();
     for page in &atlas.pages {
-        let png = png_bytes(&page.image).map_err(|e| GltfError::Atlas(Box::new(e)))?;
+        let png = crate::export::spine::png_bytes(&page.image, &page.file_name)
+            .map_err(|e| GltfError::Atlas(Box::new(e)))?;
         let view = buffer.view(&png, None);
         images_json
             .push(json!({ "bufferView": view, "mimeType": "image/png", "name": page.file_name }));
@@ -570,19 +571,15 @@ fn influences(
     let Some(weights) = &part.weights else {
         return Err(GltfError::NoWeights(part.name.clone()));
     };
-    let mut to_column = Vec::with_capacity(weights.handles.len());
-    for handle in &weights.handles {
-        let j = columns.iter().position(|c| c == handle).ok_or_else(|| {
-            GltfError::UnknownWeightHandle {
-                part: part.name.clone(),
-                handle: handle.clone(),
-            }
-        })?;
-        to_column.push(j);
-    }
+    let rows = crate::export::joints::column_rows(part, weights, columns).map_err(|e| {
+        GltfError::UnknownWeightHandle {
+            part: e.0,
+            handle: e.1,
+        }
+    })?;
     let mut joint_ids = Vec::with_capacity(weights.rows.len() * 4);
     let mut out = Vec::with_capacity(weights.rows.len() * 4);
-    for (vertex, row) in weights.rows.iter().enumerate() {
+    for (vertex, row) in rows.iter().enumerate() {
         let kept = crate::skin::strongest_influences(row, Some(MAX_INFLUENCES));
         if kept.is_empty() {
             return Err(GltfError::UnweightedVertex {
@@ -593,7 +590,7 @@ fn influences(
         let mut ids = [0u16; 4];
         let mut w = [0f32; 4];
         for (k, &(h, weight)) in kept.iter().enumerate() {
-            ids[k] = to_column[h as usize] as u16;
+            ids[k] = h as u16;
             w[k] = weight as f32;
         }
         // The strongest weight takes the f32 rounding of the sum.
@@ -627,12 +624,4 @@ fn mat4(a: &Affine) -> [f32; 16] {
         0.0,
         1.0,
     ]
-}
-
-fn png_bytes(image: &RgbaImage) -> Result<Vec<u8>, SpineError> {
-    let mut out = std::io::Cursor::new(Vec::new());
-    image
-        .write_to(&mut out, image::ImageFormat::Png)
-        .map_err(|e| SpineError::Png("atlas page".into(), e.to_string()))?;
-    Ok(out.into_inner())
 }

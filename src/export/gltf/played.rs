@@ -13,6 +13,7 @@
 
 use super::frame::Trsr;
 use super::GltfExport;
+use crate::anim::curve::f32_stored;
 use crate::geom::Vec2;
 use crate::rig::{Affine, Pose};
 use std::collections::BTreeMap;
@@ -115,28 +116,17 @@ fn pose_at(
             .to_affine()
         })
         .collect();
-    // Parents before children, however the columns are ordered (the rig has no cycles).
-    let mut world: Vec<Option<Affine>> = vec![None; locals.len()];
-    for _ in 0..locals.len() {
-        for (b, joint) in joints.iter().enumerate() {
-            if world[b].is_none() {
-                world[b] = match joint.parent {
-                    None => Some(locals[b]),
-                    Some(parent) => world[parent].map(|g| g.then_after(&locals[b])),
-                };
-            }
-        }
-    }
+    let world = crate::export::joints::compose_down(joints, &locals);
     let transforms = joints
         .iter()
         .zip(world)
         .map(|(joint, w)| {
             let ibm = joint.rest.inverse().unwrap_or(Affine::identity());
             let ibm = Affine {
-                linear: ibm.linear.map(|v| f64::from(v as f32)),
-                translation: ibm.translation.map(|v| f64::from(v as f32)),
+                linear: ibm.linear.map(f32_stored),
+                translation: ibm.translation.map(f32_stored),
             };
-            let gltf = w.unwrap_or(Affine::identity()).then_after(&ibm);
+            let gltf = w.then_after(&ibm);
             // Back to the canvas: F⁻¹ · J · F.
             let flip = nalgebra::Matrix2::new(1.0, 0.0, 0.0, -1.0);
             let linear = flip * gltf.linear * flip;
@@ -161,7 +151,7 @@ fn pose_at(
         let mut offsets = vec![Vec2::zeros(); n];
         for (w, target) in weights.iter().zip(targets) {
             for (o, t) in offsets.iter_mut().zip(target) {
-                *o += *w * t.map(|v| f64::from(v as f32));
+                *o += *w * t.map(f32_stored);
             }
         }
         pose.deform.insert(part.clone(), offsets);

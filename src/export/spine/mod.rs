@@ -466,26 +466,12 @@ pub fn export_spine(
         let Some(weights) = &part.weights else {
             return Err(SpineError::NoWeights(part.name.clone()));
         };
-        // The document names its columns; map them onto the rig's column order.
-        let mut to_column = Vec::with_capacity(weights.handles.len());
-        for handle in &weights.handles {
-            let j = columns.iter().position(|c| c == handle).ok_or_else(|| {
-                SpineError::UnknownWeightHandle {
-                    part: part.name.clone(),
-                    handle: handle.clone(),
-                }
-            })?;
-            to_column.push(j);
-        }
-        let rows: Vec<Vec<(usize, f64)>> = weights
-            .rows
-            .iter()
-            .map(|row| {
-                row.iter()
-                    .map(|&(h, w)| (to_column[h as usize], w))
-                    .collect()
-            })
-            .collect();
+        let rows = crate::export::joints::column_rows(part, weights, &columns).map_err(|e| {
+            SpineError::UnknownWeightHandle {
+                part: e.0,
+                handle: e.1,
+            }
+        })?;
         let fine = part.mesh.to_mesh();
         let (kept, triangles) = match options.max_vertices {
             Some(n) if n < fine.vertices.len() => {
@@ -647,7 +633,8 @@ pub fn export_spine(
     })
 }
 
-fn png_bytes(image: &RgbaImage, file: &str) -> Result<Vec<u8>, SpineError> {
+/// `image` encoded as PNG (an atlas page named `file`, for the error).
+pub(crate) fn png_bytes(image: &RgbaImage, file: &str) -> Result<Vec<u8>, SpineError> {
     let mut out = std::io::Cursor::new(Vec::new());
     image
         .write_to(&mut out, image::ImageFormat::Png)
