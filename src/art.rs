@@ -127,16 +127,20 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
         pivots.extend(file.pivots.iter().cloned());
         let shown = path.display();
         notes.extend(file.warnings.iter().map(|w| format!("{shown}: {w}")));
+        let (mut hidden, mut outside) = (0, 0);
+        let before = layers.len();
         for l in &file.layers {
             if !l.visible {
                 notes.push(format!("{shown}: layer '{}' is hidden; not a part", l.path));
+                hidden += 1;
                 continue;
             }
             let Some((image, offset_px)) = layered::part_image(l, file.canvas_px) else {
                 notes.push(format!(
-                    "{shown}: layer '{}' lies outside the canvas; not a part",
+                    "{shown}: layer '{}' lies outside the canvas or is fully transparent; not a part",
                     l.path
                 ));
+                outside += 1;
                 continue;
             };
             unwritten.push(layers.len());
@@ -146,6 +150,13 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
                 image,
                 offset_px,
                 canvas_px: file.canvas_px,
+            });
+        }
+        if layers.len() == before {
+            return Err(PipelineError::NoVisibleLayers {
+                path: path.clone(),
+                hidden,
+                outside,
             });
         }
     }

@@ -86,6 +86,9 @@ pub enum JobError {
     CanvasTooLarge { width: u32, height: u32 },
     #[error("cannot write JSON: {0}")]
     Serialize(serde_json::Error),
+    /// A colorize option out of its range (before any file is read).
+    #[error(transparent)]
+    ColorizeOptions(crate::colorize::ColorizeError),
     /// The scribbles or the colorization failed; `path` is the scribbles file.
     #[error("{}: {source}", .path.display())]
     Colorize {

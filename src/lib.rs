@@ -27,6 +27,7 @@ pub mod render;
 pub mod rig;
 pub mod scene;
 pub mod schema;
+pub mod shown;
 pub mod skin;
 pub mod trace;
 pub mod weights;

@@ -64,6 +64,15 @@ pub enum PipelineError {
     TooSmall { path: PathBuf, got: [u32; 2] },
     #[error("no input images")]
     NoImages,
+    #[error(
+        "{}: no layer to rig: {hidden} hidden, {outside} outside the canvas or fully \
+         transparent (show a layer, or move it onto the canvas)", .path.display()
+    )]
+    NoVisibleLayers {
+        path: PathBuf,
+        hidden: usize,
+        outside: usize,
+    },
     #[error("cancelled")]
     Cancelled,
     #[error(
@@ -81,7 +90,7 @@ pub enum PipelineError {
     PhysicsWithMomentum,
     #[error("the pose deforms part '{0}', which the rig does not have")]
     DeformUnknownPart(String),
-    #[error("momentum is simulated from the animation's start: time {0:e} s lies outside [0, {max}] s", max = crate::scene::MAX_SIMULATED_S)]
+    #[error("momentum is simulated from the animation's start: time {} s lies outside [0, {max}] s", crate::shown::Shown(*.0), max = crate::scene::MAX_SIMULATED_S)]
     SimulatedTime(f64),
     #[error("{path}: image is {got:?} px but the canvas (from the first image) is {canvas:?} px; all layers must share one canvas")]
     SizeMismatch {

@@ -502,7 +502,7 @@ fn bad_input_is_a_clear_error() {
         };
         assert!(matches!(
             colorize::colorize(&s.lineart, &scribbles(&s), &bad, false),
-            Err(ColorizeError::InvalidOptions(_))
+            Err(ColorizeError::InvalidOption { field: "scale", .. })
         ));
     }
 }

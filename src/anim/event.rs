@@ -119,7 +119,7 @@ pub struct FiredAudio {
 pub enum EventDefError {
     #[error("events: {0}")]
     Json(String),
-    #[error("event '{name}': {field} must be a finite number{range} (got {value:e})")]
+    #[error("event '{name}': {field} must be a finite number{range} (got {})", crate::shown::Shown(*.value))]
     Value {
         name: String,
         field: &'static str,

@@ -263,9 +263,9 @@ pub enum TimelineError {
     },
     #[error("key {key} has a value that is not a finite number")]
     NonFinite { key: usize },
-    #[error("key {key} has a value beyond ±{MAX_KEY_VALUE} (px, degrees or scale): {value:e}")]
+    #[error("key {key} has a value beyond ±{MAX_KEY_VALUE} (px, degrees or scale): {}", crate::shown::Shown(*.value))]
     ValueTooLarge { key: usize, value: f64 },
-    #[error("key {key} has a curve value beyond ±{MAX_KEY_VALUE}: {value:e}")]
+    #[error("key {key} has a curve value beyond ±{MAX_KEY_VALUE}: {}", crate::shown::Shown(*.value))]
     CurveValueTooLarge { key: usize, value: f64 },
     #[error("key {key} has a curve of {got} numbers; expected {expected} (4 per value channel)")]
     CurveLength {
@@ -286,8 +286,8 @@ pub enum TimelineError {
         expected: usize,
     },
     #[error(
-        "key {key}: {field} must be a finite number{} (got {value:e})",
-        super::event::range_text(field)
+        "key {key}: {field} must be a finite number{} (got {})",
+        super::event::range_text(field), crate::shown::Shown(*.value)
     )]
     Payload {
         key: usize,

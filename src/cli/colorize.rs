@@ -77,6 +77,9 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         },
         ..Default::default()
     };
+    if let Err(colorize::ColorizeError::InvalidOption { field, rule }) = options.check() {
+        anyhow::bail!("{} {rule}", flag_of(field));
+    }
     let files = sinew::jobs::ColorizeFiles {
         lineart: args.lineart.clone(),
         scribbles: args.scribbles.clone(),
@@ -101,4 +104,19 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// The flag that sets the colorize option `field` (as files name it), for refusals in the
+/// words of the command line; options without a flag keep their name.
+fn flag_of(field: &str) -> &str {
+    match field {
+        "scale" => "--scale",
+        "gap_closing_px" => "--gap-closing",
+        "split_depth_px" => "--split-depth",
+        "split_depth_exponent" => "--split-exponent",
+        "split_blur_px" => "--split-blur",
+        "end_point_join.spline_max_px" => "--join-curve",
+        "end_point_join.segment_max_px" => "--join-segment",
+        other => other,
+    }
 }

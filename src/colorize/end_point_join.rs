@@ -70,27 +70,31 @@ impl Default for EndPointJoinOptions {
 }
 
 impl EndPointJoinOptions {
-    /// Lengths finite and non-negative (at most [`MAX_JOIN_PX`]), the angle in [0, 180].
-    pub fn check(&self) -> Result<(), String> {
+    /// Lengths finite and non-negative (at most [`MAX_JOIN_PX`]), the angle in [0, 180]. A
+    /// refusal is the field as files name it (`end_point_join.spline_max_px`) and the rule.
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
         for (name, v) in [
-            ("spline_max_px", self.spline_max_px),
-            ("segment_max_px", self.segment_max_px),
-            ("roundness", self.roundness),
+            ("end_point_join.spline_max_px", self.spline_max_px),
+            ("end_point_join.segment_max_px", self.segment_max_px),
+            ("end_point_join.roundness", self.roundness),
         ] {
             if !(v.is_finite() && (0.0..=MAX_JOIN_PX).contains(&v)) {
-                return Err(format!("{name} must lie in [0, {MAX_JOIN_PX}], not {v}"));
+                return Err((name, format!("must lie in [0, {MAX_JOIN_PX}], not {v}")));
             }
         }
         if !(0.0..=180.0).contains(&self.max_angle_deg) {
-            return Err(format!(
-                "max_angle_deg must lie in [0, 180], not {}",
-                self.max_angle_deg
+            return Err((
+                "end_point_join.max_angle_deg",
+                format!("must lie in [0, 180], not {}", self.max_angle_deg),
             ));
         }
-        if self.direction_px > MAX_JOIN_PX as usize || self.branch_min_px > MAX_JOIN_PX as usize {
-            return Err(format!(
-                "direction_px and branch_min_px must be at most {MAX_JOIN_PX}"
-            ));
+        for (name, v) in [
+            ("end_point_join.direction_px", self.direction_px),
+            ("end_point_join.branch_min_px", self.branch_min_px),
+        ] {
+            if v > MAX_JOIN_PX as usize {
+                return Err((name, format!("must be at most {MAX_JOIN_PX}, not {v}")));
+            }
         }
         Ok(())
     }

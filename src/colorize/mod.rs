@@ -158,8 +158,12 @@ pub enum ColorizeError {
     OffCanvas(String),
     #[error("scribble color #{0} lies entirely on line pixels; draw it inside a region")]
     OnLines(String),
-    #[error("invalid colorize option: {0}")]
-    InvalidOptions(String),
+    /// An option out of its range: `field` as it is named in files (the batch manifest's
+    /// colorize options, `end_point_join.spline_max_px`), `rule` what it must be and what it is.
+    /// The command line names its flag instead ([`ColorizeError::InvalidOption::field`] →
+    /// `--join-curve`).
+    #[error("invalid colorize option: {field} {rule}")]
+    InvalidOption { field: &'static str, rule: String },
     #[error("{0}")]
     Mesh(#[from] image_mesh::ImageMeshError),
     #[error("{0}")]
@@ -295,17 +299,17 @@ pub const MAX_SPLIT_DEPTH_EXPONENT: f64 = 32.0;
 /// Largest soft-fill radius, px: a wider blend is a blur, not an antialiased edge.
 pub const MAX_SOFT_RADIUS_PX: u32 = 8;
 
+/// Longest gap-closing fade, px: as far as end points are joined ([`end_point_join::MAX_JOIN_PX`]).
+/// Beyond, the ridge covers whole drawings in ink and leaves nothing to color (`--gap-closing
+/// 1e9` colorized an image with no mesh and exit 0).
+pub const MAX_GAP_CLOSING_PX: f64 = end_point_join::MAX_JOIN_PX;
+
 impl ColorizeOptions {
     /// Refuses options out of their documented ranges ([`ColorizeError::InvalidOptions`]),
     /// as every colorization does before any work.
     pub fn check(&self) -> Result<(), ColorizeError> {
         use std::ops::Bound::{Excluded, Included};
-        check_range(
-            "scale (the lift scale)",
-            self.scale,
-            0.0..=MAX_LIFT_SCALE_PX,
-            " px",
-        )?;
+        check_range("scale", self.scale, 0.0..=MAX_LIFT_SCALE_PX, " px")?;
         check_range(
             "line_threshold",
             self.line_threshold,
@@ -331,10 +335,15 @@ impl ColorizeOptions {
             0.0..=f64::from(MAX_SOFT_RADIUS_PX),
             "",
         )?;
-        check_range("gap_closing_px", self.gap_closing_px, 0.0.., "")?;
+        check_range(
+            "gap_closing_px",
+            self.gap_closing_px,
+            0.0..=MAX_GAP_CLOSING_PX,
+            " px",
+        )?;
         self.end_point_join
             .check()
-            .map_err(ColorizeError::InvalidOptions)
+            .map_err(|(field, rule)| ColorizeError::InvalidOption { field, rule })
     }
 }
 
@@ -343,7 +352,7 @@ impl ColorizeOptions {
 /// one place [`ColorizeOptions::check`]'s range messages are worded. A magnitude of 10⁶ or
 /// more, or below 10⁻³, is written as `1e300`.
 fn check_range<T>(
-    name: &str,
+    name: &'static str,
     value: T,
     range: impl std::ops::RangeBounds<f64>,
     unit: &str,
@@ -371,9 +380,10 @@ where
         Excluded(hi) => format!("{hi})"),
         Unbounded => "inf)".to_string(),
     };
-    Err(ColorizeError::InvalidOptions(format!(
-        "{name} must lie in {low}, {high}{unit}, not {shown}"
-    )))
+    Err(ColorizeError::InvalidOption {
+        field: name,
+        rule: format!("must lie in {low}, {high}{unit}, not {shown}"),
+    })
 }
 
 /// What preparing line art reads of [`ColorizeOptions`], and nothing else: the preparation
@@ -645,18 +655,22 @@ mod check_tests {
             (
                 "gap_closing_px",
                 |o, v| o.gap_closing_px = v,
-                &[-0.1, NAN, INF],
-                &[0.0, 1e9],
+                &[-0.1, NAN, INF, MAX_GAP_CLOSING_PX + 1.0],
+                &[0.0, MAX_GAP_CLOSING_PX],
             ),
         ];
         for (name, set, refused, accepted) in options {
             for &value in refused {
                 let mut o = ColorizeOptions::default();
                 set(&mut o, value);
-                let Err(ColorizeError::InvalidOptions(message)) = o.check() else {
+                let Err(ColorizeError::InvalidOption {
+                    field,
+                    rule: message,
+                }) = o.check()
+                else {
                     panic!("{name} = {value} was accepted");
                 };
-                assert!(message.starts_with(name), "{name} = {value}: {message}");
+                assert_eq!(field, name, "{name} = {value}: {message}");
                 let others: Vec<_> = options.iter().map(|o| o.0).filter(|n| *n != name).collect();
                 assert!(
                     others.iter().all(|other| !message.contains(other)),
@@ -677,7 +691,7 @@ mod check_tests {
         };
         assert_eq!(
             refused(&|o| o.scale = 1e300),
-            "invalid colorize option: scale (the lift scale) must lie in [0, 100000] px, not 1e300"
+            "invalid colorize option: scale must lie in [0, 100000] px, not 1e300"
         );
         assert_eq!(
             refused(&|o| o.split_depth_exponent = 99.0),
@@ -689,7 +703,7 @@ mod check_tests {
         );
         assert_eq!(
             refused(&|o| o.gap_closing_px = f64::NAN),
-            "invalid colorize option: gap_closing_px must lie in [0, inf), not NaN"
+            "invalid colorize option: gap_closing_px must lie in [0, 256] px, not NaN"
         );
     }
 }

@@ -197,7 +197,7 @@ pub enum IkError {
     NoWeights,
     #[error("an ik drag or a handle transform is not a finite number")]
     NonFinite,
-    #[error("ik drag target ({0:e}, {1:e}) lies beyond ±{max} px", max = crate::rig::pose::MAX_POSED_PX)]
+    #[error("ik drag target ({}, {}) lies beyond ±{max} px", crate::shown::Shown(*.0), crate::shown::Shown(*.1), max = crate::rig::pose::MAX_POSED_PX)]
     TargetTooFar(f64, f64),
     #[error(transparent)]
     Pose(#[from] crate::rig::pose::PoseError),
@@ -213,6 +213,6 @@ pub enum IkError {
     UnknownStretchBone(String),
     #[error("momentum of '{0}' must be a finite number ≥ 0 s")]
     BadMomentum(String),
-    #[error("momentum_step_s must be a number of seconds in [{min}, {max}], not {0:e}", min = MIN_MOMENTUM_STEP_S, max = MAX_MOMENTUM_STEP_S)]
+    #[error("momentum_step_s must be a number of seconds in [{min}, {max}], not {}", crate::shown::Shown(*.0), min = MIN_MOMENTUM_STEP_S, max = MAX_MOMENTUM_STEP_S)]
     BadMomentumStep(f64),
 }

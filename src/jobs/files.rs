@@ -453,6 +453,7 @@ pub fn colorize_files(
         // The layers are a folder, made where missing.
         [Some(files.output.as_path())],
     )?;
+    options.check().map_err(JobError::ColorizeOptions)?;
     let lineart = io::load_png(&files.lineart)?;
     let with_path = |source: Box<dyn std::error::Error + Send + Sync>| JobError::Colorize {
         path: files.scribbles.clone(),

@@ -16,6 +16,7 @@
 
 use super::handles::Handles;
 use crate::geom::{Point, Vec2};
+use crate::shown::Shown;
 use nalgebra::Matrix2;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -208,7 +209,8 @@ pub enum PoseError {
     #[error("the pose of '{0}' has a value that is not a finite number")]
     NonFinite(String),
     #[error(
-        "the pose of '{0}' has the value {1:e}, beyond ±{MAX_POSE_VALUE} (px, degrees or scale)"
+        "the pose of '{name}' has the value {value}, beyond ±{MAX_POSE_VALUE} (px, degrees or scale)",
+        name = .0, value = Shown(*.1)
     )]
     TooLarge(String, f64),
     #[error("ik drag {0}")]
@@ -241,8 +243,11 @@ impl IkDrag {
         }
         if numbers.iter().any(|v| v.abs() > MAX_POSED_PX) {
             return Err(PoseError::BadDrag(format!(
-                "at [{:e}, {:e}] to [{:e}, {:e}] lies beyond ±{MAX_POSED_PX} px",
-                self.at[0], self.at[1], self.to[0], self.to[1]
+                "at [{}, {}] to [{}, {}] lies beyond ±{MAX_POSED_PX} px",
+                Shown(self.at[0]),
+                Shown(self.at[1]),
+                Shown(self.to[0]),
+                Shown(self.to[1])
             )));
         }
         Ok(())

@@ -147,7 +147,7 @@ pub enum HandleError {
     BadIkConstraint { name: String, problem: String },
     #[error("physics constraint '{name}': {problem}")]
     BadPhysicsConstraint { name: String, problem: String },
-    #[error("handle '{name}' has a coordinate beyond ±{MAX_COORDINATE_PX} px: {value:e}")]
+    #[error("handle '{name}' has a coordinate beyond ±{MAX_COORDINATE_PX} px: {}", crate::shown::Shown(*.value))]
     TooFar { name: String, value: f64 },
     #[error("{kind} '{name}': {problem}")]
     BadPolygon {

@@ -143,14 +143,15 @@ pub enum LayeredError {
     Malformed(String),
     #[error("unsupported: {0}")]
     Unsupported(String),
-    #[error("too large: {what} is {got}, the limit is {limit} (LayeredLimits::{field})")]
+    #[error("too large: {what} ({got} {unit}); sinew reads at most {limit} {unit}")]
     TooLarge {
         what: String,
         got: u64,
         limit: u64,
-        field: &'static str,
+        /// What `got` and `limit` count, in the user's words (`px`, `layers`, `bytes`).
+        unit: &'static str,
     },
-    #[error("groups nested {got} deep; at most {limit} (LayeredLimits::max_depth)")]
+    #[error("groups nested {got} deep; sinew reads groups at most {limit} deep")]
     TooDeep { got: usize, limit: usize },
     #[error("zip archive: {0}")]
     Zip(String),
@@ -220,7 +221,7 @@ pub fn load_layered(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage,
 /// Reads a whole file after checking its size against [`LayeredLimits::max_file_bytes`].
 pub(crate) fn read_limited(path: &Path, limits: &LayeredLimits) -> Result<Vec<u8>, LayeredError> {
     let len = std::fs::metadata(path)?.len();
-    check_limit("the file", len, limits.max_file_bytes, "max_file_bytes")?;
+    check_limit("the file", len, limits.max_file_bytes, "bytes")?;
     Ok(std::fs::read(path)?)
 }
 
@@ -229,14 +230,14 @@ pub(crate) fn check_limit(
     what: &str,
     got: u64,
     limit: u64,
-    field: &'static str,
+    unit: &'static str,
 ) -> Result<(), LayeredError> {
     if got > limit {
         return Err(LayeredError::TooLarge {
             what: what.to_string(),
             got,
             limit,
-            field,
+            unit,
         });
     }
     Ok(())
@@ -250,14 +251,9 @@ pub(crate) fn check_size(
     limits: &LayeredLimits,
 ) -> Result<(), LayeredError> {
     let side = size[0].max(size[1]);
-    check_limit(what, side, limits.max_side_px as u64, "max_side_px")?;
+    check_limit(what, side, limits.max_side_px as u64, "px a side")?;
     *total_px = total_px.saturating_add(size[0] * size[1]);
-    check_limit(
-        "the pixels of all layers",
-        *total_px,
-        limits.max_total_px,
-        "max_total_px",
-    )
+    check_limit("all layers together", *total_px, limits.max_total_px, "px")
 }
 
 /// One layer as a part's image: its pixels on the canvas (those outside it dropped), opacity

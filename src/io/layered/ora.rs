@@ -44,10 +44,10 @@ fn open<'a>(bytes: &'a [u8], limits: &LayeredLimits) -> Result<Archive<'a>, Laye
     let zip =
         zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| LayeredError::Zip(e.to_string()))?;
     check_limit(
-        "the zip's entry count",
+        "the zip",
         zip.len() as u64,
         limits.max_layers as u64 + 16,
-        "max_layers",
+        "entries",
     )?;
     Ok(zip)
 }
@@ -63,23 +63,13 @@ fn entry(zip: &mut Archive, name: &str, limits: &LayeredLimits) -> Result<Vec<u8
         e => bad(e.to_string()),
     })?;
     let limit = limits.max_entry_bytes;
-    check_limit(
-        &format!("entry {name}"),
-        file.size(),
-        limit,
-        "max_entry_bytes",
-    )?;
+    check_limit(&format!("entry {name}"), file.size(), limit, "bytes")?;
     let mut out = Vec::with_capacity(file.size() as usize);
     (&mut file)
         .take(limit + 1)
         .read_to_end(&mut out)
         .map_err(|e| bad(e.to_string()))?;
-    check_limit(
-        &format!("entry {name}"),
-        out.len() as u64,
-        limit,
-        "max_entry_bytes",
-    )?;
+    check_limit(&format!("entry {name}"), out.len() as u64, limit, "bytes")?;
     Ok(out)
 }
 
@@ -234,10 +224,10 @@ fn read_stack(
             b"stack" => {
                 count += 1;
                 check_limit(
-                    "the layer count",
+                    "the file",
                     count as u64,
                     limits.max_layers as u64,
-                    "max_layers",
+                    "layers and groups",
                 )?;
                 // The outermost stack is the image itself, not a group.
                 if stack.len() > limits.max_depth {
@@ -263,10 +253,10 @@ fn read_stack(
             b"layer" => {
                 count += 1;
                 check_limit(
-                    "the layer count",
+                    "the file",
                     count as u64,
                     limits.max_layers as u64,
-                    "max_layers",
+                    "layers and groups",
                 )?;
                 let parent = stack
                     .last_mut()

@@ -274,7 +274,10 @@ fn ora_stacks_merge_and_refusals() {
         ..LayeredLimits::default()
     };
     let e = ora::parse(&bomb, &limits).unwrap_err();
-    assert!(e.to_string().contains("max_entry_bytes"), "{e}");
+    assert!(
+        e.to_string().contains("stack.xml") && e.to_string().contains("at most 1048576 bytes"),
+        "{e}"
+    );
     assert!(matches!(
         ora::parse(b"PK\x03\x04garbage", &limits),
         Err(LayeredError::Zip(_))

@@ -258,10 +258,10 @@ fn read_layers(
     let mut r = section.sub(len, "layer info")?;
     let count = r.i16("layer count")?.unsigned_abs() as usize;
     check_limit(
-        "the layer count",
+        "the file",
         count as u64,
         limits.max_layers as u64,
-        "max_layers",
+        "layers and groups",
     )?;
     let mut records = Vec::with_capacity(count);
     for i in 0..count {
