@@ -843,6 +843,8 @@ fn demo(args: &DemoArgs) -> Result<()> {
     // A run that failed before writing anything leaves no empty folder behind (remove_dir only
     // removes an empty one).
     if result.is_err() && created {
+        // The layers it copied first go with it (the folder is its own: it made it).
+        let _ = std::fs::remove_dir_all(args.output.join("character.parts"));
         let _ = std::fs::remove_dir(&args.output);
     }
     result
@@ -864,6 +866,21 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
         .collect();
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
+    // The layers copied beside the rig (`character.parts/`), which names them there: a rig
+    // names only files inside its folder (batches refuse images outside their manifest's).
+    let parts_dir = args.output.join("character.parts");
+    std::fs::create_dir_all(&parts_dir)
+        .with_context(|| format!("{}: cannot create folder", parts_dir.display()))?;
+    let mut copies = Vec::with_capacity(paths.len());
+    for path in &paths {
+        let copy = parts_dir.join(path.file_name().unwrap_or(path.as_os_str()));
+        let bytes =
+            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        io::write_atomic(&copy, &bytes)
+            .with_context(|| format!("{}: cannot write", copy.display()))?;
+        copies.push(copy);
+    }
+    let paths = copies;
 
     let t = Instant::now();
     let layers = pipeline::load_layers(&paths)?;

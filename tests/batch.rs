@@ -14,6 +14,19 @@ use std::path::{Path, PathBuf};
 
 const CHARACTER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/character");
 
+/// Copies the bundled character's layers, handles and layer list into `dir/character/`: a
+/// manifest names only files inside its folder.
+fn character_in(dir: &Path) {
+    let to = dir.join("character");
+    std::fs::create_dir_all(&to).unwrap();
+    for entry in std::fs::read_dir(CHARACTER).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_file() {
+            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+}
+
 /// Writes `count` generated line drawings with their scribbles into `dir/in/`.
 fn line_art(dir: &Path, count: usize) {
     std::fs::create_dir_all(dir.join("in")).unwrap();
@@ -72,9 +85,10 @@ fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
     let tmp = scratch("incremental");
     let dir = tmp.path();
     line_art(dir, 3);
+    character_in(dir);
     let character: Vec<String> = ["torso", "head", "tail"]
         .iter()
-        .map(|n| format!("{CHARACTER}/{n}.png"))
+        .map(|n| format!("character/{n}.png"))
         .collect();
     let mut jobs: Vec<Value> = (0..3).map(colorize_job).collect();
     jobs.push(json!({
@@ -110,14 +124,14 @@ fn a_batch_writes_what_the_commands_write_and_reruns_only_what_changed() {
     // The rig names its images relative to its own folder: as deep as the batch's.
     std::fs::create_dir_all(cli.join("rig")).unwrap();
     let rig = cli.join("rig/parts.json");
+    let images: Vec<PathBuf> = jobs[3]["inputs"]["images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| dir.join(v.as_str().unwrap()))
+        .collect();
     let mut args = vec!["rig"];
-    args.extend(
-        jobs[3]["inputs"]["images"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_str().unwrap()),
-    );
+    args.extend(images.iter().map(|p| s(p)));
     args.extend(["-o", s(&rig), "--min-angle", "25"]);
     let run = sinew(&args);
     assert!(
@@ -209,15 +223,16 @@ fn the_character_rigs_renders_and_exports_in_one_batch() {
         .as_array()
         .unwrap()
         .iter()
-        .map(|n| format!("{CHARACTER}/{}.png", n.as_str().unwrap()))
+        .map(|n| format!("character/{}.png", n.as_str().unwrap()))
         .collect();
+    character_in(dir);
     // A rig from the demo (which adds the animations), rendered and exported by the batch.
     let demo = dir.join("demo");
     let run = sinew(&["demo", "-o", s(&demo)]);
     assert!(run.status.success());
     let jobs = vec![
         json!({"kind": "rig", "name": "rig", "inputs": {"images": images,
-               "handles": format!("{CHARACTER}/handles.json")},
+               "handles": "character/handles.json"},
                "outputs": {"rig": "out/rig.json"}}),
         json!({"kind": "export", "name": "export", "inputs": {"rig": "out/rig.json"},
                "outputs": {"folder": "out/spine"}}),

@@ -355,6 +355,48 @@ impl Job {
         }
     }
 
+    /// Every path the manifest names for the job, with its field as the manifest writes it
+    /// (`inputs.images[1]`, `outputs.rig`): what [`super::plan`] confines to the manifest's
+    /// folder.
+    pub fn named_paths(&self) -> Vec<(String, &PathBuf)> {
+        let mut out: Vec<(String, &PathBuf)> = Vec::new();
+        fn list<'a>(out: &mut Vec<(String, &'a PathBuf)>, field: &str, paths: &'a [PathBuf]) {
+            for (i, p) in paths.iter().enumerate() {
+                out.push((format!("{field}[{i}]"), p));
+            }
+        }
+        let mut named = Vec::new();
+        match self {
+            Job::Rig(j) => {
+                list(&mut out, "inputs.images", &j.inputs.images);
+                named.extend(j.inputs.handles.iter().map(|p| ("inputs.handles", p)));
+                named.push(("outputs.rig", &j.outputs.rig));
+                named.extend(j.outputs.preview.iter().map(|p| ("outputs.preview", p)));
+            }
+            Job::Autorig(j) => {
+                list(&mut out, "inputs.images", &j.inputs.images);
+                named.push(("outputs.handles", &j.outputs.handles));
+                named.extend(j.outputs.preview.iter().map(|p| ("outputs.preview", p)));
+            }
+            Job::Render(j) => {
+                named.push(("inputs.rig", &j.inputs.rig));
+                named.push(("outputs.output", &j.outputs.output));
+            }
+            Job::Export(j) => {
+                named.push(("inputs.rig", &j.inputs.rig));
+                named.push(("outputs.folder", &j.outputs.folder));
+            }
+            Job::Colorize(j) => {
+                named.push(("inputs.lineart", &j.inputs.lineart));
+                named.push(("inputs.scribbles", &j.inputs.scribbles));
+                named.push(("outputs.image", &j.outputs.image));
+                named.extend(j.outputs.layers.iter().map(|p| ("outputs.layers", p)));
+            }
+        }
+        out.extend(named.into_iter().map(|(f, p)| (f.to_string(), p)));
+        out
+    }
+
     /// What the job writes, as the manifest names it. A rig of layered files also writes
     /// `RIG.parts/` (listed here as a folder); a sprite sheet writes its `.json` beside it.
     pub fn outputs(&self) -> Vec<JobPath> {

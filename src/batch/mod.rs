@@ -50,6 +50,15 @@ pub enum BatchError {
     Cycle(String),
     #[error("{0}")]
     Options(String),
+    /// A path the manifest names (or a rig document it reads names) that leaves the
+    /// manifest's folder: the file it is written in, the job, the field as written.
+    #[error("{}: job '{job}': {field}: {problem}", .file.display())]
+    Confined {
+        file: PathBuf,
+        job: String,
+        field: String,
+        problem: crate::io::PathError,
+    },
     /// The job itself failed.
     #[error(transparent)]
     Run(Box<crate::jobs::JobError>),
@@ -75,7 +84,22 @@ pub fn load(path: &Path) -> Result<Plan, BatchError> {
         source,
     })?;
     let manifest = manifest::parse(&text)?;
-    let plan = plan::plan(manifest, crate::io::outputs::parent_dir(&path))?;
+    // A path that leaves the manifest's folder is named with the manifest file.
+    let plan =
+        plan::plan(manifest, crate::io::outputs::parent_dir(&path)).map_err(|e| match e {
+            BatchError::Confined {
+                file,
+                job,
+                field,
+                problem,
+            } if file.as_path() == crate::io::outputs::parent_dir(&path) => BatchError::Confined {
+                file: path.clone(),
+                job,
+                field,
+                problem,
+            },
+            other => other,
+        })?;
     // No job may write over the manifest or its state.
     let state = record::state_path(&path);
     for job in &plan.jobs {

@@ -1,6 +1,8 @@
 //! A manifest checked as a whole, before any work: every input exists or is written by a job,
 //! no two jobs write one output, no job writes its own input, no cycle; each job's dependencies
-//! (the jobs that write what it reads).
+//! (the jobs that write what it reads). Every path the manifest names, and every part image a
+//! rig document it reads names, is confined to the manifest's folder ([`crate::io::confine`]):
+//! no `..` out of it, no absolute path, no symbolic link leading out.
 //!
 //! In: a [`Manifest`] and the folder its paths are relative to. Out: a [`Plan`], or the first
 //! problem found as one [`BatchError`].
@@ -39,10 +41,59 @@ fn writes(output: &JobPath, path: &Path) -> bool {
     path == output.path || (output.folder && path.starts_with(&output.path))
 }
 
+/// Refuses any path of `job` that leaves `root` (see [`crate::io::confine`]); the error names
+/// `root` as the file, which [`super::load`] replaces by the manifest's path.
+fn confine_job(job: &Job, root: &Path) -> Result<(), BatchError> {
+    for (field, path) in job.named_paths() {
+        crate::io::confined(root, path).map_err(|problem| BatchError::Confined {
+            file: root.to_path_buf(),
+            job: job.name().to_string(),
+            field,
+            problem,
+        })?;
+    }
+    Ok(())
+}
+
+/// Refuses a part image of the rig document at `rig` (inside `root`, existing) that leaves
+/// `root`: a rig from elsewhere may name `../art/x.png` within the manifest's folder, not
+/// beyond it. A document that is not JSON or has no parts is left to the job to refuse.
+fn confine_rig_images(job: &Job, rig: &Path, root: &Path) -> Result<(), BatchError> {
+    let Ok(text) = std::fs::read_to_string(rig) else {
+        return Ok(());
+    };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Ok(());
+    };
+    let folder = rig
+        .parent()
+        .and_then(|f| f.strip_prefix(root).ok())
+        .unwrap_or(Path::new(""));
+    let parts = doc.get("parts").and_then(|p| p.as_array());
+    for (i, part) in parts.into_iter().flatten().enumerate() {
+        let Some(image) = part.get("image").and_then(|p| p.as_str()) else {
+            continue;
+        };
+        crate::io::confine::confined_from(root, folder, Path::new(image)).map_err(|problem| {
+            BatchError::Confined {
+                file: rig.to_path_buf(),
+                job: job.name().to_string(),
+                field: format!("parts[{i}].image"),
+                problem,
+            }
+        })?;
+    }
+    Ok(())
+}
+
 /// Checks `manifest` (paths relative to `root`) and finds each job's dependencies.
 pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
     let jobs = manifest.jobs;
     let named = |j: &Job| format!("job '{}'", j.name());
+    // Before anything else: no path leaves the manifest's folder.
+    for job in &jobs {
+        confine_job(job, root)?;
+    }
     for (i, job) in jobs.iter().enumerate() {
         if job.name().is_empty() {
             return Err(BatchError::Job(
@@ -132,7 +183,11 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
                         dependencies[i].push(j);
                     }
                 }
-                None if input.is_file() => {}
+                None if input.is_file() => {
+                    if let Job::Render(_) | Job::Export(_) = &jobs[i] {
+                        confine_rig_images(&jobs[i], input, root)?;
+                    }
+                }
                 None => {
                     return Err(BatchError::Job(
                         named(&jobs[i]),

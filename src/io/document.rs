@@ -384,6 +384,22 @@ impl RigDocument {
             path: path.into(),
             reason,
         })?;
+        // Image paths are relative to the document's folder: an absolute one is refused (a
+        // batch further confines them to its manifest's folder, `crate::batch::plan`).
+        for (i, part) in doc.parts.iter().enumerate() {
+            let image = Path::new(&part.image);
+            if image.as_os_str().is_empty() || image.has_root() {
+                return Err(DocumentError::Invalid {
+                    path: path.into(),
+                    reason: format!(
+                        "part '{}' (parts[{i}].image): \"{}\" is {}; a rig names its images relative to its folder",
+                        part.name,
+                        part.image,
+                        if image.has_root() { "absolute" } else { "empty" }
+                    ),
+                });
+            }
+        }
         Ok(doc)
     }
 

@@ -1,6 +1,7 @@
 //! Files: the native rig document, images, animation sequences, and atomic writes.
 
 pub mod atomic;
+pub mod confine;
 pub mod document;
 pub mod image;
 pub mod layered;
@@ -10,6 +11,7 @@ pub mod set;
 pub mod slots;
 
 pub use atomic::write_atomic;
+pub use confine::{confined, PathError};
 pub use document::{
     AutorigRecord, BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RecordedTemplate,
     RigDocument, RuntimeTarget, WeightsDoc,

@@ -30,11 +30,30 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
     let json: Value = serde_json::from_slice(&bytes)
         .map_err(|e| bad(format!("not a Spine skeleton JSON: {e}")))?;
     let dir = path.parent().unwrap_or(Path::new(""));
-    let images = json
-        .pointer("/skeleton/images")
-        .and_then(Value::as_str)
-        .unwrap_or("");
-    let images = dir.join(images);
+    // The PNGs lie in the JSON's folder: `skeleton.images` and every attachment's file name
+    // are confined to it (a script's JSON from a stranger reads nothing outside).
+    let images = Path::new(
+        json.pointer("/skeleton/images")
+            .and_then(Value::as_str)
+            .unwrap_or(""),
+    )
+    .to_path_buf();
+    let confine = |field: String, file: &Path| {
+        crate::io::confine::confined_from(dir_or_dot(dir), &images, file).map_err(|problem| {
+            LayeredError::Entry {
+                entry: field,
+                reason: problem.to_string(),
+            }
+        })
+    };
+    if !images.as_os_str().is_empty() {
+        crate::io::confine::confined(dir_or_dot(dir), &images).map_err(|problem| {
+            LayeredError::Entry {
+                entry: "\"skeleton\".\"images\"".into(),
+                reason: problem.to_string(),
+            }
+        })?;
+    }
     let bones = bone_positions(&json)?;
     let skin = default_skin(&json)?;
     let slots = json
@@ -82,7 +101,13 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
             )));
         }
         let file = att.get("path").and_then(Value::as_str).unwrap_or(name);
-        let png = images.join(format!("{file}.png"));
+        let png = confine(
+            match att.get("path") {
+                Some(_) => format!("attachment '{name}' (slot '{slot_name}'): \"path\""),
+                None => format!("attachment '{name}' (slot '{slot_name}'): its name"),
+            },
+            Path::new(&format!("{file}.png")),
+        )?;
         let image = load_png(&png, limits, &mut total_px)?;
         let (w, h) = (
             f("width", image.width() as f64),
@@ -143,6 +168,15 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
     }
     check_size("the canvas", size.map(u64::from), &mut 0, limits)?;
     build_layers(size, nodes, warnings, limits)
+}
+
+/// The folder a path without one names: `.`.
+fn dir_or_dot(dir: &Path) -> &Path {
+    if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    }
 }
 
 /// Each bone's world position (the sum of its and its parents' `x`, `y`).
