@@ -93,11 +93,11 @@ fn bad_physics_parameters_are_refused() {
         ),
         (
             json!({"name": "p", "bone": "b", "rotate": 1, "mass": 0}),
-            "physics constraint 'p': mass must be > 0, not 0",
+            "physics constraint 'p': \"mass\" is 0: at least",
         ),
         (
             json!({"name": "p", "bone": "b", "rotate": 1, "fps": -60}),
-            "physics constraint 'p': fps must be in (0, 1000], not -60",
+            "physics constraint 'p': \"fps\" is -60: in (0, 1000]",
         ),
         (
             json!({"name": "p", "bone": "nope", "rotate": 1}),

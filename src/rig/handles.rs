@@ -480,10 +480,11 @@ impl Handles {
             if !names.insert(c.name.as_str()) {
                 return Err(bad("another constraint has this name".into()));
             }
-            if !self.bones.iter().any(|b| b.name == c.bone) {
+            let Some(bone) = self.bones.iter().find(|b| b.name == c.bone) else {
                 return Err(bad(format!("bone '{}' does not exist", c.bone)));
-            }
-            c.check().map_err(bad)?;
+            };
+            c.check_on_bone((bone.tail - bone.head).norm())
+                .map_err(bad)?;
         }
         Ok(())
     }

@@ -93,10 +93,53 @@ fn one() -> f64 {
     1.0
 }
 
+/// The smallest mass, f32's smallest normal number: the runtimes store `massInverse = 1 / mass`
+/// in f32 (spine-cpp, spine-csharp, spine-libgdx; sinew writes the export's numbers as f32),
+/// which is then finite, and the exported mass is not 0. A mass this small passes only with a
+/// spring and forces its step can take ([`PhysicsConstraint::check_on_bone`]).
+pub const MIN_MASS: f64 = f32::MIN_POSITIVE as f64;
+/// The largest offset, px, a constant wind or gravity may hold a moved (`x`, `y`) bone at:
+/// a quarter of [`super::frames::MAX_POSED_PX`], leaving room for the spring's overshoot on the
+/// way there (up to as far again) and for the bone's own place.
+pub const MAX_FORCED_OFFSET_PX: f64 = super::frames::MAX_POSED_PX / 4.0;
+/// The largest stretch a constant wind or gravity may hold a `scale_x` bone at: a quarter of
+/// [`super::frames::MAX_POSED_SCALE`], for the same reasons.
+pub const MAX_FORCED_SCALE: f64 = super::frames::MAX_POSED_SCALE / 4.0;
+
+/// A number as a message shows it: as written, or in exponent form when extreme.
+fn shown(x: f64) -> String {
+    if x.is_finite() && x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 impl PhysicsConstraint {
-    /// Every parameter finite, `fps` in (0, [`MAX_PHYSICS_FPS`]], `mass` > 0, `limit` ≥ 0:
-    /// a one-line reason otherwise.
+    /// [`PhysicsConstraint::check_on_bone`] for a bone of no length (no rotational pull).
     pub fn check(&self) -> Result<(), String> {
+        self.check_on_bone(0.0)
+    }
+
+    /// The parameters the runtime can step, on a bone of rest length `length_px`: a one-line
+    /// reason naming the field as the file writes it otherwise. Every number finite and within
+    /// ±1e6; `x`, `y`, `rotate`, `scale_x`, `shear_x`, `inertia` and `mix` in [0, 1] (shares of
+    /// the motion; with them at most 1 the runtime's rotation lag, `offset += (angle − offset ×
+    /// (rotate + shear_x) × mix) × inertia` per update, cannot overshoot and grow); `damping`
+    /// in [0, 1] (each step multiplies the velocity by `damping^(60/fps)`: above 1 it grows
+    /// without bound, below 0 `pow` is NaN); `strength` ≥ 0; `limit` ≥ 0; `fps` in (0,
+    /// [`MAX_PHYSICS_FPS`]]; `mass` ≥ [`MIN_MASS`]; the spring's step stable; a constant
+    /// wind or gravity on a moved or stretched bone held by a spring within
+    /// [`MAX_FORCED_OFFSET_PX`] / [`MAX_FORCED_SCALE`].
+    ///
+    /// Stability: spine-core steps `v += −(strength · x + k_f · x) · t / mass; x += v · t;
+    /// v *= d` with `t = 1/fps`, `d = damping^(60 t)`; per step (x, v) is multiplied by
+    /// `[[1 − K, t], [−d K / t, d]]` with `K = (strength + k_f) · t² / mass`, whose
+    /// eigenvalues stay in the unit circle exactly when `K < 2 (1 + d)` (Jury: determinant d
+    /// ≤ 1, trace 1 − K + d > −(1 + d)). `k_f` is the stiffness wind and gravity add to the
+    /// rotation (`(wind · sin + gravity · cos) · length / 100` varies by at most
+    /// `hypot(wind, gravity) · length / 100 · (rotate + shear_x) · mix` per radian).
+    pub fn check_on_bone(&self, length_px: f64) -> Result<(), String> {
         let named = [
             ("x", self.x),
             ("y", self.y),
@@ -114,22 +157,112 @@ impl PhysicsConstraint {
             ("mix", self.mix),
         ];
         if let Some((field, value)) = named.iter().find(|(_, v)| !v.is_finite()) {
-            return Err(format!("{field} is {value}, not a finite number"));
+            return Err(format!("\"{field}\" is {value}: not a finite number"));
         }
         if let Some((field, value)) = named.iter().find(|(_, v)| v.abs() > 1e6) {
-            return Err(format!("{field} is {value:e}, beyond ±1e6"));
+            return Err(format!("\"{field}\" is {}: beyond ±1e6", shown(*value)));
+        }
+        let shares = [
+            ("x", self.x),
+            ("y", self.y),
+            ("rotate", self.rotate),
+            ("scale_x", self.scale_x),
+            ("shear_x", self.shear_x),
+            ("inertia", self.inertia),
+            ("mix", self.mix),
+        ];
+        if let Some((field, value)) = shares.iter().find(|(_, v)| !(0.0..=1.0).contains(v)) {
+            return Err(format!(
+                "\"{field}\" is {}: in [0, 1] (a share of the motion the runtime blends in)",
+                shown(*value)
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.damping) {
+            return Err(format!(
+                "\"damping\" is {}: in [0, 1] (the runtime multiplies the velocity by \
+                 damping^(60/fps) each step: above 1 it grows without bound, below 0 it is NaN)",
+                shown(self.damping)
+            ));
+        }
+        if self.strength < 0.0 {
+            return Err(format!(
+                "\"strength\" is {}: at least 0 (a negative spring pushes the bone away without bound)",
+                shown(self.strength)
+            ));
+        }
+        if self.limit < 0.0 {
+            return Err(format!("\"limit\" is {}: at least 0", shown(self.limit)));
         }
         if !(self.fps > 0.0 && self.fps <= MAX_PHYSICS_FPS) {
             return Err(format!(
-                "fps must be in (0, {MAX_PHYSICS_FPS}], not {}",
-                self.fps
+                "\"fps\" is {}: in (0, {MAX_PHYSICS_FPS}]",
+                shown(self.fps)
             ));
         }
-        if self.mass <= 0.0 {
-            return Err(format!("mass must be > 0, not {}", self.mass));
+        if self.mass < MIN_MASS {
+            return Err(format!(
+                "\"mass\" is {}: at least {:e} (the runtime divides by it in f32)",
+                shown(self.mass),
+                MIN_MASS as f32
+            ));
         }
-        if self.limit < 0.0 {
-            return Err(format!("limit must be ≥ 0, not {}", self.limit));
+        let t = self.step_s();
+        let d = self.damping.powf(60.0 * t);
+        let turning = (self.rotate + self.shear_x) * self.mix;
+        let pull = if turning > 0.0 {
+            self.wind.hypot(self.gravity) * length_px / REFERENCE_SCALE * turning
+        } else {
+            0.0
+        };
+        let k = (self.strength + pull) * t * t / self.mass;
+        let bound = 2.0 * (1.0 + d);
+        if !(k < bound) {
+            let what = if pull > 0.0 {
+                "(\"strength\" + the pull of \"wind\" and \"gravity\" on the bone)"
+            } else {
+                "\"strength\""
+            };
+            return Err(format!(
+                "\"strength\" {}, \"mass\" {}, \"fps\" {}: the runtime's spring step diverges: \
+                 {what} / (mass × fps²) is {} but must stay below 2 × (1 + damping^(60/fps)) = {} \
+                 (raise the mass or fps, or lower the strength)",
+                shown(self.strength),
+                shown(self.mass),
+                shown(self.fps),
+                shown(k),
+                shown(bound)
+            ));
+        }
+        let forced = self.wind != 0.0 || self.gravity != 0.0;
+        let moved = self.x > 0.0 || self.y > 0.0;
+        if forced && (moved || self.scale_x > 0.0) {
+            let force = self.wind.abs().max(self.gravity.abs());
+            if self.strength == 0.0 {
+                return Err(
+                    "\"wind\" or \"gravity\" without \"strength\" carries a moved or stretched \
+                     bone away without bound (give it a spring, or move only \"rotate\")"
+                        .into(),
+                );
+            }
+            let offset_px = force * REFERENCE_SCALE / self.strength;
+            if moved && offset_px > MAX_FORCED_OFFSET_PX {
+                return Err(format!(
+                    "\"wind\"/\"gravity\" {} against \"strength\" {} hold the bone {} px away: \
+                     at most {MAX_FORCED_OFFSET_PX:e} px",
+                    shown(force),
+                    shown(self.strength),
+                    shown(offset_px)
+                ));
+            }
+            let stretch = (self.wind.abs() + self.gravity.abs()) / self.strength;
+            if self.scale_x > 0.0 && stretch > MAX_FORCED_SCALE {
+                return Err(format!(
+                    "\"wind\"/\"gravity\" against \"strength\" {} stretch the bone by {}: \
+                     at most {MAX_FORCED_SCALE}",
+                    shown(self.strength),
+                    shown(stretch)
+                ));
+            }
         }
         Ok(())
     }
@@ -467,7 +600,7 @@ mod tests {
         nan.gravity = f64::NAN;
         assert_eq!(
             nan.check().unwrap_err(),
-            "gravity is NaN, not a finite number"
+            "\"gravity\" is NaN: not a finite number"
         );
     }
 

@@ -229,6 +229,12 @@ pub fn export_dragonbones(
     options: &DragonBonesOptions,
 ) -> Result<DragonBonesExport, DragonBonesError> {
     let doc = &scene.doc;
+    // Refused as render refuses it (`scene::Playhead::frame`), with or without animations.
+    if !doc.handles.physics.is_empty() && !doc.options.ik.momentum.is_empty() {
+        return Err(DragonBonesError::Pose(Box::new(
+            PipelineError::PhysicsWithMomentum,
+        )));
+    }
     if options.frame_rate == 0 || f64::from(options.frame_rate) > MAX_FRAME_RATE {
         return Err(DragonBonesError::FrameRate(options.frame_rate));
     }

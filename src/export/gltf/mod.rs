@@ -175,6 +175,12 @@ pub fn export_gltf(
     options: &GltfOptions,
 ) -> Result<GltfExport, GltfError> {
     let doc = &scene.doc;
+    // Refused as render refuses it (`scene::Playhead::frame`), with or without animations.
+    if !doc.handles.physics.is_empty() && !doc.options.ik.momentum.is_empty() {
+        return Err(GltfError::Pose(Box::new(
+            PipelineError::PhysicsWithMomentum,
+        )));
+    }
     check_options(options)?;
     let columns = handle_columns(&doc.handles);
     if columns.len() > usize::from(u16::MAX) {

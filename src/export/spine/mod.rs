@@ -394,6 +394,10 @@ pub fn export_spine(
     options: &SpineOptions,
 ) -> Result<SpineExport, SpineError> {
     let doc = &scene.doc;
+    // Refused as render refuses it (`scene::Playhead::frame`), with or without animations.
+    if !doc.handles.physics.is_empty() && !doc.options.ik.momentum.is_empty() {
+        return Err(SpineError::Pose(PipelineError::PhysicsWithMomentum));
+    }
     check_bake_fps(options.bake_fps)?;
     if options.max_influences == Some(0) {
         return Err(SpineError::MaxInfluences);
