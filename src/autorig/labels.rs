@@ -147,7 +147,7 @@ const HEAD: &[&str] = &["head", "skull", "face"];
 const NECK: &[&str] = &["neck"];
 const TORSO: &[&str] = &[
     "torso", "body", "chest", "trunk", "belly", "spine", "shirt", "abdomen", "stomach", "breast",
-    "ribcage", "thorax", "bust", "coat", "jacket",
+    "ribcage", "thorax", "bust", "coat", "jacket", "dress", "gown", "robe", "tunic", "frock",
 ];
 const PELVIS: &[&str] = &[
     "pelvis", "hip", "hips", "waist", "shorts", "pants", "skirt", "butt",
@@ -464,6 +464,9 @@ mod tests {
         assert_eq!(label("left arm"), l(Part::Arm(Whole), left));
         assert_eq!(label("Arm L"), l(Part::Arm(Whole), left));
         assert_eq!(label("L_forearm"), l(Part::Arm(Lower), left));
+        // A dress or a robe is the torso (the root), not an unknown layer.
+        assert_eq!(label("Dress").part, Part::Torso);
+        assert_eq!(label("robe").part, Part::Torso);
         assert_eq!(label("upperarm.R"), l(Part::Arm(Upper), right));
         assert_eq!(label("arm_upper_r"), l(Part::Arm(Upper), right));
         assert_eq!(label("leg_lower_l"), l(Part::Leg(Lower), left));

@@ -15,7 +15,10 @@
 //! axis to the far end of the axis. Parts that overlap nothing start their own skeleton. A
 //! part too curved for a straight axis bone inside it (a tail) gets the bones of its own
 //! medial axis instead, rooted at the axis point nearest to its joint. The largest part's
-//! bone runs upward from its lower end, as a hip does. Where the artist marked a group's pivot
+//! bone runs upward from its lower end, as a hip does. A pelvis part (shorts, a skirt) roots
+//! at the waist; a quadruped's spine bends at the chest over its front legs; a bust (a torso
+//! with a head and no limbs) gets a bone to each shoulder; a layer holding a pair of legs
+//! gets its medial-axis bones, a chain per leg. Where the artist marked a group's pivot
 //! (a pivot layer, [`Pivot`]), the bone of the group's first part starts at the pivot instead.
 
 use super::attach::{continues, part_tree, Overlaps, PartTree};
@@ -180,12 +183,28 @@ pub fn layered_skeleton(
         let max = max_part_bones(&part.label).max(split.len());
         let grown = match joint {
             None => {
-                let (hips, up) = (hip_hint(i, parts, &tree), up_hint(i, parts, &tree));
-                root_bones(part, pivot, hips, up, split.len(), max, medial, skeleton)?
+                let hints = RootHints::of(i, parts, &tree, template);
+                root_bones(part, pivot, &hints, split.len(), max, medial, skeleton)?
             }
             Some(j) => {
                 let from = pivot.unwrap_or(j.at_px);
-                ray_bones(part, from, None, split.len(), max, medial, skeleton)?
+                let pair = if holds_a_pair(part.name, &part.label) {
+                    let mut grown = medial_bones(part.shape, from, medial, skeleton)?;
+                    super::skeleton::limit_bones(&mut grown, Some(2 * max), part.shape);
+                    grown
+                } else {
+                    Vec::new()
+                };
+                if pair.len() > 1 {
+                    pair
+                } else {
+                    let mut grown =
+                        ray_bones(part, from, None, split.len(), max, medial, skeleton)?;
+                    if template == Some(Template::Quadruped) && part.label.part == LabelPart::Head {
+                        to_middle(&mut grown, part, skeleton);
+                    }
+                    grown
+                }
             }
         };
         let first = bones.len();
@@ -204,6 +223,7 @@ pub fn layered_skeleton(
             } else {
                 format!("{base}_{}", k + 1)
             };
+            let name = b.name.take().unwrap_or(name);
             b.name = Some(names.take(&name));
             bones.push(b);
             bone_part.push(i);
@@ -227,6 +247,35 @@ pub fn layered_skeleton(
         }
     }
     Ok(LayeredSkeleton { bones, bone_part })
+}
+
+/// A quadruped's head, carried forward on its neck, turns at the neck and its bone points to
+/// the middle of the head (the skull), not to the muzzle's tip: a one-bone part's bone ends
+/// at its centroid's projection on the bone (kept at least `min_bone_px` long).
+fn to_middle(bones: &mut [ProtoBone], part: &Part, skeleton: &SkeletonOptions) {
+    let ([b], Some(axis)) = (bones, part.axis) else {
+        return;
+    };
+    let d = b.tail - b.head;
+    let length = d.norm();
+    if length < 1e-9 {
+        return;
+    }
+    let t = (axis.centroid - b.head).dot(&d) / length;
+    if t >= skeleton.min_bone_px && t < length {
+        b.tail = b.head + d * (t / length);
+    }
+}
+
+/// Whether a limb part holds both limbs of a pair in one layer (`front legs`, `hind legs`:
+/// a plural limb word and no side): it gets the bones of its medial axis, a chain per limb.
+fn holds_a_pair(name: &str, label: &Label) -> bool {
+    let limb = matches!(label.part, LabelPart::Leg(_) | LabelPart::Arm(_));
+    let last = name.rsplit('/').next().unwrap_or(name);
+    limb && label.side.is_none()
+        && super::labels::words(last)
+            .iter()
+            .any(|w| matches!(w.as_str(), "legs" | "arms" | "feet" | "hands" | "paws"))
 }
 
 /// Whether `child`'s joint ends its parent part's bone: the labels say the child continues
@@ -309,35 +358,186 @@ fn mean_joint(
         .then(|| Point::from(at.iter().fold(Vec2::zeros(), |s, p| s + p.coords) / at.len() as f64))
 }
 
-/// Where the root part's children hang at the hips (legs, a tail; a quadruped's back legs).
-fn hip_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
-    mean_joint(root, parts, tree, |l| {
-        matches!(l.part, LabelPart::Leg(_) | LabelPart::Tail) && l.end != Some(End::Front)
+/// Where the root part's children join it, which places its bones.
+struct RootHints {
+    /// Where the legs and tail join (a quadruped's back legs and tail).
+    hips: Option<Point>,
+    /// Where the top of the spine's children join (a torso over a pelvis, the neck, the head,
+    /// the upper or whole arms; a quadruped's front legs).
+    up: Option<Point>,
+    /// Where a torso joins a pelvis part.
+    waist: Option<Point>,
+    /// A quadruped's front legs' joint (the shoulders).
+    front: Option<Point>,
+    /// Where the head or neck joins.
+    neck: Option<Point>,
+    /// Whether any arm or leg part hangs from the root.
+    limbs: bool,
+    template: Option<Template>,
+}
+
+impl RootHints {
+    fn of(root: usize, parts: &[Part], tree: &PartTree, template: Option<Template>) -> RootHints {
+        use super::labels::Segment;
+        let quadruped = template == Some(Template::Quadruped);
+        let front_leg =
+            |l: &Label| matches!(l.part, LabelPart::Leg(_)) && l.end == Some(End::Front);
+        let joint = |keep: &dyn Fn(&Label) -> bool| mean_joint(root, parts, tree, keep);
+        RootHints {
+            hips: joint(&|l| {
+                matches!(l.part, LabelPart::Leg(_) | LabelPart::Tail)
+                    && !(quadruped && front_leg(l))
+            }),
+            up: joint(&|l| {
+                let arm = matches!(l.part, LabelPart::Arm(Segment::Upper | Segment::Whole));
+                matches!(l.part, LabelPart::Torso | LabelPart::Neck | LabelPart::Head)
+                    || arm
+                    || (quadruped && front_leg(l))
+            }),
+            waist: joint(&|l| l.part == LabelPart::Torso),
+            front: joint(&|l| quadruped && front_leg(l)),
+            neck: joint(&|l| matches!(l.part, LabelPart::Neck | LabelPart::Head)),
+            limbs: joint(&|l| matches!(l.part, LabelPart::Arm(_) | LabelPart::Leg(_))).is_some(),
+            template,
+        }
+    }
+}
+
+/// The share of a quadruped's trunk depth, from its back, at which the chest joint (the
+/// shoulders, over the front legs) sits: below the middle.
+const CHEST_DEPTH: f64 = 0.6;
+
+/// The cross-section of `shape` through `p` across `along` (a unit direction): the point at
+/// `fraction` of the way from the side away from `belly` to the side toward it (None when `p`
+/// is outside).
+fn across_at(shape: &Shape, p: Point, along: Vec2, belly: Point, fraction: f64) -> Option<Point> {
+    if !shape.contains(p) {
+        return None;
+    }
+    let mut n = Vec2::new(-along.y, along.x);
+    if (belly - p).dot(&n) < 0.0 {
+        n = -n;
+    }
+    let reach = |dir: Vec2| {
+        let (mut lo, mut hi) = (0.0, 1.0);
+        while shape.contains(p + dir * hi) && hi < 1e5 {
+            hi *= 2.0;
+        }
+        for _ in 0..30 {
+            let mid = 0.5 * (lo + hi);
+            if shape.contains(p + dir * mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    let (back, front) = (reach(-n), reach(n));
+    Some(p + n * (-back + fraction * (back + front)))
+}
+
+/// A quadruped's spine on its trunk: the hip bone from the hips (`start`) to the chest joint
+/// over the front legs ([`CHEST_DEPTH`] down the trunk, level with the front legs' joint),
+/// the chest bone from there to where the neck or head joins. None when a bone would leave
+/// the part or be too short.
+fn quadruped_spine(
+    part: &Part,
+    start: Point,
+    hints: &RootHints,
+    skeleton: &SkeletonOptions,
+) -> Option<Vec<ProtoBone>> {
+    let (front, neck) = (hints.front?, hints.neck?);
+    let shape = part.shape;
+    let d = neck - start;
+    let along = d / d.norm().max(1e-9);
+    // Level with the front legs along the spine, on the line from the hips to the neck.
+    let on_line = start + along * (front - start).dot(&along);
+    let chest = across_at(shape, on_line, along, front, CHEST_DEPTH).unwrap_or(on_line);
+    let ok =
+        |a: Point, b: Point| (b - a).norm() >= skeleton.min_bone_px && shape.segment_inside(a, b);
+    (ok(start, chest) && ok(chest, neck)).then(|| {
+        vec![
+            ProtoBone {
+                head: start,
+                tail: chest,
+                parent: None,
+                name: None,
+            },
+            ProtoBone {
+                head: chest,
+                tail: neck,
+                parent: Some(0),
+                name: None,
+            },
+        ]
     })
 }
 
-/// Where the root part's children hang at the top of the spine (a torso over a pelvis, the
-/// neck, the head, the arms; a quadruped's front legs).
-fn up_hint(root: usize, parts: &[Part], tree: &PartTree) -> Option<Point> {
-    mean_joint(root, parts, tree, |l| {
-        matches!(
-            l.part,
-            LabelPart::Torso | LabelPart::Neck | LabelPart::Head | LabelPart::Arm(_)
-        ) || (matches!(l.part, LabelPart::Leg(_)) && l.end == Some(End::Front))
-    })
+/// A bust's bones (a torso with a head and no arm or leg parts, under the humanoid
+/// template): rooted at the body's centroid, a spine of two bones up to where the head joins
+/// (`neck`), and a bone from there to each shoulder: 80 % of the way to the torso's farthest
+/// pixel on that side in the band below the neck (the top quarter of the torso below it).
+fn bust_bones(part: &Part, neck: Point, skeleton: &SkeletonOptions) -> Option<Vec<ProtoBone>> {
+    let shape = part.shape;
+    let c = part.axis?.centroid;
+    let up = neck - c;
+    if up.norm() < 2.0 * skeleton.min_bone_px.max(1.0) {
+        return None;
+    }
+    let u = up / up.norm();
+    let side = Vec2::new(-u.y, u.x);
+    let bottom = shape
+        .inside_centers()
+        .map(|p| (p - neck).dot(&u))
+        .fold(0.0, f64::min);
+    let band = 0.25 * -bottom;
+    let mut far = [None::<(f64, Point)>; 2];
+    for p in shape.inside_centers() {
+        let down = -(p - neck).dot(&u);
+        if !(0.0..=band).contains(&down) {
+            continue;
+        }
+        let x = (p - neck).dot(&side);
+        let k = usize::from(x < 0.0);
+        if far[k].is_none_or(|(best, _)| x.abs() > best) {
+            far[k] = Some((x.abs(), p));
+        }
+    }
+    let mid = Point::from((c.coords + neck.coords) * 0.5);
+    let bone = |head: Point, tail: Point, parent: Option<usize>| ProtoBone {
+        head,
+        tail,
+        parent,
+        name: None,
+    };
+    let mut bones = vec![bone(c, mid, None), bone(mid, neck, Some(0))];
+    if !(shape.segment_inside(c, mid) || shape.contains(c)) {
+        return None;
+    }
+    for (k, found) in far.into_iter().enumerate() {
+        let Some((_, p)) = found else { continue };
+        let tail = neck + (p - neck) * 0.8;
+        if (tail - neck).norm() >= skeleton.min_bone_px {
+            let mut b = bone(neck, tail, Some(1));
+            b.name = Some(if k == 0 { "shoulder_l" } else { "shoulder_r" }.into());
+            bones.push(b);
+        }
+    }
+    Some(bones)
 }
 
 /// The root part's bones, `count` in a chain (at most `max` medial bones when the part is
-/// too curved for a straight spine). The spine starts at the hips: a marked `pivot`, else the
-/// centroid of a pelvis part, else where the legs and tail join (`hips`); it runs toward
-/// where the torso, head and arms join (`up`). Without either, it runs along the principal
-/// axis from its lower end.
-#[allow(clippy::too_many_arguments)]
+/// too curved for a straight spine). The spine starts at the hips: a marked `pivot`, else for
+/// a pelvis part (shorts, a skirt) the waist where a torso joins it (running down toward the
+/// legs), else its centroid, else where the legs and tail join (`hips`); it runs toward
+/// where the torso, head and arms join (`up`). A quadruped's spine bends at the chest over
+/// its front legs ([`quadruped_spine`]); a bust gets shoulders ([`bust_bones`]). Without
+/// hints, it runs along the principal axis from its lower end.
 fn root_bones(
     part: &Part,
     pivot: Option<Point>,
-    hips: Option<Point>,
-    up: Option<Point>,
+    hints: &RootHints,
     count: usize,
     max: usize,
     medial: &MedialOptions,
@@ -347,9 +547,22 @@ fn root_bones(
     let Some(axis) = part.axis else {
         return Ok(Vec::new());
     };
-    let pelvis = (part.label.part == LabelPart::Pelvis).then_some(axis.centroid);
-    if let Some(start) = pivot.or(pelvis) {
+    let (hips, up) = (hints.hips, hints.up);
+    if let Some(start) = pivot {
         return ray_bones(part, start, up, count, max, medial, skeleton);
+    }
+    if part.label.part == LabelPart::Pelvis {
+        // Shorts or a skirt: the pelvis is at the waist, where the torso joins it (the part's
+        // centroid sits at the thighs), and the hip bone runs down toward the legs.
+        return match hints.waist {
+            Some(w) => ray_bones(part, w, hips, count, max, medial, skeleton),
+            None => ray_bones(part, axis.centroid, up, count, max, medial, skeleton),
+        };
+    }
+    if hints.template == Some(Template::Humanoid) && !hints.limbs {
+        if let Some(bones) = hints.neck.and_then(|n| bust_bones(part, n, skeleton)) {
+            return Ok(bones);
+        }
     }
     if let Some(hips) = hips {
         // The spine runs through the part's middle, parallel to hips → top, from the hips'
@@ -360,8 +573,15 @@ fn root_bones(
                 let c = axis.centroid;
                 (c + d * (hips - c).dot(&d), Some(c + d * (u - c).dot(&d)))
             }
-            None => (hips, None),
+            // Legs drawn apart (a tee's feet): the spine starts inside, nearest the hips,
+            // and runs through the part's centroid.
+            None => (hips, Some(axis.centroid)),
         };
+        if hints.template == Some(Template::Quadruped) && count == 2 {
+            if let Some(bones) = quadruped_spine(part, start, hints, skeleton) {
+                return Ok(bones);
+            }
+        }
         return ray_bones(part, start, toward, count, max, medial, skeleton);
     }
     let [t0, t1] = axis.extent;
@@ -579,4 +799,20 @@ fn medial_bones(
     let mut builder = BoneBuilder::new(&axis, shape, skeleton);
     builder.grow(&tree, root, &tree.children[root], None);
     Ok(builder.bones)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::labels::label;
+    use super::*;
+
+    #[test]
+    fn a_layer_of_both_legs_is_a_pair() {
+        let pair = |name: &str| holds_a_pair(name, &label(name));
+        assert!(pair("front legs"));
+        assert!(pair("cat/Hind Legs"));
+        assert!(!pair("FrontLeg"));
+        assert!(!pair("legs_l"));
+        assert!(!pair("tail"));
+    }
 }
