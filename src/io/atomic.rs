@@ -108,27 +108,97 @@ pub fn resolve_output(path: &Path, kind: OutputKind) -> io::Result<PathBuf> {
 }
 
 /// Writes `bytes` to `path` atomically (temporary file + rename), through symbolic links; an
-/// existing `path` that is not a regular file is refused (see [`resolve_output`]).
+/// existing `path` that is not a regular file is refused (see [`resolve_output`]). A file it
+/// replaces keeps its permissions; the content is synced before the rename and the folder
+/// after it, so a power cut leaves the old file or the new one.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let target = resolve_output(path, OutputKind::File)?;
     remove_stale_temporaries(&target);
     let tmp = temporary_sibling(&target);
-    let result = write_new(&tmp, bytes).and_then(|()| fs::rename(&tmp, &target));
+    let result = create_new(&tmp, bytes)
+        .and_then(|file| {
+            keep_permissions(&target, &tmp)?;
+            file.sync_all()
+        })
+        .and_then(|()| fs::rename(&tmp, &target));
     if result.is_err() {
         // The temporary file may not exist; nothing else to report.
         let _ = fs::remove_file(&tmp);
+        return result;
     }
-    result
+    // Best effort: the rename is done; a folder that cannot be synced (some file systems
+    // refuse) loses it only to a power cut.
+    let _ = sync_folder(parent_or_dot(&target));
+    Ok(())
 }
 
 /// Creates `path` (which must not exist) with `bytes`, synced to disk.
 pub fn write_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    create_new(path, bytes)?.sync_all()
+}
+
+/// Creates `path` (which must not exist) with `bytes`, not yet synced: the caller syncs it
+/// ([`sync_files`]).
+pub(crate) fn create_new(path: &Path, bytes: &[u8]) -> io::Result<fs::File> {
     let mut file = fs::OpenOptions::new()
         .write(true)
         .create_new(true)
         .open(path)?;
     file.write_all(bytes)?;
-    file.sync_all()
+    Ok(file)
+}
+
+/// Gives `tmp` the permissions of `target` where `target` exists (a replaced file keeps its
+/// mode: a script's executable bit, a shared file's group write); a new file keeps the
+/// process's defaults.
+pub(crate) fn keep_permissions(target: &Path, tmp: &Path) -> io::Result<()> {
+    match fs::metadata(target) {
+        Ok(meta) => fs::set_permissions(tmp, meta.permissions()),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
+/// Files at most this many are synced one by one; more, on Linux, by one `syncfs` per file
+/// system (a layered file's thousands of part images took 2.7 ms of fsync each on a virtual
+/// disk: 5.5 s for 2,000 layers against 0.3 s of work).
+pub const SYNC_ONE_BY_ONE_MAX: usize = 8;
+
+/// Syncs `files` to disk: each with `fsync` when there are few (see [`SYNC_ONE_BY_ONE_MAX`]),
+/// else, on Linux, the file system of each with one `syncfs`.
+pub(crate) fn sync_files(files: &[fs::File]) -> io::Result<()> {
+    #[cfg(target_os = "linux")]
+    if files.len() > SYNC_ONE_BY_ONE_MAX {
+        use std::os::unix::fs::MetadataExt;
+        use std::os::unix::io::AsRawFd;
+        let mut devices = Vec::new();
+        for file in files {
+            let device = file.metadata()?.dev();
+            if devices.contains(&device) {
+                continue;
+            }
+            devices.push(device);
+            // SAFETY: the descriptor is open for the whole call (`file` is borrowed).
+            if unsafe { libc::syncfs(file.as_raw_fd()) } != 0 {
+                return Err(io::Error::last_os_error());
+            }
+        }
+        return Ok(());
+    }
+    files.iter().try_for_each(fs::File::sync_all)
+}
+
+/// Syncs the folder `dir` (its entries: a rename or a new file in it) where the system can.
+pub(crate) fn sync_folder(dir: &Path) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        fs::File::open(dir)?.sync_all()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        Ok(())
+    }
 }
 
 /// `dir/.name.PID.N.tmp`: hidden, unique per process and write (two threads writing the same
@@ -216,6 +286,49 @@ pub fn remove_stale_temporaries(target: &Path) {
             let _ = fs::remove_file(tmp);
         }
     }
+}
+
+/// [`remove_stale_temporaries`] for many targets: each folder read once (a set of thousands of
+/// files in one folder read it thousands of times).
+pub fn remove_stale_temporaries_of(targets: &[PathBuf]) {
+    let mut folders: Vec<(&Path, std::collections::HashSet<String>)> = Vec::new();
+    for target in targets {
+        let dir = parent_or_dot(target);
+        let name = file_name(target);
+        match folders.iter_mut().find(|(d, _)| *d == dir) {
+            Some((_, names)) => {
+                names.insert(name);
+            }
+            None => folders.push((dir, [name].into())),
+        }
+    }
+    for (dir, names) in folders {
+        complete_interrupted_sets(dir);
+        let Ok(entries) = fs::read_dir(dir) else {
+            continue;
+        };
+        for entry in entries.filter_map(|e| e.ok()) {
+            let Some(entry_name) = entry.file_name().to_str().map(str::to_string) else {
+                continue;
+            };
+            let stale = temporary_target_name(&entry_name).is_some_and(|name| {
+                names.contains(name)
+                    && temporary_pid(&entry_name, name).is_some_and(|pid| !may_be_running(pid))
+            });
+            let path = dir.join(&entry_name);
+            if stale && fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
+                let _ = fs::remove_file(path);
+            }
+        }
+    }
+}
+
+/// The target name in a temporary's name `.NAME.PID.N.tmp`, if it has that form.
+fn temporary_target_name(entry: &str) -> Option<&str> {
+    let rest = entry.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let mut parts = rest.rsplitn(3, '.');
+    let (_n, _pid, name) = (parts.next()?, parts.next()?, parts.next()?);
+    Some(name)
 }
 
 /// Swaps the names of two folders in one step where the system can (Linux), else by two
@@ -370,5 +483,27 @@ mod tests {
         assert_eq!(temporary_pid(".a.png.12.tmp", "a.png"), None);
         assert_eq!(temporary_pid(".b.png.12.3.tmp", "a.png"), None);
         assert_eq!(temporary_pid(".a.png.1.2.3.tmp", "a.png"), None);
+        assert_eq!(temporary_target_name(".a.png.12.3.tmp"), Some("a.png"));
+        assert_eq!(temporary_target_name(".a.b.png.12.3.tmp"), Some("a.b.png"));
+        assert_eq!(temporary_target_name("a.png.12.3.tmp"), None);
+        assert_eq!(temporary_target_name(".a.png"), None);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_replaced_file_keeps_its_permissions_and_a_new_one_gets_the_defaults() {
+        use std::os::unix::fs::PermissionsExt;
+        let tmp = scratch("mode");
+        let dir = tmp.path();
+        let (script, fresh) = (dir.join("run.sh"), dir.join("fresh.txt"));
+        write_atomic(&script, b"#!/bin/sh\n").unwrap();
+        fs::set_permissions(&script, fs::Permissions::from_mode(0o750)).unwrap();
+        write_atomic(&script, b"#!/bin/sh\ntrue\n").unwrap();
+        let mode = |p: &Path| fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&script), 0o750);
+        assert_eq!(fs::read(&script).unwrap(), b"#!/bin/sh\ntrue\n");
+        write_atomic(&fresh, b"x").unwrap();
+        // A new file: whatever the process's umask leaves of 0o666, never executable.
+        assert_eq!(mode(&fresh) & 0o111, 0);
     }
 }

@@ -89,17 +89,17 @@ pub fn check_not_overwriting<'a>(
     inputs: impl IntoIterator<Item = &'a Path>,
     outputs: impl IntoIterator<Item = Option<&'a Path>>,
 ) -> Result<(), OutputError> {
-    let inputs: Vec<PathBuf> = inputs.into_iter().map(resolved).collect();
-    let mut seen: Vec<PathBuf> = Vec::new();
+    // Sets: a layered file's thousands of part images made this quadratic (5e7 comparisons).
+    let inputs: std::collections::HashSet<PathBuf> = inputs.into_iter().map(resolved).collect();
+    let mut seen = std::collections::HashSet::new();
     for output in outputs.into_iter().flatten() {
         let at = resolved(output);
         if inputs.contains(&at) {
             return Err(OutputError::OverwritesInput(output.to_path_buf()));
         }
-        if seen.contains(&at) {
+        if !seen.insert(at) {
             return Err(OutputError::SameOutput(output.to_path_buf()));
         }
-        seen.push(at);
     }
     Ok(())
 }

@@ -27,8 +27,9 @@
 //! file name, each ended by a NUL byte (which no path holds), then `end\n`.
 
 use super::atomic::{
-    file_name, may_be_running, parent_or_dot, remove_stale_temporaries, resolve_output,
-    temporary_sibling, write_new, OutputKind,
+    create_new, file_name, keep_permissions, may_be_running, parent_or_dot,
+    remove_stale_temporaries_of, resolve_output, sync_files, sync_folder, temporary_sibling,
+    write_new, OutputKind,
 };
 use std::fs;
 use std::io;
@@ -39,6 +40,9 @@ use std::sync::Mutex;
 const JOURNAL_MAGIC: &[u8] = b"sinew-set 1\n";
 /// A journal's last line: present only in a journal written whole (a committed set).
 const JOURNAL_END: &[u8] = b"end\n";
+/// Most new files of a set held open before they are synced (well under the usual limit of
+/// 1,024 open files a process).
+const OPEN_AT_ONCE: usize = 256;
 /// Journals are named `.sinew-set.PID.N.journal`.
 const JOURNAL_PREFIX: &str = ".sinew-set.";
 const JOURNAL_SUFFIX: &str = ".journal";
@@ -62,10 +66,10 @@ pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error
     let mut targets = Vec::with_capacity(files.len());
     for (path, _) in files {
         let target = resolve_output(path, OutputKind::File).map_err(|e| (path.clone(), e))?;
-        // Completes the interrupted sets of the folder, then removes stale temporaries.
-        remove_stale_temporaries(&target);
         targets.push(target);
     }
+    // Completes the interrupted sets of the folders, then removes stale temporaries.
+    remove_stale_temporaries_of(&targets);
     let (Some((last_path, _)), Some(last_target)) = (files.last(), targets.last()) else {
         return Ok(());
     };
@@ -76,14 +80,26 @@ pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error
             let _ = fs::remove_file(tmp);
         }
     };
+    // Written, given the permissions of what they replace, then synced together.
+    let mut open = Vec::with_capacity(files.len());
     let written = files
         .iter()
         .zip(&targets)
         .try_for_each(|((path, bytes), target)| {
             let tmp = temporary_sibling(target);
             temporaries.push(tmp.clone());
-            write_new(&tmp, bytes).map_err(|e| (path.clone(), e))
-        });
+            let file = create_new(&tmp, bytes).map_err(|e| (path.clone(), e))?;
+            open.push(file);
+            keep_permissions(target, &tmp).map_err(|e| (path.clone(), e))?;
+            if open.len() == OPEN_AT_ONCE {
+                // Synced in batches: thousands of open files would pass the process's limit.
+                sync_files(&open).map_err(|e| (path.clone(), e))?;
+                open.clear();
+            }
+            Ok(())
+        })
+        .and_then(|()| sync_files(&open).map_err(|e| (last_path.clone(), e)));
+    drop(open);
     if let Err(e) = written {
         remove_temporaries(&temporaries);
         return Err(e);
@@ -215,19 +231,6 @@ fn distinct_folders(targets: &[PathBuf]) -> Vec<PathBuf> {
         }
     }
     folders
-}
-
-/// Makes the folder's entries (created, renamed, removed) durable. A no-op off Unix.
-fn sync_folder(dir: &Path) -> io::Result<()> {
-    #[cfg(unix)]
-    {
-        fs::File::open(dir)?.sync_all()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = dir;
-        Ok(())
-    }
 }
 
 /// The journal of a set: each target (made absolute) and its temporary's file name.
@@ -378,6 +381,54 @@ mod tests {
         assert_eq!(fs::read(&json).unwrap(), b"new");
         // No journal stays after a set is written.
         assert_eq!(fs::read_dir(dir).unwrap().count(), 3);
+    }
+
+    #[test]
+    fn a_large_set_in_two_folders_is_written_whole_with_modes_kept() {
+        let tmp = scratch("large");
+        let dir = tmp.path();
+        fs::create_dir(dir.join("parts")).unwrap();
+        // More files than are held open at once, in two folders: synced in batches.
+        let n = OPEN_AT_ONCE * 2 + 3;
+        let files: Vec<(PathBuf, Vec<u8>)> = (0..n)
+            .map(|i| {
+                let folder = if i % 2 == 0 {
+                    dir.join("parts")
+                } else {
+                    dir.to_path_buf()
+                };
+                (
+                    folder.join(format!("p{i}.png")),
+                    format!("old {i}").into_bytes(),
+                )
+            })
+            .collect();
+        write_set(&files).unwrap();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            fs::set_permissions(&files[1].0, fs::Permissions::from_mode(0o640)).unwrap();
+        }
+        let new: Vec<(PathBuf, Vec<u8>)> = files
+            .iter()
+            .enumerate()
+            .map(|(i, (p, _))| (p.clone(), format!("new {i}").into_bytes()))
+            .collect();
+        write_set(&new).unwrap();
+        for (path, bytes) in &new {
+            assert_eq!(&fs::read(path).unwrap(), bytes);
+        }
+        assert_eq!(
+            fs::read_dir(dir.join("parts")).unwrap().count(),
+            n.div_ceil(2)
+        );
+        assert_eq!(fs::read_dir(dir).unwrap().count(), n / 2 + 1);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = fs::metadata(&files[1].0).unwrap().permissions().mode();
+            assert_eq!(mode & 0o777, 0o640);
+        }
     }
 
     /// The folder a run killed after its commit leaves, at each point of its renames: old
