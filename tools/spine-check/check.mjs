@@ -199,7 +199,18 @@ function lint(json, atlas) {
         const where = `skin ${skin.name}, ${slotName}/${key}`;
         attachmentsOf.set(`${slotName}/${key}`, a);
         const type = a.type || "region";
-        if (type !== "mesh") { out.push(`${where}: type '${type}' (sinew writes meshes only)`); continue; }
+        if (type === "linkedmesh") {
+          // A skin's choice: the default skin's mesh of that name in this slot, no geometry of its own.
+          const sourceKey = v43 ? "source" : "parent";
+          only(where, a, ["type", "name", "path", sourceKey, "skin", "timelines", "color", "width", "height"]);
+          const owner = (json.skins || []).find((s) => s.name === (a.skin || "default"));
+          const source = owner && (owner.attachments[slotName] || {})[a[sourceKey]];
+          if (!source || source.type !== "mesh") out.push(`${where}: linked mesh's ${sourceKey} '${a[sourceKey]}' is no mesh of skin '${a.skin || "default"}' in this slot`);
+          const region = a.path || a.name || key;
+          if (!atlas.findRegion(region)) out.push(`${where}: region '${region}' is not in the atlas`);
+          continue;
+        }
+        if (type !== "mesh") { out.push(`${where}: type '${type}' (sinew writes meshes and linked meshes only)`); continue; }
         only(where, a, ["type", "name", "path", "uvs", "triangles", "vertices", "hull", "edges", "width", "height", "color", "sequence"]);
         const region = a.path || a.name || key;
         if (!atlas.findRegion(region)) out.push(`${where}: region '${region}' is not in the atlas`);

@@ -572,19 +572,23 @@ pub fn export_spine(
         if !animation.deform.is_empty() {
             let mut slots = Map::new();
             for (part, keys) in &animation.deform {
-                let Some(exported) = parts.iter().find(|p| &p.name == part) else {
+                let Some(index) = parts.iter().position(|p| &p.name == part) else {
                     continue;
                 };
+                let exported = &parts[index];
                 // Keys that change nothing are left out (deform.rs), a timeline of them too.
                 let Some(timeline) =
                     deform::deform_timeline(keys, &exported.mesh, &skeleton, &frame)?
                 else {
                     continue;
                 };
-                slots.insert(
-                    part.clone(),
-                    json!({ part.clone(): { "deform": timeline } }),
-                );
+                // Keyed on the part's mesh in the default skin, in the slot it belongs to
+                // (an attachment part lives in another part's slot); skins' linked meshes of
+                // it follow the same keys.
+                let slot = slots
+                    .entry(doc.slot_of(index).to_string())
+                    .or_insert_with(|| Value::Object(Map::new()));
+                slot[part.as_str()] = json!({ "deform": timeline });
             }
             if !slots.is_empty() {
                 a.insert("attachments".into(), json!({ "default": slots }));
@@ -719,7 +723,8 @@ fn skeleton_json(
             "height": region.map_or(0, |r| r.height),
         })
     };
-    let (slots, skins) = skins::slots_and_skins(doc, parts, root, &mesh_json);
+    let linked_by_source = options.version == SpineVersion::V4_3;
+    let (slots, skins) = skins::slots_and_skins(doc, parts, root, &mesh_json, linked_by_source);
     // Update order = file order, as sinew applies them.
     let ik: Vec<Value> = exported_ik
         .iter()
