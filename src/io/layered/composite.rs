@@ -59,13 +59,15 @@ pub fn over(
 pub fn bounds(layers: &[ArtLayer]) -> Option<([i32; 2], [u32; 2])> {
     let mut it = layers.iter().filter(|l| l.visible && l.image.width() > 0);
     let first = it.next()?;
+    // In i64: layers far apart (a PSD's rectangles may lie anywhere in i32) span more than
+    // i32 holds; the span of two i32 positions fits u32.
     let rect = |l: &ArtLayer| {
-        let [x, y] = l.offset_px;
+        let [x, y] = l.offset_px.map(i64::from);
         [
             x,
             y,
-            x + l.image.width() as i32,
-            y + l.image.height() as i32,
+            x + i64::from(l.image.width()),
+            y + i64::from(l.image.height()),
         ]
     };
     let mut r = rect(first);
@@ -78,5 +80,9 @@ pub fn bounds(layers: &[ArtLayer]) -> Option<([i32; 2], [u32; 2])> {
             r[3].max(s[3]),
         ];
     }
-    Some(([r[0], r[1]], [(r[2] - r[0]) as u32, (r[3] - r[1]) as u32]))
+    let span = |from: i64, to: i64| u32::try_from(to - from).unwrap_or(u32::MAX);
+    Some((
+        [r[0] as i32, r[1] as i32],
+        [span(r[0], r[2]), span(r[1], r[3])],
+    ))
 }

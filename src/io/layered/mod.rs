@@ -170,6 +170,11 @@ pub struct LayeredFileError {
     pub source: LayeredError,
 }
 
+/// The farthest from the canvas's top-left corner an ORA or Spine-script layer may be placed,
+/// px, either way on each axis: 2^30, far past any canvas, so that a position plus a layer's
+/// size stays within `i32`.
+pub const MAX_OFFSET_PX: i32 = 1 << 30;
+
 /// The layered formats, by file extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LayeredFormat {

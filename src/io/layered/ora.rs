@@ -9,7 +9,9 @@
 //! before decoding. Specification: <https://www.openraster.org/baseline/file-layout-spec.html>.
 
 use super::tree::{build_layers, RawLayer, RawNode};
-use super::{check_limit, check_size, BlendMode, LayeredError, LayeredImage, LayeredLimits};
+use super::{
+    check_limit, check_size, BlendMode, LayeredError, LayeredImage, LayeredLimits, MAX_OFFSET_PX,
+};
 use image::codecs::png::PngDecoder;
 use image::{DynamicImage, ImageDecoder, RgbaImage};
 use quick_xml::events::{BytesStart, Event};
@@ -64,7 +66,9 @@ fn entry(zip: &mut Archive, name: &str, limits: &LayeredLimits) -> Result<Vec<u8
     })?;
     let limit = limits.max_entry_bytes;
     check_limit(&format!("entry {name}"), file.size(), limit, "bytes")?;
-    let mut out = Vec::with_capacity(file.size() as usize);
+    // The declared size is only a claim: reserve at most 1 MiB for it (a 100-byte zip may
+    // declare 1 GiB), and let the buffer grow with what is really there.
+    let mut out = Vec::with_capacity(file.size().min(1 << 20) as usize);
     (&mut file)
         .take(limit + 1)
         .read_to_end(&mut out)
@@ -155,16 +159,40 @@ fn blend(op: Option<&str>) -> BlendMode {
     }
 }
 
+/// The `opacity` attribute, in [0, 1] (`nan` and infinities refused).
+fn opacity(attrs: &[(String, String)]) -> Result<f32, LayeredError> {
+    let v: f32 = number(attrs, "opacity", 1.0)?;
+    if !v.is_finite() {
+        return Err(xml_error(format!(
+            "attribute opacity=\"{v}\" is not a finite number"
+        )));
+    }
+    Ok(v.clamp(0.0, 1.0))
+}
+
+/// The `x`, `y` attributes added to the enclosing stack's position: canvas px, within
+/// ±[`MAX_OFFSET_PX`] (far past any canvas, so sizes added to it stay in range).
+fn position(attrs: &[(String, String)], base: [i32; 2]) -> Result<[i32; 2], LayeredError> {
+    let mut at = base;
+    for (i, key) in ["x", "y"].into_iter().enumerate() {
+        let v = i64::from(base[i]) + i64::from(number(attrs, key, 0i32)?);
+        if v.abs() > i64::from(MAX_OFFSET_PX) {
+            return Err(xml_error(format!(
+                "{key} = {v} px with its stacks': sinew reads positions within ±{MAX_OFFSET_PX} px"
+            )));
+        }
+        at[i] = v as i32;
+    }
+    Ok(at)
+}
+
 fn frame(attrs: &[(String, String)], parent: Option<&Frame>) -> Result<Frame, LayeredError> {
     let base = parent.map_or([0, 0], |p| p.offset_px);
     Ok(Frame {
         name: attr(attrs, "name").unwrap_or("group").to_string(),
         visible: attr(attrs, "visibility") != Some("hidden"),
-        opacity: number(attrs, "opacity", 1.0f32)?.clamp(0.0, 1.0),
-        offset_px: [
-            base[0] + number(attrs, "x", 0i32)?,
-            base[1] + number(attrs, "y", 0i32)?,
-        ],
+        opacity: opacity(attrs)?,
+        offset_px: position(attrs, base)?,
         children: Vec::new(),
     })
 }
@@ -273,12 +301,9 @@ fn read_stack(
                 let png = entry(zip, src, limits)?;
                 let image = decode_png(&png, src, limits, total_px)?;
                 parent.children.push(RawNode::Layer(RawLayer {
-                    offset_px: [
-                        parent.offset_px[0] + number(&attrs, "x", 0i32)?,
-                        parent.offset_px[1] + number(&attrs, "y", 0i32)?,
-                    ],
+                    offset_px: position(&attrs, parent.offset_px)?,
                     image,
-                    opacity: number(&attrs, "opacity", 1.0f32)?.clamp(0.0, 1.0),
+                    opacity: opacity(&attrs)?,
                     visible: attr(&attrs, "visibility") != Some("hidden"),
                     blend: blend(attr(&attrs, "composite-op")),
                     clipped: false,

@@ -27,9 +27,18 @@ fn bad(reason: impl Into<String>) -> LayeredError {
 /// Reads a Spine skeleton JSON of region attachments and the PNGs it names.
 pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, LayeredError> {
     let bytes = read_limited(path, limits)?;
-    let json: Value = serde_json::from_slice(&bytes)
+    parse(&bytes, path.parent().unwrap_or(Path::new("")), limits)
+}
+
+/// Reads the bytes of a Spine skeleton JSON whose file lies in `dir`, and the PNGs it names
+/// (confined to `dir`).
+pub fn parse(
+    bytes: &[u8],
+    dir: &Path,
+    limits: &LayeredLimits,
+) -> Result<LayeredImage, LayeredError> {
+    let json: Value = serde_json::from_slice(bytes)
         .map_err(|e| bad(format!("not a Spine skeleton JSON: {e}")))?;
-    let dir = path.parent().unwrap_or(Path::new(""));
     // The PNGs lie in the JSON's folder: `skeleton.images` and every attachment's file name
     // are confined to it (a script's JSON from a stranger reads nothing outside).
     let images = Path::new(
@@ -138,21 +147,37 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
             (-p.center.y - h / 2.0 + 0.5).floor(),
         ]
     };
-    let left = placed
-        .iter()
-        .map(|p| corner(p)[0])
-        .fold(f64::INFINITY, f64::min);
-    let top = placed
-        .iter()
-        .map(|p| corner(p)[1])
-        .fold(f64::INFINITY, f64::min);
-    let mut size = [0u32; 2];
+    if placed.is_empty() {
+        return Err(LayeredError::NoLayers);
+    }
+    let extent = |axis: usize, size: fn(&Placed) -> u32| {
+        let from = placed
+            .iter()
+            .map(|p| corner(p)[axis])
+            .fold(f64::INFINITY, f64::min);
+        let to = placed
+            .iter()
+            .map(|p| corner(p)[axis] + f64::from(size(p)))
+            .fold(f64::NEG_INFINITY, f64::max);
+        (from, to - from)
+    };
+    let (left, width) = extent(0, |p| p.image.width());
+    let (top, height) = extent(1, |p| p.image.height());
+    // The canvas is checked before any position becomes an integer: bones and attachments
+    // far apart (or past what an f64 holds) make a canvas too large, not a wrong one.
+    if !(width.is_finite() && height.is_finite()) {
+        return Err(bad(
+            "attachment positions (with their bones') are too large to place",
+        ));
+    }
+    let canvas = [width, height].map(|v| v.min(u64::MAX as f64) as u64);
+    check_size("the canvas", canvas, &mut 0, limits)?;
+    let size = canvas.map(|v| v as u32);
     let mut nodes = Vec::new();
     for p in placed {
         let [l, t] = corner(&p);
+        // Within [0, the canvas's side]: checked above.
         let offset_px = [(l - left) as i32, (t - top) as i32];
-        size[0] = size[0].max(offset_px[0] as u32 + p.image.width());
-        size[1] = size[1].max(offset_px[1] as u32 + p.image.height());
         nodes.push(RawNode::Layer(RawLayer {
             name: p.name,
             offset_px,
@@ -163,10 +188,6 @@ pub fn load(path: &Path, limits: &LayeredLimits) -> Result<LayeredImage, Layered
             clipped: false,
         }));
     }
-    if nodes.is_empty() {
-        return Err(LayeredError::NoLayers);
-    }
-    check_size("the canvas", size.map(u64::from), &mut 0, limits)?;
     build_layers(size, nodes, warnings, limits)
 }
 

@@ -318,3 +318,180 @@ fn a_part_image_is_the_layers_pixels_on_the_canvas_trimmed_and_placed() {
     };
     assert!(part_image(&off, [10, 10]).is_none());
 }
+
+// Found by the review that wrote the fuzz targets of the layered readers (fuzz/,
+// docs/fuzzing.md): each of these panicked (an overflow) or asked for gigabytes before the fix,
+// but the last, whose refusal was right but named a canvas computed from saturated numbers.
+
+/// A PSD of no layers whose merged image is `planes` channels of `w`×`h`, compressed as
+/// `method` with `data` after the compression code.
+fn merged_psd(w: u32, h: u32, planes: u16, method: u16, data: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(b"8BPS\0\x01\0\0\0\0\0\0");
+    out.extend_from_slice(&planes.to_be_bytes());
+    be32(&mut out, h);
+    be32(&mut out, w);
+    out.extend_from_slice(&[0, 8, 0, 3]);
+    for _ in 0..3 {
+        be32(&mut out, 0);
+    }
+    out.extend_from_slice(&method.to_be_bytes());
+    out.extend_from_slice(data);
+    out
+}
+
+#[test]
+fn psd_merged_image_keeps_only_its_colour_channels() {
+    // 56 channels (the most a document has): the colour planes are read, the other 53
+    // checked to be there and dropped.
+    let data: Vec<u8> = (0..56u8).flat_map(|c| [c; 4]).collect();
+    let img = psd::parse(&merged_psd(2, 2, 56, 0, &data), &LayeredLimits::default()).unwrap();
+    assert_eq!(img.layers[0].image.get_pixel(1, 1).0, [0, 1, 2, 255]);
+    assert_eq!(
+        psd::merged_image(&merged_psd(2, 2, 56, 0, &data), true)
+            .unwrap()
+            .get_pixel(0, 0)
+            .0,
+        [0, 1, 2, 3]
+    );
+    // Cut inside a channel it does not keep: still truncated.
+    let e = psd::parse(
+        &merged_psd(2, 2, 56, 0, &data[..200]),
+        &LayeredLimits::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(e, LayeredError::Truncated { .. }), "{e}");
+    let e = psd::parse(&merged_psd(2, 2, 57, 0, &data), &LayeredLimits::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "malformed: 57 channels (a document has 1 to 56)"
+    );
+    // 65,535 channels were accepted: a 16384² canvas (at the pixel limit) of them asked for
+    // 16 TiB up front, and the process aborted.
+    let e = psd::parse(
+        &merged_psd(16384, 16384, u16::MAX, 2, &[]),
+        &LayeredLimits::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("65535 channels"), "{e}");
+    // Of 56 ZIP channels in a 30-byte file: 14 GiB reserved up front; now what it decodes.
+    let e = psd::parse(
+        &merged_psd(16384, 16384, 56, 2, &[0x78, 0x9c, 0x03, 0x00]),
+        &LayeredLimits::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("merged image: ZIP data"), "{e}");
+    // The same for RLE: 56 × 16384 row counts of zero bytes, every row then too short.
+    let counts = vec![0u8; 2 * 56 * 16384];
+    let e = psd::parse(
+        &merged_psd(16384, 16384, 56, 1, &counts),
+        &LayeredLimits::default(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("RLE row: ends early"), "{e}");
+}
+
+#[test]
+fn a_merged_group_of_layers_far_apart_is_refused_not_overflowed() {
+    // Two 1-px layers at the ends of i32 in a `[merge]` group: their span overflowed i32
+    // (a panic), and a span within it allocated the whole merged rectangle unchecked.
+    for (a, b, what) in [
+        (
+            [i32::MIN, i32::MIN],
+            [i32::MAX - 1, i32::MAX - 1],
+            "4294967295 px a side",
+        ),
+        (
+            [0, 0],
+            [29_000, 29_000],
+            "(841058001 px); sinew reads at most 268435456 px",
+        ),
+    ] {
+        let dot = |at: [i32; 2]| [at[1], at[0], at[1] + 1, at[0] + 1];
+        let bytes = psd(
+            8,
+            8,
+            &[
+                divider("</g>", 3),
+                layer("a", dot(a), RED),
+                layer("b", dot(b), BLUE),
+                divider("g [merge]", 1),
+            ],
+        );
+        let e = psd::parse(&bytes, &LayeredLimits::default()).unwrap_err();
+        assert!(
+            matches!(e, LayeredError::TooLarge { .. }) && e.to_string().contains(what),
+            "{e}"
+        );
+        assert!(e.to_string().contains("merged group 'g [merge]'"), "{e}");
+    }
+}
+
+#[test]
+fn ora_positions_past_i32_and_opacities_not_numbers_are_refused() {
+    let dot = png(2, 2);
+    let read = |stack: &str| {
+        ora::parse(
+            &ora_zip(&[("stack.xml", stack.as_bytes()), ("a.png", &dot)]),
+            &LayeredLimits::default(),
+        )
+    };
+    // A stack's x plus its layer's overflowed i32 (a panic).
+    let e = read(
+        r#"<image w="4" h="4"><stack><stack x="1073741824"><layer src="a.png" x="1073741824"/></stack></stack></image>"#,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "stack.xml: x = 2147483648 px with its stacks': sinew reads positions within ±1073741824 px"
+    );
+    // Far, but within the range: kept at its place (off the canvas).
+    let img = read(
+        r#"<image w="4" h="4"><stack><layer src="a.png" x="1073741822" y="-1073741824"/></stack></image>"#,
+    )
+    .unwrap();
+    assert_eq!(img.layers[0].offset_px, [1_073_741_822, -1_073_741_824]);
+    // `nan` parsed as a number and stayed NaN through the clamp.
+    for opacity in ["nan", "inf", "-inf"] {
+        let e = read(&format!(
+            r#"<image w="4" h="4"><stack><layer src="a.png" opacity="{opacity}"/></stack></image>"#
+        ))
+        .unwrap_err();
+        assert!(e.to_string().contains("is not a finite number"), "{e}");
+    }
+    let e = read(r#"<image w="4" h="4"><stack opacity="NaN"><layer src="a.png"/></stack></image>"#)
+        .unwrap_err();
+    assert!(e.to_string().contains("opacity=\"NaN\""), "{e}");
+}
+
+#[test]
+fn spine_script_positions_too_far_apart_are_refused_not_overflowed() {
+    let tmp = crate::test_scratch::scratch("layered-spine-far");
+    let dir = tmp.path();
+    std::fs::write(dir.join("a.png"), png(2, 2)).unwrap();
+    let skeleton = |x: &str, bone_x: &str| {
+        format!(
+            r#"{{"bones": [{{"name": "root"}}, {{"name": "far", "parent": "root", "x": {bone_x}}}],
+               "slots": [{{"name": "s", "bone": "root", "attachment": "a"}},
+                         {{"name": "t", "bone": "far", "attachment": "a"}}],
+               "skins": {{"default": {{"s": {{"a": {{}}}}, "t": {{"a": {{"x": {x}}}}}}}}}}}"#
+        )
+    };
+    let read = |x: &str, bone_x: &str| {
+        spine_json::parse(
+            skeleton(x, bone_x).as_bytes(),
+            dir,
+            &LayeredLimits::default(),
+        )
+    };
+    assert_eq!(read("10", "0").unwrap().canvas_px, [12, 2]);
+    // A canvas wider than i32: refused by its width, checked before any offset is made.
+    let e = read("3e9", "0").unwrap_err();
+    assert!(matches!(e, LayeredError::TooLarge { .. }), "{e}");
+    // Past what an f64 holds, with the bone's: said so (was "too large" with a made-up size).
+    let e = read("1.5e308", "1.5e308").unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "malformed: attachment positions (with their bones') are too large to place"
+    );
+}

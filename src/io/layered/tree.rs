@@ -265,6 +265,11 @@ impl Builder<'_> {
             ));
             return Ok(None);
         };
+        // The merged layer spans its layers, however far apart: checked as a layer of its own.
+        let what = format!("merged group '{raw_name}'");
+        let [w, h] = size.map(u64::from);
+        super::check_limit(&what, w.max(h), self.limits.max_side_px.into(), "px a side")?;
+        super::check_limit(&what, w * h, self.limits.max_total_px, "px")?;
         let mut image = RgbaImage::new(size[0], size[1]);
         for l in sub.out.layers.iter().filter(|l| l.visible) {
             over(&mut image, origin, &l.image, l.offset_px, l.opacity);

@@ -119,8 +119,10 @@ impl Header {
                 )));
             }
         };
-        if channels < if gray { 1 } else { 3 } {
-            return Err(LayeredError::Malformed(format!("{channels} channels")));
+        if channels < if gray { 1 } else { 3 } || channels > 56 {
+            return Err(LayeredError::Malformed(format!(
+                "{channels} channels (a document has 1 to 56)"
+            )));
         }
         if w == 0 || h == 0 {
             return Err(LayeredError::Malformed(format!(
@@ -147,17 +149,19 @@ impl Header {
 fn merged(r: &mut Reader, header: &Header, alpha: bool) -> Result<RgbaImage, LayeredError> {
     let method = Compression::from_code(r.u16("merged image compression")?, "merged image")?;
     let [w, h] = header.size.map(|v| v as usize);
+    let color = if header.gray { 1 } else { 3 };
+    let with_alpha = alpha && header.channels > color;
+    // Only the colour channels and alpha are decoded (of up to 56).
     let planes = decode_planes(
         r,
         method,
         [w, h],
-        header.channels,
+        [header.channels, color + with_alpha as usize],
         header.psb,
         "merged image",
     )?;
     let plane = |c: usize| &planes[c * w * h..(c + 1) * w * h];
-    let color = if header.gray { 1 } else { 3 };
-    let a = (alpha && header.channels > color).then(|| plane(color));
+    let a = with_alpha.then(|| plane(color));
     let mut image = RgbaImage::new(w as u32, h as u32);
     for (i, p) in image.pixels_mut().enumerate() {
         for c in 0..3 {
@@ -463,7 +467,7 @@ fn read_pixels(
                 &mut data,
                 method,
                 [w, h],
-                1,
+                [1, 1],
                 header.psb,
                 &what,
             )?);
@@ -481,7 +485,7 @@ fn read_pixels(
             check_size(&format!("layer '{}' mask", rec.name), ms, total_px, limits)?;
             let ms = ms.map(|v| v as usize);
             mask = Some((
-                decode_planes(&mut data, method, ms, 1, header.psb, &what)?,
+                decode_planes(&mut data, method, ms, [1, 1], header.psb, &what)?,
                 m,
             ));
         }

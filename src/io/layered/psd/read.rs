@@ -109,20 +109,28 @@ impl Compression {
     }
 }
 
-/// Decodes the planes of `planes` channels of `w`×`h` 8-bit pixels compressed as `method`
-/// from `r` (for RLE, all row byte counts come first, as in the merged image; a layer channel
-/// is one plane). Returns `planes × w × h` bytes.
+/// Decodes the first `keep` of the `planes` channels of `w`×`h` 8-bit pixels compressed as
+/// `method` from `r` (for RLE, all row byte counts come first, as in the merged image; a layer
+/// channel is one plane). Returns `keep × w × h` bytes: the channels sinew does not use (a
+/// document may declare up to 56) are checked to be all there but never kept, so they cost no
+/// memory.
 pub fn decode_planes(
     r: &mut Reader,
     method: Compression,
     [w, h]: [usize; 2],
-    planes: usize,
+    [planes, keep]: [usize; 2],
     psb: bool,
     what: &str,
 ) -> Result<Vec<u8>, LayeredError> {
-    let size = w * h * planes;
+    let keep = keep.min(planes);
+    let size = w * h * keep;
+    let all = w * h * planes;
+    // What is reserved before decoding: the output, but no more than the compressed data can
+    // give (PackBits at most 64 bytes per byte; deflate about 1,032), so a small file declaring
+    // a large image allocates only as it decodes.
+    let reserve = |remaining: usize, ratio: usize| size.min(remaining.saturating_mul(ratio));
     match method {
-        Compression::Raw => Ok(r.take(size as u64, what)?.to_vec()),
+        Compression::Raw => Ok(r.take(all as u64, what)?[..size].to_vec()),
         Compression::Rle => {
             let rows = h * planes;
             let mut counts = Vec::with_capacity(rows.min(r.remaining() / 2));
@@ -133,23 +141,30 @@ pub fn decode_planes(
                     r.u16(what)? as u64
                 });
             }
-            let mut out = Vec::with_capacity(size);
-            for count in counts {
+            let mut out = Vec::with_capacity(reserve(r.remaining(), 64));
+            for (i, count) in counts.into_iter().enumerate() {
                 let row = r.take(count, what)?;
-                unpack_bits(row, w, &mut out).map_err(|reason| {
-                    LayeredError::Malformed(format!("{what}: RLE row: {reason}"))
-                })?;
+                if i < h * keep {
+                    unpack_bits(row, w, &mut out).map_err(|reason| {
+                        LayeredError::Malformed(format!("{what}: RLE row: {reason}"))
+                    })?;
+                }
             }
             Ok(out)
         }
         Compression::Zip | Compression::ZipPredicted => {
+            let mut out = Vec::with_capacity(reserve(r.remaining(), 1032));
             let packed = r.take(r.remaining() as u64, what)?;
-            let mut out = Vec::with_capacity(size);
-            flate2::read::ZlibDecoder::new(packed)
+            let mut zlib = flate2::read::ZlibDecoder::new(packed).take(all as u64);
+            let zip_error =
+                |e: std::io::Error| LayeredError::Malformed(format!("{what}: ZIP data: {e}"));
+            (&mut zlib)
                 .take(size as u64)
                 .read_to_end(&mut out)
-                .map_err(|e| LayeredError::Malformed(format!("{what}: ZIP data: {e}")))?;
-            if out.len() != size {
+                .map_err(zip_error)?;
+            // The channels not kept are inflated only to check that they are there.
+            let rest = std::io::copy(&mut zlib, &mut std::io::sink()).map_err(zip_error)?;
+            if out.len() != size || size as u64 + rest != all as u64 {
                 return Err(LayeredError::Truncated {
                     what: format!("{what} (ZIP data)"),
                 });
