@@ -219,5 +219,5 @@ fn huge_declared_sizes_are_refused_before_allocating() {
     };
     let bytes = std::fs::read(fixture("character.psd")).unwrap();
     let e = psd::parse(&bytes, &limits).unwrap_err();
-    assert!(e.to_string().contains("max_total_px"), "{e}");
+    assert!(e.to_string().contains("sinew reads at most 1000 px"), "{e}");
 }
