@@ -35,7 +35,39 @@ fn every_target_takes_its_seeds_and_saved_inputs_without_panicking() {
             }
         }
         println!("{name}: {runs} inputs");
-        assert!(runs > 0, "{name}: no seeds: run tools/fuzz/run.sh --seeds-only first");
+        assert!(
+            runs > 0,
+            "{name}: no seeds: run tools/fuzz/run.sh --seeds-only first"
+        );
     }
     assert!(seeds > 0);
+}
+
+/// The seeds (made from real files and docs/formats.md's examples, and by hand) are read, so
+/// fuzzing starts from accepted inputs: a reader that came to refuse them would leave AFL++
+/// mutating refusals only. The two PSDs of unsupported kinds (CMYK, 16-bit) are refused.
+#[test]
+fn the_readers_accept_their_seeds() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("seeds");
+    let refused = ["cmyk.psd", "deep16.psd"];
+    for (name, read) in sinew_fuzz::READERS {
+        let dir = root.join(name);
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap_or_else(|e| {
+                panic!(
+                    "{}: {e}: run tools/fuzz/run.sh --seeds-only first",
+                    dir.display()
+                )
+            })
+            .flatten()
+            .map(|e| e.path())
+            .collect();
+        files.sort();
+        assert!(files.len() >= 2, "{name}: {} seeds", files.len());
+        for file in files {
+            let wanted = !refused.iter().any(|r| file.ends_with(r));
+            let bytes = std::fs::read(&file).unwrap();
+            assert_eq!(read(&bytes), wanted, "{name}: {}", file.display());
+        }
+    }
 }

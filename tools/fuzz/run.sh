@@ -12,8 +12,12 @@
 # (its crashes and its queue), with the fuzz build's compiled crates.
 #
 # Targets (fuzz/src/lib.rs): rig_document, handles, pose, animations, scribbles, png_trace_mesh,
-# bvh. The seed corpus (fuzz/seeds/TARGET) comes from the bundled assets (bvh: three frames of
-# two bundled motions, small enough for AFL++, and the hand-written tools/fuzz/seeds/bvh).
+# bvh, psd, ora, spine_script, batch_manifest. The seed corpus (fuzz/seeds/TARGET) comes from the
+# bundled assets and test fixtures (bvh: three frames of two bundled motions, small enough for
+# AFL++; psd: tests/fixtures/layered and the small files tools/fuzz/psd_seeds.py writes; ora: the
+# fixtures and their stack.xml, which the target zips with fixed layers; spine_script: the
+# fixture's JSON; batch_manifest: docs/formats.md's example) and hand-written tools/fuzz/seeds/.
+# docs/fuzzing.md has the figures of the last long runs.
 # cargo-afl is installed into tools/fuzz/.root (a local cargo root, never ~/.cargo) on first
 # use, and AFL++ built by it. Where that cannot be done (no network to crates.io, no make or C compiler), the script says so
 # and exits 0 without fuzzing: the run is skipped, not failed. A crash fails the run (exit 1);
@@ -35,13 +39,14 @@ if [[ "$seconds" == --seeds-only ]]; then seconds=0; fi
 shift || true
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-    targets=(rig_document handles pose animations scribbles png_trace_mesh bvh)
+    targets=(rig_document handles pose animations scribbles png_trace_mesh bvh psd ora spine_script
+        batch_manifest)
 fi
 
 # Seeds: every bundled file of each kind (a rig document is made by hand from the
 # example in docs/formats.md when no rig has been written).
 seeds=fuzz/seeds
-mkdir -p "$seeds"/{rig_document,handles,pose,animations,scribbles,png_trace_mesh,bvh}
+mkdir -p "$seeds"/{rig_document,handles,pose,animations,scribbles,png_trace_mesh,bvh,psd,ora,spine_script,batch_manifest}
 cp assets/character/handles.json "$seeds/handles/"
 cp assets/character/poses/*.json "$seeds/pose/"
 cp assets/character/animations.json "$seeds/animations/"
@@ -52,7 +57,8 @@ text = pathlib.Path(sys.argv[1]).read_text()
 out = pathlib.Path(sys.argv[2])
 for n, (tag, body) in enumerate(re.findall(r"```json (\w+)\n(.*?)```", text, re.S)):
     kind = {"rig": "rig_document", "handles": "handles", "pose": "pose",
-            "animations": "animations", "scribbles": "scribbles"}.get(tag)
+            "animations": "animations", "scribbles": "scribbles",
+            "batch": "batch_manifest"}.get(tag)
     if kind:
         (out / kind / f"formats-{n}.json").write_text(body)
 PY
@@ -64,6 +70,18 @@ python3 tools/motions/cut_bvh.py assets/motions/idle.bvh "$seeds/bvh/idle-3.bvh"
 for png in assets/character/head.png assets/character/tail.png assets/character/bag.png; do
     cp "$png" "$seeds/png_trace_mesh/"
 done
+# Layered files: the fixtures written by real tools (psd-tools, Krita; the 190 kB bundled
+# character left out: AFL++ works best on small inputs) and small hand-made PSDs; for ORA also
+# the stack.xml alone (the target zips it with krita.ora's layers).
+layered=tests/fixtures/layered
+cp "$layered"/{character,cmyk,deep16,gray,krita,pivots}.psd "$layered/character.psb" "$seeds/psd/"
+python3 tools/fuzz/psd_seeds.py "$seeds/psd"
+cp "$layered/krita.ora" tests/fixtures/autorig-real/goblin.ora "$seeds/ora/"
+python3 -c 'import sys, zipfile; sys.stdout.buffer.write(zipfile.ZipFile(sys.argv[1]).read("stack.xml"))' \
+    "$layered/krita.ora" >"$seeds/ora/krita-stack.xml"
+cp tools/fuzz/seeds/ora/*.xml "$seeds/ora/"
+cp "$layered/spine/character.json" tools/fuzz/seeds/spine_script/*.json "$seeds/spine_script/"
+cp tools/fuzz/seeds/batch_manifest/*.json "$seeds/batch_manifest/"
 if [[ "$seconds" == 0 ]]; then
     echo "fuzz: seeds in $seeds"
     exit 0
