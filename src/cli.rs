@@ -8,6 +8,7 @@ mod auto;
 mod batch;
 mod choices;
 mod colorize;
+mod demo_assets;
 mod export_gltf;
 mod target;
 
@@ -485,9 +486,11 @@ pub struct DemoArgs {
     /// Output folder.
     #[arg(short, long, default_value = "out")]
     pub output: PathBuf,
-    /// The folder of the bundled character (holding layers.json).
-    #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/character"))]
-    pub assets: PathBuf,
+    /// A character laid out as the bundled one (layers.json, handles.json, animations.json,
+    /// events.json if it fires any, a PNG per layer and attachment) instead of the bundled
+    /// character, which is built into sinew.
+    #[arg(long, value_name = "DIR")]
+    pub assets: Option<PathBuf>,
 }
 
 /// Runs one parsed command.
@@ -852,17 +855,15 @@ fn demo(args: &DemoArgs) -> Result<()> {
 
 fn demo_steps(args: &DemoArgs) -> Result<()> {
     let started = Instant::now();
-    let list_path = args.assets.join("layers.json");
-    let list: LayerList = serde_json::from_str(
-        &std::fs::read_to_string(&list_path)
-            .with_context(|| format!("{}: cannot read", list_path.display()))?,
-    )
-    .with_context(|| format!("{}: not a layer list", list_path.display()))?;
-    let paths: Vec<PathBuf> = list
+    let assets = demo_assets::DemoAssets::new(args.assets.as_deref());
+    let list_name = assets.name("layers.json");
+    let list: LayerList = serde_json::from_slice(&assets.read("layers.json")?)
+        .with_context(|| format!("{list_name}: not a layer list"))?;
+    let files: Vec<String> = list
         .layers
         .iter()
         .chain(list.attachments.keys())
-        .map(|name| args.assets.join(format!("{name}.png")))
+        .map(|name| format!("{name}.png"))
         .collect();
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("{}: cannot create folder", args.output.display()))?;
@@ -871,11 +872,10 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let parts_dir = args.output.join("character.parts");
     std::fs::create_dir_all(&parts_dir)
         .with_context(|| format!("{}: cannot create folder", parts_dir.display()))?;
-    let mut copies = Vec::with_capacity(paths.len());
-    for path in &paths {
-        let copy = parts_dir.join(path.file_name().unwrap_or(path.as_os_str()));
-        let bytes =
-            std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let mut copies = Vec::with_capacity(files.len());
+    for file in &files {
+        let copy = parts_dir.join(file);
+        let bytes = assets.read(file)?;
         io::write_atomic(&copy, &bytes)
             .with_context(|| format!("{}: cannot write", copy.display()))?;
         copies.push(copy);
@@ -886,24 +886,24 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let layers = pipeline::load_layers(&paths)?;
     let load_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let handles: Handles = read_json(&args.assets.join("handles.json"), "handles file")?;
+    let handles: Handles = assets.read_json("handles.json", "handles file")?;
     let (doc, stats) =
         pipeline::build_rig(&layers, &args.output, &BuildOptions::default(), &handles)?;
     let rig_s = t.elapsed().as_secs_f64();
 
     let mut doc = doc;
     doc.set_slots(&list.attachments, list.skins.clone())
-        .map_err(|reason| anyhow::anyhow!("{}: {reason}", list_path.display()))?;
-    let animations_path = args.assets.join("animations.json");
-    let animations_json: serde_json::Value = read_json(&animations_path, "animations file")?;
-    let bad = || format!("{}: bad animation", animations_path.display());
+        .map_err(|reason| anyhow::anyhow!("{list_name}: {reason}"))?;
+    let animations_name = assets.name("animations.json");
+    let animations_json: serde_json::Value =
+        assets.read_json("animations.json", "animations file")?;
+    let bad = || format!("{animations_name}: bad animation");
     doc.animations = anim::animations_from_json(&animations_json).with_context(bad)?;
     // The events the animations fire (footsteps), when the assets define any.
-    let events_path = args.assets.join("events.json");
-    if events_path.exists() {
-        let events_json: serde_json::Value = read_json(&events_path, "events file")?;
+    if assets.read_optional("events.json")?.is_some() {
+        let events_json: serde_json::Value = assets.read_json("events.json", "events file")?;
         doc.events = anim::events_from_json(&events_json)
-            .with_context(|| format!("{}: bad events", events_path.display()))?;
+            .with_context(|| format!("{}: bad events", assets.name("events.json")))?;
     }
     doc.check_animations().with_context(bad)?;
     let animations = doc.animations.clone();
