@@ -1,6 +1,7 @@
 //! Running a batch's jobs as Ray tasks: an [`Executor`] over the project's Python driver
-//! (`tools/ray/driver.py`), which connects to a running Ray cluster and runs each job as a
-//! task calling `sinew batch MANIFEST --job NAME` on a worker (see docs/batch.md).
+//! (`tools/ray/driver.py`, built in as [`DRIVER_SOURCE`] and written out for a run by
+//! [`DriverFile`]), which connects to a running Ray cluster and runs each job as a task calling
+//! `sinew batch MANIFEST --job NAME` on a worker (see docs/batch.md).
 //!
 //! The protocol is lines of text: this side writes a job's name to the driver's stdin to
 //! submit it; the driver prints one JSON object per finished job on stdout:
@@ -13,7 +14,7 @@ use super::plan::Plan;
 use super::run::Executor;
 use super::BatchError;
 use std::io::{BufRead, BufReader, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 
 /// How to reach the cluster.
@@ -21,9 +22,10 @@ use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 pub struct RayOptions {
     /// The cluster's address, `HOST:PORT` of its head (GCS).
     pub address: String,
-    /// The Python of the driver's virtual environment (`tools/ray/install.sh` makes it).
+    /// A Python with the `ray` package (`tools/ray/install.sh` makes a virtual environment
+    /// with the pinned version).
     pub python: PathBuf,
-    /// The driver script.
+    /// The driver script ([`DriverFile`] writes the built-in one).
     pub driver: PathBuf,
     /// The sinew binary the workers run (the same path on every node).
     pub sinew: PathBuf,
@@ -73,7 +75,7 @@ impl<'a> RayExecutor<'a> {
             .spawn()
             .map_err(|e| {
                 BatchError::Executor(format!(
-                    "{}: cannot start the Ray driver (run tools/ray/install.sh): {e}",
+                    "{}: cannot start the Ray driver: {e} ({NEEDS_RAY})",
                     options.python.display()
                 ))
             })?;
@@ -119,7 +121,79 @@ impl<'a> RayExecutor<'a> {
             .lock()
             .map(|l| l.clone())
             .unwrap_or_default();
-        BatchError::Executor(format!("the Ray driver stopped ({status}): {last}"))
+        let hint = if last.contains("No module named 'ray'") {
+            format!(" ({NEEDS_RAY})")
+        } else {
+            String::new()
+        };
+        BatchError::Executor(format!("the Ray driver stopped ({status}): {last}{hint}"))
+    }
+}
+
+/// What the driver needs, as the errors of a Python without it say.
+const NEEDS_RAY: &str = "the driver needs a Python with the `ray` package: `pip install ray`, \
+     then point --ray-python or SINEW_RAY_PYTHON at that Python (docs/batch.md)";
+
+/// The Ray driver (`tools/ray/driver.py`), built in so that an installed sinew runs batches on
+/// Ray without its source tree.
+pub const DRIVER_SOURCE: &str = include_str!("../../tools/ray/driver.py");
+
+/// [`DRIVER_SOURCE`] written to a file for one run, in a folder of its own (made for it, so
+/// no other run or user shares or swaps it); both are removed when this is dropped.
+#[derive(Debug)]
+pub struct DriverFile {
+    dir: PathBuf,
+    path: PathBuf,
+}
+
+impl DriverFile {
+    /// Writes the built-in driver into a new folder `sinew-ray-driver-*` under `parent` (the
+    /// system's temporary folder, `std::env::temp_dir()`, for the command line).
+    pub fn write_in(parent: &Path) -> Result<Self, BatchError> {
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
+        let mut attempt = 0u32;
+        let dir = loop {
+            let dir = parent.join(format!(
+                "sinew-ray-driver-{}-{stamp}-{attempt}",
+                std::process::id()
+            ));
+            let mut builder = std::fs::DirBuilder::new();
+            #[cfg(unix)]
+            std::os::unix::fs::DirBuilderExt::mode(&mut builder, 0o700);
+            match builder.create(&dir) {
+                Ok(()) => break dir,
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < 100 => {
+                    attempt += 1
+                }
+                Err(source) => return Err(BatchError::Write { path: dir, source }),
+            }
+        };
+        let path = dir.join("driver.py");
+        let file = DriverFile { dir, path };
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&file.path)
+            .and_then(|mut f| f.write_all(DRIVER_SOURCE.as_bytes()))
+            .map_err(|source| BatchError::Write {
+                path: file.path.clone(),
+                source,
+            })?;
+        Ok(file)
+    }
+
+    /// The driver script.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for DriverFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
 
@@ -168,5 +242,36 @@ impl Drop for RayExecutor<'_> {
         // Closing stdin tells the driver no more jobs come; it exits once its tasks end.
         self.stdin.take();
         let _ = self.child.wait();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_built_in_driver_is_written_to_a_folder_of_its_own_and_removed() {
+        let tmp = crate::test_scratch::scratch("ray-driver");
+        let first = DriverFile::write_in(tmp.path()).unwrap();
+        let second = DriverFile::write_in(tmp.path()).unwrap();
+        assert_ne!(first.path().parent(), second.path().parent());
+        let written = std::fs::read_to_string(first.path()).unwrap();
+        assert_eq!(written, DRIVER_SOURCE);
+        assert!(written.contains("import ray"));
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let dir = first.path().parent().unwrap();
+            let mode = std::fs::metadata(dir).unwrap().permissions().mode();
+            assert_eq!(mode & 0o077, 0, "{mode:o}");
+        }
+        let dir = first.path().parent().unwrap().to_path_buf();
+        drop(first);
+        assert!(!dir.exists());
+        assert!(second.path().exists());
+        // A parent that cannot hold it: one error naming the folder.
+        let missing = tmp.path().join("no/such/folder");
+        let error = DriverFile::write_in(&missing).unwrap_err().to_string();
+        assert!(error.contains("no/such/folder"), "{error}");
     }
 }

@@ -19,12 +19,19 @@ pub struct BatchArgs {
     /// through tools/ray/driver.py (see docs/batch.md).
     #[arg(long, value_name = "ADDRESS")]
     pub ray: Option<String>,
-    /// The Python that runs the Ray driver (tools/ray/install.sh makes it).
-    #[arg(long, value_name = "PYTHON", default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/ray/.venv/bin/python"))]
+    /// The Python that runs the Ray driver: one with the `ray` package, e.g. a virtual
+    /// environment's bin/python (see docs/batch.md).
+    #[arg(
+        long,
+        value_name = "PYTHON",
+        env = "SINEW_RAY_PYTHON",
+        default_value = "python3"
+    )]
     pub ray_python: PathBuf,
-    /// The Ray driver script.
-    #[arg(long, value_name = "PY", default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/ray/driver.py"))]
-    pub ray_driver: PathBuf,
+    /// A Ray driver script to run instead of the built-in one (which sinew writes for each
+    /// run into a folder of its own in the temporary folder, and removes after).
+    #[arg(long, value_name = "PY")]
+    pub ray_driver: Option<PathBuf>,
     /// How many times Ray reruns a task whose worker died.
     #[arg(long, value_name = "N", default_value_t = 3)]
     pub max_retries: u32,
@@ -60,10 +67,19 @@ pub fn run(args: &BatchArgs) -> Result<()> {
             batch::run(&plan, &state, &mut executor, &mut on_job)
         }
         Some(address) => {
+            // The built-in driver lives until the executor (declared after it) is dropped.
+            let built_in;
+            let driver = match &args.ray_driver {
+                Some(path) => path.clone(),
+                None => {
+                    built_in = ray::DriverFile::write_in(&std::env::temp_dir())?;
+                    built_in.path().to_path_buf()
+                }
+            };
             let options = ray::RayOptions {
                 address: address.clone(),
                 python: args.ray_python.clone(),
-                driver: args.ray_driver.clone(),
+                driver,
                 sinew: std::env::current_exe()?,
                 manifest,
                 max_retries: args.max_retries,

@@ -3,6 +3,8 @@
 # and a second worker node on 127.0.0.1, one CPU each; sets $address) and check_loopback.
 
 ray="$here/.venv/bin/ray"
+# The Python `sinew batch --ray` runs its built-in driver with (its default is python3 on PATH).
+export SINEW_RAY_PYTHON="$here/.venv/bin/python"
 say() { echo "ray-batch: $*"; }
 skip() { say "skipped: $*"; exit 0; }
 fail() { echo "ray-batch: FAILED: $*" >&2; exit 1; }
