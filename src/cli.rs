@@ -10,6 +10,7 @@ mod choices;
 mod colorize;
 mod demo_assets;
 mod export_gltf;
+mod shell;
 mod target;
 
 use anyhow::{anyhow, bail, Context, Result};
@@ -77,6 +78,10 @@ pub enum Command {
     /// Open the editor window (rig, weigh and pose by hand).
     #[cfg(feature = "editor")]
     Edit(EditArgs),
+    /// Print the completion script of a shell (bash, zsh, fish, elvish, powershell).
+    Completions(shell::CompletionsArgs),
+    /// Print the man page sinew(1), or write a page per command into a folder (-o DIR).
+    Man(shell::ManArgs),
 }
 
 /// `sinew edit [RIG]`.
@@ -516,6 +521,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Colorize(args) => colorize::run(&args),
         Command::Batch(args) => batch::run(&args),
         Command::Schema(args) => print_schema(&args),
+        Command::Completions(args) => shell::completions(&args),
+        Command::Man(args) => shell::man(&args),
         #[cfg(feature = "editor")]
         Command::Edit(args) => edit(&args),
     }
