@@ -374,7 +374,7 @@ fn psd_merged_image_keeps_only_its_colour_channels() {
     )
     .unwrap_err();
     assert!(e.to_string().contains("65535 channels"), "{e}");
-    // Of 56 ZIP channels in a 30-byte file: 14 GiB reserved up front; now what it decodes.
+    // Of 56 ZIP channels in a 44-byte file: 14 GiB reserved up front; now what it decodes.
     let e = psd::parse(
         &merged_psd(16384, 16384, 56, 2, &[0x78, 0x9c, 0x03, 0x00]),
         &LayeredLimits::default(),
