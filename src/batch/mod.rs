@@ -59,6 +59,12 @@ pub enum BatchError {
         field: String,
         problem: crate::io::PathError,
     },
+    /// What is wrong with the manifest at `path` (its JSON, a job's fields, the plan).
+    #[error("{}: {source}", .path.display())]
+    InManifest {
+        path: PathBuf,
+        source: Box<BatchError>,
+    },
     /// The job itself failed.
     #[error(transparent)]
     Run(Box<crate::jobs::JobError>),
@@ -83,7 +89,15 @@ pub fn load(path: &Path) -> Result<Plan, BatchError> {
         path: path.clone(),
         source,
     })?;
-    let manifest = manifest::parse(&text)?;
+    // A refusal names the manifest, unless it names its file already.
+    let in_manifest = |e: BatchError| match e {
+        BatchError::Read { .. } | BatchError::Write { .. } | BatchError::Confined { .. } => e,
+        e => BatchError::InManifest {
+            path: path.clone(),
+            source: Box::new(e),
+        },
+    };
+    let manifest = manifest::parse(&text).map_err(in_manifest)?;
     // A path that leaves the manifest's folder is named with the manifest file.
     let plan =
         plan::plan(manifest, crate::io::outputs::parent_dir(&path)).map_err(|e| match e {
@@ -98,7 +112,7 @@ pub fn load(path: &Path) -> Result<Plan, BatchError> {
                 field,
                 problem,
             },
-            other => other,
+            other => in_manifest(other),
         })?;
     // No job may write over the manifest or its state.
     let state = record::state_path(&path);
@@ -106,13 +120,13 @@ pub fn load(path: &Path) -> Result<Plan, BatchError> {
         for output in job.outputs() {
             let output = plan::absolute(&plan.root, &output.path);
             if [&path, &state].iter().any(|p| p.starts_with(&output)) {
-                return Err(BatchError::Job(
+                return Err(in_manifest(BatchError::Job(
                     format!("job '{}'", job.name()),
                     format!(
                         "{}: the output would overwrite the manifest or its state",
                         output.display()
                     ),
-                ));
+                )));
             }
         }
     }

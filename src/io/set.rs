@@ -28,7 +28,7 @@
 
 use super::atomic::{
     create_new, file_name, keep_permissions, may_be_running, parent_or_dot,
-    remove_stale_temporaries_of, resolve_output, sync_files, sync_folder, temporary_sibling,
+    remove_stale_temporaries_of, resolve_output, sync_folder, sync_paths, temporary_sibling,
     write_new, OutputKind,
 };
 use std::fs;
@@ -40,9 +40,6 @@ use std::sync::Mutex;
 const JOURNAL_MAGIC: &[u8] = b"sinew-set 1\n";
 /// A journal's last line: present only in a journal written whole (a committed set).
 const JOURNAL_END: &[u8] = b"end\n";
-/// Most new files of a set held open before they are synced (well under the usual limit of
-/// 1,024 open files a process).
-const OPEN_AT_ONCE: usize = 256;
 /// Journals are named `.sinew-set.PID.N.journal`.
 const JOURNAL_PREFIX: &str = ".sinew-set.";
 const JOURNAL_SUFFIX: &str = ".journal";
@@ -80,26 +77,17 @@ pub fn write_set(files: &[(PathBuf, Vec<u8>)]) -> Result<(), (PathBuf, io::Error
             let _ = fs::remove_file(tmp);
         }
     };
-    // Written, given the permissions of what they replace, then synced together.
-    let mut open = Vec::with_capacity(files.len());
+    // Written and closed, given the permissions of what they replace, then synced together.
     let written = files
         .iter()
         .zip(&targets)
         .try_for_each(|((path, bytes), target)| {
             let tmp = temporary_sibling(target);
             temporaries.push(tmp.clone());
-            let file = create_new(&tmp, bytes).map_err(|e| (path.clone(), e))?;
-            open.push(file);
-            keep_permissions(target, &tmp).map_err(|e| (path.clone(), e))?;
-            if open.len() == OPEN_AT_ONCE {
-                // Synced in batches: thousands of open files would pass the process's limit.
-                sync_files(&open).map_err(|e| (path.clone(), e))?;
-                open.clear();
-            }
-            Ok(())
+            create_new(&tmp, bytes).map_err(|e| (path.clone(), e))?;
+            keep_permissions(target, &tmp).map_err(|e| (path.clone(), e))
         })
-        .and_then(|()| sync_files(&open).map_err(|e| (last_path.clone(), e)));
-    drop(open);
+        .and_then(|()| sync_paths(&temporaries).map_err(|e| (last_path.clone(), e)));
     if let Err(e) = written {
         remove_temporaries(&temporaries);
         return Err(e);
@@ -388,8 +376,8 @@ mod tests {
         let tmp = scratch("large");
         let dir = tmp.path();
         fs::create_dir(dir.join("parts")).unwrap();
-        // More files than are held open at once, in two folders: synced in batches.
-        let n = OPEN_AT_ONCE * 2 + 3;
+        // More files than a process may hold open (1,024 by default), in two folders.
+        let n: usize = 1_100;
         let files: Vec<(PathBuf, Vec<u8>)> = (0..n)
             .map(|i| {
                 let folder = if i % 2 == 0 {

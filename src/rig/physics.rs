@@ -107,12 +107,8 @@ pub const MAX_FORCED_OFFSET_PX: f64 = super::frames::MAX_POSED_PX / 4.0;
 pub const MAX_FORCED_SCALE: f64 = super::frames::MAX_POSED_SCALE / 4.0;
 
 /// A number as a message shows it: as written, or in exponent form when extreme.
-fn shown(x: f64) -> String {
-    if x.is_finite() && x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
+fn shown(x: f64) -> crate::shown::Shown {
+    crate::shown::Shown(x)
 }
 
 impl PhysicsConstraint {
@@ -248,10 +244,11 @@ impl PhysicsConstraint {
             if moved && offset_px > MAX_FORCED_OFFSET_PX {
                 return Err(format!(
                     "\"wind\"/\"gravity\" {} against \"strength\" {} hold the bone {} px away: \
-                     at most {MAX_FORCED_OFFSET_PX:e} px",
+                     at most {} px",
                     shown(force),
                     shown(self.strength),
-                    shown(offset_px)
+                    shown(offset_px),
+                    shown(MAX_FORCED_OFFSET_PX)
                 ));
             }
             let stretch = (self.wind.abs() + self.gravity.abs()) / self.strength;
