@@ -44,24 +44,36 @@ impl Art {
             .map(|&i| self.layers[i].path.as_path())
     }
 
+    /// The images of the layers from layered files as PNG files to write (path, bytes): what
+    /// [`Art::write_parts`] writes, or what a rig document is written with
+    /// ([`crate::io::PartImages::pending`]).
+    pub fn part_files(&self) -> Result<Vec<(PathBuf, Vec<u8>)>, ImageError> {
+        self.unwritten
+            .iter()
+            .map(|&i| {
+                let layer = &self.layers[i];
+                let bytes =
+                    io::image::encode_png(&layer.image).map_err(|e| ImageError::Encode {
+                        path: layer.path.clone(),
+                        reason: e.to_string(),
+                    })?;
+                Ok((layer.path.clone(), bytes))
+            })
+            .collect()
+    }
+
     /// Writes the images of the layers from layered files as one set (`io::atomic::write_set`:
     /// all written to temporaries, then renamed; a failure leaves none), creating their
     /// folders. Returns the paths written.
     pub fn write_parts(&self) -> Result<Vec<PathBuf>, ImageError> {
-        let mut files = Vec::with_capacity(self.unwritten.len());
-        for &i in &self.unwritten {
-            let layer = &self.layers[i];
-            let bytes = io::image::encode_png(&layer.image).map_err(|e| ImageError::Encode {
-                path: layer.path.clone(),
-                reason: e.to_string(),
-            })?;
-            if let Some(dir) = layer.path.parent() {
+        let files = self.part_files()?;
+        for (path, _) in &files {
+            if let Some(dir) = path.parent() {
                 std::fs::create_dir_all(dir).map_err(|source| ImageError::Write {
-                    path: layer.path.clone(),
+                    path: path.clone(),
                     source,
                 })?;
             }
-            files.push((layer.path.clone(), bytes));
         }
         io::atomic::write_set(&files)
             .map_err(|(path, source)| ImageError::Write { path, source })?;
@@ -74,39 +86,9 @@ pub fn is_layered(path: &Path) -> bool {
     LayeredFormat::of(path).is_some()
 }
 
-/// The image file of the part at `layer_path` (`arm_l/hand`) under `parts_dir`: each name of
-/// the path made a safe file name (characters other than letters, digits, `-`, `_`, `.` and
-/// space become `_`; `.` and `..` become `_`).
-pub fn part_image_path(parts_dir: &Path, layer_path: &str) -> PathBuf {
-    let mut out = parts_dir.to_path_buf();
-    let names: Vec<String> = layer_path
-        .split('/')
-        .map(|name| {
-            let safe: String = name
-                .chars()
-                .map(|c| {
-                    if c.is_alphanumeric() || "-_. ".contains(c) {
-                        c
-                    } else {
-                        '_'
-                    }
-                })
-                .collect();
-            match safe.trim() {
-                "" | "." | ".." => "_".to_string(),
-                s => s.to_string(),
-            }
-        })
-        .collect();
-    for (i, name) in names.iter().enumerate() {
-        if i + 1 == names.len() {
-            out.push(format!("{name}.png"));
-        } else {
-            out.push(name);
-        }
-    }
-    out
-}
+/// The image file of the part at `layer_path` under `parts_dir` (one definition, beside the
+/// rig document's self-contained writing).
+pub use crate::io::document::part_image_path;
 
 /// Loads PNG layers and layered files as the layers of one canvas (see the module docs).
 pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, PipelineError> {
@@ -166,22 +148,4 @@ pub fn load_art(paths: &[PathBuf], options: &ArtOptions) -> Result<Art, Pipeline
         unwritten,
         pivots,
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn part_paths_are_safe_file_names() {
-        let dir = Path::new("rig.parts");
-        assert_eq!(
-            part_image_path(dir, "arm_l/hand"),
-            dir.join("arm_l").join("hand.png")
-        );
-        assert_eq!(
-            part_image_path(dir, "../x:y/.."),
-            dir.join("_").join("x_y").join("_.png")
-        );
-    }
 }

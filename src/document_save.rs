@@ -61,9 +61,19 @@ impl SaveJob {
         &self.target
     }
 
-    /// Writes the snapshot to its file (atomically); returns where it went.
+    /// Writes the snapshot to its file (atomically and self-contained: layers' images outside
+    /// its folder are copied into `NAME.parts/` with it, and an image whose file is gone is
+    /// written from the layer held in memory); returns where it went.
     pub fn run(&self) -> Result<PathBuf, DocumentError> {
-        rig_document(&self.state, &self.target)?.save(&self.target)?;
+        let images = crate::io::PartImages {
+            pending: Vec::new(),
+            held: self.state.layers.iter().map(|l| Some(&l.image)).collect(),
+        };
+        rig_document(&self.state, &self.target)?.save_contained(
+            &self.target,
+            crate::io::JsonLayout::Compact,
+            images,
+        )?;
         Ok(self.target.clone())
     }
 }

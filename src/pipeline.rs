@@ -483,56 +483,19 @@ pub fn vertex_colors(layer: &Layer, vertices: &[Point]) -> Vec<[f64; 3]> {
         .collect()
 }
 
-/// `path` with its nearest existing ancestor resolved ([`std::fs::canonicalize`]: absolute,
-/// symbolic links followed) and the components below it appended; `None` when no ancestor
-/// resolves or a `..` follows a component that does not exist.
-fn resolved(path: &Path) -> Option<PathBuf> {
-    let mut missing = Vec::new();
-    let mut existing = path;
-    loop {
-        if let Ok(base) = std::fs::canonicalize(if existing.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            existing
-        }) {
-            let mut out = base;
-            for component in missing.iter().rev() {
-                match component {
-                    std::path::Component::Normal(name) => out.push(name),
-                    std::path::Component::CurDir => {}
-                    _ => return None,
-                }
-            }
-            return Some(out);
-        }
-        let component = existing.components().next_back()?;
-        missing.push(component);
-        existing = existing.parent()?;
-    }
-}
-
 /// `target` as a path relative to `dir` (with `/` separators) when both resolve; otherwise
 /// `target` as given. Either may not exist yet (a part image written with the document):
-/// its nearest existing folder is resolved and the rest appended.
+/// its nearest existing folder is resolved and the rest appended
+/// ([`crate::io::document::relative_to`]).
 pub fn relative_path(dir: &Path, target: &Path) -> String {
-    let (Some(dir), Some(target)) = (resolved(dir), resolved(target)) else {
-        return target.to_string_lossy().into_owned();
-    };
-    let common = dir
-        .components()
-        .zip(target.components())
-        .take_while(|(a, b)| a == b)
-        .count();
-    let ups = dir.components().count() - common;
-    let parts: Vec<String> = std::iter::repeat_n("..".to_string(), ups)
-        .chain(
-            target
-                .components()
-                .skip(common)
-                .map(|c| c.as_os_str().to_string_lossy().into_owned()),
-        )
-        .collect();
-    parts.join("/")
+    match crate::io::document::relative_to(dir, target) {
+        Some(rel) => rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect::<Vec<_>>()
+            .join("/"),
+        None => target.to_string_lossy().into_owned(),
+    }
 }
 
 /// For each weight column named in `columns`, whether its handle is in `locked` (a cage's

@@ -1,7 +1,7 @@
 //! Paths inside files are confined to the folder they are relative to (issue 44, item 3): a
-//! batch manifest's every path to the manifest's folder, a rig document's part images (when a
-//! batch reads it) to the manifest's folder, a Spine script's images to its JSON's folder, a
-//! rig document's images never absolute. `..` out of the folder, an absolute path and a
+//! batch manifest's every path to the manifest's folder, a rig document's part images to the
+//! rig's folder (a batch checks them before any job; tests/self_contained.rs has the other
+//! readers), a Spine script's images to its JSON's folder. `..` out of the folder, an absolute path and a
 //! symbolic link leading out are each refused before any work: one line naming the file, the
 //! field and the path as written, exit code 2, nothing written anywhere.
 
@@ -134,9 +134,14 @@ fn a_rig_a_batch_reads_may_not_name_images_outside_the_manifests_folder() {
         r#"{"bones":[{"name":"a","head":[32,45],"tail":[32,20]}]}"#,
         &[],
     );
-    // The rig in a subfolder names its image by `..` within the project: fine.
-    std::fs::create_dir_all(project.join("rigs")).unwrap();
-    doc["parts"][0]["image"] = json!("../critter.png");
+    // The rig in a subfolder names its image by a `..` that stays in the rig's folder: fine.
+    std::fs::create_dir_all(project.join("rigs/layers")).unwrap();
+    std::fs::copy(
+        project.join("critter.png"),
+        project.join("rigs/critter.png"),
+    )
+    .unwrap();
+    doc["parts"][0]["image"] = json!("layers/../critter.png");
     let inner = project.join("rigs/rig.json");
     std::fs::write(&inner, doc.to_string()).unwrap();
     std::fs::remove_file(&rig).unwrap();
@@ -153,14 +158,17 @@ fn a_rig_a_batch_reads_may_not_name_images_outside_the_manifests_folder() {
     );
     std::fs::remove_dir_all(project.join("spine")).unwrap();
     std::fs::remove_file(project.join("game.state.json")).unwrap();
-    // Out of the project by `..`, through a link, or absolute: refused, naming the rig.
+    // Out of the rig's folder by `..` (even within the project), out of the project, through
+    // a link, or absolute: refused before any job, naming the rig.
     common::critter(64)
         .save(tmp.path().join("outside/secret.png"))
         .unwrap();
+    std::os::unix::fs::symlink(tmp.path().join("outside"), project.join("rigs/away")).unwrap();
     for (image, problem) in [
+        ("../critter.png", "climbs out of"),
         ("../../outside/secret.png", "climbs out of"),
         ("../../../../../../etc/passwd", "climbs out of"),
-        ("../away/secret.png", "through a symbolic link"),
+        ("away/secret.png", "through a symbolic link"),
     ] {
         doc["parts"][0]["image"] = json!(image);
         std::fs::write(&inner, doc.to_string()).unwrap();

@@ -55,9 +55,10 @@ fn confine_job(job: &Job, root: &Path) -> Result<(), BatchError> {
     Ok(())
 }
 
-/// Refuses a part image of the rig document at `rig` (inside `root`, existing) that leaves
-/// `root`: a rig from elsewhere may name `../art/x.png` within the manifest's folder, not
-/// beyond it. A document that is not JSON or has no parts is left to the job to refuse.
+/// Refuses a part image of the rig document at `rig` (inside `root`, existing) that leaves the
+/// rig's own folder, as every reader of rig documents does ([`crate::io::document::confine_images`]),
+/// so the batch stops before any job. A document that is not JSON or has no parts is left to
+/// the job to refuse.
 fn confine_rig_images(job: &Job, rig: &Path, root: &Path) -> Result<(), BatchError> {
     let Ok(text) = std::fs::read_to_string(rig) else {
         return Ok(());
@@ -69,12 +70,13 @@ fn confine_rig_images(job: &Job, rig: &Path, root: &Path) -> Result<(), BatchErr
         .parent()
         .and_then(|f| f.strip_prefix(root).ok())
         .unwrap_or(Path::new(""));
+    let rig_root = root.join(folder);
     let parts = doc.get("parts").and_then(|p| p.as_array());
     for (i, part) in parts.into_iter().flatten().enumerate() {
         let Some(image) = part.get("image").and_then(|p| p.as_str()) else {
             continue;
         };
-        crate::io::confine::confined_from(root, folder, Path::new(image)).map_err(|problem| {
+        crate::io::confine::confined(&rig_root, Path::new(image)).map_err(|problem| {
             BatchError::Confined {
                 file: rig.to_path_buf(),
                 job: job.name().to_string(),

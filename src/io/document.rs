@@ -6,7 +6,6 @@
 //! [`Animation::from_json`]; against the rig: [`RigDocument::check_animations`]). Image paths are
 //! stored relative to the document's folder. Saving writes atomically.
 
-use super::atomic::write_atomic;
 use crate::anim::{AnimError, Animation};
 use crate::geom::Point;
 use crate::mesh::{Mesh, MeshOptions};
@@ -16,6 +15,12 @@ use crate::weights::WeightOptions;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+
+#[path = "document_parts.rs"]
+mod parts;
+pub use parts::{
+    confine_images, part_image_path, parts_folder, relative_to, resolved, PartImages, SavedRig,
+};
 
 /// The `format` field of every rig document.
 pub const RIG_FORMAT: &str = "sinew-rig";
@@ -270,6 +275,31 @@ pub enum DocumentError {
     Invalid { path: PathBuf, reason: String },
     #[error("{path}: {source}")]
     Animation { path: PathBuf, source: AnimError },
+    /// A part image that leaves the document's folder ([`confine_images`]).
+    #[error("{}: part '{part}' (parts[{index}].image): {problem}: {advice}", .path.display())]
+    Confined {
+        path: PathBuf,
+        part: String,
+        index: usize,
+        problem: crate::io::PathError,
+        /// What to do instead.
+        advice: String,
+    },
+    /// `RIG.parts/`, where images outside the folder are copied, itself leads out of it.
+    #[error("{}: cannot copy the images into the rig's folder: {problem}", .path.display())]
+    PartsFolder {
+        path: PathBuf,
+        problem: crate::io::PathError,
+    },
+    #[error("{}: cannot copy part '{part}''s image {} into the rig's folder: {source}", .path.display(), .from.display())]
+    CopyPart {
+        path: PathBuf,
+        part: String,
+        from: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: cannot encode the image: {reason}", .path.display())]
+    EncodePart { path: PathBuf, reason: String },
 }
 
 /// The `animations` map through [`crate::anim::animations_from_json`], whose messages name the
@@ -318,13 +348,16 @@ impl RigDocument {
         }
     }
 
-    /// Reads and checks the document at `path`.
+    /// Reads and checks the document at `path`; its part images must lie in its folder
+    /// ([`confine_images`]: no absolute path, no `..` out of it, no link leading out).
     pub fn load(path: &Path) -> Result<Self, DocumentError> {
         let text = std::fs::read_to_string(path).map_err(|source| DocumentError::Read {
             path: path.into(),
             source,
         })?;
-        Self::from_json(&text, path)
+        let doc = Self::from_json(&text, path)?;
+        confine_images(&doc, path)?;
+        Ok(doc)
     }
 
     /// Parses and checks a document; `path` only names it in errors.
@@ -384,35 +417,54 @@ impl RigDocument {
             path: path.into(),
             reason,
         })?;
-        // Image paths are relative to the document's folder: an absolute one is refused (a
-        // batch further confines them to its manifest's folder, `crate::batch::plan`).
-        for (i, part) in doc.parts.iter().enumerate() {
+        // Image paths are relative to the document's folder and stay in it: the names alone
+        // are checked here (empty, absolute, `..` out of the folder); `load` also follows the
+        // links ([`confine_images`]).
+        for (index, part) in doc.parts.iter().enumerate() {
             let image = Path::new(&part.image);
-            if image.as_os_str().is_empty() || image.has_root() {
-                return Err(DocumentError::Invalid {
+            let written = part.image.clone();
+            let root = path.parent().unwrap_or(Path::new("")).to_path_buf();
+            let problem = if image.as_os_str().is_empty() {
+                Some(crate::io::PathError::Empty { written })
+            } else if image.has_root() {
+                Some(crate::io::PathError::Absolute { written, root })
+            } else if parts::climbs_out(image) {
+                Some(crate::io::PathError::Climbs { written, root })
+            } else {
+                None
+            };
+            if let Some(problem) = problem {
+                return Err(DocumentError::Confined {
                     path: path.into(),
-                    reason: format!(
-                        "part '{}' (parts[{i}].image): \"{}\" is {}; a rig names its images relative to its folder",
-                        part.name,
-                        part.image,
-                        if image.has_root() { "absolute" } else { "empty" }
-                    ),
+                    part: part.name.clone(),
+                    index,
+                    problem,
+                    advice: parts::keep_inside(path),
                 });
             }
         }
         Ok(doc)
     }
 
-    /// Writes the document to `path` atomically, as compact JSON ([`JsonLayout::Compact`]).
+    /// Writes the document to `path` atomically and self-contained, as compact JSON
+    /// ([`JsonLayout::Compact`]; see [`RigDocument::save_contained`]).
     pub fn save(&self, path: &Path) -> Result<(), DocumentError> {
         self.save_with(path, JsonLayout::Compact)
     }
 
-    /// Writes the document to `path` atomically in `layout`. Weights are written at f32
-    /// precision (the shortest text that reads back as the weight's nearest f32): a row then
-    /// sums to one within 1e-7, well inside [`WEIGHT_TOLERANCE`]. The bundled character's
-    /// document is 1.3 MB this way (compact), against 5.7 MB pretty-printed with f64 weights.
+    /// Writes the document to `path` atomically and self-contained in `layout`: part images
+    /// outside the document's folder are copied into `RIG.parts/` with it
+    /// ([`RigDocument::save_contained`]). Weights are written at f32 precision (the shortest
+    /// text that reads back as the weight's nearest f32): a row then sums to one within 1e-7,
+    /// well inside [`WEIGHT_TOLERANCE`]. The bundled character's document is 1.3 MB this way
+    /// (compact), against 5.7 MB pretty-printed with f64 weights.
     pub fn save_with(&self, path: &Path, layout: JsonLayout) -> Result<(), DocumentError> {
+        self.save_contained(path, layout, PartImages::default())
+            .map(|_| ())
+    }
+
+    /// The document's JSON text in `layout`, ended by a newline.
+    fn to_text(&self, path: &Path, layout: JsonLayout) -> Result<String, DocumentError> {
         let json_error = |e: serde_json::Error| DocumentError::Json {
             path: path.into(),
             reason: e.to_string(),
@@ -422,10 +474,7 @@ impl RigDocument {
             JsonLayout::Pretty => serde_json::to_string_pretty(self).map_err(json_error)?,
         };
         text.push('\n');
-        write_atomic(path, text.as_bytes()).map_err(|source| DocumentError::Write {
-            path: path.into(),
-            source,
-        })
+        Ok(text)
     }
 
     /// Checks every animation against the handles and the parts: the names its timelines use,

@@ -13,8 +13,8 @@ pub mod slots;
 pub use atomic::write_atomic;
 pub use confine::{confined, PathError};
 pub use document::{
-    AutorigRecord, BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, RecordedTemplate,
-    RigDocument, RuntimeTarget, WeightsDoc,
+    AutorigRecord, BuildOptions, DocumentError, JsonLayout, MeshDoc, PartDoc, PartImages,
+    RecordedTemplate, RigDocument, RuntimeTarget, SavedRig, WeightsDoc,
 };
 pub use image::{load_png, save_png, ImageError};
 pub use slots::{Skin, Skins, SlotError};

@@ -138,8 +138,13 @@ pub fn rig_files(
         }
         None => None,
     };
-    art.write_parts()?;
-    doc.save_with(&files.output, files.layout)?;
+    // The document with its layered files' parts, and copies of the images outside its folder
+    // (`OUTPUT.parts/`), as one set: a rig names only files inside its folder.
+    let images = io::PartImages {
+        pending: art.part_files()?,
+        held: Vec::new(),
+    };
+    let doc = doc.save_contained(&files.output, files.layout, images)?.doc;
     if let (Some(path), Some(image)) = (&files.preview, preview) {
         io::save_png(path, &image)?;
     }
