@@ -42,8 +42,58 @@ use std::time::Instant;
     about = "2D cutout animation: trace, mesh, weigh, pose, render"
 )]
 pub struct Cli {
+    /// The most memory a command may allocate, e.g. 512MiB or 8GiB (default 2GiB, or the
+    /// SINEW_MEMORY_BUDGET environment variable); work beyond it is refused before it starts.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = parse_memory_budget)]
+    pub memory_budget: Option<sinew::budget::MemoryBudget>,
     #[command(subcommand)]
     pub command: Command,
+}
+
+/// Bounds the thread pool `RAYON_NUM_THREADS` asks for by the machine
+/// ([`sinew::budget::bounded_threads`]): a count such as 1000000 cannot start at all.
+fn bound_rayon_threads() {
+    let Some(asked) = std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|text| text.trim().parse::<usize>().ok())
+    else {
+        return;
+    };
+    let (threads, lowered) = sinew::budget::bounded_threads(asked);
+    if lowered {
+        eprintln!(
+            "sinew: note: RAYON_NUM_THREADS={asked}: this machine runs at most {threads} threads \
+             ({} per core); using {threads}",
+            sinew::budget::THREADS_PER_CORE
+        );
+        // Fails only when a pool was built already, which leaves that one.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global();
+    }
+}
+
+/// Parses `--memory-budget`.
+fn parse_memory_budget(text: &str) -> Result<sinew::budget::MemoryBudget, String> {
+    sinew::budget::MemoryBudget::parse(text).map_err(|e| e.to_string())
+}
+
+/// Sets the process's memory budget: `--memory-budget`, else `SINEW_MEMORY_BUDGET`, else the
+/// default ([`sinew::budget`]).
+fn set_memory_budget(flag: Option<sinew::budget::MemoryBudget>) -> Result<()> {
+    use sinew::budget::{MemoryBudget, MEMORY_BUDGET_ENV};
+    let budget = match (flag, std::env::var_os(MEMORY_BUDGET_ENV)) {
+        (Some(budget), _) => budget,
+        (None, None) => MemoryBudget::default(),
+        (None, Some(text)) => {
+            let text = text
+                .to_str()
+                .with_context(|| format!("{MEMORY_BUDGET_ENV} is not UTF-8"))?;
+            MemoryBudget::parse(text).with_context(|| MEMORY_BUDGET_ENV.to_string())?
+        }
+    };
+    sinew::budget::set_memory_budget(budget);
+    Ok(())
 }
 
 #[derive(Subcommand, Debug)]
@@ -401,6 +451,28 @@ pub enum Detail {
 }
 
 impl BuildArgs {
+    /// The options of the flags, checked: a value out of range is refused naming its flag.
+    fn checked_options(&self) -> Result<BuildOptions> {
+        let options = self.options();
+        let flag_of = |field: &'static str| match field {
+            "alpha_threshold" => "--alpha-threshold",
+            "padding_px" => "--padding",
+            "simplify_tolerance_px" => "--simplify",
+            "min_angle_deg" => "--min-angle",
+            "max_area_fraction" => "--max-area-fraction",
+            other => other,
+        };
+        if let Err(sinew::trace::TraceError::InvalidOption { field, rule }) =
+            sinew::trace::check_options(&options.trace)
+        {
+            anyhow::bail!("{} {rule}", flag_of(field));
+        }
+        if let Err(sinew::mesh::MeshError::InvalidOption { field, rule }) = options.mesh.check() {
+            anyhow::bail!("{} {rule}", flag_of(field));
+        }
+        Ok(options)
+    }
+
     fn options(&self) -> BuildOptions {
         let (mut trace, mut mesh) = match self.detail {
             Detail::Fine => (TraceOptions::default(), MeshOptions::default()),
@@ -500,6 +572,8 @@ pub struct DemoArgs {
 
 /// Runs one parsed command.
 pub fn run(cli: Cli) -> Result<()> {
+    set_memory_budget(cli.memory_budget)?;
+    bound_rayon_threads();
     match cli.command {
         Command::Rig(args) => rig(&args),
         Command::Pose(args) => pose(&args),
@@ -640,7 +714,8 @@ fn rig(args: &RigArgs) -> Result<()> {
     if let Ok(style) = indicatif::ProgressStyle::with_template("rigging: {pos} parts done {msg}") {
         bar.set_style(style);
     }
-    let done = sinew::jobs::rig_files(&files, &args.build.options(), &mut |done, name| {
+    let options = args.build.checked_options()?;
+    let done = sinew::jobs::rig_files(&files, &options, &mut |done, name| {
         bar.set_position(done as u64);
         bar.set_message(name.to_string());
     });
@@ -696,6 +771,9 @@ fn pose(args: &PoseArgs) -> Result<()> {
             .chain(images.iter().map(PathBuf::as_path)),
         [args.output.as_deref(), args.vertices.as_deref()],
     )?;
+    if args.output.is_some() {
+        playback::check_pose_memory(scene.doc.canvas)?;
+    }
     let (pose, transforms) = match (&args.pose, &args.anim) {
         (Some(path), _) => {
             let pose: Pose = read_json(path, "pose file")?;

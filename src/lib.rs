@@ -10,6 +10,7 @@ pub mod anim;
 pub mod art;
 pub mod autorig;
 pub mod batch;
+pub mod budget;
 pub mod colorize;
 pub mod document;
 #[cfg(feature = "editor")]

@@ -258,25 +258,32 @@ pub fn run(
 }
 
 /// Runs jobs on this machine: each on a pool of `threads` threads (the jobs' own parallel
-/// stages share the pool).
+/// stages share the pool), at most [`crate::budget::max_threads`]; the jobs running at once
+/// share the memory budget ([`crate::budget`]) equally.
 pub struct LocalExecutor<'a> {
     plan: &'a Plan,
     pool: rayon::ThreadPool,
+    /// Each job's share of the memory budget.
+    budget: crate::budget::MemoryBudget,
     sender: std::sync::mpsc::Sender<(usize, Result<(), String>, f64)>,
     receiver: std::sync::mpsc::Receiver<(usize, Result<(), String>, f64)>,
 }
 
 impl<'a> LocalExecutor<'a> {
-    /// `threads`: 0 = one per core.
+    /// `threads`: 0 = one per core; more than [`crate::budget::max_threads`] run as that many.
     pub fn new(plan: &'a Plan, threads: usize) -> Result<Self, BatchError> {
+        let (threads, _) = crate::budget::bounded_threads(threads);
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| BatchError::Executor(e.to_string()))?;
+        let at_once = pool.current_num_threads().min(plan.jobs.len());
+        let budget = crate::budget::memory_budget().share(at_once);
         let (sender, receiver) = std::sync::mpsc::channel();
         Ok(LocalExecutor {
             plan,
             pool,
+            budget,
             sender,
             receiver,
         })
@@ -288,10 +295,12 @@ impl Executor for LocalExecutor<'_> {
         let job = self.plan.jobs[index].clone();
         let root = self.plan.root.clone();
         let sender = self.sender.clone();
+        let budget = self.budget;
         self.pool.spawn(move || {
             let started = Instant::now();
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                run_job(&job, &root).map_err(|e| one_line(&e))
+                crate::budget::with_memory_budget(budget, || run_job(&job, &root))
+                    .map_err(|e| one_line(&e))
             }))
             .unwrap_or_else(|_| Err("the job panicked (a bug in sinew)".into()));
             let _ = sender.send((index, result, started.elapsed().as_secs_f64()));

@@ -12,7 +12,8 @@ pub struct BatchArgs {
     /// The manifest: jobs with their inputs, options and outputs (see docs/formats.md, "Batch
     /// manifest"). Its state is kept beside it (NAME.state.json).
     pub manifest: PathBuf,
-    /// Jobs run at once on this machine (0 = one per core).
+    /// Jobs run at once on this machine (0 = one per core; at most 4 per core, more run as
+    /// that many). They share the memory budget (--memory-budget) equally.
     #[arg(long, value_name = "N", default_value_t = 0, conflicts_with = "ray")]
     pub jobs: usize,
     /// Run each job as a task on the Ray cluster at this address (HOST:PORT of its head),
@@ -63,7 +64,16 @@ pub fn run(args: &BatchArgs) -> Result<()> {
     };
     let report = match &args.ray {
         None => {
-            let mut executor = LocalExecutor::new(&plan, args.jobs)?;
+            let (jobs, lowered) = sinew::budget::bounded_threads(args.jobs);
+            if lowered {
+                eprintln!(
+                    "sinew: note: --jobs {}: this machine runs at most {jobs} threads ({} per \
+                     core); running {jobs} jobs at once",
+                    args.jobs,
+                    sinew::budget::THREADS_PER_CORE
+                );
+            }
+            let mut executor = LocalExecutor::new(&plan, jobs)?;
             batch::run(&plan, &state, &mut executor, &mut on_job)
         }
         Some(address) => {

@@ -34,12 +34,15 @@ pub const MIN_FPS: f64 = 0.1;
 /// Most frames one animation may play as (duration × fps): beyond, a typo'd key time (1e6 s)
 /// would allocate and render for ever.
 pub const MAX_FRAMES: f64 = 100_000.0;
-/// Largest output frame side, px.
+/// Largest output frame side, px. Whether frames of a size may be drawn at all is the memory
+/// budget's to say ([`crate::budget`]): [`render_animation`] holds every frame, renders written
+/// to files ([`write_animation`]) as many at once as the budget allows.
 pub const MAX_FRAME_SIDE_PX: u32 = 16_384;
-/// Most memory [`render_animation`] may hold in frames (it returns them all), bytes: 8 GiB,
-/// a third of the reference machine's memory. Renders written to files stream instead
-/// ([`write_animation`]) and have no such cap.
-pub const MAX_RENDER_BYTES: f64 = 8.0 * 1024.0 * 1024.0 * 1024.0;
+/// Bytes per px of drawing one pose and saving it as a PNG (`sinew pose -o`): the straight
+/// frame (4), the premultiplied pixmap and the coverage scratch while drawing
+/// ([`crate::budget::DRAW_BYTES_PER_PX`]), or the encoded PNG (at most about 4) after.
+pub const POSE_BYTES_PER_PX: u64 =
+    crate::budget::FRAME_BYTES_PER_PX + crate::budget::DRAW_BYTES_PER_PX;
 
 /// Where frames are drawn: an output of `size_px`, the canvas scaled by `scale` about its
 /// center and centered in it, over `background` (straight RGBA8; transparent when `None`).
@@ -254,16 +257,9 @@ pub enum PlaybackError {
         "the animation would play as {0:.3e} frames (duration × frame rate): at most {MAX_FRAMES}"
     )]
     TooManyFrames(f64),
-    #[error(
-        "the render would hold {frames} frames of {width}×{height} px, {gib:.1} GiB: at most 8 \
-         GiB (lower the frame rate, the scale or the duration)"
-    )]
-    TooMuchMemory {
-        frames: usize,
-        width: u32,
-        height: u32,
-        gib: f64,
-    },
+    /// More than the memory budget would be allocated ([`crate::budget`]).
+    #[error(transparent)]
+    Budget(#[from] crate::budget::BudgetError),
 }
 
 impl FrameView {
@@ -328,18 +324,35 @@ pub fn frame_times(duration_s: f64, fps: f64) -> Result<Vec<f64>, PlaybackError>
     Ok((0..count as usize).map(|i| i as f64 / fps).collect())
 }
 
-/// Fails when `frames` frames of `view`'s size would take more than [`MAX_RENDER_BYTES`].
+/// Fails when holding `frames` frames of `view`'s size, while the pool's threads draw them
+/// ([`render_animation`]), is over the memory budget in force ([`crate::budget`]).
 pub fn check_render_memory(frames: usize, view: &FrameView) -> Result<(), PlaybackError> {
-    let [width, height] = view.size_px;
-    let bytes = frames as f64 * f64::from(width) * f64::from(height) * 4.0;
-    if bytes > MAX_RENDER_BYTES {
-        return Err(PlaybackError::TooMuchMemory {
-            frames,
-            width,
-            height,
-            gib: bytes / (1024.0 * 1024.0 * 1024.0),
-        });
-    }
+    use crate::budget::{px_bytes, FrameCost, DRAW_BYTES_PER_PX, FRAME_BYTES_PER_PX};
+    let size = (view.size_px[0], view.size_px[1]);
+    let cost = FrameCost {
+        fixed_bytes: 0,
+        per_frame_bytes: px_bytes(size, FRAME_BYTES_PER_PX),
+        per_thread_bytes: px_bytes(size, DRAW_BYTES_PER_PX),
+        threads: rayon::current_num_threads(),
+    };
+    crate::budget::memory_budget().check(cost.peak_bytes(frames), || {
+        format!(
+            "a render holding {frames} frames of {}×{} px (lower the frame rate, the scale or \
+             the duration)",
+            size.0, size.1
+        )
+    })?;
+    Ok(())
+}
+
+/// Fails when drawing one frame of `size_px` and saving it as a PNG ([`POSE_BYTES_PER_PX`];
+/// `sinew pose -o`) is over the memory budget in force.
+pub fn check_pose_memory(size_px: [u32; 2]) -> Result<(), PlaybackError> {
+    let size = (size_px[0], size_px[1]);
+    let need = crate::budget::px_bytes(size, POSE_BYTES_PER_PX);
+    crate::budget::memory_budget().check(need, || {
+        format!("a {}×{} px pose drawn and saved", size.0, size.1)
+    })?;
     Ok(())
 }
 
@@ -650,11 +663,35 @@ mod tests {
             Err(PlaybackError::TooLarge(..))
         ));
         let view = FrameView::new([64, 64], 1.0, Some([4096, 4096]), None).unwrap();
-        assert!(check_render_memory(128, &view).is_ok());
-        assert!(matches!(
-            check_render_memory(129, &view),
-            Err(PlaybackError::TooMuchMemory { frames: 129, .. })
-        ));
+        // 64 MiB frames, 144 MiB per drawing thread: 20 frames and 4 threads take 1856 MiB.
+        let budget = crate::budget::MemoryBudget {
+            bytes: 1856 * crate::budget::MIB,
+        };
+        let four = rayon::ThreadPoolBuilder::new()
+            .num_threads(4)
+            .build()
+            .unwrap();
+        four.install(|| {
+            crate::budget::with_memory_budget(budget, || {
+                assert!(check_render_memory(20, &view).is_ok());
+                let err = check_render_memory(21, &view).unwrap_err();
+                assert!(
+                    matches!(
+                        err,
+                        PlaybackError::Budget(crate::budget::BudgetError::OverBudget { .. })
+                    ),
+                    "{err}"
+                );
+                assert!(err.to_string().contains("--memory-budget"), "{err}");
+            })
+        });
+        let small = crate::budget::MemoryBudget {
+            bytes: 64 * crate::budget::MIB,
+        };
+        crate::budget::with_memory_budget(small, || {
+            assert!(check_pose_memory([4096, 4096]).is_err());
+            assert!(check_pose_memory([2048, 2048]).is_ok());
+        });
     }
 
     #[test]

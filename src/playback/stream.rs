@@ -5,7 +5,8 @@
 //! [`AnimationFrames`], the [`FrameSource`] of its frames at [`frame_times`]: each chunk posed
 //! by the one pose path ([`crate::scene::Playhead`], or the export as Spine's runtime plays it)
 //! and drawn by the one draw ([`render_frames`]); and [`write_animation`], which writes them
-//! with the animation's events to a frame folder, a GIF or a sprite sheet.
+//! with the animation's events to a frame folder, a GIF or a sprite sheet, as many frames at
+//! once as the memory budget allows ([`crate::budget`]; the output does not depend on it).
 
 use super::{
     frame_times, render_events, render_frames, BakedRuntime, FrameView, RenderAnimationError,
@@ -207,6 +208,10 @@ impl FrameSource for AnimationFrames<'_> {
 
     fn frame_size_px(&self) -> (u32, u32) {
         (self.view.size_px[0], self.view.size_px[1])
+    }
+
+    fn draw_bytes_per_thread(&self) -> u64 {
+        crate::budget::px_bytes(self.frame_size_px(), crate::budget::DRAW_BYTES_PER_PX)
     }
 
     fn draw(&self, range: Range<usize>) -> Result<Vec<Cow<'_, RgbaImage>>, SequenceError> {

@@ -14,7 +14,9 @@
 //! subfolders are moved over right after it. A temporary folder left by a killed run is tidied by
 //! the next run into the same folder (its frames removed, anything else moved back).
 
-use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
+use super::source::{
+    check_chunk, chunks, first_frame_size, frames_in_flight, FrameSource, WriterCost,
+};
 use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::io::atomic::{
     exchange_folders, resolve_output, stale_temporaries, temporary_sibling, write_new, OutputKind,
@@ -57,6 +59,12 @@ pub fn write_folder<S: FrameSource + ?Sized>(
     let size = first_frame_size(frames)?;
     check_fps(fps)?;
     let count = frames.frame_count();
+    // Each thread compressing a frame holds its PNG: at most about the frame's size.
+    let encoding = WriterCost {
+        per_thread_bytes: crate::budget::px_bytes(size, crate::budget::FRAME_BYTES_PER_PX),
+        ..WriterCost::default()
+    };
+    let in_flight = frames_in_flight(frames, encoding, "numbered PNGs")?;
     let target = resolve_output(dir, OutputKind::Folder).map_err(write_error(dir))?;
     if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
         fs::create_dir_all(parent).map_err(write_error(parent))?;
@@ -68,7 +76,7 @@ pub fn write_folder<S: FrameSource + ?Sized>(
     let names: Vec<String> = (0..count).map(|i| frame_file_name(i, digits)).collect();
     let staging = temporary_sibling(&target);
     fs::create_dir(&staging).map_err(write_error(&staging))?;
-    let result = fill_and_swap(frames, size, &names, &staging, &target);
+    let result = fill_and_swap(frames, size, in_flight, &names, &staging, &target);
     if result.is_err() {
         // Before the swap the staging folder holds only new frames and links; after a failed
         // swap the same. Nothing of the user's is in it.
@@ -92,14 +100,15 @@ pub fn write_folder<S: FrameSource + ?Sized>(
 fn fill_and_swap<S: FrameSource + ?Sized>(
     frames: &S,
     size: (u32, u32),
+    in_flight: usize,
     names: &[String],
     staging: &Path,
     target: &Path,
 ) -> Result<Vec<String>, SequenceError> {
-    // A chunk at a time (bounded memory). PNG compression dominates; frames are independent.
-    // Results are gathered in frame order so the error reported (the first frame's) does not
-    // depend on scheduling.
-    for range in chunks(frames.frame_count()) {
+    // A chunk of `in_flight` frames at a time (bounded memory). PNG compression dominates;
+    // frames are independent. Results are gathered in frame order so the error reported (the
+    // first frame's) does not depend on scheduling.
+    for range in chunks(frames.frame_count(), in_flight) {
         let drawn = frames.draw(range.clone())?;
         check_chunk(&drawn, range.start, size)?;
         let results: Vec<Result<(), SequenceError>> = drawn

@@ -21,7 +21,9 @@
 //!   its visible pixels, which saves the transparent margins' bytes.
 
 use super::palette::{pack_rgb, quantize, Histogram};
-use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
+use super::source::{
+    check_chunk, chunks, first_frame_size, frame_cost, frames_in_flight, FrameSource, WriterCost,
+};
 use super::timing::{frame_durations, GIF_TICKS_PER_S};
 use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::io::atomic::write_atomic;
@@ -119,14 +121,26 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
     let visible = |px: &image::Rgba<u8>| px[3] >= threshold;
     let count = frames.frame_count();
 
-    // Pass 1: the histogram of every frame's visible colours, pooled chunk by chunk.
+    // What the two passes hold, within the memory budget (the frames in flight are chosen
+    // for it; frames are kept for the second pass only where that still fits).
     let frame_bytes = u64::from(width) * u64::from(height) * 4;
-    let keep = !frames.in_memory()
-        && (count as u64).saturating_mul(frame_bytes)
-            <= options.keep_frames_mib.saturating_mul(1024 * 1024);
+    let kept_bytes = (count as u64).saturating_mul(frame_bytes);
+    let mut keep =
+        !frames.in_memory() && kept_bytes <= options.keep_frames_mib.saturating_mul(1024 * 1024);
+    let cost = |keep: bool| gif_cost((width, height), if keep { kept_bytes } else { 0 });
+    let in_flight = match frames_in_flight(frames, cost(keep), "a GIF") {
+        Err(_) if keep => {
+            keep = false;
+            frames_in_flight(frames, cost(false), "a GIF")?
+        }
+        other => other?,
+    };
+    let in_flight_bytes = frame_cost(frames, cost(keep)).peak_bytes(in_flight);
+
+    // Pass 1: the histogram of every frame's visible colours, pooled chunk by chunk.
     let mut kept: Vec<RgbaImage> = Vec::new();
     let mut histogram = Histogram::default();
-    for range in chunks(count) {
+    for range in chunks(count, in_flight) {
         let drawn = frames.draw(range.clone())?;
         check_chunk(&drawn, range.start, (width, height))?;
         let part = Histogram::from_frames(
@@ -141,6 +155,17 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
                 .collect(),
         );
         histogram = histogram.merge(&part);
+        // The histogram's size is known only as it grows: checked with the chunk's frames.
+        let need = in_flight_bytes.saturating_add(
+            (histogram.colours.len() as u64).saturating_mul(HISTOGRAM_BYTES_PER_COLOUR),
+        );
+        crate::budget::memory_budget().check(need, || {
+            format!(
+                "a GIF of {count} frames of {width}×{height} px ({} colours by frame {})",
+                histogram.colours.len(),
+                range.end
+            )
+        })?;
         if keep {
             kept.extend(drawn.into_iter().map(Cow::into_owned));
         }
@@ -157,6 +182,8 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
     for (&colour, &i) in histogram.colours.iter().zip(&quantized.index_of_colour) {
         index_of[colour as usize] = i + 1;
     }
+    let palette_colours = quantized.palette.len();
+    drop((histogram, quantized));
 
     let delays_cs: Vec<u16> = frame_durations(count, fps, GIF_TICKS_PER_S)
         .into_iter()
@@ -200,7 +227,9 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
         gif_frame
     };
     let mut encoded_frames: Vec<Frame<'static>> = Vec::with_capacity(count);
-    for range in chunks(count) {
+    let mut encoded_bytes = 0u64;
+    for range in chunks(count, in_flight) {
+        let done = range.clone();
         let delays = &delays_cs[range.clone()];
         if keep {
             encoded_frames.par_extend(
@@ -219,6 +248,20 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
                     .map(|(f, &d)| encode_frame(f, d)),
             );
         }
+        // The compressed frames stay until the file is assembled from them (a second copy):
+        // their size is known only now, so they are checked as they come.
+        encoded_bytes = encoded_frames[done.clone()]
+            .iter()
+            .map(|f| f.buffer.len() as u64)
+            .fold(encoded_bytes, u64::saturating_add);
+        let need = in_flight_bytes.saturating_add(encoded_bytes.saturating_mul(2));
+        crate::budget::memory_budget().check(need, || {
+            format!(
+                "a GIF of {count} frames of {width}×{height} px (compressed: {} by frame {})",
+                crate::budget::format_bytes(encoded_bytes),
+                done.end
+            )
+        })?;
     }
 
     let mut bytes = Vec::new();
@@ -237,10 +280,34 @@ pub fn encode_gif<S: FrameSource + ?Sized>(
     }
     Ok(EncodedGif {
         bytes,
-        palette_colours: quantized.palette.len(),
+        palette_colours,
         delays_cs,
         size_px: (width, height),
     })
+}
+
+/// Distinct colours a frame may have at most (24-bit RGB).
+const MAX_COLOURS: u64 = 1 << 24;
+/// Bytes per distinct colour of the pooled histogram while pass 1 merges into it and the
+/// quantizer reads it: colour and count (12), the merge's copy (12), the quantizer's work (8).
+const HISTOGRAM_BYTES_PER_COLOUR: u64 = 32;
+
+/// What [`encode_gif`] holds for frames of `size_px` besides the frames themselves, bytes
+/// (upper bounds): fixed, the colour-to-index table (16 MiB) and `kept_bytes` of frames kept
+/// for the second pass; per frame of pass 1, its list of visible colours (4 B/px) and its and
+/// the chunk's runs (12 B per distinct colour, twice); per thread of pass 2, the frame's
+/// palette indices, their cropped copy and the compressed frame (1 + 1 + 1.5 B/px). The
+/// pooled histogram and the compressed frames, whose sizes are known only as they grow, are
+/// checked as they do.
+fn gif_cost(size_px: (u32, u32), kept_bytes: u64) -> WriterCost {
+    let px = u64::from(size_px.0) * u64::from(size_px.1);
+    WriterCost {
+        fixed_bytes: MAX_COLOURS.saturating_add(kept_bytes),
+        per_frame_bytes: px
+            .saturating_mul(4)
+            .saturating_add(px.min(MAX_COLOURS).saturating_mul(24)),
+        per_thread_bytes: px.saturating_mul(7) / 2,
+    }
 }
 
 /// An encoding failure before there is a path to blame: reported against the GIF being built.

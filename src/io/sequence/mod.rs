@@ -4,7 +4,8 @@
 //! `render::rgba_from_pixmap` makes of the renderer's premultiplied pixmaps), and the frame rate
 //! in frames per second. The frames come from a [`FrameSource`]: frames in memory, or an
 //! animation drawn as the writers pull it, a chunk at a time, so a render of any length is
-//! written in bounded memory. Out, chosen by the target path:
+//! written in bounded memory: within the memory budget ([`crate::budget`]), which sets how many
+//! frames a chunk holds and refuses, before drawing, what does not fit. Out, chosen by the target path:
 //!
 //! - an existing folder, or a path without extension: numbered PNGs `frame_0000.png`, … ([`folder`]);
 //! - `NAME.gif`: an animated GIF looping forever, one global palette ([`gif`]);
@@ -28,7 +29,7 @@ pub use background::{composite_over_background, parse_rgba_hex};
 pub use folder::write_folder;
 pub use gif::{encode_gif, write_gif, GifOptions};
 pub use sheet::{build_sheet, write_sheet, FrameNaming, SheetOptions};
-pub use source::{FrameSource, STREAM_CHUNK_FRAMES};
+pub use source::{frames_in_flight, FrameSource, WriterCost, STREAM_CHUNK_FRAMES};
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -84,6 +85,9 @@ pub enum SequenceError {
     /// Drawing the frames failed (posing or rendering them as they were asked for).
     #[error("{0}")]
     Draw(String),
+    /// Not even one frame, or what the format must hold, fits in the memory budget.
+    #[error(transparent)]
+    Budget(#[from] crate::budget::BudgetError),
 }
 
 /// The kind of file(s) a target path asks for.

@@ -31,7 +31,9 @@
 //! for a frame that fires none.
 
 use super::folder::digits_for;
-use super::source::{check_chunk, chunks, first_frame_size, FrameSource};
+use super::source::{
+    check_chunk, chunks, first_frame_size, frames_in_flight, FrameSource, WriterCost,
+};
 use super::timing::{frame_durations, MS_PER_S};
 use super::{check_fps, write_error, SequenceError, SequenceFormat, SequenceReport};
 use crate::anim::FiredEvent;
@@ -172,8 +174,21 @@ pub fn build_sheet<S: FrameSource + ?Sized>(
     let mut regions: Vec<RgbaImage> = Vec::new();
     let mut by_hash: HashMap<u64, Vec<usize>> = HashMap::new();
     let max_area = u64::from(options.max_side_px).pow(2);
+    // Held whatever the frames in flight: the stored regions (at most the sheet's area before
+    // they are refused), the sheet and its PNG, 4 B/px each; per frame, its trimmed copy.
+    let sheet_px = max_area.min(
+        u64::from(width)
+            .saturating_mul(u64::from(height))
+            .saturating_mul(count as u64),
+    );
+    let holding = WriterCost {
+        fixed_bytes: sheet_px.saturating_mul(12),
+        per_frame_bytes: crate::budget::px_bytes((width, height), 4),
+        per_thread_bytes: 0,
+    };
+    let in_flight = frames_in_flight(frames, holding, "a sprite sheet")?;
     let mut area = 0u64;
-    for range in chunks(count) {
+    for range in chunks(count, in_flight) {
         let drawn = frames.draw(range.clone())?;
         check_chunk(&drawn, range.start, (width, height))?;
         let boxes: Vec<PxRect> = drawn

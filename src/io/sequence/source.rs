@@ -3,8 +3,9 @@
 //! In: a [`FrameSource`], anything that can draw frames `range` of a sequence of same-size
 //! straight-alpha RGBA8 frames (frames already in memory, or an animation posed and drawn as
 //! they are asked for, see [`crate::playback::AnimationFrames`]). Out: the frames in chunks of
-//! [`STREAM_CHUNK_FRAMES`], in order, so a writer holds one chunk at a time and a render of any
-//! length runs in bounded memory.
+//! at most [`STREAM_CHUNK_FRAMES`], in order, so a writer holds one chunk at a time and a render
+//! of any length runs in bounded memory; [`frames_in_flight`] makes the chunks as small as the
+//! memory budget ([`crate::budget`]) needs, and refuses frames of which not even one fits.
 
 use super::SequenceError;
 use image::RgbaImage;
@@ -29,6 +30,12 @@ pub trait FrameSource: Sync {
     /// reads them twice need not keep copies). Default false.
     fn in_memory(&self) -> bool {
         false
+    }
+    /// Bytes a thread allocates to draw one frame besides the frame it returns (and may keep
+    /// for its next one): [`crate::budget::DRAW_BYTES_PER_PX`] per px for a rendered frame.
+    /// Default 0 (frames already drawn).
+    fn draw_bytes_per_thread(&self) -> u64 {
+        0
     }
 }
 
@@ -68,11 +75,70 @@ impl FrameSource for Vec<RgbaImage> {
     }
 }
 
-/// The chunks `0..count` is pulled in: [`STREAM_CHUNK_FRAMES`] frames each, the last shorter.
-pub fn chunks(count: usize) -> impl Iterator<Item = Range<usize>> {
+/// The chunks `0..count` is pulled in: `chunk_frames` frames each (at least one), the last
+/// shorter.
+pub fn chunks(count: usize, chunk_frames: usize) -> impl Iterator<Item = Range<usize>> {
+    let chunk_frames = chunk_frames.max(1);
     (0..count)
-        .step_by(STREAM_CHUNK_FRAMES)
-        .map(move |start| start..(start + STREAM_CHUNK_FRAMES).min(count))
+        .step_by(chunk_frames)
+        .map(move |start| start..(start + chunk_frames).min(count))
+}
+
+/// What a writer holds besides the frames themselves (see [`frames_in_flight`]), bytes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WriterCost {
+    /// Held whatever the number of frames in flight (a palette table, a sheet).
+    pub fixed_bytes: u64,
+    /// Held per frame in flight besides the frame (a colour list, a trimmed copy).
+    pub per_frame_bytes: u64,
+    /// Allocated per thread busy with a frame (an encoded PNG).
+    pub per_thread_bytes: u64,
+}
+
+/// What a writer with `cost` holds with frames of `source` in flight: each frame drawn (4 B/px
+/// unless the source holds it already), each drawing thread's pixmap and scratch
+/// ([`FrameSource::draw_bytes_per_thread`]) and the writer's own, on the current thread pool.
+pub fn frame_cost<S: FrameSource + ?Sized>(
+    source: &S,
+    cost: WriterCost,
+) -> crate::budget::FrameCost {
+    use crate::budget::{px_bytes, FRAME_BYTES_PER_PX};
+    let held = if source.in_memory() {
+        0
+    } else {
+        px_bytes(source.frame_size_px(), FRAME_BYTES_PER_PX)
+    };
+    crate::budget::FrameCost {
+        fixed_bytes: cost.fixed_bytes,
+        per_frame_bytes: held.saturating_add(cost.per_frame_bytes),
+        per_thread_bytes: source
+            .draw_bytes_per_thread()
+            .saturating_add(cost.per_thread_bytes),
+        threads: rayon::current_num_threads(),
+    }
+}
+
+/// How many frames of `source` a writer with `cost` may draw and hold at once: at most
+/// [`STREAM_CHUNK_FRAMES`], as many as the memory budget in force allows
+/// ([`crate::budget::memory_budget`]) — each frame drawn (4 B/px unless the source holds it
+/// already), each drawing thread's pixmap and scratch, the writer's own. Fails before anything
+/// is drawn when not even one frame fits; `writing` names the output ("numbered PNGs").
+/// The output does not depend on the chunk size.
+pub fn frames_in_flight<S: FrameSource + ?Sized>(
+    source: &S,
+    cost: WriterCost,
+    writing: &str,
+) -> Result<usize, SequenceError> {
+    let size = source.frame_size_px();
+    let max = STREAM_CHUNK_FRAMES.min(source.frame_count().max(1));
+    let budget = crate::budget::memory_budget();
+    let in_flight = budget.frames_in_flight(&frame_cost(source, cost), max, || {
+        format!(
+            "a {}×{} px frame drawn and written as {writing}",
+            size.0, size.1
+        )
+    })?;
+    Ok(in_flight)
 }
 
 /// Checks the frames of one chunk (starting at frame `first`) against the sequence's size
@@ -128,8 +194,8 @@ mod tests {
 
     #[test]
     fn chunks_cover_every_frame_once_in_order() {
-        assert_eq!(chunks(0).count(), 0);
-        let c: Vec<_> = chunks(2 * STREAM_CHUNK_FRAMES + 3).collect();
+        assert_eq!(chunks(0, STREAM_CHUNK_FRAMES).count(), 0);
+        let c: Vec<_> = chunks(2 * STREAM_CHUNK_FRAMES + 3, STREAM_CHUNK_FRAMES).collect();
         assert_eq!(
             c,
             vec![
@@ -138,6 +204,9 @@ mod tests {
                 2 * STREAM_CHUNK_FRAMES..2 * STREAM_CHUNK_FRAMES + 3
             ]
         );
+        let c: Vec<_> = chunks(5, 2).collect();
+        assert_eq!(c, vec![0..2, 2..4, 4..5]);
+        assert_eq!(chunks(2, 0).count(), 2);
     }
 
     #[test]
