@@ -109,7 +109,7 @@ fn a_scale_that_rounds_the_frame_to_nothing_is_refused() {
             "-o",
             s(&gif),
         ],
-        "smaller than 1 px a side: use a scale of at least 1.5625e-2",
+        "smaller than 1 px a side: use a scale of at least 0.015625",
     );
     assert!(!gif.exists());
 }

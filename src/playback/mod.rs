@@ -17,6 +17,7 @@ use crate::pipeline::{PipelineError, Scene};
 use crate::render;
 use crate::rig::{Handles, Pose};
 use crate::scene::{Frame, PlayOptions};
+use crate::shown::Shown;
 use crate::skin::Blend;
 use image::RgbaImage;
 use rayon::prelude::*;
@@ -232,14 +233,16 @@ pub const MIN_SCALED_SIDE_PX: f64 = 1.0;
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum PlaybackError {
     #[error(
-        "the frame rate must be a number in [{MIN_FPS}, {MAX_FPS}] frames per second, not {0:e}"
+        "the frame rate must be a number in [{MIN_FPS}, {MAX_FPS}] frames per second, not {}",
+        Shown(*.0)
     )]
     Fps(f64),
-    #[error("the scale must be a positive number, not {0}")]
+    #[error("the scale must be a positive number, not {}", Shown(*.0))]
     Scale(f64),
     #[error(
-        "the scale {scale:e} draws the {}×{} px canvas smaller than {MIN_SCALED_SIDE_PX} px a \
-         side: use a scale of at least {min_scale:e}", canvas[0], canvas[1]
+        "the scale {} draws the {}×{} px canvas smaller than {MIN_SCALED_SIDE_PX} px a side: \
+         use a scale of at least {}",
+        Shown(*scale), canvas[0], canvas[1], Shown(*min_scale)
     )]
     ScaleTooSmall {
         scale: f64,
@@ -254,7 +257,8 @@ pub enum PlaybackError {
     )]
     TooLarge(f64, f64),
     #[error(
-        "the animation would play as {0:.3e} frames (duration × frame rate): at most {MAX_FRAMES}"
+        "the animation would play as {} frames (duration × frame rate): at most {MAX_FRAMES}",
+        Shown(*.0)
     )]
     TooManyFrames(f64),
     /// More than the memory budget would be allocated ([`crate::budget`]).
