@@ -104,8 +104,9 @@ pub fn translated(mut outlines: Vec<Outline>, offset_px: [i32; 2]) -> Vec<Outlin
 pub enum TraceError {
     #[error("the image has no pixel with alpha at or above {threshold}")]
     NoOpaquePixels { threshold: u8 },
-    #[error("invalid trace option: {0}")]
-    InvalidOptions(String),
+    /// An option out of range: the field as files write it, and the rule with the value.
+    #[error("invalid trace option: {field} {rule}")]
+    InvalidOption { field: &'static str, rule: String },
 }
 
 /// Traces the opaque regions of `image`.
@@ -113,7 +114,7 @@ pub enum TraceError {
 /// Returns one outline per connected opaque region (after padding) of at least
 /// `min_area_px2`; the list is empty when every region is smaller than that.
 pub fn trace(image: &image::RgbaImage, options: &TraceOptions) -> Result<Vec<Outline>, TraceError> {
-    validate(options)?;
+    check_options(options)?;
     let threshold = options.alpha_threshold;
     if !image
         .pixels()
@@ -130,32 +131,42 @@ pub fn trace(image: &image::RgbaImage, options: &TraceOptions) -> Result<Vec<Out
     Ok(assemble(simplified, &owners))
 }
 
-fn validate(options: &TraceOptions) -> Result<(), TraceError> {
+/// Checks `options`: each out of range is refused naming the field as files write it
+/// (`padding_px`; the command line maps it to its flag) and the rule with the value.
+pub fn check_options(options: &TraceOptions) -> Result<(), TraceError> {
     if options.alpha_threshold == 0 {
-        return Err(TraceError::InvalidOptions(
-            "alpha_threshold must be at least 1 (at 0 every pixel, transparent ones included, \
-             would count as opaque)"
+        return Err(TraceError::InvalidOption {
+            field: "alpha_threshold",
+            rule: "must be at least 1 (at 0 every pixel, transparent ones included, would \
+                   count as opaque)"
                 .into(),
-        ));
+        });
     }
     check_non_negative("padding_px", options.padding_px)?;
     if options.padding_px > MAX_PADDING_PX {
-        return Err(TraceError::InvalidOptions(format!(
-            "padding_px must be at most {MAX_PADDING_PX}, got {}",
-            options.padding_px
-        )));
+        return Err(TraceError::InvalidOption {
+            field: "padding_px",
+            rule: format!(
+                "must be at most {MAX_PADDING_PX}, not {}",
+                crate::shown::Shown(options.padding_px)
+            ),
+        });
     }
     check_non_negative("min_area_px2", options.min_area_px2)?;
     check_non_negative("simplify_tolerance_px", options.simplify_tolerance_px)
 }
 
-fn check_non_negative(name: &str, value: f64) -> Result<(), TraceError> {
+fn check_non_negative(field: &'static str, value: f64) -> Result<(), TraceError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(TraceError::InvalidOptions(format!(
-            "{name} must be a finite number at least 0, got {value}"
-        )))
+        Err(TraceError::InvalidOption {
+            field,
+            rule: format!(
+                "must be a number at least 0, not {}",
+                crate::shown::Shown(value)
+            ),
+        })
     }
 }
 
@@ -680,7 +691,7 @@ mod tests {
         ];
         for o in bad {
             assert!(
-                matches!(trace(&image, &o), Err(TraceError::InvalidOptions(_))),
+                matches!(trace(&image, &o), Err(TraceError::InvalidOption { .. })),
                 "{o:?} accepted"
             );
         }

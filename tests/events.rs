@@ -172,7 +172,7 @@ fn bad_events_are_refused_in_one_line() {
         (
             serde_json::json!({"step": {"audio": "a.wav", "volume": 3}}),
             anim("step"),
-            "event 'step': volume must be a finite number in [0, 1] (got 3e0)",
+            "event 'step': volume must be a finite number in [0, 1] (got 3)",
         ),
         (
             serde_json::json!({"step": {"balance": 0.5}}),

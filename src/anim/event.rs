@@ -406,7 +406,7 @@ mod tests {
                 .check("hit")
                 .unwrap_err()
                 .to_string(),
-            "event 'hit': volume must be a finite number in [0, 1] (got 2e0)"
+            "event 'hit': volume must be a finite number in [0, 1] (got 2)"
         );
         assert_eq!(
             def(json!({"balance": 0.5}))
@@ -427,7 +427,7 @@ mod tests {
         );
         assert_eq!(
             message(json!([{"time": 0, "name": "a", "volume": -1}])),
-            "animation 'walk', events: key 0: volume must be a finite number in [0, 1] (got -1e0)"
+            "animation 'walk', events: key 0: volume must be a finite number in [0, 1] (got -1)"
         );
         assert!(message(json!([{"time": 0, "name": "a", "value": 1}]))
             .starts_with("animation 'walk', events key 0: unknown field `value`"),);

@@ -70,21 +70,45 @@ impl MeshOptions {
         }
     }
 
-    fn validate(&self) -> Result<(), MeshError> {
-        let bad = |what: &str| Err(MeshError::InvalidOptions(what.to_string()));
+    /// Checks the options: each out of range is refused naming the field as files write it
+    /// (`min_angle_deg`; the command line maps it to its flag) and the rule with the value.
+    pub fn check(&self) -> Result<(), MeshError> {
+        let shown = crate::shown::Shown;
+        let bad = |field: &'static str, rule: String| Err(MeshError::InvalidOption { field, rule });
         if !(self.min_angle_deg.is_finite()
             && (0.0..=MAX_ANGLE_LIMIT_DEG).contains(&self.min_angle_deg))
         {
-            return bad("min_angle_deg must lie in [0, 33]");
+            return bad(
+                "min_angle_deg",
+                format!(
+                    "must lie in [0, {MAX_ANGLE_LIMIT_DEG}] degrees, not {}",
+                    shown(self.min_angle_deg)
+                ),
+            );
         }
         if !(self.max_area_fraction.is_finite() && self.max_area_fraction > 0.0) {
-            return bad("max_area_fraction must be positive");
+            return bad(
+                "max_area_fraction",
+                format!("must be positive, not {}", shown(self.max_area_fraction)),
+            );
         }
         if !(self.steiner_budget_factor.is_finite() && self.steiner_budget_factor >= 1.0) {
-            return bad("steiner_budget_factor must be at least 1");
+            return bad(
+                "steiner_budget_factor",
+                format!(
+                    "must be at least 1, not {}",
+                    shown(self.steiner_budget_factor)
+                ),
+            );
         }
         if !(self.min_refine_area_px2.is_finite() && self.min_refine_area_px2 >= 0.0) {
-            return bad("min_refine_area_px2 must be non-negative");
+            return bad(
+                "min_refine_area_px2",
+                format!(
+                    "must be at least 0, not {}",
+                    shown(self.min_refine_area_px2)
+                ),
+            );
         }
         Ok(())
     }
@@ -127,8 +151,11 @@ pub enum MeshError {
     CageAlongOutline { cage: usize, edge: usize },
     #[error("cage {first} and cage {second} cross each other: cages must not overlap")]
     CagesCross { first: usize, second: usize },
-    #[error("invalid mesh option: {0}")]
-    InvalidOptions(String),
+    #[error("the canvas has no area to mesh")]
+    EmptyCanvas,
+    /// An option out of range: the field as files write it, and the rule with the value.
+    #[error("invalid mesh option: {field} {rule}")]
+    InvalidOption { field: &'static str, rule: String },
     #[error(
         "the area limit asks for about {expected:.3e} mesh vertices, more than {MAX_MESH_VERTICES}: \
          raise max_area_fraction"
@@ -421,11 +448,9 @@ fn checked_rings<'a>(
     canvas_area_px2: f64,
     options: &MeshOptions,
 ) -> Result<Vec<&'a [Point]>, MeshError> {
-    options.validate()?;
+    options.check()?;
     if !(canvas_area_px2.is_finite() && canvas_area_px2 > 0.0) {
-        return Err(MeshError::InvalidOptions(
-            "the canvas area must be positive".into(),
-        ));
+        return Err(MeshError::EmptyCanvas);
     }
     let rings = outline_rings(outlines);
     if rings.is_empty() {
@@ -824,7 +849,7 @@ mod tests {
         }];
         assert!(matches!(
             triangulate(&sq, 1.0, &o),
-            Err(MeshError::InvalidOptions(_))
+            Err(MeshError::InvalidOption { .. })
         ));
         let nan = [Outline {
             outer: vec![
