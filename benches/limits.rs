@@ -53,17 +53,33 @@ fn main() {
         ),
         (
             "autorig/psd_10000_layers",
-            vec!["autorig".into(), s(&psd), "-o".into(), out("psd-handles.json")],
+            vec![
+                "autorig".into(),
+                s(&psd),
+                "-o".into(),
+                out("psd-handles.json"),
+            ],
             false,
         ),
         (
             "rig/spine_script_10000_slots",
-            vec!["rig".into(), s(&script), "-o".into(), out("script-rig.json")],
+            vec![
+                "rig".into(),
+                s(&script),
+                "-o".into(),
+                out("script-rig.json"),
+            ],
             true,
         ),
         (
             "export_spine/1000_skins",
-            vec!["export".into(), "spine".into(), s(&skins), "-o".into(), out("spine")],
+            vec![
+                "export".into(),
+                "spine".into(),
+                s(&skins),
+                "-o".into(),
+                out("spine"),
+            ],
             true,
         ),
     ];
@@ -147,7 +163,12 @@ fn psd_of_discs(n: usize) -> Vec<u8> {
         }
         records.extend(4u16.to_be_bytes());
         let plane = |k: usize| -> Vec<u8> { image.pixels().map(|p| p[k]).collect() };
-        let planes = [(-1i16, plane(3)), (0, plane(0)), (1, plane(1)), (2, plane(2))];
+        let planes = [
+            (-1i16, plane(3)),
+            (0, plane(0)),
+            (1, plane(1)),
+            (2, plane(2)),
+        ];
         for (id, data) in &planes {
             records.extend(id.to_be_bytes());
             records.extend((2 + data.len() as u32).to_be_bytes());
