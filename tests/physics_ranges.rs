@@ -2,7 +2,9 @@
 //! range is refused by render and every export alike (one line naming the file, the
 //! constraint and the field as written, exit 2, nothing written), and every value just inside
 //! is rendered with finite output and exported with the numbers the runtime reads (a mass that
-//! is not 0 in f32). Physics together with momentum is refused by the exports as by render.
+//! is not 0 in f32), and played: sinew's simulation and spine-core's (tools/spine-check) of the
+//! export stay finite and agree. Physics together with momentum is refused by the exports as
+//! by render.
 
 mod command;
 mod common;
@@ -224,6 +226,152 @@ fn values_just_inside_are_rendered_finite_and_exported_as_the_runtime_reads_them
             "{constraint}: damping {damping}"
         );
     }
+}
+
+/// Runtime vs sinew's runtime-matching playback, px (as tests/spine_runtime.rs).
+const ANIMATION_TOLERANCE_PX: f64 = 0.01;
+/// Where positions are large, the tolerance is this many f32 roundings of the coordinate.
+const F32_ULPS: f64 = 16.0;
+/// The rate games update physics at (spine-check's UPDATE_HZ), and how long it is played: past
+/// the animation's end (0.75 s), where only the spring still moves.
+const PHYSICS_HZ: f64 = 60.0;
+const PHYSICS_SECONDS: f64 = 2.0;
+
+/// The world vertices spine-core (tools/spine-check, pinned) gives every mesh of the export
+/// `dir/rig.json` playing `swing` at `times`, as a game updates physics at 60 Hz: per time, per
+/// slot, its attachment's name and vertices (Spine's axes).
+fn spine_core_plays(dir: &Path, times: &[f64]) -> Vec<(f64, Vec<(String, Vec<f64>)>)> {
+    let request = dir.join("request.json");
+    let out = dir.join("oracle.json");
+    std::fs::write(&request, json!({"times": {"swing": times}}).to_string()).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tools/spine-check/run.sh");
+    let status = std::process::Command::new(script)
+        .args([
+            s(&dir.join("rig.json")),
+            s(&dir.join("rig.atlas")),
+            s(&request),
+            s(&out),
+        ])
+        .status()
+        .expect("run tools/spine-check/run.sh (needs bash, node and npm, or root to install them)");
+    assert!(status.success(), "spine-core refused {}", dir.display());
+    let oracle: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(oracle["warnings"], json!([]), "spine-core's loader warns");
+    let frames = oracle["animations"]["swing"]["frames"].as_array().unwrap();
+    frames
+        .iter()
+        .map(|f| {
+            let slots = f["slots"].as_array().unwrap();
+            let meshes = slots
+                .iter()
+                .filter(|slot| slot["vertices"].is_array())
+                .map(|slot| {
+                    let name = slot["attachment"]
+                        .as_str()
+                        .or(slot["name"].as_str())
+                        .unwrap()
+                        .to_string();
+                    // A non-finite number arrives as JSON null: kept as NaN, and refused below.
+                    let v = slot["vertices"].as_array().unwrap();
+                    (
+                        name,
+                        v.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect(),
+                    )
+                })
+                .collect();
+            (f["time"].as_f64().unwrap(), meshes)
+        })
+        .collect()
+}
+
+/// Every value just inside the ranges, played: sinew's own simulation (the render's and
+/// `--match-runtime spine`'s, `export::spine::played`) is finite at every 60 Hz update for 2 s,
+/// the Spine export of it plays finitely in spine-core (the runtime's PhysicsConstraint), and the
+/// two agree within 0.01 px (or 16 f32 roundings of the coordinate, where it is far out) at every update — so a value the check lets through is one the
+/// runtime can step, not just one that exports.
+#[test]
+fn values_just_inside_play_in_spine_core_as_sinew_simulates_them() {
+    use sinew::export::spine::played::as_played;
+    use sinew::export::spine::{export_spine, SpineOptions};
+    use sinew::pipeline::Scene;
+    use sinew::skin::Blend;
+    let tmp = scratch("physics-played");
+    let dir = tmp.path();
+    let (doc, rig) = rig(dir);
+    let n = (PHYSICS_SECONDS * PHYSICS_HZ) as usize;
+    let times: Vec<f64> = (0..=n).map(|k| k as f64 / PHYSICS_HZ).collect();
+    let mut moved_most: f64 = 0.0;
+    for constraint in inside() {
+        std::fs::write(&rig, with_physics(&doc, constraint.clone()).to_string()).unwrap();
+        let out = dir.join("spine");
+        let _ = std::fs::remove_dir_all(&out);
+        let run = sinew(&["export", "spine", s(&rig), "-o", s(&out), "--name", "rig"]);
+        assert!(
+            run.status.success(),
+            "{constraint}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let scene = Scene::load(&rig).unwrap();
+        let images: Vec<_> = scene
+            .doc
+            .parts
+            .iter()
+            .map(|p| sinew::io::load_png(&sinew::io::RigDocument::image_path(&rig, p)).unwrap())
+            .collect();
+        let options = SpineOptions::default();
+        let export = export_spine(&scene, &images, "rig", &options).unwrap();
+        let played = as_played(&scene, "swing", &scene.doc.animations["swing"], &options).unwrap();
+        let runtime = spine_core_plays(&out, &times);
+        assert_eq!(runtime.len(), times.len());
+        let (mut worst, mut moved, mut far) = (0.0_f64, 0.0_f64, 0.0_f64);
+        for (t, meshes) in &runtime {
+            let f = played.frame(*t, false).unwrap();
+            let ours = scene
+                .positions_from_transforms(&f.transforms, &f.pose, Blend::Linear)
+                .unwrap();
+            let still = scene.without_physics().pose_positions(&f.pose).unwrap();
+            for (name, vertices) in meshes {
+                let part = scene
+                    .doc
+                    .parts
+                    .iter()
+                    .position(|p| &p.name == name)
+                    .unwrap();
+                let mesh = &export.parts[part].mesh;
+                assert_eq!(vertices.len(), 2 * mesh.vertex_source.len(), "{name}");
+                for (k, &v) in mesh.vertex_source.iter().enumerate() {
+                    let (x, y) = (vertices[2 * k], vertices[2 * k + 1]);
+                    let ours = ours[part][v];
+                    assert!(
+                        x.is_finite() && y.is_finite() && ours.x.is_finite() && ours.y.is_finite(),
+                        "{constraint} at {t} s: spine-core [{x}, {y}], sinew {ours:?}"
+                    );
+                    let c = export.frame.canvas_from_spine([x, y].into());
+                    let d = (sinew::geom::Point::new(c[0], c[1]) - ours).norm();
+                    // The runtime computes in f32: far out (a strong gravity on a weak spring
+                    // holds the bone thousands of px away), its rounding exceeds 0.01 px.
+                    let f32_rounding = F32_ULPS * f64::from(f32::EPSILON) * ours.coords.abs().max();
+                    assert!(
+                        d <= ANIMATION_TOLERANCE_PX.max(f32_rounding),
+                        "{constraint} at {t} s: spine-core and sinew {d} px apart"
+                    );
+                    worst = worst.max(d);
+                    far = far.max(ours.coords.abs().max());
+                    moved = moved.max((ours - still[part][v]).norm());
+                }
+            }
+        }
+        println!(
+            "{constraint}: {} updates, spine-core vs sinew max {worst:.2e} px (at most {far:.0} px from the origin), physics moves up to {moved:.2} px",
+            times.len()
+        );
+        moved_most = moved_most.max(moved);
+    }
+    // The simulation matters: some of the values swing the bone away from its pose.
+    assert!(
+        moved_most > 1.0,
+        "physics moved the mesh only {moved_most} px"
+    );
 }
 
 #[test]
