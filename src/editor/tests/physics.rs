@@ -74,7 +74,7 @@ fn a_physics_constraints_fields_in_the_tree_edit_it_and_refuse_bad_numbers() {
     // A mass of 0 is refused with the document's message; nothing changes.
     enter(&mut h, "Physics mass", "0");
     let message = h.state().message.clone().unwrap_or_default();
-    assert!(message.contains("mass must be > 0"), "{message}");
+    assert!(message.contains("\"mass\" is 0: at least"), "{message}");
     assert_eq!(tail_sway(&h), after);
 
     // Undo, three steps, back to the constraint as opened.
