@@ -96,6 +96,7 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
     for job in &jobs {
         confine_job(job, root)?;
     }
+    let mut names = std::collections::HashSet::new();
     for (i, job) in jobs.iter().enumerate() {
         if job.name().is_empty() {
             return Err(BatchError::Job(
@@ -103,7 +104,7 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
                 "the name is empty".into(),
             ));
         }
-        if jobs[..i].iter().any(|other| other.name() == job.name()) {
+        if !names.insert(job.name()) {
             return Err(BatchError::Job(
                 named(job),
                 "two jobs have this name".into(),
@@ -146,24 +147,44 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
         .iter()
         .map(|j| j.inputs().iter().map(|p| absolute(root, p)).collect())
         .collect();
-    // No two jobs write one output (nor one into the other's folder); no job writes its own
-    // input.
+    // No two jobs write one output (nor one into the other's folder): the outputs in path
+    // order, where a folder's contents follow it (paths compare by component), so one pass
+    // with the folders still open finds every clash (pairwise, 8,000 jobs took 8 s).
+    let mut sorted: Vec<(&Path, usize, bool)> = outputs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, outs)| outs.iter().map(move |o| (o.path.as_path(), i, o.folder)))
+        .collect();
+    sorted.sort();
+    let mut open_folders: Vec<(&Path, usize)> = Vec::new();
+    let mut previous: Option<(&Path, usize)> = None;
+    for &(path, i, folder) in &sorted {
+        while open_folders
+            .last()
+            .is_some_and(|(f, _)| !path.starts_with(f))
+        {
+            open_folders.pop();
+        }
+        let clash = match previous {
+            Some((p, j)) if p == path => Some(j),
+            _ => open_folders.last().map(|&(_, j)| j),
+        };
+        if let Some(j) = clash {
+            let (first, second) = (i.min(j), i.max(j));
+            return Err(BatchError::SameOutput {
+                path: path.to_path_buf(),
+                first: jobs[first].name().to_string(),
+                second: jobs[second].name().to_string(),
+            });
+        }
+        if folder {
+            open_folders.push((path, i));
+        }
+        previous = Some((path, i));
+    }
+    // No job writes its own input.
     for (i, outs) in outputs.iter().enumerate() {
-        for (k, out) in outs.iter().enumerate() {
-            for (j, others) in outputs.iter().enumerate() {
-                for (l, other) in others.iter().enumerate() {
-                    if (j, l) <= (i, k) {
-                        continue;
-                    }
-                    if writes(out, &other.path) || writes(other, &out.path) {
-                        return Err(BatchError::SameOutput {
-                            path: out.path.clone(),
-                            first: jobs[i].name().to_string(),
-                            second: jobs[j].name().to_string(),
-                        });
-                    }
-                }
-            }
+        for out in outs {
             if let Some(input) = inputs[i].iter().find(|p| writes(out, p)) {
                 return Err(BatchError::Job(
                     named(&jobs[i]),
@@ -172,14 +193,28 @@ pub fn plan(manifest: Manifest, root: &Path) -> Result<Plan, BatchError> {
             }
         }
     }
+    // Each output's job, by path, to find an input's writer: the job writing that path or a
+    // folder it lies in (no two, checked above).
+    let writer_of: std::collections::HashMap<&Path, (usize, bool)> = sorted
+        .iter()
+        .map(|&(path, i, folder)| (path, (i, folder)))
+        .collect();
+    let writer = |input: &Path| {
+        if let Some(&(i, _)) = writer_of.get(input) {
+            return Some(i);
+        }
+        input.ancestors().skip(1).find_map(|a| {
+            writer_of
+                .get(a)
+                .filter(|(_, folder)| *folder)
+                .map(|&(i, _)| i)
+        })
+    };
     // Every input exists or is written by a job.
     let mut dependencies = vec![Vec::new(); jobs.len()];
     for (i, ins) in inputs.iter().enumerate() {
         for input in ins {
-            let writer = outputs
-                .iter()
-                .position(|outs| outs.iter().any(|o| writes(o, input)));
-            match writer {
+            match writer(input) {
                 Some(j) => {
                     if !dependencies[i].contains(&j) {
                         dependencies[i].push(j);
@@ -269,6 +304,57 @@ mod tests {
         assert_eq!(cycle.len(), 4);
         assert_eq!(cycle.first(), cycle.last());
         assert_eq!(find_cycle(&[vec![], vec![0], vec![0, 1]]), None);
+    }
+
+    /// The plan of export jobs reading `rigs` (a file each, made in `root` unless a job writes
+    /// it) and writing the folders `folders`.
+    fn exports(root: &Path, jobs: &[(&str, &str)]) -> Result<Plan, BatchError> {
+        let jobs: Vec<String> = jobs
+            .iter()
+            .enumerate()
+            .map(|(i, (rig, folder))| {
+                format!(
+                    r#"{{"kind": "export", "name": "e{i}", "inputs": {{"rig": "{rig}"}},
+                        "outputs": {{"folder": "{folder}"}}}}"#
+                )
+            })
+            .collect();
+        let manifest =
+            super::super::manifest::parse(&format!(r#"{{"jobs": [{}]}}"#, jobs.join(",")))?;
+        plan(manifest, root)
+    }
+
+    #[test]
+    fn outputs_clash_when_equal_or_nested_and_inputs_find_the_folder_that_writes_them() {
+        let tmp = crate::test_scratch::scratch("plan-clash");
+        let root = tmp.path();
+        std::fs::write(root.join("a.json"), "{}").unwrap();
+        // Siblings whose names share a prefix do not clash; a reader of a file inside another
+        // job's folder depends on that job.
+        let plan = exports(root, &[("a.json", "out"), ("out/x.json", "out2")]).unwrap();
+        assert_eq!(plan.dependencies, vec![vec![], vec![0]]);
+        let clash = |jobs: &[(&str, &str)]| match exports(root, jobs) {
+            Err(BatchError::SameOutput {
+                path,
+                first,
+                second,
+            }) => Some((
+                path.strip_prefix(root).unwrap().to_path_buf(),
+                first,
+                second,
+            )),
+            _ => None,
+        };
+        let named = |p: &str, a: &str, b: &str| Some((PathBuf::from(p), a.into(), b.into()));
+        assert_eq!(
+            clash(&[("a.json", "out"), ("a.json", "b"), ("a.json", "out")]),
+            named("out", "e0", "e2")
+        );
+        assert_eq!(
+            clash(&[("a.json", "out/inner"), ("a.json", "out")]),
+            named("out/inner", "e0", "e1")
+        );
+        assert_eq!(clash(&[("a.json", "out"), ("a.json", "out2")]), None);
     }
 
     #[test]
