@@ -30,7 +30,7 @@ sinew="${CARGO_TARGET_DIR:-$root/target}/debug/sinew"
 
 make_work
 
-# The batch, twice at the same depth (the demo rig names the bundled images by relative path).
+# The batch, twice at the same depth (the demo rig names its images in its own character.parts/).
 python3 "$here/make_batch.py" "$work/local" "$root/assets/character" >/dev/null
 "$sinew" demo -o "$work/local/in/demo" >/dev/null
 mkdir "$work/ray"
