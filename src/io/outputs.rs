@@ -32,27 +32,10 @@ pub fn check_output_kind(
     })
 }
 
-/// The file `path` names, resolved through links when it (or its folder) exists.
+/// The file `path` names, resolved through links as far as it exists (its nearest existing
+/// ancestor resolved, [`crate::io::document::resolved`]); as given when nothing resolves.
 pub fn resolved(path: &Path) -> PathBuf {
-    if let Ok(p) = path.canonicalize() {
-        return p;
-    }
-    match (
-        path.parent().map(|d| {
-            if d.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                d
-            }
-        }),
-        path.file_name(),
-    ) {
-        (Some(dir), Some(name)) => dir
-            .canonicalize()
-            .map(|d| d.join(name))
-            .unwrap_or_else(|_| path.to_path_buf()),
-        _ => path.to_path_buf(),
-    }
+    crate::io::document::resolved(path).unwrap_or_else(|| path.to_path_buf())
 }
 
 /// The folder `path` is in (`.` for a bare file name).
