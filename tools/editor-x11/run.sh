@@ -19,8 +19,8 @@ need_x11
 cd "$root"
 # The binary `cargo test` built (an integration test's build brings it up to date): a plain
 # `cargo build` would compile the dependencies again with other features, minutes on CI.
-cargo test --locked --quiet --no-run --test cli
-sinew="${CARGO_TARGET_DIR:-$root/target}/debug/sinew"
+cargo test --release --locked --quiet --no-run --test cli
+sinew="${CARGO_TARGET_DIR:-$root/target}/release/sinew"
 make_work
 
 "$sinew" demo -o "$work/demo" >/dev/null

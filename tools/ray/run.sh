@@ -25,8 +25,8 @@ if ! reason="$("$here/install.sh" 2>&1 >/dev/null)"; then
   skip "${reason:-cannot install ray}"
 fi
 # The binary `cargo test` built (as tools/editor-x11/run.sh does).
-cargo test --locked --quiet --no-run --test batch
-sinew="${CARGO_TARGET_DIR:-$root/target}/debug/sinew"
+cargo test --release --locked --quiet --no-run --test batch
+sinew="${CARGO_TARGET_DIR:-$root/target}/release/sinew"
 
 make_work
 
