@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Screenshots of the editor, one per mode, for docs/ (a person runs this on purpose and looks at
-# the PNGs before committing them).
+# Screenshots of the editor, one per mode, for the guide's images (a person runs this on purpose
+# and looks at the PNGs before committing them).
 #
-#   tools/editor-screenshots/run.sh [OUT_DIR]      (default: docs/)
+#   tools/editor-screenshots/run.sh [OUT_DIR]      (default: docs/guide/src/images/)
 #
 # Builds in $CARGO_TARGET_DIR (default target/) with $PROFILE (default release; debug works
 # too and is what a worktree sharing its dependencies with others would use).
@@ -13,7 +13,7 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
-out="${1:-$root/docs}"
+out="${1:-$root/docs/guide/src/images}"
 
 as_root() {
   if [ "$(id -u)" -eq 0 ]; then "$@"
