@@ -22,6 +22,7 @@ pub mod io;
 pub mod jobs;
 pub mod mesh;
 pub mod motion;
+pub mod names;
 pub mod pipeline;
 pub mod playback;
 pub mod render;
