@@ -81,7 +81,18 @@ pub fn load_art(images: &[PathBuf], output: &Path) -> Result<crate::art::Art, Jo
         parts_dir: output.with_extension("parts"),
         ..Default::default()
     };
-    Ok(crate::art::load_art(images, &options)?)
+    // A file that is not a PNG is refused with the formats art may come in, not only PNG.
+    crate::art::load_art(images, &options).map_err(|e| match e {
+        pipeline::PipelineError::Image(io::ImageError::NotPng { path, found, .. }) => {
+            io::ImageError::NotPng {
+                path,
+                found,
+                expected: io::image::Expected::Art,
+            }
+            .into()
+        }
+        e => e.into(),
+    })
 }
 
 /// Traces, meshes and weighs `files.images` into a rig document (`sinew rig`); `progress` as
