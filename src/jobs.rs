@@ -19,6 +19,7 @@ use crate::export::spine::{self, SpineError, SpineOptions};
 use crate::io::outputs::{check_not_overwriting, OutputError};
 use crate::io::sequence::{self, SequenceError, SequenceReport};
 use crate::io::RigDocument;
+use crate::names;
 use crate::pipeline::{Layer, PipelineError, Scene};
 use crate::playback::{self, PlaybackError, RenderAnimationError, RenderSettings};
 use std::path::{Path, PathBuf};
@@ -79,9 +80,44 @@ pub enum JobError {
     },
     /// A slot attachment naming no layer, or making a slot of something that cannot be one.
     #[error("attachment: {0}")]
-    Attachment(String),
-    #[error("the rig has no animation '{name}' (it has: {known})")]
-    NoAnimation { name: String, known: String },
+    Attachment(AttachmentError),
+    /// The rig (at `rig`, when known) has no animation `name`.
+    #[error("{}", no_animation_message(.rig.as_deref(), .name, .known, .suggestion))]
+    NoAnimation {
+        rig: Option<PathBuf>,
+        name: String,
+        /// The animations it has, in name order.
+        known: Vec<String>,
+        /// The one of `known` most like `name` ([`names::closest`]).
+        suggestion: Option<String>,
+    },
+    /// The handles file at `path` is not a valid set of handles.
+    #[error("{}: {source}", .path.display())]
+    Handles {
+        path: PathBuf,
+        source: crate::rig::HandleError,
+    },
+    /// The handles file at `path` binds a handle to a part the art does not have.
+    #[error(
+        "{}: 'bind' gives handle '{handle}' the part '{part}', which is not a layer of the art{} \
+         (its layers: {})",
+        .path.display(),
+        names::did_you_mean(.suggestion),
+        names::listed(.layers)
+    )]
+    UnknownBindPart {
+        path: PathBuf,
+        handle: String,
+        part: String,
+        layers: Vec<String>,
+        suggestion: Option<String>,
+    },
+    /// The rig at `path` cannot be drawn with the skins asked for.
+    #[error("{}: {source}", .path.display())]
+    Skins {
+        path: PathBuf,
+        source: crate::io::SlotError,
+    },
     #[error("a canvas of {width}×{height} px is too large to draw")]
     CanvasTooLarge { width: u32, height: u32 },
     #[error("cannot write JSON: {0}")]
@@ -95,6 +131,77 @@ pub enum JobError {
         path: PathBuf,
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+}
+
+/// What is wrong with the attachments of a rig job (`--attachment PART=SLOT`, a batch job's
+/// `attachments`).
+#[derive(Debug, thiserror::Error)]
+pub enum AttachmentError {
+    /// A name that is no layer of the art.
+    #[error(
+        "'{name}' is not a layer of the rig{} (its layers: {})",
+        names::did_you_mean(.suggestion),
+        names::listed(.layers)
+    )]
+    NoLayer {
+        name: String,
+        /// The art's layers, in order.
+        layers: Vec<String>,
+        /// The one of `layers` most like `name` ([`names::closest`]).
+        suggestion: Option<String>,
+    },
+    /// Layers that cannot be made slots and attachments as asked (the reason).
+    #[error("{0}")]
+    Slots(String),
+}
+
+/// The refusal of an animation `name` the rig at `rig` lacks: the closest name it has, or, when
+/// it has none or `name` is a motion of the bundled library, how to make one.
+fn no_animation_message(
+    rig: Option<&Path>,
+    name: &str,
+    known: &[String],
+    suggestion: &Option<String>,
+) -> String {
+    let (file, shown) = match rig {
+        Some(rig) => (format!("{}: ", rig.display()), command_path(rig)),
+        None => (String::new(), "RIG.json".to_string()),
+    };
+    let library = crate::motion::library::find(name).map(|m| m.name);
+    if known.is_empty() {
+        let motion = library.unwrap_or("walk");
+        return format!(
+            "{file}the rig has no animations yet; make one with 'sinew animate {shown} --motion \
+             {motion}' (the bundled {motion}, retargeted) or key one in 'sinew edit {shown} \
+             --mode animate' (New animation)"
+        );
+    }
+    let hint = match (suggestion, library) {
+        (None, Some(motion)) => format!(
+            "; 'sinew animate {shown} --motion {motion}' adds the bundled library's {motion}"
+        ),
+        _ => String::new(),
+    };
+    format!(
+        "{file}the rig has no animation '{name}'{} (it has: {}){hint}",
+        names::did_you_mean(suggestion),
+        names::listed(known)
+    )
+}
+
+/// `path` as it would be typed in a command line: in double quotes when it holds anything but
+/// letters, digits and `._/-`.
+fn command_path(path: &Path) -> String {
+    let text = path.display().to_string();
+    let plain = !text.is_empty()
+        && text
+            .chars()
+            .all(|c| c.is_alphanumeric() || "._/-".contains(c));
+    if plain {
+        text
+    } else {
+        format!("\"{text}\"")
+    }
 }
 
 /// Exports the document's current state for Spine's runtimes into `dir` (see
@@ -189,4 +296,33 @@ pub fn propose_handles<L: std::borrow::Borrow<Layer>>(
         })
         .collect();
     Ok(autorig::autorig(&refs, pivots, options)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_animation_says_what_to_do_next() {
+        let known = names::owned(["hop", "walk"]);
+        let rig = Path::new("my rig.json");
+        assert_eq!(
+            no_animation_message(Some(rig), "walkk", &known, &Some("walk".into())),
+            "my rig.json: the rig has no animation 'walkk'; did you mean 'walk'? (it has: hop, walk)"
+        );
+        let none = no_animation_message(Some(rig), "stroll", &[], &None);
+        assert!(
+            none.starts_with("my rig.json: the rig has no animations yet; make one with 'sinew animate \"my rig.json\" --motion walk'"),
+            "{none}"
+        );
+        assert!(
+            none.contains("'sinew edit \"my rig.json\" --mode animate'"),
+            "{none}"
+        );
+        assert_eq!(
+            no_animation_message(None, "run", &known, &None),
+            "the rig has no animation 'run' (it has: hop, walk); 'sinew animate RIG.json --motion \
+             run' adds the bundled library's run"
+        );
+    }
 }

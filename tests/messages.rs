@@ -14,10 +14,11 @@ mod command;
 use command::{s, scratch, sinew, EXIT_BAD_INPUT};
 use std::path::{Path, PathBuf};
 
-/// One bad input: the command line and what its one line must name (a file, a flag, a name).
+/// One bad input: the command line and what its one line must name (a file, a flag, a name,
+/// a suggestion: each of `names`).
 struct Case {
     args: Vec<String>,
-    names: String,
+    names: Vec<String>,
 }
 
 /// Everything the user wrote or could read for `case`: its arguments, the text of the files
@@ -97,8 +98,10 @@ fn problems(case: &Case, code: Option<i32>, message: &str) -> Vec<String> {
             found.push(format!("code word '{word}' the user did not write"));
         }
     }
-    if !line.contains(&case.names) {
-        found.push(format!("does not name '{}'", case.names));
+    for name in &case.names {
+        if !line.contains(name.as_str()) {
+            found.push(format!("does not name '{name}'"));
+        }
     }
     found
 }
@@ -167,11 +170,50 @@ fn every_refusal_is_one_line_in_the_users_words_naming_its_file() {
         br#"{"scribbles":[{"color":[255,0,0],"points":[[2,2],[3,3]]}]}"#,
     );
     let missing = dir.join("missing.png");
+    // Issue 45: refusals that say what to do next.
+    let kra = write("cat.kra", &krita_head());
+    let misspelt = write(
+        "misspelt.json",
+        br#"{"bones":[{"name":"shoulder","head":[1,1],"tail":[9,9]},
+                     {"name":"arm","parent":"sholder","head":[9,9],"tail":[20,20]}]}"#,
+    );
+    let layer = part.file_stem().unwrap().to_string_lossy().into_owned();
+    // The layer's name with its last two letters swapped.
+    let mut swapped: Vec<char> = layer.chars().collect();
+    let n = swapped.len();
+    swapped.swap(n - 1, n - 2);
+    let swapped: String = swapped.into_iter().collect();
+    let bind = write(
+        "bind.json",
+        format!(
+            r#"{{"bones":[{{"name":"b","head":[1,1],"tail":[9,9]}}],"bind":{{"b":["{swapped}"]}}}}"#
+        )
+        .as_bytes(),
+    );
+    let ik = write(
+        "ik.json",
+        br#"{"bones":[{"name":"upper","head":[1,1],"tail":[9,9]},
+                     {"name":"lower","parent":"upper","head":[9,9],"tail":[20,20]},
+                     {"name":"goal","head":[30,30],"tail":[31,31]}],
+             "ik":[{"name":"reach","bones":["upper","lower"],"target":"gaol"}]}"#,
+    );
+    // The demo's rig without its animations, beside it (its part images are found).
+    let bare = rig.with_file_name("bare.json");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rig).unwrap()).unwrap();
+    doc.as_object_mut().unwrap().remove("animations");
+    doc.as_object_mut().unwrap().remove("events");
+    std::fs::write(&bare, doc.to_string()).unwrap();
     let out = |name: &str| dir.join("out").join(name).to_string_lossy().into_owned();
     std::fs::create_dir_all(dir.join("out")).unwrap();
     let case = |args: &[&str], names: &str| Case {
         args: args.iter().map(|a| a.to_string()).collect(),
-        names: names.to_string(),
+        names: vec![names.to_string()],
+    };
+    // A case whose message must name several things (the file and a suggestion, say).
+    let naming = |args: &[&str], names: &[&str]| Case {
+        args: args.iter().map(|a| a.to_string()).collect(),
+        names: names.iter().map(|n| n.to_string()).collect(),
     };
     let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
     let cases = vec![
@@ -223,6 +265,78 @@ fn every_refusal_is_one_line_in_the_users_words_naming_its_file() {
         case(
             &["render", s(&rig), "--anim", "moonwalk", "-o", &out("r.gif")],
             "moonwalk",
+        ),
+        naming(
+            &["render", s(&rig), "--anim", "walkk", "-o", &out("r.gif")],
+            &[&name(&rig), "did you mean 'walk'?"],
+        ),
+        naming(
+            &["render", s(&bare), "--anim", "walk", "-o", &out("r.gif")],
+            &[
+                &name(&bare),
+                "sinew animate",
+                "--motion walk",
+                "--mode animate",
+            ],
+        ),
+        naming(
+            &[
+                "render",
+                s(&rig),
+                "--anim",
+                "walk",
+                "--skin",
+                "pails",
+                "-o",
+                &out("r.gif"),
+            ],
+            &[&name(&rig), "did you mean 'pail'?"],
+        ),
+        naming(
+            &["pose", s(&rig), "--skin", "pails", "-o", &out("p.png")],
+            &["did you mean 'pail'?"],
+        ),
+        naming(
+            &["rig", s(&jpg), "-o", &out("a.json")],
+            &[&name(&jpg), "JPEG", "PSD, PSB or OpenRaster (.ora)"],
+        ),
+        naming(
+            &["rig", s(&kra), "-o", &out("a.json")],
+            &[&name(&kra), "Krita", "OpenRaster (.ora)", "File ▸ Export"],
+        ),
+        naming(
+            &[
+                "rig",
+                s(&part),
+                "--handles",
+                s(&misspelt),
+                "-o",
+                &out("a.json"),
+            ],
+            &[&name(&misspelt), "did you mean 'shoulder'?"],
+        ),
+        naming(
+            &["rig", s(&part), "--handles", s(&bind), "-o", &out("a.json")],
+            &[&name(&bind), &format!("did you mean '{layer}'?")],
+        ),
+        naming(
+            &["rig", s(&part), "--handles", s(&ik), "-o", &out("a.json")],
+            &[&name(&ik), "did you mean 'goal'?"],
+        ),
+        naming(
+            &[
+                "rig",
+                s(&part),
+                "--attachment",
+                &format!("{swapped}={layer}"),
+                "-o",
+                &out("a.json"),
+            ],
+            &["--attachment", &format!("did you mean '{layer}'?")],
+        ),
+        naming(
+            &["animate", s(&rig), "--motion", "wlak"],
+            &["--motion", "did you mean 'walk'?"],
         ),
         case(
             &[
@@ -362,7 +476,7 @@ fn every_refusal_is_one_line_in_the_users_words_naming_its_file() {
 fn code_talk_is_caught() {
     let case = Case {
         args: vec!["rig".into(), "a.png".into()],
-        names: "a.png".into(),
+        names: vec!["a.png".into()],
     };
     let bad = [
         "sinew: error: a.png: limit exceeded (LayeredLimits::max_side_px)",
@@ -388,6 +502,22 @@ fn code_talk_is_caught() {
         ),
         Vec::<String>::new()
     );
+}
+
+/// The start of a Krita document: a zip whose first entry, stored, is `mimetype` saying
+/// `application/x-krita`.
+fn krita_head() -> Vec<u8> {
+    let content = b"application/x-krita";
+    let mut out = b"PK\x03\x04".to_vec();
+    out.extend([20, 0, 0, 0, 0, 0]); // version, flags, method 0 (stored)
+    out.extend([0u8; 8]); // time, date, CRC
+    out.extend((content.len() as u32).to_le_bytes());
+    out.extend((content.len() as u32).to_le_bytes());
+    out.extend(8u16.to_le_bytes());
+    out.extend(0u16.to_le_bytes());
+    out.extend(b"mimetype");
+    out.extend(content);
+    out
 }
 
 fn walk_png(dir: &Path) -> Option<PathBuf> {

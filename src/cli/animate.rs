@@ -133,9 +133,12 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         (clip, stem)
     } else {
         let Some(m) = library::find(&args.motion) else {
+            let names = library::MOTIONS.iter().map(|m| m.name);
             bail!(
-                "no motion '{}' in the library (it has: {}); give a .bvh file for your own capture",
+                "--motion: no motion '{}' in the library{} (it has: {}); give a .bvh file for your \
+                 own capture",
                 args.motion,
+                sinew::names::did_you_mean(&sinew::names::closest(&args.motion, names)),
                 library::names()
             );
         };

@@ -30,13 +30,29 @@ pub const DEFAULT_SKIN: &str = "default";
 /// What is wrong with a choice of skins.
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum SlotError {
-    #[error("the rig has no skin '{name}' (its skins: {known})")]
-    UnknownSkin { name: String, known: String },
-    #[error("the pose shows attachment '{attachment}' in slot '{slot}', which the slot does not have (its attachments: {known})")]
+    #[error(
+        "the rig has no skin '{name}'{} (its skins: {})",
+        crate::names::did_you_mean(.suggestion),
+        crate::names::listed(.known)
+    )]
+    UnknownSkin {
+        name: String,
+        /// The rig's skins, in name order.
+        known: Vec<String>,
+        /// The one of `known` most like `name` ([`crate::names::closest`]).
+        suggestion: Option<String>,
+    },
+    #[error(
+        "the pose shows attachment '{attachment}' in slot '{slot}', which the slot does not \
+         have{} (its attachments: {})",
+        crate::names::did_you_mean(.suggestion),
+        crate::names::listed(.known)
+    )]
     UnknownAttachment {
         slot: String,
         attachment: String,
-        known: String,
+        known: Vec<String>,
+        suggestion: Option<String>,
     },
 }
 
@@ -85,11 +101,8 @@ impl RigDocument {
             None => Ok(()),
             Some(name) => Err(SlotError::UnknownSkin {
                 name: name.clone(),
-                known: if self.skins.is_empty() {
-                    "none".into()
-                } else {
-                    self.skins.keys().cloned().collect::<Vec<_>>().join(", ")
-                },
+                known: crate::names::owned(self.skins.keys()),
+                suggestion: crate::names::closest(name, self.skins.keys()),
             }),
         }
     }
@@ -154,10 +167,12 @@ impl RigDocument {
                 continue;
             };
             if self.shown_part(slot, Some(attachment), &[]).is_none() {
+                let known = self.attachment_names(slot);
                 return Err(SlotError::UnknownAttachment {
                     slot: slot.clone(),
                     attachment: attachment.clone(),
-                    known: self.attachment_names(slot).join(", "),
+                    suggestion: crate::names::closest(attachment, &known),
+                    known: crate::names::owned(known),
                 });
             }
         }
@@ -299,6 +314,10 @@ pub(crate) mod tests {
         assert_eq!(
             doc.check_skins(&s(&["hats"])).unwrap_err().to_string(),
             "the rig has no skin 'hats' (its skins: fists, gloves)"
+        );
+        assert_eq!(
+            doc.check_skins(&s(&["glove"])).unwrap_err().to_string(),
+            "the rig has no skin 'glove'; did you mean 'gloves'? (its skins: fists, gloves)"
         );
     }
 

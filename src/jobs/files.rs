@@ -122,8 +122,13 @@ pub fn rig_files(
             .chain(files.preview.as_deref())
             .map(Some),
     )?;
+    let layer_names = || art.layers.iter().map(|l| l.name.as_str());
     let handles: Handles = match &files.handles {
-        Some(path) => read_json(path, "handles file")?,
+        Some(path) => {
+            let handles: Handles = read_json(path, "handles file")?;
+            check_handles(&handles, path, &layer_names().collect::<Vec<_>>())?;
+            handles
+        }
         None => Handles::default(),
     };
     // Attachments name layers: checked before any work.
@@ -131,17 +136,19 @@ pub fn rig_files(
         .attachments
         .iter()
         .flat_map(|(part, slot)| [part, slot])
-        .find(|n| !art.layers.iter().any(|l| &l.name == *n))
+        .find(|n| !layer_names().any(|l| l == n.as_str()))
     {
-        return Err(JobError::Attachment(format!(
-            "'{name}' is not a layer of the rig"
-        )));
+        return Err(JobError::Attachment(super::AttachmentError::NoLayer {
+            name: name.clone(),
+            layers: crate::names::owned(layer_names()),
+            suggestion: crate::names::closest(name, layer_names()),
+        }));
     }
     let doc_dir = parent_dir(&files.output);
     let (mut doc, stats) =
         pipeline::build_rig_with_progress(&art.layers, doc_dir, options, &handles, progress)?;
     doc.set_slots(&files.attachments, io::Skins::new())
-        .map_err(JobError::Attachment)?;
+        .map_err(|reason| JobError::Attachment(super::AttachmentError::Slots(reason)))?;
     let preview = match &files.preview {
         Some(_) => {
             let images: Vec<_> = art.layers.iter().map(|l| l.image.clone()).collect();
@@ -164,6 +171,27 @@ pub fn rig_files(
         stats,
         notes: art.notes,
     })
+}
+
+/// The handles read from `path` checked as the rig will check them, and each part their
+/// `bind` names against the art's `layers`, so that a refusal names the file.
+fn check_handles(handles: &Handles, path: &Path, layers: &[&str]) -> Result<(), JobError> {
+    handles.validate().map_err(|source| JobError::Handles {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    for (handle, parts) in &handles.bind {
+        if let Some(part) = parts.iter().find(|p| !layers.contains(&p.as_str())) {
+            return Err(JobError::UnknownBindPart {
+                path: path.to_path_buf(),
+                handle: handle.clone(),
+                part: part.clone(),
+                layers: crate::names::owned(layers),
+                suggestion: crate::names::closest(part, layers),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The rest pose on white with every part's wireframe on top.
@@ -270,8 +298,7 @@ pub fn render_files(
     settings: &RenderSettings,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<RenderDone, JobError> {
-    let mut scene = Scene::load(&files.rig)?;
-    scene.set_skins(&files.skins)?;
+    let scene = scene_with_skins(&files.rig, &files.skins)?;
     // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
     let written = match sequence::format_for_path(&files.output)? {
         SequenceFormat::Folder => vec![],
@@ -286,7 +313,7 @@ pub fn render_files(
         std::iter::once(files.rig.as_path()).chain(images.iter().map(PathBuf::as_path)),
         written.iter().map(|f| Some(f.as_path())),
     )?;
-    let animation = animation(&scene.doc, &files.animation)?;
+    let animation = animation_in(&scene.doc, &files.rig, &files.animation)?;
     let targeted;
     let settings = match scene.doc.target.filter(|_| files.follow_target) {
         Some(target) => {
@@ -323,20 +350,48 @@ pub struct RenderDone {
     pub frame_times_s: Vec<f64>,
 }
 
-/// The document's animation `name`, checked against its rig.
+/// The rig at `rig` with its parts' images, drawing `skins` ([`Scene::set_skins`]); a skin it
+/// lacks is refused naming the file and the closest skin it has.
+pub fn scene_with_skins(rig: &Path, skins: &[String]) -> Result<Scene, JobError> {
+    let mut scene = Scene::load(rig)?;
+    scene.set_skins(skins).map_err(|source| JobError::Skins {
+        path: rig.to_path_buf(),
+        source,
+    })?;
+    Ok(scene)
+}
+
+/// The document's animation `name`, checked against its rig; a refusal names no file (see
+/// [`animation_in`]).
 pub fn animation(doc: &RigDocument, name: &str) -> Result<crate::anim::Animation, JobError> {
+    find_animation(doc, None, name)
+}
+
+/// The animation `name` of `doc`, read from `rig`, checked against its rig; a missing one is
+/// refused naming `rig`, the closest name it has, or how to make one.
+pub fn animation_in(
+    doc: &RigDocument,
+    rig: &Path,
+    name: &str,
+) -> Result<crate::anim::Animation, JobError> {
+    find_animation(doc, Some(rig), name)
+}
+
+fn find_animation(
+    doc: &RigDocument,
+    rig: Option<&Path>,
+    name: &str,
+) -> Result<crate::anim::Animation, JobError> {
     doc.check_animations()?;
-    doc.animations.get(name).cloned().ok_or_else(|| {
-        let known: Vec<&str> = doc.animations.keys().map(String::as_str).collect();
-        JobError::NoAnimation {
+    doc.animations
+        .get(name)
+        .cloned()
+        .ok_or_else(|| JobError::NoAnimation {
+            rig: rig.map(Path::to_path_buf),
             name: name.to_string(),
-            known: if known.is_empty() {
-                "none".to_string()
-            } else {
-                known.join(", ")
-            },
-        }
-    })
+            known: crate::names::owned(doc.animations.keys()),
+            suggestion: crate::names::closest(name, doc.animations.keys()),
+        })
 }
 
 /// Exports a rig file for Spine into folder `output` (`sinew export spine`): `NAME.json`,

@@ -127,10 +127,25 @@ pub enum HandleError {
     DuplicateName(String),
     #[error("handle names must not be empty")]
     EmptyName,
-    #[error("bone '{bone}' has unknown parent '{parent}'")]
-    UnknownParent { bone: String, parent: String },
-    #[error("point '{point}' has unknown parent bone '{parent}'")]
-    UnknownPointParent { point: String, parent: String },
+    #[error(
+        "bone '{bone}' has unknown parent '{parent}'{}",
+        crate::names::did_you_mean(.suggestion)
+    )]
+    UnknownParent {
+        bone: String,
+        parent: String,
+        /// The bone most like `parent` ([`crate::names::closest`]).
+        suggestion: Option<String>,
+    },
+    #[error(
+        "point '{point}' has unknown parent bone '{parent}'{}",
+        crate::names::did_you_mean(.suggestion)
+    )]
+    UnknownPointParent {
+        point: String,
+        parent: String,
+        suggestion: Option<String>,
+    },
     #[error("bone '{0}' is its own ancestor (cyclic parents)")]
     CyclicParents(String),
     #[error("bone '{0}' has zero length (head = tail)")]
@@ -139,8 +154,15 @@ pub enum HandleError {
     DegeneratePolygon { kind: &'static str, name: String },
     #[error("handle '{0}' has a coordinate that is not a finite number")]
     NonFinite(String),
-    #[error("'bind' names handle '{0}', which does not exist")]
-    UnknownBindHandle(String),
+    #[error(
+        "'bind' names handle '{name}', which does not exist{}",
+        crate::names::did_you_mean(.suggestion)
+    )]
+    UnknownBindHandle {
+        name: String,
+        /// The handle most like `name`.
+        suggestion: Option<String>,
+    },
     #[error("'bind' lists no part for handle '{0}'")]
     EmptyBind(String),
     #[error("ik constraint '{name}': {problem}")]
@@ -406,7 +428,10 @@ impl Handles {
         }
         for (name, parts) in &self.bind {
             if !seen.contains(name.as_str()) {
-                return Err(HandleError::UnknownBindHandle(name.clone()));
+                return Err(HandleError::UnknownBindHandle {
+                    name: name.clone(),
+                    suggestion: crate::names::closest(name, self.names()),
+                });
             }
             if parts.is_empty() {
                 return Err(HandleError::EmptyBind(name.clone()));
@@ -481,7 +506,11 @@ impl Handles {
                 return Err(bad("another constraint has this name".into()));
             }
             let Some(bone) = self.bones.iter().find(|b| b.name == c.bone) else {
-                return Err(bad(format!("bone '{}' does not exist", c.bone)));
+                return Err(bad(format!(
+                    "bone '{}' does not exist{}",
+                    c.bone,
+                    self.did_you_mean_bone(&c.bone)
+                )));
             };
             c.check_on_bone((bone.tail - bone.head).norm())
                 .map_err(bad)?;
@@ -513,7 +542,10 @@ impl Handles {
                 ));
             }
             for (k, name) in c.bones.iter().enumerate() {
-                let bone = find(name).ok_or_else(|| bad(c, format!("unknown bone '{name}'")))?;
+                let bone = find(name).ok_or_else(|| {
+                    let guess = self.did_you_mean_bone(name);
+                    bad(c, format!("unknown bone '{name}'{guess}"))
+                })?;
                 if k > 0 && bone.parent.as_deref() != Some(c.bones[k - 1].as_str()) {
                     return Err(bad(
                         c,
@@ -521,7 +553,10 @@ impl Handles {
                     ));
                 }
             }
-            find(&c.target).ok_or_else(|| bad(c, format!("unknown target bone '{}'", c.target)))?;
+            find(&c.target).ok_or_else(|| {
+                let guess = self.did_you_mean_bone(&c.target);
+                bad(c, format!("unknown target bone '{}'{guess}", c.target))
+            })?;
             // The target must not hang below the chain, or solving would move its own goal.
             let mut at = Some(c.target.as_str());
             while let Some(name) = at {
@@ -595,6 +630,16 @@ impl Handles {
         Ok(())
     }
 
+    /// The bone most like `name` ([`crate::names::closest`]).
+    fn closest_bone(&self, name: &str) -> Option<String> {
+        crate::names::closest(name, self.bones.iter().map(|b| &b.name))
+    }
+
+    /// `; did you mean 'BONE'?` for the bone most like `name`, or nothing.
+    fn did_you_mean_bone(&self, name: &str) -> String {
+        crate::names::did_you_mean(&self.closest_bone(name))
+    }
+
     fn check_parents(&self) -> Result<(), HandleError> {
         let index: HashMap<&str, usize> = self
             .bones
@@ -611,6 +656,7 @@ impl Handles {
                         return Err(HandleError::UnknownParent {
                             bone: b.name.clone(),
                             parent: p.clone(),
+                            suggestion: self.closest_bone(p),
                         })
                     }
                 }
@@ -625,6 +671,7 @@ impl Handles {
                 return Err(HandleError::UnknownPointParent {
                     point: p.name.clone(),
                     parent: parent.clone(),
+                    suggestion: self.closest_bone(parent),
                 });
             }
         }
@@ -712,9 +759,20 @@ mod tests {
             bones: vec![bone("a", Some("zz"))],
             ..Default::default()
         };
+        let misspelt = Handles {
+            bones: vec![bone("shoulder", None), bone("arm", Some("sholder"))],
+            ..Default::default()
+        };
+        assert_eq!(
+            misspelt.validate().unwrap_err().to_string(),
+            "bone 'arm' has unknown parent 'sholder'; did you mean 'shoulder'?"
+        );
         assert!(matches!(
             unknown.validate(),
-            Err(HandleError::UnknownParent { .. })
+            Err(HandleError::UnknownParent {
+                suggestion: None,
+                ..
+            })
         ));
         let cyclic = Handles {
             bones: vec![bone("a", Some("b")), bone("b", Some("a"))],
@@ -776,7 +834,8 @@ mod tests {
             h.validate(),
             Err(HandleError::UnknownPointParent {
                 point: "p".into(),
-                parent: "zz".into()
+                parent: "zz".into(),
+                suggestion: None
             })
         );
         h.points[0] = point("b");
@@ -818,7 +877,10 @@ mod tests {
         h.bind.insert("ghost".into(), vec!["body".into()]);
         assert_eq!(
             h.validate(),
-            Err(HandleError::UnknownBindHandle("ghost".into()))
+            Err(HandleError::UnknownBindHandle {
+                name: "ghost".into(),
+                suggestion: None
+            })
         );
         h.bind.remove("ghost");
         h.bind.insert("p".into(), vec![]);
