@@ -82,7 +82,10 @@ pub enum JobError {
     #[error("attachment: {0}")]
     Attachment(AttachmentError),
     /// The rig (at `rig`, when known) has no animation `name`.
-    #[error("{}", no_animation_message(.rig.as_deref(), .name, .known, .suggestion))]
+    #[error(
+        "{}",
+        no_animation_message(.rig.as_deref(), .name, .known, .suggestion, *.bones)
+    )]
     NoAnimation {
         rig: Option<PathBuf>,
         name: String,
@@ -90,6 +93,8 @@ pub enum JobError {
         known: Vec<String>,
         /// The one of `known` most like `name` ([`names::closest`]).
         suggestion: Option<String>,
+        /// Whether the rig has bones (a motion of the bundled library drives bones).
+        bones: bool,
     },
     /// The handles file at `path` is not a valid set of handles.
     #[error("{}: {source}", .path.display())]
@@ -162,12 +167,20 @@ fn no_animation_message(
     name: &str,
     known: &[String],
     suggestion: &Option<String>,
+    bones: bool,
 ) -> String {
     let (file, shown) = match rig {
         Some(rig) => (format!("{}: ", rig.display()), command_path(rig)),
         None => (String::new(), "RIG.json".to_string()),
     };
     let library = crate::motion::library::find(name).map(|m| m.name);
+    if known.is_empty() && !bones {
+        return format!(
+            "{file}the rig has no animations yet; key one in 'sinew edit {shown} --mode animate' \
+             (New animation); a motion of the bundled library needs bones, which 'sinew autorig' \
+             proposes"
+        );
+    }
     if known.is_empty() {
         let motion = library.unwrap_or("walk");
         return format!(
@@ -177,7 +190,7 @@ fn no_animation_message(
         );
     }
     let hint = match (suggestion, library) {
-        (None, Some(motion)) => format!(
+        (None, Some(motion)) if bones => format!(
             "; 'sinew animate {shown} --motion {motion}' adds the bundled library's {motion}"
         ),
         _ => String::new(),
@@ -307,10 +320,10 @@ mod tests {
         let known = names::owned(["hop", "walk"]);
         let rig = Path::new("my rig.json");
         assert_eq!(
-            no_animation_message(Some(rig), "walkk", &known, &Some("walk".into())),
+            no_animation_message(Some(rig), "walkk", &known, &Some("walk".into()), true),
             "my rig.json: the rig has no animation 'walkk'; did you mean 'walk'? (it has: hop, walk)"
         );
-        let none = no_animation_message(Some(rig), "stroll", &[], &None);
+        let none = no_animation_message(Some(rig), "stroll", &[], &None, true);
         assert!(
             none.starts_with("my rig.json: the rig has no animations yet; make one with 'sinew animate \"my rig.json\" --motion walk'"),
             "{none}"
@@ -319,8 +332,11 @@ mod tests {
             none.contains("'sinew edit \"my rig.json\" --mode animate'"),
             "{none}"
         );
+        let boneless = no_animation_message(Some(rig), "walk", &[], &None, false);
+        assert!(!boneless.contains("sinew animate"), "{boneless}");
+        assert!(boneless.contains("sinew autorig"), "{boneless}");
         assert_eq!(
-            no_animation_message(None, "run", &known, &None),
+            no_animation_message(None, "run", &known, &None, true),
             "the rig has no animation 'run' (it has: hop, walk); 'sinew animate RIG.json --motion \
              run' adds the bundled library's run"
         );

@@ -391,6 +391,7 @@ fn find_animation(
             name: name.to_string(),
             known: crate::names::owned(doc.animations.keys()),
             suggestion: crate::names::closest(name, doc.animations.keys()),
+            bones: !doc.handles.bones.is_empty(),
         })
 }
 
