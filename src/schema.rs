@@ -93,8 +93,22 @@ impl std::str::FromStr for SchemaKind {
     }
 }
 
-/// The JSON Schema of `kind`.
+/// The JSON Schema of `kind`, its descriptions in plain words (see [`plain_description`]).
 pub fn schema(kind: SchemaKind) -> Schema {
+    let mut schema = derived_schema(kind);
+    if let Some(object) = schema.as_object_mut() {
+        for value in object.values_mut() {
+            plain_descriptions(value);
+        }
+        if let Some(serde_json::Value::String(text)) = object.get_mut("description") {
+            *text = plain_description(text);
+        }
+    }
+    schema
+}
+
+/// The schema schemars derives from the types' serde attributes and doc comments.
+fn derived_schema(kind: SchemaKind) -> Schema {
     match kind {
         SchemaKind::Handles => schemars::schema_for!(Handles),
         SchemaKind::Rig => schemars::schema_for!(RigDocument),
@@ -104,6 +118,62 @@ pub fn schema(kind: SchemaKind) -> Schema {
         SchemaKind::Events => schemars::schema_for!(crate::anim::EventDefs),
         SchemaKind::Batch => schemars::schema_for!(crate::batch::Manifest),
     }
+}
+
+/// Rewrites every `description` string under `value` with [`plain_description`].
+fn plain_descriptions(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Object(map) => {
+            for (key, value) in map.iter_mut() {
+                match value {
+                    serde_json::Value::String(text) if key == "description" => {
+                        *text = plain_description(text);
+                    }
+                    _ => plain_descriptions(value),
+                }
+            }
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(plain_descriptions),
+        _ => {}
+    }
+}
+
+/// A doc comment as a reader of the schema sees it: a parenthesized reference to Rust code
+/// (`` ([`super::rigid`]) ``, `` (see [`IkOptions`]) ``) is left out; any other intra-doc
+/// link `` [`path::Name`] `` becomes `` `Name` ``, and `[text](target)` becomes `text`; line
+/// breaks become spaces.
+pub fn plain_description(text: &str) -> String {
+    let mut text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    // Parenthesized references first: " ([`x`])" and " (see [`x`])" go whole.
+    for opening in [" ([`", " (see [`", "([`", "(see [`"] {
+        while let Some(start) = text.find(opening) {
+            let Some(len) = text[start..].find("`])") else {
+                break;
+            };
+            text.replace_range(start..start + len + 3, "");
+        }
+    }
+    // Remaining intra-doc links: the last path segment, in code quotes.
+    while let Some(start) = text.find("[`") {
+        let Some(len) = text[start..].find("`]") else {
+            break;
+        };
+        let path = &text[start + 2..start + len];
+        let name = path.rsplit("::").next().unwrap_or(path).to_string();
+        text.replace_range(start..start + len + 2, &format!("`{name}`"));
+    }
+    // Markdown links: their text.
+    while let Some(middle) = text.find("](") {
+        let Some(open) = text[..middle].rfind('[') else {
+            break;
+        };
+        let Some(len) = text[middle..].find(')') else {
+            break;
+        };
+        let label = text[open + 1..middle].to_string();
+        text.replace_range(open..middle + len + 1, &label);
+    }
+    text.replace("::", " ")
 }
 
 /// The animations map: name → animation (an animations file, or the rig document's
@@ -290,6 +360,30 @@ impl From<IkOptions> for IkOptionsSchema {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn descriptions_lose_their_rustdoc_syntax() {
+        assert_eq!(
+            plain_description("Rigid weights (see [`super::rigid`]).\nBlended."),
+            "Rigid weights. Blended."
+        );
+        assert_eq!(
+            plain_description("How weights are solved ([`super::two_level`])."),
+            "How weights are solved."
+        );
+        assert_eq!(
+            plain_description("At most [`MAX_PADDING_PX`] px, as [`crate::rig::pose::PartPose`]."),
+            "At most `MAX_PADDING_PX` px, as `PartPose`."
+        );
+        assert_eq!(
+            plain_description("See [the guide](docs/guide.md) and `a::b`."),
+            "See the guide and `a b`."
+        );
+        for kind in SchemaKind::ALL {
+            let text = serde_json::to_string(&schema(kind)).unwrap();
+            assert!(!text.contains("[`"), "{}", kind.name());
+        }
+    }
 
     #[test]
     fn kinds_parse_by_name_and_unknown_names_are_refused() {
