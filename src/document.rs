@@ -688,8 +688,7 @@ pub fn compute_rig(
     cancel: &AtomicBool,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Scene, DocumentError> {
-    let total = inputs.layers.len();
-    let mut report = |done: usize, _: &str| progress(done, total);
+    let mut report = |done: usize, total: usize, _: &str| progress(done, total);
     let built = pipeline::build_rig_cancellable(
         &inputs.layers,
         dir,

@@ -229,17 +229,17 @@ pub fn build_rig<L: Borrow<Layer>>(
     options: &BuildOptions,
     handles: &Handles,
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
-    build_rig_with_progress(layers, doc_dir, options, handles, &mut |_, _| {})
+    build_rig_with_progress(layers, doc_dir, options, handles, &mut |_, _, _| {})
 }
 
-/// [`build_rig`], calling `progress(parts_done, part_name)` before each part and once at the
-/// end (with an empty name), for progress bars.
+/// [`build_rig`], calling `progress(parts_done, parts_in_all, part_name)` before each part and
+/// once at the end (with an empty name), for progress bars.
 pub fn build_rig_with_progress<L: Borrow<Layer>>(
     layers: &[L],
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
-    progress: &mut dyn FnMut(usize, &str),
+    progress: &mut dyn FnMut(usize, usize, &str),
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     let never = std::sync::atomic::AtomicBool::new(false);
     build_rig_cancellable(layers, doc_dir, options, handles, progress, &never)
@@ -252,7 +252,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
     doc_dir: &Path,
     options: &BuildOptions,
     handles: &Handles,
-    progress: &mut dyn FnMut(usize, &str),
+    progress: &mut dyn FnMut(usize, usize, &str),
     cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<(RigDocument, Vec<PartReport>), PipelineError> {
     let first: &Layer = layers.first().ok_or(PipelineError::NoImages)?.borrow();
@@ -281,7 +281,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
         if cancel.load(std::sync::atomic::Ordering::Relaxed) {
             return Err(PipelineError::Cancelled);
         }
-        progress(done, &layer.name);
+        progress(done, layers.len(), &layer.name);
         let outlines = trace::trace(&layer.image, &options.trace)
             .map(|o| trace::translated(o, layer.offset_px))
             .map_err(|source| PipelineError::Trace {
@@ -369,7 +369,7 @@ pub fn build_rig_cancellable<L: Borrow<Layer>>(
             stale_weights: None,
         });
     }
-    progress(layers.len(), "");
+    progress(layers.len(), layers.len(), "");
     if let Some(column) = touched.iter().position(|&n| n == 0) {
         return Err(PipelineError::HandleOutside(columns[column].clone()));
     }

@@ -76,7 +76,7 @@ pub fn run_job(job: &Job, root: &Path) -> Result<(), BatchError> {
                 preview: at_opt(&j.outputs.preview),
                 layout: Default::default(),
             };
-            jobs::rig_files(&files, &j.options.build, &mut |_, _| {})?;
+            jobs::rig_files(&files, &j.options.build, &mut |_, _, _| {})?;
         }
         Job::Autorig(j) => {
             let mut options = crate::autorig::AutorigOptions {
@@ -103,7 +103,7 @@ pub fn run_job(job: &Job, root: &Path) -> Result<(), BatchError> {
                 follow_target: settings.sampling.curves == crate::anim::CurveEvaluation::Exact
                     && settings.baked_runtime.is_none(),
             };
-            jobs::render_files(&files, &settings, &|| {})?;
+            jobs::render_files(&files, &settings, &|_| {})?;
         }
         Job::Export(j) => {
             jobs::export_spine_files(

@@ -100,7 +100,7 @@ pub fn load_art(images: &[PathBuf], output: &Path) -> Result<crate::art::Art, Jo
 pub fn rig_files(
     files: &RigFiles,
     options: &BuildOptions,
-    progress: &mut dyn FnMut(usize, &str),
+    progress: &mut dyn FnMut(usize, usize, &str),
 ) -> Result<RigDone, JobError> {
     let inputs = || {
         files
@@ -292,11 +292,11 @@ pub struct RenderFiles {
 }
 
 /// Renders an animation of a rig file to `files.output` (`sinew render`), in bounded memory;
-/// `on_frame` is called once per frame drawn.
+/// `on_frame(frames_in_all)` is called once per frame drawn.
 pub fn render_files(
     files: &RenderFiles,
     settings: &RenderSettings,
-    on_frame: &(dyn Fn() + Sync),
+    on_frame: &(dyn Fn(usize) + Sync),
 ) -> Result<RenderDone, JobError> {
     let scene = scene_with_skins(&files.rig, &files.skins)?;
     // A frame folder is made where it is missing; a sprite sheet writes its JSON beside it.
@@ -325,6 +325,7 @@ pub fn render_files(
     // Check the settings and the target before rendering: a bad one fails at once.
     settings.view(scene.doc.canvas)?;
     let frame_times_s = playback::frame_times(animation.duration_s(), settings.fps)?;
+    let frames = frame_times_s.len();
     let (report, events) = playback::write_animation(
         &scene,
         &files.animation,
@@ -332,7 +333,7 @@ pub fn render_files(
         settings,
         &files.output,
         &Default::default(),
-        on_frame,
+        &|| on_frame(frames),
     )?;
     Ok(RenderDone {
         report,
