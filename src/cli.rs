@@ -9,7 +9,9 @@ mod batch;
 mod choices;
 mod colorize;
 mod demo_assets;
+mod examples;
 mod export_gltf;
+pub(crate) mod out;
 mod shell;
 mod target;
 
@@ -39,13 +41,20 @@ use std::time::Instant;
 #[command(
     name = "sinew",
     version,
-    about = "2D cutout animation: trace, mesh, weigh, pose, render"
+    about = "2D cutout animation: rig your art, animate it, export it to your game",
+    after_help = examples::SINEW
 )]
 pub struct Cli {
     /// The most memory a command may allocate, e.g. 512MiB or 8GiB (default 2GiB, or the
     /// SINEW_MEMORY_BUDGET environment variable); work beyond it is refused before it starts.
     #[arg(long, global = true, value_name = "SIZE", value_parser = parse_memory_budget)]
     pub memory_budget: Option<sinew::budget::MemoryBudget>,
+    /// Print only warnings, errors and the data asked for: no reports, notes or progress bars.
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
+    pub quiet: bool,
+    /// Also print details: each part's mesh quality and how long the command took.
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
     #[command(subcommand)]
     pub command: Command,
 }
@@ -61,8 +70,8 @@ fn bound_rayon_threads() {
     };
     let (threads, lowered) = sinew::budget::bounded_threads(asked);
     if lowered {
-        eprintln!(
-            "sinew: note: RAYON_NUM_THREADS={asked}: this machine runs at most {threads} threads \
+        out::note!(
+            "RAYON_NUM_THREADS={asked}: this machine runs at most {threads} threads \
              ({} per core); using {threads}",
             sinew::budget::THREADS_PER_CORE
         );
@@ -98,39 +107,66 @@ fn set_memory_budget(flag: Option<sinew::budget::MemoryBudget>) -> Result<()> {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Trace and mesh images into a rig document (several images = several parts, in draw order).
+    /// Trace, mesh and weigh images into a rig document (each image or layer a part).
+    ///
+    /// Layer images (PNG, all the same size) or layered files are traced, meshed and, with a
+    /// handles file, given bounded biharmonic weights; parts are in draw order, back to front.
+    #[command(after_help = examples::RIG)]
     Rig(RigArgs),
     /// Draw a rig in a pose (the rest pose when none is given).
+    #[command(after_help = examples::POSE)]
     Pose(PoseArgs),
-    /// Render an animation of a rig to numbered PNGs (a folder), a GIF or a sprite sheet.
+    /// Render an animation to numbered PNGs (a folder), a GIF or a sprite sheet.
+    #[command(after_help = examples::RENDER)]
     Render(RenderArgs),
     /// Run the whole pipeline on the bundled character.
+    #[command(after_help = examples::DEMO)]
     Demo(DemoArgs),
-    /// Export a rig for a game runtime.
+    /// Export a rig for a game runtime: Spine, glTF or DragonBones.
+    #[command(after_help = examples::EXPORT)]
     Export(ExportArgs),
     /// Propose handles (a skeleton, a cage, points) from the drawing.
+    #[command(after_help = examples::AUTORIG)]
     Autorig(AutorigArgs),
-    /// Add an animation to a rig from motion capture: a clip of the bundled library (idle,
-    /// walk, run, jump, jump_forward, wave) or a BVH file, retargeted onto the rig's bones.
+    /// Add an animation to a rig from motion capture, retargeted onto its bones.
+    ///
+    /// The motion is a clip of the bundled library (idle, walk, run, jump, jump_forward,
+    /// wave) or a BVH file of your own.
+    #[command(after_help = examples::ANIMATE)]
     Animate(animate::AnimateArgs),
-    /// Art in, a character that moves out: the automatic rig, weights, the library's motions,
-    /// GIF and sprite-sheet renders and the Spine export, with a summary of what was chosen.
+    /// Art in, a character that moves out: rig, motions, renders and a Spine export.
+    ///
+    /// The automatic rig, weights, the library's motions, GIF and sprite-sheet renders and
+    /// the Spine export, with a summary of what was chosen.
+    #[command(after_help = examples::AUTO)]
     Auto(auto::AutoArgs),
-    /// The runtime a rig is made for: pose, render and the editor play as it plays the export.
+    /// Show or set the runtime a rig plays as (pose, render and the editor follow it).
+    #[command(after_help = examples::TARGET)]
     Target(target::TargetArgs),
-    /// Color line art from a few colored scribbles (content-aware weights over the image).
+    /// Color line art from a few colored scribbles.
+    ///
+    /// Each scribble's color fills the regions the lines close around it; a region holding
+    /// several colors is split between them (--split).
+    #[command(after_help = examples::COLORIZE)]
     Colorize(colorize::ColorizeArgs),
-    /// Run the jobs of a manifest (rig, autorig, render, export, colorize) in parallel, here
-    /// or on a Ray cluster; unchanged jobs are skipped.
+    /// Run the jobs of a manifest in parallel, here or on a Ray cluster.
+    ///
+    /// Jobs rig, autorig, render, export or colorize; a job whose inputs, options and sinew
+    /// version are unchanged since its last success is skipped.
+    #[command(after_help = examples::BATCH)]
     Batch(batch::BatchArgs),
     /// Print the JSON Schema of a file sinew reads (see docs/formats.md).
+    #[command(after_help = examples::SCHEMA)]
     Schema(SchemaArgs),
-    /// Open the editor window (rig, weigh and pose by hand).
+    /// Open the editor window: rig, weigh, pose, animate and colorize by hand.
     #[cfg(feature = "editor")]
+    #[command(after_help = examples::EDIT)]
     Edit(EditArgs),
     /// Print the completion script of a shell (bash, zsh, fish, elvish, powershell).
+    #[command(after_help = examples::COMPLETIONS)]
     Completions(shell::CompletionsArgs),
     /// Print the man page sinew(1), or write a page per command into a folder (-o DIR).
+    #[command(after_help = examples::MAN)]
     Man(shell::ManArgs),
 }
 
@@ -192,13 +228,21 @@ pub struct ExportArgs {
 
 #[derive(Subcommand, Debug)]
 pub enum ExportFormat {
-    /// Spine skeleton JSON + .atlas + page PNGs (DIR/NAME.json, DIR/NAME.atlas, DIR/NAME.png).
+    /// Spine skeleton JSON, .atlas and page PNGs, for the Spine runtimes.
+    ///
+    /// Writes DIR/NAME.json, DIR/NAME.atlas and DIR/NAME.png.
+    #[command(after_help = examples::EXPORT_SPINE)]
     Spine(SpineArgs),
-    /// Binary glTF 2.0 (FILE.glb): skinned meshes, textures and baked animations, for Godot,
-    /// Bevy, Unity, Blender and three.js.
+    /// Binary glTF 2.0 (.glb), for Godot, Bevy, Unity, Blender and three.js.
+    ///
+    /// Skinned meshes, their textures and the animations baked on frames, in one file.
+    #[command(after_help = examples::EXPORT_GLTF)]
     Gltf(export_gltf::GltfArgs),
-    /// DragonBones 5.5 JSON + texture atlas (DIR/NAME_ske.json, DIR/NAME_tex.json,
-    /// DIR/NAME_tex.png), every motion baked on the armature's frames.
+    /// DragonBones 5.5 JSON and texture atlas, for Cocos, Egret, Pixi and Phaser.
+    ///
+    /// Writes DIR/NAME_ske.json, DIR/NAME_tex.json and DIR/NAME_tex.png; every motion is
+    /// baked on the armature's frames.
+    #[command(after_help = examples::EXPORT_DRAGONBONES)]
     Dragonbones(export_gltf::DragonBonesArgs),
 }
 
@@ -321,21 +365,21 @@ pub struct RenderArgs {
     #[arg(long, value_parser = choices::parser::<BlendArg, Blend>(), default_value = choices::default_name!(BlendArg, playback::RenderSettings::default().blend))]
     pub blend: Blend,
     /// Play as this runtime plays the export of its format instead of exactly (default: the
-    /// rig's target runtime, `sinew target`; see docs/guide.md, "Spine export").
+    /// rig's target runtime, which `sinew target` sets).
     #[arg(long, value_enum)]
     pub match_runtime: Option<RuntimeMatch>,
     /// Play exactly, even when the rig names a target runtime.
     #[arg(long, conflicts_with = "match_runtime")]
     pub exact: bool,
-    /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
+    /// With --match-runtime spine: the Spine line the export was written for (`sinew export spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
     #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
     pub spine_version: String,
-    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
+    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew export spine
     /// --fps`).
     #[arg(long, default_value_t = SpineOptions::default().bake_fps, requires = "match_runtime")]
     pub bake_fps: f64,
-    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// Draw with this skin (a rig's `skins`: see docs/formats.md, "Rig document"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.
     #[arg(long = "skin", value_name = "NAME")]
     pub skins: Vec<String>,
@@ -544,15 +588,15 @@ pub struct PoseArgs {
     /// With --anim: play exactly, even when the rig names a target runtime.
     #[arg(long, requires = "anim", conflicts_with = "match_runtime")]
     pub exact: bool,
-    /// With --match-runtime spine: the Spine line the export was written for (`sinew spine
+    /// With --match-runtime spine: the Spine line the export was written for (`sinew export spine
     /// --spine-version`): 4.2 (or 4.1, whose export bakes physics, or 4.3).
     #[arg(long, default_value = SpineVersion::default().name(), requires = "match_runtime")]
     pub spine_version: String,
-    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew spine
+    /// With --match-runtime spine: the export's keys per second of baked motion (`sinew export spine
     /// --fps`).
     #[arg(long, default_value_t = SpineOptions::default().bake_fps, requires = "match_runtime")]
     pub bake_fps: f64,
-    /// Draw with this skin (see docs/formats.md, "Slots, attachments and skins"); repeat to
+    /// Draw with this skin (a rig's `skins`: see docs/formats.md, "Rig document"); repeat to
     /// combine skins, a later one overriding an earlier one on the same slot.
     #[arg(long = "skin", value_name = "NAME")]
     pub skins: Vec<String>,
@@ -572,9 +616,17 @@ pub struct DemoArgs {
 
 /// Runs one parsed command.
 pub fn run(cli: Cli) -> Result<()> {
+    out::set(cli.quiet, cli.verbose);
     set_memory_budget(cli.memory_budget)?;
     bound_rayon_threads();
-    match cli.command {
+    let started = Instant::now();
+    run_command(cli.command)?;
+    out::detail!("done in {:.2} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn run_command(command: Command) -> Result<()> {
+    match command {
         Command::Rig(args) => rig(&args),
         Command::Pose(args) => pose(&args),
         Command::Render(args) => render_animation(&args),
@@ -658,7 +710,7 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
     let (proposal, notes) = sinew::jobs::autorig_files(&files, &options)?;
     print_notes(&notes);
     let h = &proposal.handles;
-    println!(
+    out::report!(
         "{}: {} bones, {} points, {} cages",
         args.output.display(),
         h.bones.len(),
@@ -671,14 +723,14 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
         .iter()
         .partition(|n| n.starts_with("template: "));
     match chosen.first() {
-        Some(line) => println!("{line}"),
-        None => println!(
+        Some(line) => out::report!("{line}"),
+        None => out::report!(
             "template: {}",
             sinew::autorig::template_name(proposal.template)
         ),
     }
     for note in rest {
-        println!("  {note}");
+        out::report!("  {note}");
     }
     Ok(())
 }
@@ -686,7 +738,7 @@ fn autorig(args: &AutorigArgs) -> Result<()> {
 /// The notes on layers skipped or drawn differently.
 fn print_notes(notes: &[String]) {
     for note in notes {
-        println!("note: {note}");
+        out::report!("note: {note}");
     }
 }
 
@@ -708,14 +760,11 @@ fn rig(args: &RigArgs) -> Result<()> {
             io::JsonLayout::Compact
         },
     };
-    // Parts done (a layered file holds several); indicatif draws nothing when stderr is not a
-    // terminal.
-    let bar = indicatif::ProgressBar::no_length();
-    if let Ok(style) = indicatif::ProgressStyle::with_template("rigging: {pos} parts done {msg}") {
-        bar.set_style(style);
-    }
+    // Parts done (a layered file holds several), each traced, meshed and weighed.
+    let bar = out::bar("rigging", "parts");
     let options = args.build.checked_options()?;
-    let done = sinew::jobs::rig_files(&files, &options, &mut |done, name| {
+    let done = sinew::jobs::rig_files(&files, &options, &mut |done, total, name| {
+        bar.set_length(total as u64);
         bar.set_position(done as u64);
         bar.set_message(name.to_string());
     });
@@ -733,9 +782,12 @@ fn rig(args: &RigArgs) -> Result<()> {
 
 fn report_part(name: &str, r: &PartReport) {
     let s = &r.mesh;
-    println!(
-        "{name}: {} vertices, {} triangles, smallest angle {:.1}°",
-        s.vertices, s.triangles, s.min_angle_deg
+    out::report!("{name}: {} vertices, {} triangles", s.vertices, s.triangles);
+    out::detail!(
+        "  {name}: smallest triangle angle {:.1}° (skinning deforms thin triangles badly; \
+         --min-angle sets what refinement aims for, outlines narrower than a triangle keep \
+         thinner ones)",
+        s.min_angle_deg
     );
     if !r.bound_to_nearest.is_empty() {
         eprintln!(
@@ -846,13 +898,13 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         output: args.output.clone(),
         follow_target: args.match_runtime.is_none() && !args.exact,
     };
-    // The frame count is known inside the job: the bar counts frames drawn.
-    let bar = indicatif::ProgressBar::no_length();
-    if let Ok(style) = indicatif::ProgressStyle::with_template("rendering {pos} frames") {
-        bar.set_style(style);
-    }
+    // The frame count is known inside the job, and told with every frame drawn.
+    let bar = out::bar("rendering", "frames");
     // Drawn and written a chunk of frames at a time: any length renders in bounded memory.
-    let written = sinew::jobs::render_files(&files, &settings, &|| bar.inc(1));
+    let written = sinew::jobs::render_files(&files, &settings, &|total| {
+        bar.set_length(total as u64);
+        bar.inc(1);
+    });
     bar.finish_and_clear();
     let sinew::jobs::RenderDone {
         report,
@@ -877,9 +929,11 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         report.duration_s
     );
     if args.events {
-        eprintln!("{summary}");
+        if !out::quiet() {
+            eprintln!("{summary}");
+        }
     } else {
-        println!("{summary}");
+        out::report!("{summary}");
     }
     Ok(())
 }
@@ -1059,30 +1113,30 @@ fn demo_steps(args: &DemoArgs) -> Result<()> {
     let (v, t_count): (usize, usize) = stats.iter().fold((0, 0), |a, s| {
         (a.0 + s.mesh.vertices, a.1 + s.mesh.triangles)
     });
-    println!(
+    out::report!(
         "sinew demo: {} parts, {v} vertices, {t_count} triangles; animations {}",
         doc.parts.len(),
         animations.keys().cloned().collect::<Vec<_>>().join(", ")
     );
-    println!("  load images   {:>8.1} ms", load_s * 1e3);
-    println!(
+    out::report!("  load images   {:>8.1} ms", load_s * 1e3);
+    out::report!(
         "  rig           {:>8.1} ms (trace, mesh, weights)",
         rig_s * 1e3
     );
-    println!("  rest pose     {:>8.1} ms", rest_s * 1e3);
-    println!("  spine export  {:>8.1} ms", spine_s * 1e3);
-    println!(
+    out::report!("  rest pose     {:>8.1} ms", rest_s * 1e3);
+    out::report!("  spine export  {:>8.1} ms", spine_s * 1e3);
+    out::report!(
         "  animate       {:>8.1} ms ({frame_count} frames at {DEMO_FPS} fps, sampled and rendered)",
         render_s * 1e3
     );
-    println!(
+    out::report!(
         "  write         {:>8.1} ms (GIFs, sheets, frames)",
         write_s * 1e3
     );
     for path in &written {
-        println!("  wrote {}", path.display());
+        out::report!("  wrote {}", path.display());
     }
-    println!(
+    out::report!(
         "  total         {:>8.1} ms",
         started.elapsed().as_secs_f64() * 1e3
     );
@@ -1106,7 +1160,7 @@ fn export_spine(args: &SpineArgs) -> Result<()> {
 
 fn report_spine_export(export: &spine::SpineExport, written: &[PathBuf]) {
     let vertices: usize = export.parts.iter().map(|p| p.mesh.uvs.len()).sum();
-    println!(
+    out::report!(
         "spine {}: {} bones, {} slots, {vertices} mesh vertices",
         export.name,
         export.skeleton.bones.len(),
@@ -1114,13 +1168,13 @@ fn report_spine_export(export: &spine::SpineExport, written: &[PathBuf]) {
     );
     for (animation, baked) in &export.baked {
         if baked.is_empty() {
-            println!("  {animation}: native timelines");
+            out::report!("  {animation}: native timelines");
         } else {
-            println!("  {animation}: baked {}", baked.join(", "));
+            out::report!("  {animation}: baked {}", baked.join(", "));
         }
     }
     for path in written {
-        println!("  wrote {}", path.display());
+        out::report!("  wrote {}", path.display());
     }
 }
 

@@ -34,6 +34,8 @@ pub fn run(args: &AutoArgs) -> Result<()> {
         output: args.output.clone(),
     };
     let summary = auto_files(&files, &options)?;
-    print!("{}", summary.text(&args.output));
+    if !super::out::quiet() {
+        print!("{}", summary.text(&args.output));
+    }
     Ok(())
 }

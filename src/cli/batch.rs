@@ -17,7 +17,7 @@ pub struct BatchArgs {
     #[arg(long, value_name = "N", default_value_t = 0, conflicts_with = "ray")]
     pub jobs: usize,
     /// Run each job as a task on the Ray cluster at this address (HOST:PORT of its head),
-    /// through tools/ray/driver.py (see docs/batch.md).
+    /// through sinew's built-in Ray driver (see docs/batch.md).
     #[arg(long, value_name = "ADDRESS")]
     pub ray: Option<String>,
     /// The Python that runs the Ray driver: one with the `ray` package, e.g. a virtual
@@ -50,12 +50,8 @@ pub fn run(args: &BatchArgs) -> Result<()> {
     }
     let manifest = std::path::absolute(&args.manifest)?;
     let state = batch::record::state_path(&manifest);
-    let bar = indicatif::ProgressBar::new(plan.jobs.len() as u64);
-    if let Ok(style) =
-        indicatif::ProgressStyle::with_template("batch {bar:30} {pos}/{len} jobs {msg}")
-    {
-        bar.set_style(style);
-    }
+    let bar = super::out::bar("batch", "jobs");
+    bar.set_length(plan.jobs.len() as u64);
     let mut on_job = |r: &JobReport| {
         bar.inc(1);
         if r.status == Status::Failed {
@@ -66,8 +62,8 @@ pub fn run(args: &BatchArgs) -> Result<()> {
         None => {
             let (jobs, lowered) = sinew::budget::bounded_threads(args.jobs);
             if lowered {
-                eprintln!(
-                    "sinew: note: --jobs {}: this machine runs at most {jobs} threads ({} per \
+                super::out::note!(
+                    "--jobs {}: this machine runs at most {jobs} threads ({} per \
                      core); running {jobs} jobs at once",
                     args.jobs,
                     sinew::budget::THREADS_PER_CORE

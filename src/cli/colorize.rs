@@ -88,7 +88,7 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
     };
     let done = sinew::jobs::colorize_files(&files, &options)?;
     let s = &done.stats;
-    println!(
+    super::out::report!(
         "colorized {}×{} px with {} colors: {} mesh vertices, {} triangles, {:.2} s",
         done.size_px.0,
         done.size_px.1,
@@ -98,7 +98,7 @@ pub fn run(args: &ColorizeArgs) -> Result<()> {
         start.elapsed().as_secs_f64()
     );
     if s.scribble_pixels_on_lines > 0 {
-        println!(
+        super::out::report!(
             "  {} scribble pixels lie on lines and were ignored",
             s.scribble_pixels_on_lines
         );

@@ -34,14 +34,14 @@ pub fn run(args: &GltfArgs) -> Result<()> {
         ..GltfOptions::default()
     };
     let export = sinew::jobs::export_gltf_file(&args.rig, &args.output, &options)?;
-    println!(
+    super::out::report!(
         "gltf: {} joints, {} meshes (at most {MAX_INFLUENCES} influences per vertex), {} KB",
         export.joints.len(),
         export.parts.len(),
         export.glb.len().div_ceil(1024)
     );
     for animation in &export.animations {
-        println!(
+        super::out::report!(
             "  {}: baked {} keys at {} fps",
             animation.name,
             animation.times_s.len(),
@@ -49,9 +49,9 @@ pub fn run(args: &GltfArgs) -> Result<()> {
         );
     }
     for line in &export.left_out {
-        println!("  not in glTF: {line}");
+        super::out::report!("  not in glTF: {line}");
     }
-    println!("  wrote {}", args.output.display());
+    super::out::report!("  wrote {}", args.output.display());
     Ok(())
 }
 
@@ -90,14 +90,14 @@ pub fn run_dragonbones(args: &DragonBonesArgs) -> Result<()> {
         args.name.as_deref(),
         &options,
     )?;
-    println!(
+    super::out::report!(
         "dragonbones {}: {} bones, {} animations",
         export.name,
         export.joints.len() + 1,
         export.animations.len()
     );
     for animation in &export.animations {
-        println!(
+        super::out::report!(
             "  {}: baked {} frames at {} fps",
             animation.name,
             animation.frame_count + 1,
@@ -105,10 +105,10 @@ pub fn run_dragonbones(args: &DragonBonesArgs) -> Result<()> {
         );
     }
     for line in &export.left_out {
-        println!("  not in DragonBones: {line}");
+        super::out::report!("  not in DragonBones: {line}");
     }
     for path in &written {
-        println!("  wrote {}", path.display());
+        super::out::report!("  wrote {}", path.display());
     }
     Ok(())
 }

@@ -8,10 +8,6 @@ use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
-#[command(after_help = "Examples:
-  sinew completions bash > ~/.local/share/bash-completion/completions/sinew
-  sinew completions zsh > ~/.zfunc/_sinew        # with fpath+=~/.zfunc in ~/.zshrc
-  sinew completions fish > ~/.config/fish/completions/sinew.fish")]
 pub struct CompletionsArgs {
     /// The shell to complete in.
     #[arg(value_enum)]
@@ -19,9 +15,6 @@ pub struct CompletionsArgs {
 }
 
 #[derive(Args, Debug)]
-#[command(after_help = "Examples:
-  sinew man | man -l -                          # read it now
-  sinew man -o ~/.local/share/man/man1          # install it: man sinew, man sinew-rig")]
 pub struct ManArgs {
     /// Write sinew.1 and a page per command (sinew-rig.1, sinew-export-spine.1, ...) into this
     /// folder (created if missing) instead of printing sinew.1.
@@ -59,7 +52,7 @@ pub fn man(args: &ManArgs) -> Result<()> {
                 sinew::io::write_atomic(&path, text)
                     .with_context(|| format!("{}: cannot write", path.display()))?;
             }
-            println!("wrote {} man pages into {}", pages.len(), dir.display());
+            super::out::report!("wrote {} man pages into {}", pages.len(), dir.display());
             Ok(())
         }
     }

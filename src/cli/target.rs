@@ -37,12 +37,12 @@ pub fn run(args: &TargetArgs) -> Result<()> {
         doc.save(&args.rig)?;
     }
     match target {
-        Some(t) => println!(
+        Some(t) => super::out::report!(
             "{}: pose, render and the editor play as {} plays the export",
             args.rig.display(),
             t.label()
         ),
-        None => println!("{}: animations play exactly", args.rig.display()),
+        None => super::out::report!("{}: animations play exactly", args.rig.display()),
     }
     Ok(())
 }
