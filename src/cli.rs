@@ -263,11 +263,12 @@ pub struct SpineArgs {
     /// at most 4 influences per vertex (the two options below override the preset's).
     #[arg(long, value_parser = choices::parser::<SpinePresetArg, SpinePreset>(), default_value = choices::default_name!(SpinePresetArg, SpinePreset::default()))]
     pub preset: SpinePreset,
-    /// Keep the K strongest weights per vertex, renormalized.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", help = format!("Keep the K strongest weights per vertex, \
+        renormalized (default: the preset's; full keeps all, game {})", spine::GAME_PRESET_MAX_INFLUENCES))]
     pub max_influences: Option<usize>,
-    /// Decimate each part's mesh to at most N vertices (weights carried from the fine mesh).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", help = format!("Decimate each part's mesh to at most N \
+        vertices, weights carried from the fine mesh (default: the preset's; full keeps all, \
+        game {})", spine::GAME_PRESET_MAX_VERTICES))]
     pub max_vertices: Option<usize>,
     /// auto: bake only what native timelines cannot express; all: bake every bone.
     #[arg(long, value_parser = choices::parser::<BakeModeArg, BakeMode>(), default_value = choices::default_name!(BakeModeArg, SpineOptions::default().bake))]
@@ -323,10 +324,11 @@ pub struct AutorigArgs {
     /// The handles file to write.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// At most this many bones.
+    /// At most this many bones (default: the template's budget, humanoid 20, quadruped 25,
+    /// 25 without a template).
     #[arg(long, value_name = "N")]
     pub bones: Option<usize>,
-    /// Also propose a cage of at most N vertices.
+    /// Also propose a cage of at most N vertices (default: no cage).
     #[arg(long, value_name = "N")]
     pub cage: Option<usize>,
     /// Also propose N point handles.
@@ -434,6 +436,14 @@ pub struct RigArgs {
     pub build: BuildArgs,
 }
 
+/// The help of a tracing or meshing flag of `sinew rig`: `text` and its defaults for `--detail
+/// fine` and `--detail coarse`, read from the library's options.
+fn tuning_help(text: &str, default: impl Fn(&TraceOptions, &MeshOptions) -> String) -> String {
+    let fine = default(&TraceOptions::default(), &MeshOptions::default());
+    let coarse = default(&TraceOptions::coarse(), &MeshOptions::coarse());
+    format!("{text} [default: {fine}; with --detail coarse: {coarse}]")
+}
+
 /// Parses `PART=SLOT`.
 fn parse_attachment(text: &str) -> Result<(String, String), String> {
     match text.split_once('=') {
@@ -450,28 +460,23 @@ pub struct BuildArgs {
     /// fine: quality mesh for skinning; coarse: few vertices, for game runtimes.
     #[arg(long, value_enum, default_value_t = Detail::Fine)]
     pub detail: Detail,
-    /// A pixel is opaque from this alpha on (0–255).
-    #[arg(long)]
+    #[arg(long, help = tuning_help("A pixel is opaque from this alpha on (0–255)", |t, _| t.alpha_threshold.to_string()))]
     pub alpha_threshold: Option<u8>,
-    /// Outward padding of the outline, px.
-    #[arg(long)]
+    #[arg(long, help = tuning_help("Outward padding of the outline, px", |t, _| t.padding_px.to_string()))]
     pub padding: Option<f64>,
-    /// Outline simplification tolerance, px.
-    #[arg(long)]
+    #[arg(long, help = tuning_help("Outline simplification tolerance, px", |t, _| t.simplify_tolerance_px.to_string()))]
     pub simplify: Option<f64>,
-    /// Smallest triangle angle refinement aims for, degrees.
-    #[arg(long)]
+    #[arg(long, help = tuning_help("Smallest triangle angle refinement aims for, degrees", |_, m| m.min_angle_deg.to_string()))]
     pub min_angle: Option<f64>,
-    /// Largest triangle area as a fraction of the canvas area.
-    #[arg(long)]
+    #[arg(long, help = tuning_help("Largest triangle area as a fraction of the canvas area", |_, m| m.max_area_fraction.to_string()))]
     pub max_area_fraction: Option<f64>,
     /// The weights' energy.
     #[arg(long = "weights", value_parser = choices::parser::<WeightMethodArg, WeightMethod>(), default_value = choices::default_name!(WeightMethodArg, WeightOptions::default().method))]
     pub weight_method: WeightMethod,
-    /// Content-aware weights: measure color changes as this many px.
+    /// Content-aware weights: measure color changes as this many px (default: off).
     #[arg(long, value_name = "S")]
     pub content_aware: Option<f64>,
-    /// Keep the K largest weights per vertex.
+    /// Keep the K largest weights per vertex (default: all).
     #[arg(long, value_name = "K")]
     pub max_influences: Option<usize>,
     /// Monotone bounded biharmonic weights: no spurious local extrema (slower).
@@ -482,7 +487,8 @@ pub struct BuildArgs {
     pub rigid_blend_px: f64,
     /// Two-level weights: solve on a coarse mesh of about N vertices of the same domain, carry
     /// the weights to the fine mesh and polish them there (faster on large meshes; see
-    /// docs/two-level-weights.md for how far they are from the exact solve).
+    /// docs/two-level-weights.md for how far they are from the exact solve). Default: off,
+    /// the exact solve on the fine mesh.
     #[arg(long, value_name = "N")]
     pub coarse_weights: Option<usize>,
 }
