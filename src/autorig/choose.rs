@@ -10,10 +10,12 @@
 //! as fractions of the box; the axis's ends as extremities first, then the cuts of its
 //! cycles, [`super::template::Extremities`]), so that a fit that would put limb names on props is refused
 //! (the caller then rigs the medial axis):
-//! - humanoid: the head above the hips; each leg reaches the lowest [`FOOT_BAND`] of the
-//!   box and is at least [`MIN_LEG_FRACTION`] of the height long; legs long enough for a
-//!   body and not arms alone. A bust (head and shoulders, nothing reaching the bottom as
-//!   legs do) is no humanoid here: its arms and head stay on the medial axis.
+//! - humanoid: the head above the hips; each leg's chain (its named bones and the bones
+//!   hanging below them: a foot, a shoe) reaches the lowest [`FOOT_BAND`] of the box and ends
+//!   at least [`MIN_LEG_FRACTION`] of the height from the hips (or the thigh's start, when
+//!   higher); legs long enough for a body and not arms alone. A bust (head and shoulders,
+//!   nothing reaching the bottom as legs do) is no humanoid here: its arms and head stay on
+//!   the medial axis.
 //! - quadruped: a spine more level than upright, four legs reaching the lowest
 //!   [`FOOT_BAND`], the box wider than tall.
 
@@ -25,7 +27,8 @@ use crate::geom::Point;
 
 /// A foot must end in the lowest this fraction of the box.
 pub const FOOT_BAND: f64 = 0.25;
-/// A humanoid's leg (thigh and shin) spans at least this fraction of the box's height.
+/// A humanoid's leg (from the hips to the lowest end of its chain) spans at least this
+/// fraction of the box's height.
 pub const MIN_LEG_FRACTION: f64 = 0.2;
 /// A quadruped's box is at least this much wider than tall (width / height).
 pub const QUADRUPED_MIN_ASPECT: f64 = 0.9;
@@ -61,7 +64,27 @@ fn named<'a>(bones: &'a [ProtoBone], name: &str) -> Option<&'a ProtoBone> {
     bones.iter().find(|b| b.name.as_deref() == Some(name))
 }
 
-/// Why a humanoid fit is implausible, or `None` when it is plausible.
+/// The lowest point (largest y) of bone `b` and the bones hanging below it: where a limb's
+/// chain ends, past the named lower bone (a foot, a shoe left to extra bones).
+fn chain_bottom(bones: &[ProtoBone], b: usize) -> Point {
+    let mut below = vec![false; bones.len()];
+    below[b] = true;
+    let mut bottom = bones[b].tail;
+    // Parents come before their children.
+    for k in b + 1..bones.len() {
+        if bones[k].parent.is_some_and(|p| below[p]) {
+            below[k] = true;
+            if bones[k].tail.y > bottom.y {
+                bottom = bones[k].tail;
+            }
+        }
+    }
+    bottom
+}
+
+/// Why a humanoid fit is implausible, or `None` when it is plausible. A leg is measured from
+/// the hips to the lowest end of its chain (a thigh hidden under a skirt or a coat is drawn
+/// short, and the foot may hang below the named shin as an extra bone).
 fn humanoid_doubt(bones: &[ProtoBone], frame: &Frame) -> Option<String> {
     let hip = named(bones, "hip")?;
     let head = named(bones, "head").or_else(|| named(bones, "neck"))?;
@@ -69,16 +92,24 @@ fn humanoid_doubt(bones: &[ProtoBone], frame: &Frame) -> Option<String> {
         return Some("its head is not above its hips".into());
     }
     for side in ["l", "r"] {
-        let (Some(upper), Some(lower)) = (
-            named(bones, &format!("leg_upper_{side}")),
-            named(bones, &format!("leg_lower_{side}")),
-        ) else {
+        let lower = bones
+            .iter()
+            .position(|b| b.name.as_deref() == Some(&format!("leg_lower_{side}")));
+        let (Some(upper), Some(lower)) = (named(bones, &format!("leg_upper_{side}")), lower) else {
             return Some("a leg is missing".into());
         };
-        if frame.v(lower.tail) < 1.0 - FOOT_BAND {
+        let foot = chain_bottom(bones, lower);
+        if frame.v(foot) < 1.0 - FOOT_BAND {
             return Some("its legs do not reach the ground".into());
         }
-        if (upper.length_px() + lower.length_px()) < MIN_LEG_FRACTION * frame.h {
+        // From the higher of the hips and the thigh's start (the root may sit between the
+        // legs, below where their axis paths meet).
+        let top = if upper.head.y < hip.head.y {
+            upper.head
+        } else {
+            hip.head
+        };
+        if (foot - top).norm() < MIN_LEG_FRACTION * frame.h {
             return Some("its legs are too short for a body".into());
         }
     }
@@ -268,4 +299,84 @@ pub fn fit_plausibly(
     }
     Err(first_doubt
         .unwrap_or_else(|| "no assignment of its limbs to the drawing's extremities".to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bone(
+        name: Option<&str>,
+        head: (f64, f64),
+        tail: (f64, f64),
+        parent: Option<usize>,
+    ) -> ProtoBone {
+        ProtoBone {
+            head: Point::new(head.0, head.1),
+            tail: Point::new(tail.0, tail.1),
+            parent,
+            name: name.map(str::to_string),
+        }
+    }
+
+    /// A figure 400 px tall whose coat hides its thighs: the legs' axis paths meet at the
+    /// hem (y 300), the named leg bones are short (40 px) and the shoes hang below them as
+    /// extra bones. The leg runs from the hips to the shoe's end: plausible.
+    #[test]
+    fn a_leg_is_measured_from_the_hips_to_the_end_of_its_chain() {
+        let frame = Frame {
+            lo: Point::new(0.0, 0.0),
+            w: 160.0,
+            h: 400.0,
+        };
+        let mut bones = vec![
+            bone(Some("hip"), (80.0, 300.0), (80.0, 200.0), None),
+            bone(Some("chest"), (80.0, 200.0), (80.0, 100.0), Some(0)),
+            bone(Some("head"), (80.0, 70.0), (80.0, 10.0), Some(1)),
+        ];
+        for (side, x) in [("l", 100.0), ("r", 60.0)] {
+            let upper = bones.len();
+            bones.push(bone(
+                Some(&format!("leg_upper_{side}")),
+                (x, 310.0),
+                (x, 330.0),
+                Some(0),
+            ));
+            bones.push(bone(
+                Some(&format!("leg_lower_{side}")),
+                (x, 330.0),
+                (x, 350.0),
+                Some(upper),
+            ));
+            bones.push(bone(None, (x, 350.0), (x + 5.0, 395.0), Some(upper + 1)));
+        }
+        assert_eq!(humanoid_doubt(&bones, &frame), None);
+        // Without the shoes the chain ends 50 px below the hips: too short for a body.
+        let mut barefoot = bones.clone();
+        barefoot.retain(|b| b.name.is_some());
+        barefoot[6].parent = Some(5);
+        assert_eq!(
+            humanoid_doubt(&barefoot, &frame).as_deref(),
+            Some("its legs are too short for a body")
+        );
+        // Arms hanging from a bust's shoulders are no legs: they start low and end near it.
+        let mut short = bones.clone();
+        short[0].head = Point::new(80.0, 340.0);
+        for b in short.iter_mut() {
+            if b.name
+                .as_deref()
+                .is_some_and(|n| n.starts_with("leg_upper"))
+            {
+                b.head.y = 345.0;
+            }
+        }
+        assert_eq!(
+            humanoid_doubt(&short, &frame).as_deref(),
+            Some("its legs are too short for a body")
+        );
+        // The root between the legs, below where their paths meet: the thighs' start counts.
+        let mut between = bones.clone();
+        between[0].head = Point::new(80.0, 340.0);
+        assert_eq!(humanoid_doubt(&between, &frame), None);
+    }
 }

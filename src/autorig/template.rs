@@ -17,11 +17,16 @@
 //! [`super::budget`]). Among the valid assignments the one with the best score wins:
 //! extremities where the template expects them in the drawing's box (head up, feet down, `_l`
 //! limbs on the right of the screen: the character's left, facing the viewer) and left/right
-//! limbs of similar length. Bones then follow the tree paths between the joints: hip and chest
-//! along the spine, a neck and a head split where the path widens into the skull, two bones per
-//! limb split at the limbs' bends (elbows, knees), a quadruped's tail in up to three bones, all
-//! kept straight and inside; axis branches the template does not name (ears, a tail on a
-//! humanoid, a held prop) become extra bones hanging from the named bone they leave.
+//! limbs of similar length; a quadruped's head is the thicker of its two ends along the axis
+//! toward the body ([`end_thickness`]). The root is not where the legs' paths meet: a
+//! humanoid's hip starts a third of its height below the base of the skull
+//! ([`PELVIS_BELOW_SKULL`]; on the spine above a skirt's hem, or between the legs below a wide
+//! trunk's junction), a quadruped's where the rump ends in the tail ([`rump_end`]). Bones then
+//! follow the tree paths between the joints: hip and chest along the spine, a neck and a head
+//! split where the path widens into the skull, two bones per limb split at the limbs' bends
+//! (elbows, knees), a quadruped's tail in up to three bones, all kept straight and inside;
+//! axis branches the template does not name (ears, a tail on a humanoid, a held prop) become
+//! extra bones hanging from the named bone they leave.
 
 use super::medial::AxisGraph;
 use super::shape::Shape;
@@ -254,12 +259,17 @@ pub fn fit_template_with(
         Template::Humanoid => {
             let fit = fit_humanoid(&leaves, &tree.order, &lca, &frame, &pos)?;
             let chest = fit.chest(&lca);
-            Some(build_humanoid(axis, shape, options, &fit, chest))
+            Some(build_humanoid(axis, shape, options, &fit, chest, frame.h))
         }
         Template::Quadruped => {
             let thickness: Vec<(usize, f64)> = leaves
                 .iter()
-                .map(|&v| (v, end_thickness(axis, v, END_WALK_FRACTION * frame.h)))
+                .map(|&v| {
+                    (
+                        v,
+                        end_thickness(axis, &tree, v, END_WALK_FRACTION * frame.h),
+                    )
+                })
                 .collect();
             let thick = |v: usize| thickness.iter().find(|t| t.0 == v).map_or(0.0, |t| t.1);
             let fit = fit_quadruped(&leaves, &lca, &frame, &pos, &thick)?;
@@ -563,6 +573,75 @@ impl<'a> NamedBuilder<'a> {
         self.bones_along(&path, 0, &[base, path.len() - 1], &["neck", "head"], parent);
     }
 
+    /// The height of the base of the skull, px: the bottom of the head's inscribed disc, the
+    /// widest on the path from `chest` to the head's leaf `head` among those wholly above the
+    /// chest joint (the discs reaching below it are the trunk's; a big head's may be wider
+    /// than the trunk, and its neck need not narrow where a small head's does).
+    fn skull_base(&self, chest: usize, head: usize) -> f64 {
+        let axis = self.builder.axis;
+        let at = axis.nodes[chest].pos;
+        let widest = self
+            .path(chest, head)
+            .into_iter()
+            .filter(|&v| axis.nodes[v].pos.y + axis.nodes[v].radius_px < at.y)
+            .max_by(|&a, &b| axis.nodes[a].radius_px.total_cmp(&axis.nodes[b].radius_px))
+            .unwrap_or(head);
+        let node = &axis.nodes[widest];
+        node.pos.y + node.radius_px
+    }
+
+    /// The height of a standing figure's pelvis, px: [`PELVIS_BELOW_SKULL`] of the drawing's
+    /// `height` below the base of its skull. Where the legs' axis paths meet is no pelvis: a
+    /// skirt or a coat joins them at its hem, below the hips; a wide trunk joins them half its
+    /// width above the crotch (the medial axis of a box branches toward its corners).
+    fn pelvis_height(&self, fit: &HumanoidFit, chest: usize, height: f64) -> f64 {
+        self.skull_base(chest, fit.head) + PELVIS_BELOW_SKULL * height
+    }
+
+    /// The node of the path from `from` up to `to` (the legs' junction to the chest) where it
+    /// first rises to height `y`, at most half way along the path (the spine keeps its
+    /// length); `from` when the path does not rise that high.
+    fn spine_node_at(&self, from: usize, to: usize, y: f64) -> usize {
+        let path = self.path(from, to);
+        if path.len() < 3 {
+            return from;
+        }
+        let points = self.points(&path);
+        let half = half_index(&points);
+        path.iter()
+            .zip(&points)
+            .take(half)
+            .find(|(_, p)| p.y <= y)
+            .map_or(from, |(&v, _)| v)
+    }
+
+    /// Starts the `hip` bone lower, at height `y` between the legs, when the legs' junction
+    /// lies above it (a wide trunk): at the middle of the two legs' axis paths at that height,
+    /// when the bone stays inside.
+    fn lower_hip(&mut self, hip: usize, fit: &HumanoidFit, y: f64) {
+        let junction = self.builder.axis.nodes[fit.pelvis].pos;
+        if y <= junction.y {
+            return;
+        }
+        let at_height = |points: &[Point]| {
+            points.windows(2).find_map(|w| {
+                let (a, b) = (w[0], w[1]);
+                (a.y < y && b.y >= y).then(|| a.x + (b.x - a.x) * (y - a.y) / (b.y - a.y))
+            })
+        };
+        let xs: Vec<f64> = fit
+            .feet
+            .iter()
+            .filter_map(|&f| at_height(&self.points(&self.path(fit.pelvis, f))))
+            .collect();
+        let [xl, xr] = xs[..] else { return };
+        let head = Point::new(0.5 * (xl + xr), y);
+        let tail = self.builder.bones[hip].tail;
+        if self.builder.shape.segment_inside(head, tail) {
+            self.builder.bones[hip].head = head;
+        }
+    }
+
     /// An upper and a lower limb bone from `from` down to `to`: the limb starts where the path
     /// leaves the thick joint (the stretch before belongs to `parent`), bends at its elbow or
     /// knee (the bend, else half way), and the lower bone is at most `lower_limb_ratio` times
@@ -629,6 +708,15 @@ impl<'a> NamedBuilder<'a> {
 /// A quadruped's tail bones, root first.
 const TAIL_NAMES: [&str; 3] = ["tail_1", "tail_2", "tail_3"];
 
+/// A standing figure's pelvis lies this fraction of its height below the base of its skull,
+/// whatever the size of its head (the real-art set's 18 humanoid references with a pelvis:
+/// 0.33 ± 0.07 of the height; a share of the way from the skull to the feet spreads more:
+/// 0.35–0.74, big heads lowest).
+const PELVIS_BELOW_SKULL: f64 = 0.33;
+/// How far (a fraction of the height) the estimate of [`PELVIS_BELOW_SKULL`] strays on the
+/// set: within it, the legs' junction stays the root.
+const PELVIS_SPREAD: f64 = 0.07;
+
 /// Default for [`NamedBuilder::limb_radius_ratio`].
 const LIMB_RADIUS_RATIO: f64 = 0.5;
 /// Default for [`NamedBuilder::lower_limb_ratio`].
@@ -653,11 +741,25 @@ fn build_humanoid(
     options: &SkeletonOptions,
     fit: &HumanoidFit,
     chest: usize,
+    height: f64,
 ) -> Vec<ProtoBone> {
     let tree = NodeTree::new(axis, fit.pelvis);
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
-    let spine = nb.even_chain(fit.pelvis, chest, &["hip", "chest"], None);
+    // The legs' junction is the pelvis unless the estimate is farther from it than the
+    // estimate's own spread (a stick figure's legs meet at its pelvis).
+    let junction_y = axis.nodes[fit.pelvis].pos.y;
+    let pelvis_y = Some(nb.pelvis_height(fit, chest, height))
+        .filter(|y| (y - junction_y).abs() > PELVIS_SPREAD * height)
+        .unwrap_or(junction_y);
+    let root = nb.spine_node_at(fit.pelvis, chest, pelvis_y);
+    let spine = nb.even_chain(root, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
+    // Between where the legs meet (a skirt's hem) and the pelvis: the hip's.
+    let below = nb.path(fit.pelvis, root);
+    nb.cover(&below, hip);
+    if let (Some(hip), true) = (hip, root == fit.pelvis) {
+        nb.lower_hip(hip, fit, pelvis_y);
+    }
     if chest != fit.head {
         nb.neck_and_head(chest, fit.head, chest_bone);
     }
@@ -679,20 +781,22 @@ struct QuadrupedFit {
 }
 
 /// How far from a leaf its end's thickness is measured, as a fraction of the drawing's height.
-const END_WALK_FRACTION: f64 = 0.1;
+const END_WALK_FRACTION: f64 = 0.2;
 
-/// The largest radius within `walk_px` (along the axis) of `leaf`: how thick that end is.
-fn end_thickness(axis: &AxisGraph, leaf: usize, walk_px: f64) -> f64 {
+/// The largest radius on the axis path from `leaf` toward the tree's root (the thickest node:
+/// the body) within `walk_px` of the leaf: how thick that end is. A head is a blob behind its
+/// ears, horns or snout; a tail stays thin until it reaches the body. Only the path toward the
+/// body counts: a walk in every direction from a curled tail's tip reaches the rump.
+fn end_thickness(axis: &AxisGraph, tree: &NodeTree, leaf: usize, walk_px: f64) -> f64 {
     let mut best = axis.nodes[leaf].radius_px;
-    let mut stack = vec![(leaf, usize::MAX, 0.0)];
-    while let Some((v, from, d)) = stack.pop() {
-        best = best.max(axis.nodes[v].radius_px);
-        for &w in &axis.adjacency[v] {
-            let step = (axis.nodes[w].pos - axis.nodes[v].pos).norm();
-            if w != from && d + step <= walk_px {
-                stack.push((w, v, d + step));
-            }
+    let (mut at, mut run) = (leaf, 0.0);
+    while let Some(p) = tree.parent[at] {
+        run += (axis.nodes[p].pos - axis.nodes[at].pos).norm();
+        if run > walk_px {
+            break;
         }
+        best = best.max(axis.nodes[p].radius_px);
+        at = p;
     }
     best
 }
@@ -774,6 +878,30 @@ fn fit_quadruped(
     best.map(|b| b.1)
 }
 
+/// Where a quadruped's hips are: on the axis path from `pelvis` (where the back legs' paths
+/// meet the spine, deep inside the body: the medial axis of a box branches toward its
+/// corners) to the tail's leaf, where the path leaves the rump (its radius under
+/// [`LIMB_RADIUS_RATIO`] of the pelvis node's), at most [`RUMP_FRACTION`] of the way.
+fn rump_end(axis: &AxisGraph, pelvis: usize, tail: usize) -> usize {
+    let path = NodeTree::new(axis, pelvis)
+        .path_down(pelvis, tail)
+        .unwrap_or_default();
+    if path.len() < 3 {
+        return pelvis;
+    }
+    let points: Vec<Point> = path.iter().map(|&v| axis.nodes[v].pos).collect();
+    let cap = fraction_index(&points, RUMP_FRACTION).min(path.len() - 2);
+    let thin = LIMB_RADIUS_RATIO * axis.nodes[pelvis].radius_px;
+    let end = path[..=cap]
+        .iter()
+        .position(|&v| axis.nodes[v].radius_px < thin)
+        .unwrap_or(cap);
+    path[end]
+}
+
+/// See [`rump_end`].
+const RUMP_FRACTION: f64 = 1.0 / 3.0;
+
 fn build_quadruped(
     axis: &AxisGraph,
     shape: &Shape,
@@ -803,15 +931,16 @@ fn build_quadruped(
     } else {
         a[3]
     };
-    let tree = NodeTree::new(axis, pelvis);
+    let root = rump_end(axis, pelvis, fit.tail);
+    let tree = NodeTree::new(axis, root);
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
-    let spine = nb.even_chain(pelvis, chest, &["hip", "chest"], None);
+    let spine = nb.even_chain(root, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
     nb.neck_and_head(chest, fit.head, chest_bone);
     // A tail of up to three bones, each at least twice the shortest bone.
-    let tail_px = polyline_length(&nb.points(&nb.path(pelvis, fit.tail)));
+    let tail_px = polyline_length(&nb.points(&nb.path(root, fit.tail)));
     let tail_bones = ((tail_px / (2.0 * options.min_bone_px)) as usize).clamp(1, 3);
-    nb.even_chain(pelvis, fit.tail, &TAIL_NAMES[..tail_bones], hip);
+    nb.even_chain(root, fit.tail, &TAIL_NAMES[..tail_bones], hip);
     let names = [
         ["leg_front_upper_l", "leg_front_lower_l"],
         ["leg_front_upper_r", "leg_front_lower_r"],
@@ -869,6 +998,159 @@ mod tests {
             assert!((lca.dist(3, 5) - 4.0).abs() < 1e-12);
             assert!(lca.on_path(1, 0, 5) && lca.on_path(2, 0, 3) && !lca.on_path(4, 0, 3));
         }
+    }
+
+    /// A figure of `segments` (capsules: end points and radius, px) on a 200 × 420 canvas,
+    /// traced.
+    fn figure(segments: &[((f64, f64), (f64, f64), f64)]) -> Shape {
+        let image = image::RgbaImage::from_fn(200, 420, |x, y| {
+            let p = Point::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let inside = segments.iter().any(|&((ax, ay), (bx, by), r)| {
+                point_segment_distance(p, Point::new(ax, ay), Point::new(bx, by)) <= r
+            });
+            image::Rgba([80, 80, 80, if inside { 255 } else { 0 }])
+        });
+        Shape::trace(&image, &Default::default())
+            .expect("traced")
+            .expect("a shape")
+    }
+
+    fn fitted(shape: &Shape, template: Template) -> Vec<ProtoBone> {
+        let medial = crate::autorig::medial::MedialOptions {
+            junction_merge_ratio: 0.0,
+            ..Default::default()
+        };
+        let axis = crate::autorig::medial::medial_axis(shape, &medial).expect("an axis");
+        fit_template(&axis, shape, template, &SkeletonOptions::default()).expect("a fit")
+    }
+
+    fn bone<'a>(bones: &'a [ProtoBone], name: &str) -> &'a ProtoBone {
+        bones
+            .iter()
+            .find(|b| b.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name} in {bones:?}"))
+    }
+
+    /// A woman in a long, narrow dress: the legs' axis paths meet at its hem (y ≈ 300), far
+    /// below her hips (a third of her height below the base of the skull, y ≈ 66 + 130); the
+    /// root rises from the hem toward them, at most half way up to the chest joint.
+    #[test]
+    fn a_dress_roots_the_humanoid_at_the_pelvis_not_at_its_hem() {
+        let shape = figure(&[
+            ((100.0, 40.0), (100.0, 40.0), 26.0),   // head
+            ((100.0, 60.0), (100.0, 90.0), 9.0),    // neck
+            ((100.0, 100.0), (100.0, 300.0), 30.0), // dress
+            ((80.0, 100.0), (22.0, 220.0), 9.0),    // arms held out
+            ((120.0, 100.0), (178.0, 220.0), 9.0),
+            ((86.0, 300.0), (80.0, 400.0), 8.0), // legs
+            ((114.0, 300.0), (120.0, 400.0), 8.0),
+        ]);
+        let bones = fitted(&shape, Template::Humanoid);
+        let hip = bone(&bones, "hip");
+        assert!(
+            (190.0..275.0).contains(&hip.head.y),
+            "the hip starts at {:?}",
+            hip.head
+        );
+        assert!(bones
+            .iter()
+            .all(|b| b.parent.is_some() || b.name.as_deref() == Some("hip")));
+    }
+
+    /// A squat figure with a big head: its legs join a wide trunk, whose medial axis branches
+    /// about half the trunk's width above the crotch (y ≈ 260); the root starts lower, between
+    /// the legs (a third of the height below the skull, y ≈ 235).
+    #[test]
+    fn a_wide_trunk_roots_the_humanoid_between_its_legs() {
+        let shape = figure(&[
+            ((100.0, 60.0), (100.0, 60.0), 45.0),   // a big head
+            ((100.0, 180.0), (100.0, 230.0), 70.0), // a wide trunk
+            ((40.0, 150.0), (8.0, 250.0), 9.0),     // arms
+            ((160.0, 150.0), (192.0, 250.0), 9.0),
+            ((75.0, 250.0), (70.0, 405.0), 12.0), // legs
+            ((125.0, 250.0), (130.0, 405.0), 12.0),
+        ]);
+        let bones = fitted(&shape, Template::Humanoid);
+        let hip = bone(&bones, "hip");
+        assert!(
+            hip.head.y > 220.0 && (hip.head.x - 100.0).abs() < 15.0,
+            "the hip starts at {:?}",
+            hip.head
+        );
+    }
+
+    /// An end's thickness follows the axis toward the body only: a thin branch next to a thick
+    /// one is not as thick as its neighbour.
+    #[test]
+    fn an_ends_thickness_follows_the_path_to_the_body() {
+        // 0 (the body, r 30) - 1 (junction, r 6) - 2 (thin leaf, r 4); 1 - 3 (a thick
+        // blob, r 20) - 4 (its leaf, r 5).
+        let nodes = [
+            ((-15.0, 0.0), 30.0),
+            ((10.0, 0.0), 6.0),
+            ((20.0, 0.0), 4.0),
+            ((14.0, 6.0), 20.0),
+            ((18.0, 12.0), 5.0),
+        ]
+        .iter()
+        .map(|&((x, y), r)| AxisNode {
+            pos: Point::new(x, y),
+            radius_px: r,
+        })
+        .collect();
+        let axis = AxisGraph {
+            nodes,
+            adjacency: vec![vec![1], vec![0, 2, 3], vec![1], vec![1, 4], vec![3]],
+        };
+        let tree = NodeTree::new(&axis, 0);
+        // Within 20 px of leaf 2 lie the junction and the blob (17 px away through the
+        // junction); only the junction is on the way to the body.
+        assert_eq!(end_thickness(&axis, &tree, 2, 20.0), 6.0);
+        assert_eq!(end_thickness(&axis, &tree, 4, 20.0), 20.0);
+        assert_eq!(end_thickness(&axis, &tree, 2, 40.0), 30.0);
+    }
+
+    /// A line of axis nodes 10 px apart with these radii.
+    fn line(radii: &[f64]) -> AxisGraph {
+        let n = radii.len();
+        AxisGraph {
+            nodes: radii
+                .iter()
+                .enumerate()
+                .map(|(k, &r)| AxisNode {
+                    pos: Point::new(10.0 * k as f64, 0.0),
+                    radius_px: r,
+                })
+                .collect(),
+            adjacency: (0..n)
+                .map(|k| {
+                    let mut a = Vec::new();
+                    if k > 0 {
+                        a.push(k - 1);
+                    }
+                    if k + 1 < n {
+                        a.push(k + 1);
+                    }
+                    a
+                })
+                .collect(),
+        }
+    }
+
+    /// The hips of a quadruped are where the rump ends in the tail (the path thins to under
+    /// half the pelvis node's radius), at most a third of the way to the tail's tip.
+    #[test]
+    fn a_quadrupeds_root_is_where_the_rump_ends_in_the_tail() {
+        // The back legs meet the spine at node 0 (r 40); the rump thins at node 3.
+        let axis = line(&[
+            40.0, 38.0, 30.0, 12.0, 6.0, 6.0, 6.0, 6.0, 6.0, 5.0, 4.0, 3.0,
+        ]);
+        assert_eq!(rump_end(&axis, 0, 11), 3);
+        // A long fat rump: a third of the way (110 px / 3 ≈ node 4).
+        let axis = line(&[
+            40.0, 38.0, 36.0, 34.0, 32.0, 30.0, 28.0, 26.0, 24.0, 22.0, 21.0, 20.0,
+        ]);
+        assert_eq!(rump_end(&axis, 0, 11), 4);
     }
 
     #[test]
