@@ -59,6 +59,15 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// The names of sinew's commands (for "did you mean").
+pub fn command_names() -> Vec<String> {
+    use clap::CommandFactory;
+    Cli::command()
+        .get_subcommands()
+        .map(|c| c.get_name().to_string())
+        .collect()
+}
+
 /// Bounds the thread pool `RAYON_NUM_THREADS` asks for by the machine
 /// ([`sinew::budget::bounded_threads`]): a count such as 1000000 cannot start at all.
 fn bound_rayon_threads() {
@@ -819,8 +828,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
     if args.output.is_none() && args.vertices.is_none() {
         bail!("nothing to write: give -o OUT.png and/or --vertices V.json");
     }
-    let mut scene = Scene::load(&args.rig)?;
-    scene.set_skins(&args.skins)?;
+    let scene = sinew::jobs::scene_with_skins(&args.rig, &args.skins)?;
     let images = sinew::jobs::part_images(&args.rig, &scene.doc);
     check_outputs(
         [Some(args.rig.as_path()), args.pose.as_deref()]
@@ -844,7 +852,7 @@ fn pose(args: &PoseArgs) -> Result<()> {
             if !time_s.is_finite() {
                 bail!("--time must be a finite number of seconds");
             }
-            let animation = animation(&scene.doc, name)?;
+            let animation = sinew::jobs::animation_in(&scene.doc, &args.rig, name)?;
             let mut settings = playback::RenderSettings {
                 sampling: sample_options(args.match_runtime),
                 export: export_played(&args.spine_version, args.bake_fps)?,
@@ -942,11 +950,6 @@ fn render_animation(args: &RenderArgs) -> Result<()> {
         out::report!("{summary}");
     }
     Ok(())
-}
-
-/// The document's animation `name`, checked against its rig.
-fn animation(doc: &RigDocument, name: &str) -> Result<anim::Animation> {
-    Ok(sinew::jobs::animation(doc, name)?)
 }
 
 /// The `--vertices` file of docs/formats.md.

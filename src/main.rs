@@ -61,9 +61,26 @@ fn clap_one_line(error: &clap::Error) -> String {
         .collect();
     let what = what.join(" ");
     let mut line = what.strip_prefix("error: ").unwrap_or(&what).to_string();
-    for tip in lines.iter().filter(|l| l.starts_with("tip:")) {
+    let tips: Vec<&str> = lines
+        .iter()
+        .copied()
+        .filter(|l| l.starts_with("tip:"))
+        .collect();
+    for tip in &tips {
         line.push_str("; ");
         line.push_str(tip);
+    }
+    // clap suggests a subcommand only when it is close by its own measure ("rnder"); sinew's
+    // finds a few more ("rgi").
+    if tips.is_empty() && error.kind() == clap::error::ErrorKind::InvalidSubcommand {
+        if let Some(clap::error::ContextValue::String(given)) =
+            error.get(clap::error::ContextKind::InvalidSubcommand)
+        {
+            let names = cli::command_names();
+            if let Some(name) = sinew::names::closest(given, &names) {
+                line.push_str(&format!("; did you mean '{name}'?"));
+            }
+        }
     }
     // "Usage: sinew rig [OPTIONS] ...": the words before the first placeholder name the command.
     let command = lines
