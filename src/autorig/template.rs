@@ -17,11 +17,9 @@
 //! [`super::budget`]). Among the valid assignments the one with the best score wins:
 //! extremities where the template expects them in the drawing's box (head up, feet down, `_l`
 //! limbs on the right of the screen: the character's left, facing the viewer) and left/right
-//! limbs of similar length; a quadruped's head is the thicker of its two ends along the axis
-//! toward the body ([`end_thickness`]). The root is not where the legs' paths meet: a
-//! humanoid's hip starts a third of its height below the base of the skull
-//! ([`PELVIS_BELOW_SKULL`]; on the spine above a skirt's hem, or between the legs below a wide
-//! trunk's junction), a quadruped's where the rump ends in the tail ([`rump_end`]). Bones then
+//! limbs of similar length. A humanoid's root is not where the legs' paths meet: its hip
+//! starts a third of its height below the base of the skull ([`PELVIS_BELOW_SKULL`]; on the
+//! spine above a skirt's hem, or between the legs below a wide trunk's junction). Bones then
 //! follow the tree paths between the joints: hip and chest along the spine, a neck and a head
 //! split where the path widens into the skull, two bones per limb split at the limbs' bends
 //! (elbows, knees), a quadruped's tail in up to three bones, all kept straight and inside;
@@ -264,12 +262,7 @@ pub fn fit_template_with(
         Template::Quadruped => {
             let thickness: Vec<(usize, f64)> = leaves
                 .iter()
-                .map(|&v| {
-                    (
-                        v,
-                        end_thickness(axis, &tree, v, END_WALK_FRACTION * frame.h),
-                    )
-                })
+                .map(|&v| (v, end_thickness(axis, v, END_WALK_FRACTION * frame.h)))
                 .collect();
             let thick = |v: usize| thickness.iter().find(|t| t.0 == v).map_or(0.0, |t| t.1);
             let fit = fit_quadruped(&leaves, &lca, &frame, &pos, &thick)?;
@@ -781,22 +774,20 @@ struct QuadrupedFit {
 }
 
 /// How far from a leaf its end's thickness is measured, as a fraction of the drawing's height.
-const END_WALK_FRACTION: f64 = 0.2;
+const END_WALK_FRACTION: f64 = 0.1;
 
-/// The largest radius on the axis path from `leaf` toward the tree's root (the thickest node:
-/// the body) within `walk_px` of the leaf: how thick that end is. A head is a blob behind its
-/// ears, horns or snout; a tail stays thin until it reaches the body. Only the path toward the
-/// body counts: a walk in every direction from a curled tail's tip reaches the rump.
-fn end_thickness(axis: &AxisGraph, tree: &NodeTree, leaf: usize, walk_px: f64) -> f64 {
+/// The largest radius within `walk_px` (along the axis) of `leaf`: how thick that end is.
+fn end_thickness(axis: &AxisGraph, leaf: usize, walk_px: f64) -> f64 {
     let mut best = axis.nodes[leaf].radius_px;
-    let (mut at, mut run) = (leaf, 0.0);
-    while let Some(p) = tree.parent[at] {
-        run += (axis.nodes[p].pos - axis.nodes[at].pos).norm();
-        if run > walk_px {
-            break;
+    let mut stack = vec![(leaf, usize::MAX, 0.0)];
+    while let Some((v, from, d)) = stack.pop() {
+        best = best.max(axis.nodes[v].radius_px);
+        for &w in &axis.adjacency[v] {
+            let step = (axis.nodes[w].pos - axis.nodes[v].pos).norm();
+            if w != from && d + step <= walk_px {
+                stack.push((w, v, d + step));
+            }
         }
-        best = best.max(axis.nodes[p].radius_px);
-        at = p;
     }
     best
 }
@@ -878,30 +869,6 @@ fn fit_quadruped(
     best.map(|b| b.1)
 }
 
-/// Where a quadruped's hips are: on the axis path from `pelvis` (where the back legs' paths
-/// meet the spine, deep inside the body: the medial axis of a box branches toward its
-/// corners) to the tail's leaf, where the path leaves the rump (its radius under
-/// [`LIMB_RADIUS_RATIO`] of the pelvis node's), at most [`RUMP_FRACTION`] of the way.
-fn rump_end(axis: &AxisGraph, pelvis: usize, tail: usize) -> usize {
-    let path = NodeTree::new(axis, pelvis)
-        .path_down(pelvis, tail)
-        .unwrap_or_default();
-    if path.len() < 3 {
-        return pelvis;
-    }
-    let points: Vec<Point> = path.iter().map(|&v| axis.nodes[v].pos).collect();
-    let cap = fraction_index(&points, RUMP_FRACTION).min(path.len() - 2);
-    let thin = LIMB_RADIUS_RATIO * axis.nodes[pelvis].radius_px;
-    let end = path[..=cap]
-        .iter()
-        .position(|&v| axis.nodes[v].radius_px < thin)
-        .unwrap_or(cap);
-    path[end]
-}
-
-/// See [`rump_end`].
-const RUMP_FRACTION: f64 = 1.0 / 3.0;
-
 fn build_quadruped(
     axis: &AxisGraph,
     shape: &Shape,
@@ -931,16 +898,15 @@ fn build_quadruped(
     } else {
         a[3]
     };
-    let root = rump_end(axis, pelvis, fit.tail);
-    let tree = NodeTree::new(axis, root);
+    let tree = NodeTree::new(axis, pelvis);
     let mut nb = NamedBuilder::new(axis, shape, options, tree);
-    let spine = nb.even_chain(root, chest, &["hip", "chest"], None);
+    let spine = nb.even_chain(pelvis, chest, &["hip", "chest"], None);
     let (hip, chest_bone) = (spine.first().copied(), spine.last().copied());
     nb.neck_and_head(chest, fit.head, chest_bone);
     // A tail of up to three bones, each at least twice the shortest bone.
-    let tail_px = polyline_length(&nb.points(&nb.path(root, fit.tail)));
+    let tail_px = polyline_length(&nb.points(&nb.path(pelvis, fit.tail)));
     let tail_bones = ((tail_px / (2.0 * options.min_bone_px)) as usize).clamp(1, 3);
-    nb.even_chain(root, fit.tail, &TAIL_NAMES[..tail_bones], hip);
+    nb.even_chain(pelvis, fit.tail, &TAIL_NAMES[..tail_bones], hip);
     let names = [
         ["leg_front_upper_l", "leg_front_lower_l"],
         ["leg_front_upper_r", "leg_front_lower_r"],
@@ -1077,80 +1043,6 @@ mod tests {
             "the hip starts at {:?}",
             hip.head
         );
-    }
-
-    /// An end's thickness follows the axis toward the body only: a thin branch next to a thick
-    /// one is not as thick as its neighbour.
-    #[test]
-    fn an_ends_thickness_follows_the_path_to_the_body() {
-        // 0 (the body, r 30) - 1 (junction, r 6) - 2 (thin leaf, r 4); 1 - 3 (a thick
-        // blob, r 20) - 4 (its leaf, r 5).
-        let nodes = [
-            ((-15.0, 0.0), 30.0),
-            ((10.0, 0.0), 6.0),
-            ((20.0, 0.0), 4.0),
-            ((14.0, 6.0), 20.0),
-            ((18.0, 12.0), 5.0),
-        ]
-        .iter()
-        .map(|&((x, y), r)| AxisNode {
-            pos: Point::new(x, y),
-            radius_px: r,
-        })
-        .collect();
-        let axis = AxisGraph {
-            nodes,
-            adjacency: vec![vec![1], vec![0, 2, 3], vec![1], vec![1, 4], vec![3]],
-        };
-        let tree = NodeTree::new(&axis, 0);
-        // Within 20 px of leaf 2 lie the junction and the blob (17 px away through the
-        // junction); only the junction is on the way to the body.
-        assert_eq!(end_thickness(&axis, &tree, 2, 20.0), 6.0);
-        assert_eq!(end_thickness(&axis, &tree, 4, 20.0), 20.0);
-        assert_eq!(end_thickness(&axis, &tree, 2, 40.0), 30.0);
-    }
-
-    /// A line of axis nodes 10 px apart with these radii.
-    fn line(radii: &[f64]) -> AxisGraph {
-        let n = radii.len();
-        AxisGraph {
-            nodes: radii
-                .iter()
-                .enumerate()
-                .map(|(k, &r)| AxisNode {
-                    pos: Point::new(10.0 * k as f64, 0.0),
-                    radius_px: r,
-                })
-                .collect(),
-            adjacency: (0..n)
-                .map(|k| {
-                    let mut a = Vec::new();
-                    if k > 0 {
-                        a.push(k - 1);
-                    }
-                    if k + 1 < n {
-                        a.push(k + 1);
-                    }
-                    a
-                })
-                .collect(),
-        }
-    }
-
-    /// The hips of a quadruped are where the rump ends in the tail (the path thins to under
-    /// half the pelvis node's radius), at most a third of the way to the tail's tip.
-    #[test]
-    fn a_quadrupeds_root_is_where_the_rump_ends_in_the_tail() {
-        // The back legs meet the spine at node 0 (r 40); the rump thins at node 3.
-        let axis = line(&[
-            40.0, 38.0, 30.0, 12.0, 6.0, 6.0, 6.0, 6.0, 6.0, 5.0, 4.0, 3.0,
-        ]);
-        assert_eq!(rump_end(&axis, 0, 11), 3);
-        // A long fat rump: a third of the way (110 px / 3 ≈ node 4).
-        let axis = line(&[
-            40.0, 38.0, 36.0, 34.0, 32.0, 30.0, 28.0, 26.0, 24.0, 22.0, 21.0, 20.0,
-        ]);
-        assert_eq!(rump_end(&axis, 0, 11), 4);
     }
 
     #[test]
