@@ -96,8 +96,12 @@ pub fn resolve_output(path: &Path, kind: OutputKind) -> io::Result<PathBuf> {
                 format!(" (the link leads to {})", at.display())
             };
             return Err(refuse(format!(
-                "it is {}{via}, not {wanted}: sinew replaces only {wanted}s; remove it or choose another path",
-                describe(&file_type)
+                "it is {}{via}, not {wanted}: sinew replaces only {}; remove it or choose another path",
+                describe(&file_type),
+                match kind {
+                    OutputKind::File => "regular files",
+                    OutputKind::Folder => "folders",
+                }
             )));
         }
         return Ok(at);
