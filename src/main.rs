@@ -76,10 +76,8 @@ fn clap_one_line(error: &clap::Error) -> String {
         if let Some(clap::error::ContextValue::String(given)) =
             error.get(clap::error::ContextKind::InvalidSubcommand)
         {
-            let names = cli::command_names();
-            if let Some(name) = sinew::names::closest(given, &names) {
-                line.push_str(&format!("; did you mean '{name}'?"));
-            }
+            let suggestion = sinew::names::closest(given, cli::command_names());
+            line.push_str(&sinew::names::did_you_mean(&suggestion));
         }
     }
     // "Usage: sinew rig [OPTIONS] ...": the words before the first placeholder name the command.
